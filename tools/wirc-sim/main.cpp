@@ -1,0 +1,299 @@
+// wirc-sim: a complete WiRC device on this machine, for tests, demos and
+// benchmarks. See --help.
+#include <getopt.h>
+#include <signal.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include "follow_scene.h"
+#include "jpeg_sequence_scene.h"
+#include "wirc/device.h"
+
+using namespace wircam;
+
+namespace {
+
+constexpr const char* kUsage = R"(Usage: wirc-sim [OPTIONS]
+
+A WiRC device (protocol v1.3) on this machine: discovery on UDP, login and
+control on TCP, PCD with failsafe, PSD, and MJPEG camera streams. The default
+scene is a car whose camera follows an AprilTag target, driven by the PCD it
+receives; --frames streams JPEG files instead.
+
+Device:
+  --port N             TCP control and UDP discovery port (default 1984;
+                       0 = pick a free one). The port is printed on stdout.
+  --bind ADDR          address to listen on (default 127.0.0.1)
+  --name NAME          device name in BCSA (default wirc-sim)
+  --serial SERIAL      serial number in BCSA, up to 7 characters (default SIM0001)
+  --hw-version M.m     hardware version in BCSA (default 1.0)
+  --sw-version M.m     software version in BCSA (default 1.3)
+  --cameras N          number of cameras (default 1)
+  --fps F              frames per second per camera (default 15)
+  --size WxH           picture size (default 352x288, CIF)
+  --quality Q          JPEG quality 1..100 (default 85)
+  --fragment BYTES     payload bytes per UDP packet (default 64512, the device's)
+  --pcd-timeout MS     failsafe after this long without PCD (default 800)
+  --duration S         stop after S seconds (default: run until SIGINT/SIGTERM)
+
+Scene:
+  --scene follow|static  follow: the car drives by PCD (default);
+                       static: the car stays put, the target still moves
+  --frames DIR         stream the .jpg/.jpeg files of DIR in name order,
+                       byte for byte, looping (instead of a rendered scene)
+  --family NAME        tag family (default tag36h11)
+  --tags ID[,ID...]    tag ids; the first rides on the target (default 0)
+  --tag-size M         tag edge (black border) in metres (default 0.16)
+  --path still|line|circle  target path (default circle)
+  --target-speed M/S   target speed (default 0.3)
+  --start-distance M   camera to target at the start (default 1.2)
+  --follow-distance M  set point the summary measures against (default 1.0)
+  --steering-channel N PCD channel steering the car, 1..8 (default 1; 2000 = left)
+  --throttle-channel N PCD channel driving the car, 1..8 (default 2; 1500 = stop)
+  --truth FILE         write the truth per frame as JSON lines
+
+Impairments of the video stream (all seeded by --seed, repeatable):
+  --loss P             probability a packet is lost (0..1)
+  --burst-loss P       probability a loss burst starts at a packet
+  --burst-length N     packets lost per burst (default 5)
+  --duplicate P        probability a packet is sent twice
+  --reorder N          hold N packets back and release them in random order
+  --jitter BYTES       vary the fragment size by up to +-BYTES
+  --start-frame N      first frame number (e.g. 4294967290 to test wrap-around)
+  --reserved-bits      set the version's reserved bits 31..17
+  --stray P            per frame, probability of a forged packet from another port
+  --seed N             random seed (default 1)
+
+  -h, --help           show this text
+
+On exit (SIGINT, SIGTERM or --duration) it prints a summary: frames sent, PCD
+received, the longest PCD gap, failsafe entries, and how well the car followed.
+)";
+
+enum Option {
+  kPort = 1000, kBind, kName, kSerial, kHwVersion, kSwVersion, kCameras, kFps, kSize, kQuality,
+  kFragment, kPcdTimeout, kDuration, kScene, kFrames, kFamily, kTags, kTagSize, kPath,
+  kTargetSpeed, kStartDistance, kFollowDistance, kSteeringChannel, kThrottleChannel, kTruth,
+  kLoss, kBurstLoss, kBurstLength, kDuplicate, kReorder, kJitter, kStartFrame, kReservedBits,
+  kStray, kSeed,
+};
+
+const option kOptions[] = {
+    {"port", required_argument, nullptr, kPort},
+    {"bind", required_argument, nullptr, kBind},
+    {"name", required_argument, nullptr, kName},
+    {"serial", required_argument, nullptr, kSerial},
+    {"hw-version", required_argument, nullptr, kHwVersion},
+    {"sw-version", required_argument, nullptr, kSwVersion},
+    {"cameras", required_argument, nullptr, kCameras},
+    {"fps", required_argument, nullptr, kFps},
+    {"size", required_argument, nullptr, kSize},
+    {"quality", required_argument, nullptr, kQuality},
+    {"fragment", required_argument, nullptr, kFragment},
+    {"pcd-timeout", required_argument, nullptr, kPcdTimeout},
+    {"duration", required_argument, nullptr, kDuration},
+    {"scene", required_argument, nullptr, kScene},
+    {"frames", required_argument, nullptr, kFrames},
+    {"family", required_argument, nullptr, kFamily},
+    {"tags", required_argument, nullptr, kTags},
+    {"tag-size", required_argument, nullptr, kTagSize},
+    {"path", required_argument, nullptr, kPath},
+    {"target-speed", required_argument, nullptr, kTargetSpeed},
+    {"start-distance", required_argument, nullptr, kStartDistance},
+    {"follow-distance", required_argument, nullptr, kFollowDistance},
+    {"steering-channel", required_argument, nullptr, kSteeringChannel},
+    {"throttle-channel", required_argument, nullptr, kThrottleChannel},
+    {"truth", required_argument, nullptr, kTruth},
+    {"loss", required_argument, nullptr, kLoss},
+    {"burst-loss", required_argument, nullptr, kBurstLoss},
+    {"burst-length", required_argument, nullptr, kBurstLength},
+    {"duplicate", required_argument, nullptr, kDuplicate},
+    {"reorder", required_argument, nullptr, kReorder},
+    {"jitter", required_argument, nullptr, kJitter},
+    {"start-frame", required_argument, nullptr, kStartFrame},
+    {"reserved-bits", no_argument, nullptr, kReservedBits},
+    {"stray", required_argument, nullptr, kStray},
+    {"seed", required_argument, nullptr, kSeed},
+    {"help", no_argument, nullptr, 'h'},
+    {nullptr, 0, nullptr, 0},
+};
+
+[[noreturn]] void usageError(const std::string& message) {
+  std::fprintf(stderr, "wirc-sim: %s (see wirc-sim --help)\n", message.c_str());
+  std::exit(2);
+}
+
+double number(const char* text, const char* option, double min, double max) {
+  char* end = nullptr;
+  double value = std::strtod(text, &end);
+  if (end == text || *end != '\0' || value < min || value > max) {
+    std::ostringstream message;
+    message << "--" << option << " wants a number in " << min << ".." << max << ", not '" << text
+            << "'";
+    usageError(message.str());
+  }
+  return value;
+}
+
+wirc::Version version(const char* text, const char* option) {
+  unsigned major = 0, minor = 0;
+  if (std::sscanf(text, "%u.%u", &major, &minor) != 2 || major > 255 || minor > 255)
+    usageError(std::string("--") + option + " wants MAJOR.MINOR, not '" + text + "'");
+  return {static_cast<uint8_t>(major), static_cast<uint8_t>(minor)};
+}
+
+std::vector<int> idList(const char* text) {
+  std::vector<int> ids;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) ids.push_back(static_cast<int>(number(item.c_str(), "tags", 0, 1e6)));
+  if (ids.empty()) usageError("--tags wants a list like 0,3,7");
+  return ids;
+}
+
+std::string timestamp() {
+  using namespace std::chrono;
+  auto now = system_clock::now();
+  auto seconds = system_clock::to_time_t(now);
+  auto ms = duration_cast<milliseconds>(now.time_since_epoch()).count() % 1000;
+  char text[32];
+  std::strftime(text, sizeof text, "%H:%M:%S", std::localtime(&seconds));
+  return std::string(text) + "." + std::to_string(1000 + ms).substr(1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  wirc::DeviceConfig device;
+  sim::FollowSceneConfig scene;
+  std::optional<std::string> framesDir, truthPath;
+  std::optional<double> duration;
+
+  int opt;
+  while ((opt = getopt_long(argc, argv, "h", kOptions, nullptr)) != -1) {
+    switch (opt) {
+      case 'h': std::fputs(kUsage, stdout); return 0;
+      case kPort: device.port = static_cast<uint16_t>(number(optarg, "port", 0, 65535)); break;
+      case kBind: device.bindAddress = optarg; break;
+      case kName: device.name = optarg; break;
+      case kSerial: device.serial = optarg; break;
+      case kHwVersion: device.hardware = version(optarg, "hw-version"); break;
+      case kSwVersion: device.software = version(optarg, "sw-version"); break;
+      case kCameras: device.cameras = static_cast<int>(number(optarg, "cameras", 1, 255)); break;
+      case kFps: device.fps = number(optarg, "fps", 0.1, 240); break;
+      case kSize:
+        if (std::sscanf(optarg, "%dx%d", &scene.width, &scene.height) != 2)
+          usageError(std::string("--size wants WIDTHxHEIGHT, not '") + optarg + "'");
+        break;
+      case kQuality: scene.jpegQuality = static_cast<int>(number(optarg, "quality", 1, 100)); break;
+      case kFragment: device.fragmentSize = static_cast<size_t>(number(optarg, "fragment", 1, 65491)); break;
+      case kPcdTimeout:
+        device.pcdTimeout = std::chrono::milliseconds(static_cast<int>(number(optarg, "pcd-timeout", 200, 2000)));
+        break;
+      case kDuration: duration = number(optarg, "duration", 0, 1e7); break;
+      case kScene:
+        if (std::string(optarg) == "static") scene.carFixed = true;
+        else if (std::string(optarg) != "follow") usageError("--scene is follow or static");
+        break;
+      case kFrames: framesDir = optarg; break;
+      case kFamily: scene.family = optarg; break;
+      case kTags: scene.tagIds = idList(optarg); break;
+      case kTagSize: scene.tagSize = number(optarg, "tag-size", 0.01, 10); break;
+      case kPath: {
+        auto path = sim::parseTargetPath(optarg);
+        if (!path) usageError(path.error());
+        scene.path = *path;
+        break;
+      }
+      case kTargetSpeed: scene.targetSpeed = number(optarg, "target-speed", 0, 10); break;
+      case kStartDistance: scene.startDistance = number(optarg, "start-distance", 0.2, 100); break;
+      case kFollowDistance: scene.followDistance = number(optarg, "follow-distance", 0.1, 100); break;
+      case kSteeringChannel: scene.steeringChannel = static_cast<int>(number(optarg, "steering-channel", 1, 8)); break;
+      case kThrottleChannel: scene.throttleChannel = static_cast<int>(number(optarg, "throttle-channel", 1, 8)); break;
+      case kTruth: truthPath = optarg; break;
+      case kLoss: device.impairments.loss = number(optarg, "loss", 0, 1); break;
+      case kBurstLoss: device.impairments.burstLoss = number(optarg, "burst-loss", 0, 1); break;
+      case kBurstLength: device.impairments.burstLength = static_cast<int>(number(optarg, "burst-length", 1, 10000)); break;
+      case kDuplicate: device.impairments.duplication = number(optarg, "duplicate", 0, 1); break;
+      case kReorder: device.impairments.reorderDepth = static_cast<int>(number(optarg, "reorder", 0, 1000)); break;
+      case kJitter: device.impairments.fragmentJitter = static_cast<size_t>(number(optarg, "jitter", 0, 65000)); break;
+      case kStartFrame: device.impairments.startFrameNumber = static_cast<uint32_t>(number(optarg, "start-frame", 0, 4294967295.0)); break;
+      case kReservedBits: device.impairments.reservedBits = true; break;
+      case kStray: device.impairments.strayRate = number(optarg, "stray", 0, 1); break;
+      case kSeed: device.impairments.seed = static_cast<uint32_t>(number(optarg, "seed", 0, 4294967295.0)); break;
+      default: usageError("unknown option");
+    }
+  }
+  if (optind < argc) usageError(std::string("unexpected argument '") + argv[optind] + "'");
+  if (device.serial.size() > wirc::kSerialWidth) usageError("--serial is at most 7 characters");
+  if (device.name.size() > wirc::kNameWidth) usageError("--name is at most 64 characters");
+
+  std::shared_ptr<wirc::DeviceScene> deviceScene;
+  sim::FollowScene* follow = nullptr;
+  if (framesDir) {
+    auto frames = sim::JpegSequenceScene::loadFolder(*framesDir);
+    if (!frames) usageError(frames.error());
+    deviceScene = std::make_shared<sim::JpegSequenceScene>(std::move(*frames));
+  } else {
+    auto created = sim::FollowScene::create(scene);
+    if (!created) usageError(created.error());
+    follow = created->get();
+    if (truthPath) {
+      if (auto error = follow->writeTruthTo(*truthPath)) usageError(*error);
+    }
+    deviceScene = std::move(*created);
+  }
+
+  // Signals are taken synchronously below; block them before any thread starts.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  auto logger = [](const std::string& line) {
+    std::fprintf(stderr, "%s wirc-sim: %s\n", timestamp().c_str(), line.c_str());
+  };
+  auto started = wirc::Device::start(device, deviceScene, logger);
+  if (!started) {
+    std::fprintf(stderr, "wirc-sim: %s\n", started.error().c_str());
+    return 1;
+  }
+  auto& sim = *started;
+  std::printf("wirc-sim: listening on %s:%u\n", device.bindAddress.c_str(), sim->port());
+  std::fflush(stdout);
+
+  timespec wait{};
+  if (duration) {
+    wait.tv_sec = static_cast<time_t>(*duration);
+    wait.tv_nsec = static_cast<long>((*duration - static_cast<double>(wait.tv_sec)) * 1e9);
+  }
+  int caught = duration ? sigtimedwait(&signals, nullptr, &wait) : sigwaitinfo(&signals, nullptr);
+  sim->stop();
+
+  auto stats = sim->stats();
+  std::printf("wirc-sim summary:%s\n", caught > 0 ? " (stopped by signal)" : "");
+  std::printf("  frames sent        %llu (%llu datagrams)\n",
+              static_cast<unsigned long long>(stats.framesSent),
+              static_cast<unsigned long long>(stats.datagramsSent));
+  std::printf("  logins             %llu\n", static_cast<unsigned long long>(stats.logins));
+  std::printf("  PCD received       %llu (%llu rejected)\n",
+              static_cast<unsigned long long>(stats.pcdReceived),
+              static_cast<unsigned long long>(stats.pcdRejected));
+  std::printf("  max PCD gap        %lld ms\n", static_cast<long long>(stats.maxPcdGap.count()));
+  std::printf("  failsafe entries   %llu\n", static_cast<unsigned long long>(stats.failsafeEntries));
+  if (follow) {
+    auto s = follow->summary();
+    std::printf("  following error    bearing mean %.2f° max %.2f°, distance mean %.3f m max %.3f m"
+                " (after the first 3 s, %llu frames)\n",
+                s.meanBearingDeg, s.maxBearingDeg, s.meanDistanceError, s.maxDistanceError,
+                static_cast<unsigned long long>(s.measuredTicks));
+  }
+  return 0;
+}

@@ -1,0 +1,66 @@
+// AprilTag detection over a grayscale image: the AprilTag 3 detector with its
+// options, returning plain structs so no library pointer leaves this file.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/expected.h"
+#include "tag_family.h"
+
+struct apriltag_detector;
+
+namespace wircam::vision {
+
+struct Point2 {
+  double x = 0;
+  double y = 0;
+};
+
+struct TagDetection {
+  int id = 0;
+  std::string family;
+  int hamming = 0;
+  double margin = 0;  // decision margin: higher is surer
+  Point2 center;
+  std::array<Point2, 4> corners;        // in the library's order, input pixels
+  std::array<double, 9> homography{};   // row-major, tag [-1,1]² → image
+};
+
+struct DetectorOptions {
+  std::string family = "tag36h11";
+  float quadDecimate = 2.0f;
+  float quadSigma = 0.0f;
+  int threads = 1;
+  bool refineEdges = true;
+  double decodeSharpening = 0.25;
+  int maxHamming = 1;      // detections with more bit errors are dropped
+  double minMargin = 0.0;  // detections less sure than this are dropped
+};
+
+// A grayscale image in memory the caller owns.
+struct GrayView {
+  const uint8_t* data = nullptr;
+  int width = 0;
+  int height = 0;
+  int stride = 0;
+};
+
+class TagDetector {
+ public:
+  static Expected<TagDetector, std::string> create(const DetectorOptions& options);
+
+  std::vector<TagDetection> detect(const GrayView& image);
+  const DetectorOptions& options() const { return options_; }
+
+ private:
+  TagDetector(DetectorOptions options, TagFamily family);
+
+  DetectorOptions options_;
+  TagFamily family_;
+  std::shared_ptr<apriltag_detector> detector_;
+};
+
+}  // namespace wircam::vision
