@@ -640,8 +640,10 @@ void Device::Impl::sweepClosed() {
 }
 
 void Device::Impl::restart() {
+  // Called while the connection list is being walked: the connections close
+  // at the end of this loop turn.
   for (auto& c : connections_) closeConnection(c, "firmware update");
-  sweepClosed();
+  controller_.reset();
   enterFailsafe("restarting");
   listener_.reset();
   if (!pendingName_.empty()) name_ = pendingName_;
