@@ -212,6 +212,10 @@ FrameAssembler::Slot* FrameAssembler::openSlot(uint32_t number, Clock::time_poin
     slot->buffer = std::move(spareBuffers_.back());
     spareBuffers_.pop_back();
   }
+  // A fresh buffer starts at the size of recent frames plus a margin, so a
+  // caller that does not recycle still avoids regrowing (and recopying).
+  if (slot->buffer.capacity() < largestRecentFrame_)
+    slot->buffer.reserve(std::min(largestRecentFrame_ + largestRecentFrame_ / 4, config_.maxFrameBytes));
   slot->active = true;
   slot->number = number;
   slot->firstPacketTime = now;
@@ -245,6 +249,8 @@ void FrameAssembler::emit(Slot& slot, const FrameHandler& onFrame) {
   frame.discont = discontPending_ || !lastEmitted_ || slot.number != *lastEmitted_ + 1;
 
   ++stats_.framesComplete;
+  // Decays slowly so one huge frame does not inflate every later buffer.
+  largestRecentFrame_ = std::max(frame.data.size(), largestRecentFrame_ - largestRecentFrame_ / 64);
   discontPending_ = false;
   lastEmitted_ = slot.number;
   markResolved(slot.number);

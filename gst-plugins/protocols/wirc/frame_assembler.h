@@ -133,6 +133,7 @@ class FrameAssembler {
   std::optional<uint32_t> lastResolved_;
   std::optional<uint32_t> lastEmitted_;
   bool discontPending_ = true;
+  size_t largestRecentFrame_ = 0;
   AssemblerStats stats_;
 };
 

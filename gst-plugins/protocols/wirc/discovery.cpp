@@ -1,0 +1,61 @@
+#include "wirc/discovery.h"
+
+#include <poll.h>
+#include <sys/socket.h>
+
+#include <array>
+
+namespace wircam::wirc {
+
+Expected<std::vector<DiscoveredDevice>, std::string> discoverDevices(
+    std::chrono::milliseconds timeout, const std::string& target, uint16_t port) {
+  auto destination = SocketAddress::resolve(target, port);
+  if (!destination) return unexpected(destination.error());
+  auto socket = bindUdp(*SocketAddress::resolve("", 0));
+  if (!socket) return unexpected(socket.error());
+  int on = 1;
+  setsockopt(socket->get(), SOL_SOCKET, SO_BROADCAST, &on, sizeof on);
+  auto request = encode(Bcsd{.system = static_cast<uint8_t>(SystemType::PcClient), .version = {1, 0}});
+  if (!sendDatagram(socket->get(), *destination, *request))
+    return unexpected("cannot send discovery to " + destination->toString() + ": " +
+                      errnoText(errno));
+
+  std::vector<DiscoveredDevice> found;
+  auto deadline = std::chrono::steady_clock::now() + timeout;
+  std::array<uint8_t, 512> buffer;
+  for (;;) {
+    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) break;
+    pollfd p{socket->get(), POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
+    sockaddr_in from{};
+    socklen_t size = sizeof from;
+    ssize_t n = ::recvfrom(socket->get(), buffer.data(), buffer.size(), 0,
+                           reinterpret_cast<sockaddr*>(&from), &size);
+    if (n <= 0) continue;
+    auto message = decode(std::span(buffer.data(), static_cast<size_t>(n)));
+    if (!message || !std::holds_alternative<Bcsa>(*message)) continue;
+    SocketAddress address(from);
+    bool known = false;
+    for (const auto& device : found) known = known || device.address == address;
+    if (!known) found.push_back({address, std::get<Bcsa>(*message)});
+  }
+  return found;
+}
+
+Expected<DiscoveredDevice, std::string> pickDevice(const std::vector<DiscoveredDevice>& found,
+                                                   const std::string& wanted) {
+  if (found.empty()) return unexpected(std::string("no WiRC device answered discovery"));
+  std::string names;
+  for (const auto& device : found) {
+    const auto& ad = device.advertisement;
+    if (!wanted.empty() && (ad.name == wanted || ad.serial == wanted)) return device;
+    names += (names.empty() ? "" : ", ") + ad.name + " (" + ad.serial + ") at " +
+             device.address.host();
+  }
+  if (wanted.empty() && found.size() == 1) return found[0];
+  return unexpected(wanted.empty() ? "several devices answered, pick one by name or serial: " + names
+                                   : "no device named '" + wanted + "'; found: " + names);
+}
+
+}  // namespace wircam::wirc
