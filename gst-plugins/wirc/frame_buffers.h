@@ -1,0 +1,21 @@
+// Turning assembled frames into GstBuffers without copying them, and the
+// stats structure both wircsrc and wircdepay expose.
+#pragma once
+
+#include <gst/gst.h>
+
+#include "wirc/frame_assembler.h"
+
+namespace wircam::gst {
+
+// Hands the frame's memory to a GstBuffer; it is freed with the buffer.
+GstBuffer* wrapFrame(wirc::AssembledFrame&& frame);
+
+// New image/jpeg caps when the frame's size (read from its SOF) differs from
+// width × height, which are updated; nullptr when nothing changed.
+GstCaps* jpegCapsIfChanged(GstBuffer* frame, int& width, int& height);
+
+// "wirc-stats": the assembler's counters under the names users see.
+GstStructure* statsStructure(const wirc::AssemblerStats& stats, uint64_t foreignPackets);
+
+}  // namespace wircam::gst

@@ -1,0 +1,210 @@
+/**
+ * SECTION:element-wircdepay
+ *
+ * Reassembles the WiRC MJPEG-over-UDP packets, one UDP payload per input
+ * buffer, into whole JPEG frames: for captures, or when another application
+ * holds the device's control connection. Same assembler and counters as
+ * wircsrc; it never pushes a corrupt or partial frame. The device sends
+ * datagrams of up to 64 KB, so give udpsrc a large enough buffer and mtu.
+ *
+ * ## Example launch line
+ * |[
+ * gst-launch-1.0 udpsrc port=5000 buffer-size=8388608 mtu=65536 caps=application/x-wirc-mjpeg ! wircdepay ! jpegdec ! videoconvert ! autovideosink
+ * ]|
+ */
+#include "gstwircdepay.h"
+
+#include <memory>
+#include <mutex>
+
+#include "frame_buffers.h"
+#include "glib_locker.h"
+#include "wirc/frame_assembler.h"
+
+GST_DEBUG_CATEGORY_STATIC(wirc_depay_debug);
+#define GST_CAT_DEFAULT wirc_depay_debug
+
+namespace {
+
+using namespace wircam;
+using Clock = std::chrono::steady_clock;
+
+#define DEFAULT_FRAME_TIMEOUT 200
+
+enum { PROP_0, PROP_FRAME_TIMEOUT, PROP_STATS };
+
+struct WircDepayState {
+  guint frameTimeoutMs = DEFAULT_FRAME_TIMEOUT;  // guarded by the object lock
+  std::unique_ptr<wirc::FrameAssembler> assembler;  // streaming thread only
+  int width = 0;
+  int height = 0;
+  std::mutex statsMutex;  // guards stats, read by the property
+  wirc::AssemblerStats stats;
+};
+
+}  // namespace
+
+struct _GstWircDepay {
+  GstElement parent;
+  GstPad* sinkpad;
+  GstPad* srcpad;
+  WircDepayState* state;
+};
+
+G_DEFINE_TYPE(GstWircDepay, gst_wirc_depay, GST_TYPE_ELEMENT)
+
+static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
+    "sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS("application/x-wirc-mjpeg"));
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("image/jpeg"));
+
+static wirc::FrameAssembler& assembler_of(GstWircDepay* self) {
+  auto* state = self->state;
+  if (!state->assembler) {
+    guint timeout;
+    {
+      gst::GLibLocker lock(self);
+      timeout = state->frameTimeoutMs;
+    }
+    state->assembler = std::make_unique<wirc::FrameAssembler>(
+        wirc::FrameAssemblerConfig{.frameTimeout = std::chrono::milliseconds(timeout)});
+  }
+  return *state->assembler;
+}
+
+static GstFlowReturn push_frames(GstWircDepay* self, std::vector<wirc::AssembledFrame>& frames,
+                                 GstClockTime arrival) {
+  auto* state = self->state;
+  GstFlowReturn result = GST_FLOW_OK;
+  auto now = Clock::now();
+  for (auto& frame : frames) {
+    // Stamped like the datagram that started it: this buffer's time less
+    // the time that has passed since the first packet came.
+    auto age = static_cast<GstClockTime>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(now - frame.firstPacketTime).count());
+    bool discont = frame.discont;
+    GstBuffer* buffer = gst::wrapFrame(std::move(frame));
+    if (GST_CLOCK_TIME_IS_VALID(arrival)) GST_BUFFER_PTS(buffer) = arrival > age ? arrival - age : 0;
+    if (discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    if (GstCaps* caps = gst::jpegCapsIfChanged(buffer, state->width, state->height)) {
+      gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
+      gst_caps_unref(caps);
+    }
+    if (result == GST_FLOW_OK)
+      result = gst_pad_push(self->srcpad, buffer);
+    else
+      gst_buffer_unref(buffer);
+  }
+  frames.clear();
+  return result;
+}
+
+static GstFlowReturn gst_wirc_depay_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  auto* self = GST_WIRC_DEPAY(parent);
+  auto& assembler = assembler_of(self);
+  std::vector<wirc::AssembledFrame> frames;
+  auto collect = [&](wirc::AssembledFrame&& frame) { frames.push_back(std::move(frame)); };
+  GstMapInfo map;
+  if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    assembler.pushDatagram({map.data, map.size}, Clock::now(), collect);
+    gst_buffer_unmap(buffer, &map);
+  }
+  assembler.expire(Clock::now(), collect);
+  {
+    std::lock_guard lock(self->state->statsMutex);
+    self->state->stats = assembler.stats();
+  }
+  GstClockTime arrival = GST_BUFFER_PTS(buffer);
+  gst_buffer_unref(buffer);
+  return push_frames(self, frames, arrival);
+}
+
+static gboolean gst_wirc_depay_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  auto* self = GST_WIRC_DEPAY(parent);
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_CAPS:
+      // Output caps come from the frames' SOF markers.
+      gst_event_unref(event);
+      return TRUE;
+    case GST_EVENT_FLUSH_STOP:
+      if (self->state->assembler) self->state->assembler->reset();
+      break;
+    default:
+      break;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+static GstStateChangeReturn gst_wirc_depay_change_state(GstElement* element, GstStateChange transition) {
+  auto* self = GST_WIRC_DEPAY(element);
+  auto result = GST_ELEMENT_CLASS(gst_wirc_depay_parent_class)->change_state(element, transition);
+  if (transition == GST_STATE_CHANGE_PAUSED_TO_READY) {
+    self->state->assembler.reset();
+    self->state->width = self->state->height = 0;
+  }
+  return result;
+}
+
+static void gst_wirc_depay_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+  auto* self = GST_WIRC_DEPAY(object);
+  gst::GLibLocker lock(self);
+  if (id == PROP_FRAME_TIMEOUT)
+    self->state->frameTimeoutMs = g_value_get_uint(value);
+  else
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+}
+
+static void gst_wirc_depay_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
+  auto* self = GST_WIRC_DEPAY(object);
+  if (id == PROP_STATS) {
+    std::lock_guard lock(self->state->statsMutex);
+    g_value_take_boxed(value, gst::statsStructure(self->state->stats, 0));
+  } else if (id == PROP_FRAME_TIMEOUT) {
+    gst::GLibLocker lock(self);
+    g_value_set_uint(value, self->state->frameTimeoutMs);
+  } else {
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+  }
+}
+
+static void gst_wirc_depay_finalize(GObject* object) {
+  delete GST_WIRC_DEPAY(object)->state;
+  G_OBJECT_CLASS(gst_wirc_depay_parent_class)->finalize(object);
+}
+
+static void gst_wirc_depay_init(GstWircDepay* self) {
+  self->state = new WircDepayState();
+  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
+  gst_pad_set_chain_function(self->sinkpad, gst_wirc_depay_chain);
+  gst_pad_set_event_function(self->sinkpad, gst_wirc_depay_sink_event);
+  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
+  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
+  gst_pad_use_fixed_caps(self->srcpad);
+  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
+}
+
+static void gst_wirc_depay_class_init(GstWircDepayClass* klass) {
+  auto* gobject = G_OBJECT_CLASS(klass);
+  auto* element = GST_ELEMENT_CLASS(klass);
+  gobject->set_property = gst_wirc_depay_set_property;
+  gobject->get_property = gst_wirc_depay_get_property;
+  gobject->finalize = gst_wirc_depay_finalize;
+  element->change_state = gst_wirc_depay_change_state;
+
+  g_object_class_install_property(gobject, PROP_FRAME_TIMEOUT,
+      g_param_spec_uint("frame-timeout", "Frame timeout", "Milliseconds an incomplete frame may "
+                        "wait for its missing packets before it is dropped", 10, 10000,
+                        DEFAULT_FRAME_TIMEOUT,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_READY)));
+  g_object_class_install_property(gobject, PROP_STATS,
+      g_param_spec_boxed("stats", "Statistics", "Counters: packets, bytes, frames-complete, "
+                         "frames-incomplete, packets-duplicate, packets-invalid, ...",
+                         GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+
+  gst_element_class_add_static_pad_template(element, &sink_template);
+  gst_element_class_add_static_pad_template(element, &src_template);
+  gst_element_class_set_static_metadata(element, "WiRC MJPEG depayloader", "Codec/Depayloader/Network",
+      "Reassembles WiRC MJPEG-over-UDP packets into whole JPEG frames", "wircam authors");
+  GST_DEBUG_CATEGORY_INIT(wirc_depay_debug, "wircdepay", 0, "WiRC MJPEG depayloader");
+}

@@ -1,0 +1,493 @@
+/**
+ * SECTION:element-wircsrc
+ *
+ * Receives the camera stream of a WiRC device (or wirc-sim): logs in over
+ * TCP (shared with every other wirc element naming the same device), asks
+ * for camera `camera` with STST, reassembles the MJPEG-over-UDP packets and
+ * pushes whole JPEG frames. Never pushes a corrupt or partial frame; every
+ * dropped packet or frame is counted in `stats` and in a periodic
+ * `wirc-stats` element message. Stopping sends EST and logs out.
+ *
+ * ## Example launch line
+ * |[
+ * gst-launch-1.0 -e wircsrc host=127.0.0.1 ! jpegdec ! videoconvert ! autovideosink
+ * ]|
+ */
+#include "gstwircsrc.h"
+
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <array>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "frame_buffers.h"
+#include "glib_locker.h"
+#include "wirc/frame_assembler.h"
+#include "wirc/transmitter_session.h"
+
+GST_DEBUG_CATEGORY_STATIC(wirc_src_debug);
+#define GST_CAT_DEFAULT wirc_src_debug
+
+namespace {
+
+using namespace wircam;
+using Clock = std::chrono::steady_clock;
+
+#define DEFAULT_HOST ""
+#define DEFAULT_PORT 1984
+#define DEFAULT_DEVICE ""
+#define DEFAULT_CAMERA 0
+#define DEFAULT_STREAM_PORT 0
+#define DEFAULT_TRANSMITTER_NAME "wircam"
+#define DEFAULT_PRIORITY 0
+#define DEFAULT_FRAME_TIMEOUT 200
+#define DEFAULT_RECONNECT TRUE
+#define DEFAULT_DISCOVERY_ADDRESS "255.255.255.255"
+#define DEFAULT_LOGIN_TIMEOUT 3000
+#define DEFAULT_STATS_INTERVAL 1000
+
+constexpr size_t kBatch = 16;             // datagrams per recvmmsg
+constexpr int kReceiveBufferBytes = 8 << 20;
+
+enum {
+  PROP_0,
+  PROP_HOST,
+  PROP_PORT,
+  PROP_DEVICE,
+  PROP_CAMERA,
+  PROP_STREAM_PORT,
+  PROP_TRANSMITTER_NAME,
+  PROP_PRIORITY,
+  PROP_FRAME_TIMEOUT,
+  PROP_RECONNECT,
+  PROP_DISCOVERY_ADDRESS,
+  PROP_LOGIN_TIMEOUT,
+  PROP_STATS_INTERVAL,
+  PROP_STATS,
+};
+
+struct Settings {
+  std::string host = DEFAULT_HOST;
+  guint port = DEFAULT_PORT;
+  std::string device = DEFAULT_DEVICE;
+  guint camera = DEFAULT_CAMERA;
+  guint streamPort = DEFAULT_STREAM_PORT;
+  std::string transmitterName = DEFAULT_TRANSMITTER_NAME;
+  guint priority = DEFAULT_PRIORITY;
+  guint frameTimeoutMs = DEFAULT_FRAME_TIMEOUT;
+  gboolean reconnect = DEFAULT_RECONNECT;
+  std::string discoveryAddress = DEFAULT_DISCOVERY_ADDRESS;
+  guint loginTimeoutMs = DEFAULT_LOGIN_TIMEOUT;
+  guint statsIntervalMs = DEFAULT_STATS_INTERVAL;
+};
+
+// The C++ side of the element; GObject memory runs no constructors.
+struct WircSrcState {
+  Settings settings;  // guarded by the object lock
+
+  // Streaming-thread state, set up in start() and torn down in stop().
+  std::shared_ptr<wirc::TransmitterSession> session;
+  std::unique_ptr<wirc::FrameAssembler> assembler;
+  UniqueFd socket;
+  UniqueFd wake;  // unlock() writes here to end a blocking receive
+  SocketAddress device;
+  std::optional<uint16_t> senderPort;  // the device's video port, once seen
+  uint64_t sessionLogins = 0;          // a new login means a new sender port
+  std::vector<wirc::AssembledFrame> ready;
+  std::array<std::vector<uint8_t>, kBatch> buffers;
+  int width = 0;
+  int height = 0;
+  Clock::time_point nextStats;
+
+  std::mutex statsMutex;  // guards the copies read by the stats property
+  wirc::AssemblerStats stats;
+  uint64_t foreignPackets = 0;
+};
+
+}  // namespace
+
+struct _GstWircSrc {
+  GstPushSrc parent;
+  WircSrcState* state;
+};
+
+G_DEFINE_TYPE(GstWircSrc, gst_wirc_src, GST_TYPE_PUSH_SRC)
+
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("image/jpeg"));
+
+namespace {
+
+Settings settingsOf(GstWircSrc* self) {
+  gst::GLibLocker lock(self);
+  return self->state->settings;
+}
+
+void publishStats(GstWircSrc* self) {
+  auto* state = self->state;
+  std::lock_guard lock(state->statsMutex);
+  state->stats = state->assembler->stats();
+}
+
+void postStats(GstWircSrc* self) {
+  auto* state = self->state;
+  GstStructure* stats;
+  {
+    std::lock_guard lock(state->statsMutex);
+    stats = gst::statsStructure(state->stats, state->foreignPackets);
+  }
+  gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), stats));
+}
+
+}  // namespace
+
+static gboolean gst_wirc_src_start(GstBaseSrc* base) {
+  auto* self = GST_WIRC_SRC(base);
+  auto* state = self->state;
+  Settings settings = settingsOf(self);
+
+  wirc::SessionConfig config{.host = settings.host,
+                             .port = static_cast<uint16_t>(settings.port),
+                             .device = settings.device,
+                             .discoveryAddress = settings.discoveryAddress,
+                             .transmitterName = settings.transmitterName,
+                             .priority = static_cast<uint8_t>(settings.priority),
+                             .loginTimeout = std::chrono::milliseconds(settings.loginTimeoutMs),
+                             .reconnect = settings.reconnect != FALSE};
+  state->session = wirc::TransmitterSession::acquire(config);
+  if (auto error = state->session->waitLoggedIn(std::chrono::milliseconds(settings.loginTimeoutMs + 500))) {
+    state->session.reset();
+    GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
+                      ("Could not log in to the WiRC device %s",
+                       settings.host.empty() ? "(discovery)" : settings.host.c_str()),
+                      ("%s. Check host/port, or leave host empty to discover the device.",
+                       error->c_str()));
+    return FALSE;
+  }
+  auto status = state->session->status();
+  if (settings.camera >= status.cameraCount) {
+    state->session.reset();
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("The device has no camera %u", settings.camera),
+                      ("It reports %u camera(s): set camera=0..%d", status.cameraCount,
+                       status.cameraCount - 1));
+    return FALSE;
+  }
+
+  auto bindAddress = SocketAddress::resolve("", static_cast<uint16_t>(settings.streamPort));
+  auto socket = bindUdp(*bindAddress);
+  if (!socket) {
+    state->session.reset();
+    GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Could not open the stream port"),
+                      ("%s. Set stream-port=0 to pick a free port.", socket.error().c_str()));
+    return FALSE;
+  }
+  state->socket = std::move(*socket);
+  // The device sends whole frames in bursts of up to 64 KB datagrams.
+  int size = kReceiveBufferBytes;
+  if (setsockopt(state->socket.get(), SOL_SOCKET, SO_RCVBUFFORCE, &size, sizeof size) != 0)
+    setsockopt(state->socket.get(), SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
+  int granted = 0;
+  socklen_t length = sizeof granted;
+  getsockopt(state->socket.get(), SOL_SOCKET, SO_RCVBUF, &granted, &length);
+  if (granted < kReceiveBufferBytes)
+    GST_WARNING_OBJECT(self, "the kernel capped the receive buffer at %d bytes (wanted %d): "
+                       "raise net.core.rmem_max to avoid losing packets in bursts",
+                       granted, kReceiveBufferBytes);
+  state->wake = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
+  state->assembler = std::make_unique<wirc::FrameAssembler>(wirc::FrameAssemblerConfig{
+      .frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)});
+  state->device = *state->session->deviceAddress();
+  state->senderPort.reset();
+  state->sessionLogins = status.logins;
+  state->width = state->height = 0;
+  state->nextStats = Clock::now() + std::chrono::milliseconds(settings.statsIntervalMs);
+  {
+    std::lock_guard lock(state->statsMutex);
+    state->stats = {};
+    state->foreignPackets = 0;
+  }
+  uint16_t port = localAddress(state->socket.get()).port();
+  state->session->startStream(static_cast<uint8_t>(settings.camera), port);
+  GST_INFO_OBJECT(self, "logged in to %s, camera %u streaming to port %u",
+                  state->device.toString().c_str(), settings.camera, port);
+  return TRUE;
+}
+
+static gboolean gst_wirc_src_stop(GstBaseSrc* base) {
+  auto* self = GST_WIRC_SRC(base);
+  auto* state = self->state;
+  if (state->session) {
+    state->session->stopStream(static_cast<uint8_t>(settingsOf(self).camera));
+    state->session.reset();  // the last user's release logs out
+  }
+  if (state->assembler) publishStats(self);
+  state->ready.clear();
+  state->assembler.reset();
+  state->socket.reset();
+  state->wake.reset();
+  return TRUE;
+}
+
+static gboolean gst_wirc_src_unlock(GstBaseSrc* base) {
+  auto* state = GST_WIRC_SRC(base)->state;
+  uint64_t one = 1;
+  if (state->wake.valid() && write(state->wake.get(), &one, sizeof one) < 0)
+    GST_WARNING_OBJECT(base, "could not wake the streaming thread");
+  return TRUE;
+}
+
+static gboolean gst_wirc_src_unlock_stop(GstBaseSrc* base) {
+  auto* state = GST_WIRC_SRC(base)->state;
+  uint64_t value;
+  if (state->wake.valid() && read(state->wake.get(), &value, sizeof value) < 0) {
+    // Nothing was pending: fine.
+  }
+  return TRUE;
+}
+
+static gboolean gst_wirc_src_query(GstBaseSrc* base, GstQuery* query) {
+  if (GST_QUERY_TYPE(query) == GST_QUERY_LATENCY) {
+    // Frames are stamped when their first packet arrives and pushed when the
+    // last one does; an incomplete frame waits at most frame-timeout.
+    guint timeout = settingsOf(GST_WIRC_SRC(base)).frameTimeoutMs;
+    gst_query_set_latency(query, TRUE, 0, timeout * GST_MSECOND);
+    return TRUE;
+  }
+  return GST_BASE_SRC_CLASS(gst_wirc_src_parent_class)->query(base, query);
+}
+
+// Reads whatever datagrams are queued (up to a batch) into the assembler.
+static void receive_batch(GstWircSrc* self) {
+  auto* state = self->state;
+  std::array<mmsghdr, kBatch> headers{};
+  std::array<iovec, kBatch> vectors{};
+  std::array<sockaddr_in, kBatch> sources{};
+  for (size_t i = 0; i < kBatch; ++i) {
+    vectors[i] = {state->buffers[i].data(), state->buffers[i].size()};
+    headers[i].msg_hdr.msg_iov = &vectors[i];
+    headers[i].msg_hdr.msg_iovlen = 1;
+    headers[i].msg_hdr.msg_name = &sources[i];
+    headers[i].msg_hdr.msg_namelen = sizeof sources[i];
+  }
+  int count = recvmmsg(state->socket.get(), headers.data(), kBatch, MSG_DONTWAIT, nullptr);
+  auto now = Clock::now();
+  for (int i = 0; i < count; ++i) {
+    SocketAddress from(sources[i]);
+    // Only the device may feed the stream, and only from the port it first
+    // used in this login: stray or hostile senders are counted and ignored.
+    if (!from.sameHost(state->device) || (state->senderPort && *state->senderPort != from.port())) {
+      std::lock_guard lock(state->statsMutex);
+      ++state->foreignPackets;
+      GST_LOG_OBJECT(self, "ignored a packet from %s", from.toString().c_str());
+      continue;
+    }
+    if (!state->senderPort) state->senderPort = from.port();
+    state->assembler->pushDatagram({state->buffers[i].data(), headers[i].msg_len}, now,
+                                   [&](wirc::AssembledFrame&& frame) {
+                                     state->ready.push_back(std::move(frame));
+                                   });
+  }
+}
+
+static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
+  auto* self = GST_WIRC_SRC(pushsrc);
+  auto* state = self->state;
+  auto intervalMs = settingsOf(self).statsIntervalMs;
+
+  while (state->ready.empty()) {
+    // After a reconnect the device streams from a new port.
+    auto logins = state->session->status().logins;
+    if (logins != state->sessionLogins) {
+      state->sessionLogins = logins;
+      state->senderPort.reset();
+      state->assembler->reset();
+      GST_INFO_OBJECT(self, "the session logged in again: following the new stream");
+    }
+    auto deadline = state->assembler->nextDeadline();
+    int timeoutMs = 100;
+    if (deadline)
+      timeoutMs = std::clamp<int>(static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(
+                                                       *deadline - Clock::now()).count()) + 1, 0, 100);
+    std::array<pollfd, 2> fds = {pollfd{state->socket.get(), POLLIN, 0},
+                                 pollfd{state->wake.get(), POLLIN, 0}};
+    ::poll(fds.data(), fds.size(), timeoutMs);
+    if (fds[1].revents & POLLIN) return GST_FLOW_FLUSHING;
+    if (fds[0].revents & POLLIN) receive_batch(self);
+    state->assembler->expire(Clock::now(), [&](wirc::AssembledFrame&& frame) {
+      state->ready.push_back(std::move(frame));
+    });
+    publishStats(self);
+    if (intervalMs > 0 && Clock::now() >= state->nextStats) {
+      state->nextStats = Clock::now() + std::chrono::milliseconds(intervalMs);
+      postStats(self);
+    }
+  }
+
+  wirc::AssembledFrame frame = std::move(state->ready.front());
+  state->ready.erase(state->ready.begin());
+  auto age = Clock::now() - frame.firstPacketTime;
+  bool discont = frame.discont;
+  GstBuffer* buffer = gst::wrapFrame(std::move(frame));
+
+  if (GstCaps* caps = gst::jpegCapsIfChanged(buffer, state->width, state->height)) {
+    gst_base_src_set_caps(GST_BASE_SRC(self), caps);
+    gst_caps_unref(caps);
+  }
+  // PTS: the pipeline clock when the frame's first packet arrived.
+  if (GstClock* clock = gst_element_get_clock(GST_ELEMENT(self))) {
+    GstClockTime now = gst_clock_get_time(clock);
+    GstClockTime base = gst_element_get_base_time(GST_ELEMENT(self));
+    auto ageNs = static_cast<GstClockTime>(std::chrono::duration_cast<std::chrono::nanoseconds>(age).count());
+    GST_BUFFER_PTS(buffer) = now > base + ageNs ? now - base - ageNs : 0;
+    gst_object_unref(clock);
+  }
+  if (discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+  *out = buffer;
+  return GST_FLOW_OK;
+}
+
+static gboolean gst_wirc_src_negotiate(GstBaseSrc*) {
+  // Caps come from each frame's SOF marker, set in create().
+  return TRUE;
+}
+
+static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+  auto* self = GST_WIRC_SRC(object);
+  gst::GLibLocker lock(self);
+  auto& s = self->state->settings;
+  switch (id) {
+    case PROP_HOST: s.host = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
+    case PROP_PORT: s.port = g_value_get_uint(value); break;
+    case PROP_DEVICE: s.device = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
+    case PROP_CAMERA: s.camera = g_value_get_uint(value); break;
+    case PROP_STREAM_PORT: s.streamPort = g_value_get_uint(value); break;
+    case PROP_TRANSMITTER_NAME:
+      s.transmitterName = g_value_get_string(value) ? g_value_get_string(value) : "";
+      if (s.transmitterName.size() > 64) s.transmitterName.resize(64);
+      break;
+    case PROP_PRIORITY: s.priority = g_value_get_uint(value); break;
+    case PROP_FRAME_TIMEOUT: s.frameTimeoutMs = g_value_get_uint(value); break;
+    case PROP_RECONNECT: s.reconnect = g_value_get_boolean(value); break;
+    case PROP_DISCOVERY_ADDRESS:
+      s.discoveryAddress = g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_DISCOVERY_ADDRESS;
+      break;
+    case PROP_LOGIN_TIMEOUT: s.loginTimeoutMs = g_value_get_uint(value); break;
+    case PROP_STATS_INTERVAL: s.statsIntervalMs = g_value_get_uint(value); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+  }
+}
+
+static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
+  auto* self = GST_WIRC_SRC(object);
+  if (id == PROP_STATS) {
+    std::lock_guard lock(self->state->statsMutex);
+    g_value_take_boxed(value, gst::statsStructure(self->state->stats, self->state->foreignPackets));
+    return;
+  }
+  gst::GLibLocker lock(self);
+  const auto& s = self->state->settings;
+  switch (id) {
+    case PROP_HOST: g_value_set_string(value, s.host.c_str()); break;
+    case PROP_PORT: g_value_set_uint(value, s.port); break;
+    case PROP_DEVICE: g_value_set_string(value, s.device.c_str()); break;
+    case PROP_CAMERA: g_value_set_uint(value, s.camera); break;
+    case PROP_STREAM_PORT: g_value_set_uint(value, s.streamPort); break;
+    case PROP_TRANSMITTER_NAME: g_value_set_string(value, s.transmitterName.c_str()); break;
+    case PROP_PRIORITY: g_value_set_uint(value, s.priority); break;
+    case PROP_FRAME_TIMEOUT: g_value_set_uint(value, s.frameTimeoutMs); break;
+    case PROP_RECONNECT: g_value_set_boolean(value, s.reconnect); break;
+    case PROP_DISCOVERY_ADDRESS: g_value_set_string(value, s.discoveryAddress.c_str()); break;
+    case PROP_LOGIN_TIMEOUT: g_value_set_uint(value, s.loginTimeoutMs); break;
+    case PROP_STATS_INTERVAL: g_value_set_uint(value, s.statsIntervalMs); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+  }
+}
+
+static void gst_wirc_src_finalize(GObject* object) {
+  delete GST_WIRC_SRC(object)->state;
+  G_OBJECT_CLASS(gst_wirc_src_parent_class)->finalize(object);
+}
+
+static void gst_wirc_src_init(GstWircSrc* self) {
+  self->state = new WircSrcState();
+  for (auto& buffer : self->state->buffers) buffer.resize(wirc::kMaxDatagramSize);
+  gst_base_src_set_live(GST_BASE_SRC(self), TRUE);
+  gst_base_src_set_format(GST_BASE_SRC(self), GST_FORMAT_TIME);
+}
+
+static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
+  auto* gobject = G_OBJECT_CLASS(klass);
+  auto* element = GST_ELEMENT_CLASS(klass);
+  auto* basesrc = GST_BASE_SRC_CLASS(klass);
+  auto* pushsrc = GST_PUSH_SRC_CLASS(klass);
+
+  gobject->set_property = gst_wirc_src_set_property;
+  gobject->get_property = gst_wirc_src_get_property;
+  gobject->finalize = gst_wirc_src_finalize;
+
+  constexpr auto kReady = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                   GST_PARAM_MUTABLE_READY);
+  g_object_class_install_property(gobject, PROP_HOST,
+      g_param_spec_string("host", "Host", "Address of the WiRC device; empty = discover it on the "
+                          "local network (see device, discovery-address)", DEFAULT_HOST, kReady));
+  g_object_class_install_property(gobject, PROP_PORT,
+      g_param_spec_uint("port", "Port", "TCP control / UDP discovery port of the device", 1, 65535,
+                        DEFAULT_PORT, kReady));
+  g_object_class_install_property(gobject, PROP_DEVICE,
+      g_param_spec_string("device", "Device", "When discovering: the device name or serial to "
+                          "pick (empty = the only one that answers)", DEFAULT_DEVICE, kReady));
+  g_object_class_install_property(gobject, PROP_CAMERA,
+      g_param_spec_uint("camera", "Camera", "Camera index on the device (0 .. its camera count - 1)",
+                        0, 255, DEFAULT_CAMERA, kReady));
+  g_object_class_install_property(gobject, PROP_STREAM_PORT,
+      g_param_spec_uint("stream-port", "Stream port", "Local UDP port for the video (0 = any free "
+                        "port)", 0, 65535, DEFAULT_STREAM_PORT, kReady));
+  g_object_class_install_property(gobject, PROP_TRANSMITTER_NAME,
+      g_param_spec_string("transmitter-name", "Transmitter name", "Name this transmitter logs in "
+                          "with (up to 64 ASCII characters; shown in TLST)", DEFAULT_TRANSMITTER_NAME, kReady));
+  g_object_class_install_property(gobject, PROP_PRIORITY,
+      g_param_spec_uint("priority", "Priority", "Login priority: the highest may hand out the "
+                        "control right", 0, 255, DEFAULT_PRIORITY, kReady));
+  g_object_class_install_property(gobject, PROP_FRAME_TIMEOUT,
+      g_param_spec_uint("frame-timeout", "Frame timeout", "Milliseconds an incomplete frame may "
+                        "wait for its missing packets before it is dropped", 10, 10000,
+                        DEFAULT_FRAME_TIMEOUT, kReady));
+  g_object_class_install_property(gobject, PROP_RECONNECT,
+      g_param_spec_boolean("reconnect", "Reconnect", "Log in again (with backoff) after the "
+                           "connection is lost, and restart the stream", DEFAULT_RECONNECT, kReady));
+  g_object_class_install_property(gobject, PROP_DISCOVERY_ADDRESS,
+      g_param_spec_string("discovery-address", "Discovery address", "Where BCSD is sent when host "
+                          "is empty (broadcast by default)", DEFAULT_DISCOVERY_ADDRESS, kReady));
+  g_object_class_install_property(gobject, PROP_LOGIN_TIMEOUT,
+      g_param_spec_uint("login-timeout", "Login timeout", "Milliseconds to wait for discovery "
+                        "and login before failing", 100, 60000, DEFAULT_LOGIN_TIMEOUT, kReady));
+  g_object_class_install_property(gobject, PROP_STATS_INTERVAL,
+      g_param_spec_uint("stats-interval", "Stats interval", "Milliseconds between wirc-stats "
+                        "element messages (0 = none)", 0, 3600000, DEFAULT_STATS_INTERVAL,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS)));
+  g_object_class_install_property(gobject, PROP_STATS,
+      g_param_spec_boxed("stats", "Statistics", "Counters: packets, bytes, frames-complete, "
+                         "frames-incomplete, packets-duplicate, packets-invalid, packets-foreign, ...",
+                         GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+
+  gst_element_class_add_static_pad_template(element, &src_template);
+  gst_element_class_set_static_metadata(element, "WiRC camera source", "Source/Network",
+      "Receives the MJPEG stream of a WiRC device camera as whole JPEG frames",
+      "wircam authors");
+
+  basesrc->start = gst_wirc_src_start;
+  basesrc->stop = gst_wirc_src_stop;
+  basesrc->unlock = gst_wirc_src_unlock;
+  basesrc->unlock_stop = gst_wirc_src_unlock_stop;
+  basesrc->query = gst_wirc_src_query;
+  basesrc->negotiate = gst_wirc_src_negotiate;
+  pushsrc->create = gst_wirc_src_create;
+
+  GST_DEBUG_CATEGORY_INIT(wirc_src_debug, "wircsrc", 0, "WiRC camera source");
+}

@@ -1,0 +1,15 @@
+// The "wirc" GStreamer plugin: elements that speak the WiRC protocols.
+#include <gst/gst.h>
+
+#include "gstwircdepay.h"
+#include "gstwircsrc.h"
+
+static gboolean plugin_init(GstPlugin* plugin) {
+  return gst_element_register(plugin, "wircsrc", GST_RANK_NONE, GST_TYPE_WIRC_SRC) &&
+         gst_element_register(plugin, "wircdepay", GST_RANK_NONE, GST_TYPE_WIRC_DEPAY);
+}
+
+#define PACKAGE "wircam"
+GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, wirc,
+                  "WiRC vehicle camera stream, control and telemetry", plugin_init, WIRCAM_VERSION,
+                  "MIT/X11", "wircam", "wircam")
