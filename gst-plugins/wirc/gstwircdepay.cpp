@@ -38,6 +38,9 @@ struct WircDepayState {
   std::unique_ptr<wirc::FrameAssembler> assembler;  // streaming thread only
   int width = 0;
   int height = 0;
+  // Held back until the first frame's caps are out: sticky events must go
+  // caps before segment.
+  GstEvent* pendingSegment = nullptr;
   std::mutex statsMutex;  // guards stats, read by the property
   wirc::AssemblerStats stats;
 };
@@ -90,6 +93,10 @@ static GstFlowReturn push_frames(GstWircDepay* self, std::vector<wirc::Assembled
       gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
       gst_caps_unref(caps);
     }
+    if (state->pendingSegment) {
+      gst_pad_push_event(self->srcpad, state->pendingSegment);
+      state->pendingSegment = nullptr;
+    }
     if (result == GST_FLOW_OK)
       result = gst_pad_push(self->srcpad, buffer);
     else
@@ -126,6 +133,13 @@ static gboolean gst_wirc_depay_sink_event(GstPad* pad, GstObject* parent, GstEve
       // Output caps come from the frames' SOF markers.
       gst_event_unref(event);
       return TRUE;
+    case GST_EVENT_SEGMENT:
+      if (!gst_pad_has_current_caps(self->srcpad)) {
+        gst_event_replace(&self->state->pendingSegment, event);
+        gst_event_unref(event);
+        return TRUE;
+      }
+      break;
     case GST_EVENT_FLUSH_STOP:
       if (self->state->assembler) self->state->assembler->reset();
       break;
@@ -139,6 +153,7 @@ static GstStateChangeReturn gst_wirc_depay_change_state(GstElement* element, Gst
   auto* self = GST_WIRC_DEPAY(element);
   auto result = GST_ELEMENT_CLASS(gst_wirc_depay_parent_class)->change_state(element, transition);
   if (transition == GST_STATE_CHANGE_PAUSED_TO_READY) {
+    gst_event_replace(&self->state->pendingSegment, nullptr);
     self->state->assembler.reset();
     self->state->width = self->state->height = 0;
   }

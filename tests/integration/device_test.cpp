@@ -9,6 +9,7 @@
 #include "follow_scene.h"
 #include "jpeg_sequence_scene.h"
 #include "raw_transmitter.h"
+#include "scene_frames.h"
 #include "wirc/frame_assembler.h"
 
 namespace wircam::wirc {
@@ -16,6 +17,7 @@ namespace {
 
 using std::chrono::milliseconds;
 using testing::RawTransmitter;
+using testing::sceneFrames;
 using testing::receiveDatagram;
 
 std::unique_ptr<Device> startDevice(DeviceConfig config = {},
@@ -26,19 +28,6 @@ std::unique_ptr<Device> startDevice(DeviceConfig config = {},
   return device.has_value() ? std::move(*device) : nullptr;
 }
 
-// A few distinct rendered frames, reused by every streaming test.
-const std::vector<std::vector<uint8_t>>& sceneFrames() {
-  static const auto frames = [] {
-    auto scene = sim::FollowScene::create({.path = sim::TargetPath::Line});
-    std::vector<std::vector<uint8_t>> all;
-    for (int i = 0; i < 6; ++i) {
-      (*scene)->step(0.2, {});
-      all.push_back((*scene)->renderJpeg(0));
-    }
-    return all;
-  }();
-  return frames;
-}
 
 ChannelValues pulses(uint16_t steering, uint16_t throttle) {
   ChannelValues values = neutralChannels();
@@ -310,11 +299,7 @@ Received receiveStream(int socket, const SocketAddress& device, milliseconds dur
   return got;
 }
 
-bool isSentFrame(const std::vector<uint8_t>& frame) {
-  for (const auto& sent : sceneFrames())
-    if (sent == frame) return true;
-  return false;
-}
+bool isSentFrame(const std::vector<uint8_t>& frame) { return testing::isSceneFrame(frame); }
 
 struct StreamFixture {
   std::unique_ptr<Device> device;

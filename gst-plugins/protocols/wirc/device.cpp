@@ -295,10 +295,11 @@ void Device::Impl::tickFrame(DeviceClock::time_point now) {
       if (key.camera != camera) continue;
       if (jpeg.empty()) jpeg = scene_->renderJpeg(camera);
       if (jpeg.empty()) break;
-      auto before = stream.stats().datagrams;
+      auto before = stream.stats();
       stream.sendFrame(jpeg);
       ++localStats_.framesSent;
-      localStats_.datagramsSent += stream.stats().datagrams - before;
+      localStats_.framesSentWhole += stream.stats().framesWhole - before.framesWhole;
+      localStats_.datagramsSent += stream.stats().datagrams - before.datagrams;
     }
   }
 }
@@ -670,6 +671,7 @@ void Device::Impl::sendError(Connection& c, uint8_t command, ErrorCode code) {
 }
 
 void Device::Impl::publish() {
+  localStats_.activeStreams = streams_.size();
   std::lock_guard lock(mutex_);
   stats_ = localStats_;
   outputs_ = localOutputs_;

@@ -56,6 +56,8 @@ struct DeviceConfig {
 
 struct DeviceStats {
   uint64_t framesSent = 0;     // frames handed to streams (per receiver)
+  uint64_t framesSentWhole = 0;  // of those, frames no impairment took a packet from
+  uint64_t activeStreams = 0;
   uint64_t datagramsSent = 0;
   uint64_t pcdReceived = 0;    // valid PCD from the controller
   uint64_t pcdRejected = 0;    // not from the controller, malformed or out of range

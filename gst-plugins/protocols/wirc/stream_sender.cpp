@@ -24,6 +24,7 @@ uint32_t StreamSender::sendFrame(std::span<const uint8_t> jpeg) {
   uint32_t number = frameNumber_++;
   uint32_t reserved = impairments_.reservedBits ? 0xFFFE0000u : 0u;
   size_t offset = 0;
+  bool whole = true;
   do {
     size_t fragment = fragmentSize_;
     if (impairments_.fragmentJitter > 0) {
@@ -40,7 +41,7 @@ uint32_t StreamSender::sendFrame(std::span<const uint8_t> jpeg) {
     datagram.reserve(kMjpegHeaderSize + length);
     writeMjpegHeader(header, datagram);
     datagram.insert(datagram.end(), jpeg.begin() + offset, jpeg.begin() + offset + length);
-    emit(std::move(datagram));
+    whole = emit(std::move(datagram)) && whole;
     offset += length;
   } while (offset < jpeg.size());
 
@@ -55,23 +56,24 @@ uint32_t StreamSender::sendFrame(std::span<const uint8_t> jpeg) {
     if (sendDatagram(straySocket_, receiver_, forged)) ++stats_.stray;
   }
   ++stats_.frames;
+  if (whole) ++stats_.framesWhole;
   return number;
 }
 
-void StreamSender::emit(std::vector<uint8_t>&& datagram) {
+bool StreamSender::emit(std::vector<uint8_t>&& datagram) {
   if (burstLeft_ > 0) {
     --burstLeft_;
     ++stats_.dropped;
-    return;
+    return false;
   }
   if (chance(impairments_.burstLoss)) {
     burstLeft_ = std::max(impairments_.burstLength, 1) - 1;
     ++stats_.dropped;
-    return;
+    return false;
   }
   if (chance(impairments_.loss)) {
     ++stats_.dropped;
-    return;
+    return false;
   }
   int copies = chance(impairments_.duplication) ? 2 : 1;
   if (copies == 2) ++stats_.duplicated;
@@ -87,6 +89,7 @@ void StreamSender::emit(std::vector<uint8_t>&& datagram) {
       heldBack_.erase(heldBack_.begin() + static_cast<long>(pick));
     }
   }
+  return true;
 }
 
 void StreamSender::put(const std::vector<uint8_t>& datagram) {

@@ -33,7 +33,8 @@ struct Impairments {
 
 struct StreamSenderStats {
   uint64_t frames = 0;
-  uint64_t datagrams = 0;   // put on the wire, duplicates included
+  uint64_t framesWhole = 0;  // frames none of whose packets was dropped on purpose
+  uint64_t datagrams = 0;    // put on the wire, duplicates included
   uint64_t dropped = 0;     // lost on purpose (loss, burst loss)
   uint64_t duplicated = 0;
   uint64_t stray = 0;
@@ -56,7 +57,8 @@ class StreamSender {
   const StreamSenderStats& stats() const { return stats_; }
 
  private:
-  void emit(std::vector<uint8_t>&& datagram);
+  // False when the impairments dropped the datagram.
+  bool emit(std::vector<uint8_t>&& datagram);
   void put(const std::vector<uint8_t>& datagram);
   bool chance(double probability);
 

@@ -1,0 +1,12 @@
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+
+int main(int argc, char** argv) {
+  // The plugins under test come from the build tree, with a registry of
+  // their own so an installed wircam can never be picked up instead.
+  g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, TRUE);
+  g_setenv("GST_REGISTRY", WIRCAM_TEST_REGISTRY, TRUE);
+  gst_init(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

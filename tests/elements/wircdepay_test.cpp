@@ -1,0 +1,107 @@
+// wircdepay in a GstHarness: datagrams in, whole JPEG frames out.
+#include <gst/check/gstharness.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "scene_frames.h"
+#include "wirc/mjpeg_packet.h"
+
+namespace {
+
+using wircam::testing::sceneFrames;
+
+class WircDepayTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    harness_ = gst_harness_new("wircdepay");
+    ASSERT_NE(harness_, nullptr) << "wircdepay not found: is GST_PLUGIN_PATH set?";
+    gst_harness_set_src_caps_str(harness_, "application/x-wirc-mjpeg");
+  }
+  void TearDown() override { gst_harness_teardown(harness_); }
+
+  void push(const std::vector<uint8_t>& datagram) {
+    GstBuffer* buffer = gst_buffer_new_memdup(datagram.data(), datagram.size());
+    GST_BUFFER_PTS(buffer) = pts_;
+    pts_ += GST_MSECOND;
+    ASSERT_EQ(gst_harness_push(harness_, buffer), GST_FLOW_OK);
+  }
+
+  std::vector<uint8_t> pullBytes(GstBuffer** keep = nullptr) {
+    GstBuffer* buffer = gst_harness_try_pull(harness_);
+    if (!buffer) return {};
+    GstMapInfo map;
+    gst_buffer_map(buffer, &map, GST_MAP_READ);
+    std::vector<uint8_t> bytes(map.data, map.data + map.size);
+    gst_buffer_unmap(buffer, &map);
+    if (keep)
+      *keep = buffer;
+    else
+      gst_buffer_unref(buffer);
+    return bytes;
+  }
+
+  guint64 stat(const char* name) {
+    GstStructure* stats = nullptr;
+    g_object_get(harness_->element, "stats", &stats, nullptr);
+    guint64 value = 0;
+    gst_structure_get_uint64(stats, name, &value);
+    gst_structure_free(stats);
+    return value;
+  }
+
+  GstHarness* harness_ = nullptr;
+  GstClockTime pts_ = GST_SECOND;
+};
+
+TEST_F(WircDepayTest, ReassemblesReorderedDuplicatedPacketsIntoTheSentFrame) {
+  const auto& jpeg = sceneFrames()[0];
+  auto packets = wircam::wirc::packetizeFrame(jpeg, 1, 1000);
+  std::reverse(packets.begin(), packets.end());
+  packets.insert(packets.begin() + 2, packets[1]);  // a duplicate while the frame is open
+  for (const auto& p : packets) push(p);
+  GstBuffer* buffer = nullptr;
+  EXPECT_EQ(pullBytes(&buffer), jpeg);
+  ASSERT_NE(buffer, nullptr);
+  EXPECT_TRUE(GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_DISCONT));
+  EXPECT_TRUE(GST_BUFFER_PTS_IS_VALID(buffer));
+  gst_buffer_unref(buffer);
+  EXPECT_EQ(stat("packets-duplicate"), 1u);
+
+  GstCaps* caps = gst_pad_get_current_caps(harness_->sinkpad);
+  GstStructure* s = gst_caps_get_structure(caps, 0);
+  int width = 0, height = 0;
+  gst_structure_get_int(s, "width", &width);
+  gst_structure_get_int(s, "height", &height);
+  EXPECT_STREQ(gst_structure_get_name(s), "image/jpeg");
+  EXPECT_EQ(width, 352);
+  EXPECT_EQ(height, 288);
+  gst_caps_unref(caps);
+}
+
+TEST_F(WircDepayTest, NeverPushesAFrameWithAMissingPacketAndMarksTheGap) {
+  auto first = wircam::wirc::packetizeFrame(sceneFrames()[0], 1, 1000);
+  auto second = wircam::wirc::packetizeFrame(sceneFrames()[1], 2, 1000);
+  auto third = wircam::wirc::packetizeFrame(sceneFrames()[2], 3, 1000);
+  for (const auto& p : first) push(p);
+  EXPECT_EQ(pullBytes(), sceneFrames()[0]);
+  for (size_t i = 0; i + 1 < second.size(); ++i) push(second[i]);  // last packet lost
+  for (const auto& p : third) push(p);
+  GstBuffer* buffer = nullptr;
+  EXPECT_EQ(pullBytes(&buffer), sceneFrames()[2]);
+  EXPECT_TRUE(GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_DISCONT));
+  gst_buffer_unref(buffer);
+  EXPECT_TRUE(pullBytes().empty());
+  EXPECT_EQ(stat("frames-complete"), 2u);
+  EXPECT_EQ(stat("frames-incomplete"), 1u);
+}
+
+TEST_F(WircDepayTest, CountsGarbageAndKeepsGoing) {
+  push({1, 2, 3});
+  push(std::vector<uint8_t>(40, 0xAB));
+  for (const auto& p : wircam::wirc::packetizeFrame(sceneFrames()[3], 9, 64512)) push(p);
+  EXPECT_EQ(pullBytes(), sceneFrames()[3]);
+  EXPECT_EQ(stat("packets-invalid"), 2u);
+}
+
+}  // namespace

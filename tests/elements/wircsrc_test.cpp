@@ -1,0 +1,221 @@
+// wircsrc in real pipelines against the simulated device on loopback.
+#include <gst/check/gstharness.h>
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "jpeg_sequence_scene.h"
+#include "scene_frames.h"
+#include "wirc/device.h"
+
+namespace {
+
+using namespace wircam;
+using std::chrono::milliseconds;
+using wircam::testing::isSceneFrame;
+using wircam::testing::sceneFrames;
+
+std::unique_ptr<wirc::Device> startDevice(wirc::DeviceConfig config = {}) {
+  config.fps = 30;
+  auto device = wirc::Device::start(config, std::make_shared<sim::JpegSequenceScene>(sceneFrames()));
+  EXPECT_TRUE(device.has_value()) << device.error();
+  return std::move(*device);
+}
+
+wirc::DeviceConfig ephemeral(wirc::DeviceConfig config = {}) {
+  config.port = 0;
+  return config;
+}
+
+GstElement* launch(const std::string& description) {
+  GError* error = nullptr;
+  GstElement* pipeline = gst_parse_launch(description.c_str(), &error);
+  EXPECT_EQ(error, nullptr) << (error ? error->message : "");
+  return pipeline;
+}
+
+// The first error on the bus within `timeout`, or "".
+std::string busError(GstElement* pipeline, milliseconds timeout) {
+  GstBus* bus = gst_element_get_bus(pipeline);
+  GstMessage* message = gst_bus_timed_pop_filtered(bus, timeout.count() * GST_MSECOND, GST_MESSAGE_ERROR);
+  std::string text;
+  if (message) {
+    GError* error = nullptr;
+    gchar* debug = nullptr;
+    gst_message_parse_error(message, &error, &debug);
+    text = std::string(error->message) + " | " + (debug ? debug : "");
+    g_error_free(error);
+    g_free(debug);
+    gst_message_unref(message);
+  }
+  gst_object_unref(bus);
+  return text;
+}
+
+guint64 stat(GstElement* element, const char* name) {
+  GstStructure* stats = nullptr;
+  g_object_get(element, "stats", &stats, nullptr);
+  guint64 value = 0;
+  gst_structure_get_uint64(stats, name, &value);
+  gst_structure_free(stats);
+  return value;
+}
+
+class WircSrcHarness {
+ public:
+  explicit WircSrcHarness(uint16_t port, int camera = 0) {
+    harness_ = gst_harness_new("wircsrc");
+    g_object_set(harness_->element, "host", "127.0.0.1", "port", static_cast<guint>(port),
+                 "camera", static_cast<guint>(camera), nullptr);
+    gst_harness_play(harness_);
+  }
+  ~WircSrcHarness() { gst_harness_teardown(harness_); }
+
+  GstBuffer* pull(milliseconds timeout = milliseconds(3000)) {
+    auto end = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < end) {
+      if (GstBuffer* buffer = gst_harness_try_pull(harness_)) return buffer;
+      std::this_thread::sleep_for(milliseconds(5));
+    }
+    return nullptr;
+  }
+  std::vector<uint8_t> pullBytes(milliseconds timeout = milliseconds(3000)) {
+    GstBuffer* buffer = pull(timeout);
+    if (!buffer) return {};
+    GstMapInfo map;
+    gst_buffer_map(buffer, &map, GST_MAP_READ);
+    std::vector<uint8_t> bytes(map.data, map.data + map.size);
+    gst_buffer_unmap(buffer, &map);
+    gst_buffer_unref(buffer);
+    return bytes;
+  }
+  GstElement* element() const { return harness_->element; }
+  GstHarness* harness() const { return harness_; }
+
+ private:
+  GstHarness* harness_;
+};
+
+TEST(WircSrc, DeliversTheSimulatorsFramesByteForByteWithCaps) {
+  auto device = startDevice(ephemeral({.fragmentSize = 1400}));
+  WircSrcHarness src(device->port());
+  for (int i = 0; i < 20; ++i) {
+    auto frame = src.pullBytes();
+    ASSERT_FALSE(frame.empty()) << "frame " << i;
+    EXPECT_TRUE(isSceneFrame(frame)) << "frame " << i;
+  }
+  GstCaps* caps = gst_pad_get_current_caps(src.harness()->sinkpad);
+  ASSERT_NE(caps, nullptr);
+  int width = 0;
+  gst_structure_get_int(gst_caps_get_structure(caps, 0), "width", &width);
+  EXPECT_EQ(width, 352);
+  gst_caps_unref(caps);
+}
+
+TEST(WircSrc, DeliversAtLeast95PercentOfWholeFramesAtFivePercentLoss) {
+  auto device = startDevice(ephemeral({.fragmentSize = 1400, .impairments = {.loss = 0.05, .seed = 5}}));
+  WircSrcHarness src(device->port());
+  uint64_t delivered = 0;
+  auto end = std::chrono::steady_clock::now() + milliseconds(3000);
+  while (std::chrono::steady_clock::now() < end) {
+    auto frame = src.pullBytes(milliseconds(500));
+    if (frame.empty()) continue;
+    EXPECT_TRUE(isSceneFrame(frame));
+    ++delivered;
+  }
+  uint64_t whole = device->stats().framesSentWhole;
+  ASSERT_GT(whole, 20u);
+  EXPECT_GE(static_cast<double>(delivered) + 2, 0.95 * static_cast<double>(whole))
+      << delivered << " delivered of " << whole << " sent whole";
+  EXPECT_GT(stat(src.element(), "frames-incomplete"), 0u);
+}
+
+TEST(WircSrc, TwoCamerasShareOneLoginAndStopSendsEst) {
+  auto device = startDevice(ephemeral({.cameras = 2, .fragmentSize = 8000}));
+  auto port = std::to_string(device->port());
+  GstElement* pipeline = launch("wircsrc name=a host=127.0.0.1 camera=0 port=" + port +
+                                " ! fakesink wircsrc name=b host=127.0.0.1 camera=1 port=" + port +
+                                " ! fakesink");
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  std::this_thread::sleep_for(milliseconds(1000));
+  EXPECT_EQ(busError(pipeline, milliseconds(0)), "");
+  GstElement* a = gst_bin_get_by_name(GST_BIN(pipeline), "a");
+  GstElement* b = gst_bin_get_by_name(GST_BIN(pipeline), "b");
+  EXPECT_GT(stat(a, "frames-complete"), 5u);
+  EXPECT_GT(stat(b, "frames-complete"), 5u);
+  EXPECT_EQ(device->stats().logins, 1u);
+  EXPECT_EQ(device->stats().activeStreams, 2u);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(a);
+  gst_object_unref(b);
+  gst_object_unref(pipeline);
+  std::this_thread::sleep_for(milliseconds(200));
+  EXPECT_EQ(device->stats().activeStreams, 0u);
+}
+
+TEST(WircSrc, ReportsAnUnreachableDevice) {
+  auto device = startDevice(ephemeral());
+  auto port = std::to_string(device->port());
+  device.reset();
+  GstElement* pipeline = launch("wircsrc host=127.0.0.1 reconnect=false port=" + port + " ! fakesink");
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  auto error = busError(pipeline, milliseconds(5000));
+  EXPECT_NE(error.find("Could not log in"), std::string::npos) << error;
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+}
+
+TEST(WircSrc, ReportsACameraTheDeviceDoesNotHave) {
+  auto device = startDevice(ephemeral({.cameras = 1}));
+  GstElement* pipeline =
+      launch("wircsrc host=127.0.0.1 camera=3 port=" + std::to_string(device->port()) + " ! fakesink");
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  auto error = busError(pipeline, milliseconds(5000));
+  EXPECT_NE(error.find("no camera 3"), std::string::npos) << error;
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+}
+
+TEST(WircSrc, FollowsTheDeviceThroughARestart) {
+  auto device = startDevice(ephemeral({.fragmentSize = 4000}));
+  uint16_t port = device->port();
+  WircSrcHarness src(port);
+  ASSERT_FALSE(src.pullBytes().empty());
+  device.reset();
+  std::this_thread::sleep_for(milliseconds(300));
+  while (gst_harness_buffers_in_queue(src.harness()) > 0) gst_buffer_unref(gst_harness_pull(src.harness()));
+  device = startDevice({.port = port, .fragmentSize = 4000});
+  auto frame = src.pullBytes(milliseconds(8000));
+  ASSERT_FALSE(frame.empty());
+  EXPECT_TRUE(isSceneFrame(frame));
+}
+
+TEST(WircSrc, PcdKeepsFlowingWhileThePipelineIsBlocked) {
+  auto device = startDevice(ephemeral());
+  GstElement* pipeline =
+      launch("wircsrc name=src host=127.0.0.1 port=" + std::to_string(device->port()) + " ! fakesink");
+  GstElement* src = gst_bin_get_by_name(GST_BIN(pipeline), "src");
+  GstPad* pad = gst_element_get_static_pad(src, "src");
+  // Every buffer waits 2 s: the streaming thread stalls as a busy pipeline would.
+  gulong probe = gst_pad_add_probe(
+      pad, GST_PAD_PROBE_TYPE_BUFFER,
+      [](GstPad*, GstPadProbeInfo*, gpointer) {
+        std::this_thread::sleep_for(milliseconds(2000));
+        return GST_PAD_PROBE_OK;
+      },
+      nullptr, nullptr);
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  std::this_thread::sleep_for(milliseconds(2500));
+  auto stats = device->stats();
+  EXPECT_GT(stats.pcdReceived, 100u);
+  EXPECT_LE(stats.maxPcdGap.count(), 60);
+  EXPECT_EQ(stats.failsafeEntries, 0u);
+  gst_pad_remove_probe(pad, probe);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pad);
+  gst_object_unref(src);
+  gst_object_unref(pipeline);
+}
+
+}  // namespace
