@@ -1,28 +1,441 @@
-// wirc-cli: talk to a WiRC device (or wirc-sim) from a shell.
+// wirc-cli: talk to a WiRC device (or wirc-sim) from a shell. See --help.
+#include <getopt.h>
+#include <poll.h>
+#include <sys/socket.h>
+
+#include <chrono>
 #include <cstdio>
-#include <cstring>
-#include <string_view>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "message_json.h"
+#include "wirc/discovery.h"
+#include "wirc/frame_assembler.h"
+#include "wirc/message_stream_parser.h"
+#include "wirc/transmitter_session.h"
+
+using namespace wircam;
+using std::chrono::milliseconds;
 
 namespace {
 
 constexpr const char* kUsage = R"(Usage: wirc-cli COMMAND [OPTIONS]
 
-Talk to a WiRC device or wirc-sim from the shell.
+Talk to a WiRC device (or wirc-sim) from the shell.
 
 Commands:
-  help            show this text
+  discover                     list the devices that answer discovery
+  info                         log in and show the device's cameras, connection and status
+  transmitters                 list the logged-in transmitters (TLR)
+  request-control ID           ask for the control right to go to connection ID (AREQ)
+  configure [--periods US,..] [--failsafe US,..]
+                               set channel periods (CCFG) and failsafe values (FCFG);
+                               12 comma-separated values, or one for all channels
+  set-name NAME                rename the device (DCFG; after its next restart)
+  wifi --ssid S [--password-stdin] [--station] [--channel N] [--country CC]
+                               WiFi settings (WCFG); the password is read from
+                               stdin and never printed or logged
+  stream --camera N --out FILE.mjpeg|DIR [--frames N] [--duration S]
+                               save whole frames: concatenated to a file, or one
+                               JPEG per frame into a folder
+  stream --camera N --to-port P --duration S
+                               hold the login and have the device stream to UDP
+                               port P of this host, for another app (e.g.
+                               udpsrc ! wircdepay)
+  drive --steering US --throttle US [--duration S]
+                               send these pulses for at most 10 s, then neutral
+  decode [--raw]               read messages (hex text, or raw bytes with --raw) on
+                               stdin; print one JSON object per message
+  encode [--raw]               read JSON objects (one per line) on stdin; print
+                               each message as hex (or raw bytes with --raw)
 
-Exit codes: 0 success, 1 failure, 2 bad usage.
+Connection options (all commands but decode/encode):
+  --host ADDR                  device address (default: discover)
+  --port N                     control port (default 1984)
+  --device NAME                when discovering: the name or serial to pick
+  --discovery-address ADDR     where discovery is sent (default 255.255.255.255)
+  --name NAME                  transmitter name (default wirc-cli)
+  --priority N                 transmitter priority 0..255 (default 0)
+  --timeout MS                 discovery/login/answer timeout (default 3000)
+
+Exit codes: 0 success, 1 failure (device unreachable, refused, ERR), 2 bad usage.
 )";
+
+struct Options {
+  std::string host;
+  uint16_t port = wirc::kDefaultPort;
+  std::string device;
+  std::string discoveryAddress = "255.255.255.255";
+  std::string name = "wirc-cli";
+  uint8_t priority = 0;
+  milliseconds timeout{3000};
+  // Command-specific.
+  std::optional<std::string> periods, failsafe, ssid, out, country;
+  bool passwordStdin = false, station = false, raw = false;
+  int camera = 0, channel = 1;
+  std::optional<int> frames;
+  std::optional<uint16_t> toPort;
+  double duration = 0;
+  std::optional<int> steering, throttle;
+  std::vector<std::string> positional;
+};
+
+[[noreturn]] void usageError(const std::string& message) {
+  std::fprintf(stderr, "wirc-cli: %s (see wirc-cli --help)\n", message.c_str());
+  std::exit(2);
+}
+
+[[noreturn]] void fail(const std::string& message) {
+  std::fprintf(stderr, "wirc-cli: %s\n", message.c_str());
+  std::exit(1);
+}
+
+long integer(const char* text, const char* what, long min, long max) {
+  char* end = nullptr;
+  long value = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || value < min || value > max)
+    usageError(std::string(what) + " wants a whole number in " + std::to_string(min) + ".." +
+               std::to_string(max) + ", not '" + text + "'");
+  return value;
+}
+
+Options parse(int argc, char** argv) {
+  enum { kHost = 1000, kPort, kDevice, kDiscovery, kName, kPriority, kTimeout, kPeriods, kFailsafe,
+         kSsid, kPasswordStdin, kStation, kChannel, kCountry, kCamera, kOut, kFrames, kDuration,
+         kSteering, kThrottle, kRaw, kToPort };
+  static const option options[] = {
+      {"host", required_argument, nullptr, kHost}, {"port", required_argument, nullptr, kPort},
+      {"device", required_argument, nullptr, kDevice},
+      {"discovery-address", required_argument, nullptr, kDiscovery},
+      {"name", required_argument, nullptr, kName}, {"priority", required_argument, nullptr, kPriority},
+      {"timeout", required_argument, nullptr, kTimeout},
+      {"periods", required_argument, nullptr, kPeriods},
+      {"failsafe", required_argument, nullptr, kFailsafe},
+      {"ssid", required_argument, nullptr, kSsid},
+      {"password-stdin", no_argument, nullptr, kPasswordStdin},
+      {"station", no_argument, nullptr, kStation},
+      {"channel", required_argument, nullptr, kChannel},
+      {"country", required_argument, nullptr, kCountry},
+      {"camera", required_argument, nullptr, kCamera}, {"out", required_argument, nullptr, kOut},
+      {"frames", required_argument, nullptr, kFrames},
+      {"duration", required_argument, nullptr, kDuration},
+      {"steering", required_argument, nullptr, kSteering},
+      {"throttle", required_argument, nullptr, kThrottle}, {"raw", no_argument, nullptr, kRaw},
+      {"to-port", required_argument, nullptr, kToPort},
+      {"help", no_argument, nullptr, 'h'}, {nullptr, 0, nullptr, 0}};
+  Options o;
+  optind = 2;
+  int opt;
+  while ((opt = getopt_long(argc, argv, "h", options, nullptr)) != -1) {
+    switch (opt) {
+      case 'h': std::fputs(kUsage, stdout); std::exit(0);
+      case kHost: o.host = optarg; break;
+      case kPort: o.port = static_cast<uint16_t>(integer(optarg, "--port", 1, 65535)); break;
+      case kDevice: o.device = optarg; break;
+      case kDiscovery: o.discoveryAddress = optarg; break;
+      case kName: o.name = optarg; break;
+      case kPriority: o.priority = static_cast<uint8_t>(integer(optarg, "--priority", 0, 255)); break;
+      case kTimeout: o.timeout = milliseconds(integer(optarg, "--timeout", 10, 600000)); break;
+      case kPeriods: o.periods = optarg; break;
+      case kFailsafe: o.failsafe = optarg; break;
+      case kSsid: o.ssid = optarg; break;
+      case kPasswordStdin: o.passwordStdin = true; break;
+      case kStation: o.station = true; break;
+      case kChannel: o.channel = static_cast<int>(integer(optarg, "--channel", 1, 165)); break;
+      case kCountry: o.country = optarg; break;
+      case kCamera: o.camera = static_cast<int>(integer(optarg, "--camera", 0, 255)); break;
+      case kOut: o.out = optarg; break;
+      case kFrames: o.frames = static_cast<int>(integer(optarg, "--frames", 1, 100000000)); break;
+      case kDuration: o.duration = static_cast<double>(integer(optarg, "--duration", 0, 100000000)); break;
+      case kSteering: o.steering = static_cast<int>(integer(optarg, "--steering", 800, 2200)); break;
+      case kThrottle: o.throttle = static_cast<int>(integer(optarg, "--throttle", 800, 2200)); break;
+      case kRaw: o.raw = true; break;
+      case kToPort: o.toPort = static_cast<uint16_t>(integer(optarg, "--to-port", 1, 65535)); break;
+      default: usageError("unknown option");
+    }
+  }
+  for (int i = optind; i < argc; ++i) o.positional.emplace_back(argv[i]);
+  return o;
+}
+
+std::shared_ptr<wirc::TransmitterSession> login(const Options& o) {
+  auto session = wirc::TransmitterSession::acquire({.host = o.host,
+                                                    .port = o.port,
+                                                    .device = o.device,
+                                                    .discoveryAddress = o.discoveryAddress,
+                                                    .transmitterName = o.name,
+                                                    .priority = o.priority,
+                                                    .loginTimeout = o.timeout,
+                                                    .reconnect = false});
+  if (auto error = session->waitLoggedIn(o.timeout + milliseconds(500)))
+    fail("cannot log in: " + *error);
+  return session;
+}
+
+wirc::ChannelValues channelList(const std::string& text, const char* what) {
+  std::vector<long> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) values.push_back(integer(item.c_str(), what, 0, 65535));
+  if (values.size() != 1 && values.size() != wirc::kChannelCount)
+    usageError(std::string(what) + " wants 1 or 12 comma-separated values");
+  wirc::ChannelValues channels{};
+  for (size_t i = 0; i < wirc::kChannelCount; ++i)
+    channels[i] = static_cast<uint16_t>(values.size() == 1 ? values[0] : values[i]);
+  return channels;
+}
+
+void sendConfiguration(wirc::TransmitterSession& session, const wirc::Message& message,
+                       milliseconds timeout) {
+  if (auto error = wirc::validate(message)) fail(error->message());
+  if (auto err = session.sendConfiguration(message, timeout))
+    fail("the device refused " + wirc::commandName(err->command) + " with ERR code " +
+         std::to_string(err->code) + (err->code == 2 ? " (denied: only the first transmitter may configure)" : ""));
+}
+
+int discover(const Options& o) {
+  auto found = wirc::discoverDevices(o.timeout, o.host.empty() ? o.discoveryAddress : o.host, o.port);
+  if (!found) fail(found.error());
+  std::printf("%-21s %-24s %-8s %-5s %-5s\n", "ADDRESS", "NAME", "SERIAL", "HW", "SW");
+  for (const auto& d : *found) {
+    const auto& a = d.advertisement;
+    std::printf("%-21s %-24s %-8s %u.%-3u %u.%u\n", d.address.toString().c_str(), a.name.c_str(),
+                a.serial.c_str(), a.hardware.major, a.hardware.minor, a.software.major, a.software.minor);
+  }
+  return found->empty() ? 1 : 0;
+}
+
+int info(const Options& o) {
+  auto session = login(o);
+  std::this_thread::sleep_for(milliseconds(wirc::kPsdPeriodMs + 100));  // one PSD
+  auto s = session->status();
+  std::printf("device        %s %s\n", s.deviceAddress.c_str(), s.deviceName.c_str());
+  std::printf("cameras       %u\n", s.cameraCount);
+  std::printf("connection    %u%s\n", s.connectionId, s.hasControl ? " (has the control right)" : "");
+  if (s.lastStatus) {
+    const auto& p = *s.lastStatus;
+    std::printf("battery       %.2f V\nanalog input  %.2f V\ninputs        %u %u %u %u\n",
+                p.batteryMillivolts / 1000.0, p.analogMillivolts / 1000.0, p.inputs[0], p.inputs[1],
+                p.inputs[2], p.inputs[3]);
+  } else {
+    std::printf("status        no PSD received\n");
+  }
+  return 0;
+}
+
+int transmitters(const Options& o) {
+  auto session = login(o);
+  auto list = session->listTransmitters(o.timeout);
+  if (!list) fail("no transmitter list from the device");
+  std::printf("%-4s %-4s %s\n", "ID", "PRIO", "NAME");
+  for (const auto& t : *list) std::printf("%-4u %-4u %s\n", t.connectionId, t.priority, t.name.c_str());
+  return 0;
+}
+
+int forwardStream(const Options& o) {
+  if (o.duration <= 0) usageError("stream --to-port needs --duration S");
+  auto session = login(o);
+  session->startStream(static_cast<uint8_t>(o.camera), *o.toPort);
+  std::fprintf(stderr, "wirc-cli: camera %d streaming to port %u for %.0f s\n", o.camera, *o.toPort, o.duration);
+  std::this_thread::sleep_for(std::chrono::duration<double>(o.duration));
+  session->stopStream(static_cast<uint8_t>(o.camera));
+  return 0;
+}
+
+int stream(const Options& o) {
+  if (o.toPort) return forwardStream(o);
+  if (!o.out) usageError("stream needs --out FILE.mjpeg or --out DIR");
+  if (!o.frames && o.duration <= 0) usageError("stream needs --frames N or --duration S");
+  namespace fs = std::filesystem;
+  bool toFolder = fs::is_directory(*o.out);
+  std::ofstream file;
+  if (!toFolder) {
+    file.open(*o.out, std::ios::binary);
+    if (!file) fail("cannot write '" + *o.out + "'");
+  }
+  auto session = login(o);
+  if (o.camera >= session->status().cameraCount)
+    fail("the device has " + std::to_string(session->status().cameraCount) + " camera(s); use --camera 0..");
+  auto socket = bindUdp(*SocketAddress::resolve("", 0));
+  if (!socket) fail(socket.error());
+  int size = 8 << 20;
+  setsockopt(socket->get(), SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
+  auto device = *session->deviceAddress();
+  session->startStream(static_cast<uint8_t>(o.camera), localAddress(socket->get()).port());
+
+  wirc::FrameAssembler assembler;
+  int saved = 0;
+  auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.duration > 0 ? o.duration : 1e9);
+  std::vector<uint8_t> buffer(wirc::kMaxDatagramSize);
+  auto save = [&](wirc::AssembledFrame&& frame) {
+    if (o.frames && saved >= *o.frames) return;
+    auto bytes = frame.data.bytes();
+    if (toFolder) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame-%06d.jpg", saved);
+      std::ofstream(fs::path(*o.out) / name, std::ios::binary)
+          .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    } else {
+      file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    }
+    ++saved;
+    assembler.recycle(std::move(frame.data));
+  };
+  while ((!o.frames || saved < *o.frames) && std::chrono::steady_clock::now() < end) {
+    pollfd p{socket->get(), POLLIN, 0};
+    if (::poll(&p, 1, 100) > 0) {
+      sockaddr_in from{};
+      socklen_t length = sizeof from;
+      ssize_t n = ::recvfrom(socket->get(), buffer.data(), buffer.size(), 0,
+                             reinterpret_cast<sockaddr*>(&from), &length);
+      if (n > 0 && SocketAddress(from).sameHost(device))
+        assembler.pushDatagram({buffer.data(), static_cast<size_t>(n)}, std::chrono::steady_clock::now(), save);
+    }
+    assembler.expire(std::chrono::steady_clock::now(), save);
+    if (session->status().state == wirc::SessionState::Failed) fail("lost the device");
+  }
+  session->stopStream(static_cast<uint8_t>(o.camera));
+  auto stats = assembler.stats();
+  std::fprintf(stderr, "wirc-cli: saved %d frames to %s (%llu incomplete dropped, %llu packets)\n", saved,
+               o.out->c_str(), static_cast<unsigned long long>(stats.framesDropped()),
+               static_cast<unsigned long long>(stats.packets));
+  return saved > 0 ? 0 : 1;
+}
+
+int drive(const Options& o) {
+  if (!o.steering || !o.throttle) usageError("drive needs --steering US and --throttle US (800..2200)");
+  double seconds = std::min(o.duration > 0 ? o.duration : 1.0, 10.0);
+  auto session = login(o);
+  for (int i = 0; i < 50 && !session->status().hasControl; ++i) std::this_thread::sleep_for(milliseconds(20));
+  if (!session->status().hasControl) fail("another transmitter has the control right (see transmitters, request-control)");
+  wirc::ChannelValues pulses = wirc::neutralChannels();
+  pulses[0] = static_cast<uint16_t>(*o.steering);
+  pulses[1] = static_cast<uint16_t>(*o.throttle);
+  auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    session->setCommand(pulses);
+    std::this_thread::sleep_for(milliseconds(50));
+  }
+  session->setCommand(wirc::neutralChannels());
+  std::this_thread::sleep_for(milliseconds(100));  // let neutral go out before logging out
+  std::fprintf(stderr, "wirc-cli: drove %.1f s, %llu PCD sent\n", seconds,
+               static_cast<unsigned long long>(session->status().pcdSent));
+  return 0;
+}
+
+std::vector<uint8_t> readStdin(bool raw) {
+  std::string input((std::istreambuf_iterator<char>(std::cin)), {});
+  if (raw) return {input.begin(), input.end()};
+  std::vector<uint8_t> bytes;
+  std::string digits;
+  for (char c : input) {
+    if (std::isxdigit(static_cast<unsigned char>(c))) digits += c;
+    else if (!std::isspace(static_cast<unsigned char>(c)) && c != ',' && c != ':') usageError(std::string("not hex: '") + c + "'");
+  }
+  if (digits.size() % 2) usageError("an odd number of hex digits");
+  for (size_t i = 0; i < digits.size(); i += 2) bytes.push_back(static_cast<uint8_t>(std::stoi(digits.substr(i, 2), nullptr, 16)));
+  return bytes;
+}
+
+int decodeCommand(const Options& o) {
+  wirc::MessageStreamParser parser;
+  int errors = 0;
+  parser.feed(readStdin(o.raw), [&](const Expected<wirc::Message, wirc::ProtocolError>& result) {
+    if (result) {
+      std::cout << cli::toJson(*result).dump() << "\n";
+    } else {
+      ++errors;
+      nlohmann::json error = {{"error", wirc::errorKindName(result.error().kind)},
+                              {"command", wirc::commandName(result.error().command)},
+                              {"field", result.error().field}, {"message", result.error().message()}};
+      std::cout << error.dump() << "\n";
+    }
+  });
+  return errors > 0 ? 1 : 0;
+}
+
+int encodeCommand(const Options& o) {
+  std::string line;
+  int lineNumber = 0;
+  while (std::getline(std::cin, line)) {
+    ++lineNumber;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    auto json = nlohmann::json::parse(line, nullptr, false);
+    if (json.is_discarded()) fail("line " + std::to_string(lineNumber) + ": not JSON");
+    auto message = cli::fromJson(json);
+    if (!message) fail("line " + std::to_string(lineNumber) + ": " + message.error());
+    auto frame = wirc::encode(*message);
+    if (!frame) fail("line " + std::to_string(lineNumber) + ": " + frame.error().message());
+    if (o.raw) {
+      std::cout.write(reinterpret_cast<const char*>(frame->data()), static_cast<std::streamsize>(frame->size()));
+    } else {
+      for (size_t i = 0; i < frame->size(); ++i) std::printf("%s%02X", i ? " " : "", (*frame)[i]);
+      std::printf("\n");
+    }
+  }
+  return 0;
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string_view command = argc > 1 ? argv[1] : "help";
+  std::string command = argc > 1 ? argv[1] : "help";
   if (command == "help" || command == "--help" || command == "-h") {
     std::fputs(kUsage, stdout);
     return 0;
   }
-  std::fprintf(stderr, "wirc-cli: unknown command '%s' (see wirc-cli --help)\n", argv[1]);
-  return 2;
+  Options o = parse(argc, argv);
+  auto wantArguments = [&](size_t n) {
+    if (o.positional.size() != n) usageError(command + " takes " + std::to_string(n) + " argument(s)");
+  };
+  if (command == "discover") return discover(o);
+  if (command == "info") return info(o);
+  if (command == "transmitters") return transmitters(o);
+  if (command == "request-control") {
+    wantArguments(1);
+    auto id = static_cast<uint8_t>(integer(o.positional[0].c_str(), "ID", 1, 255));
+    auto session = login(o);
+    session->requestControl(id);
+    std::this_thread::sleep_for(milliseconds(300));
+    return 0;
+  }
+  if (command == "configure") {
+    if (!o.periods && !o.failsafe) usageError("configure needs --periods and/or --failsafe");
+    auto session = login(o);
+    if (o.periods) sendConfiguration(*session, wirc::Ccfg{channelList(*o.periods, "--periods")}, milliseconds(500));
+    if (o.failsafe) sendConfiguration(*session, wirc::Fcfg{channelList(*o.failsafe, "--failsafe")}, milliseconds(500));
+    return 0;
+  }
+  if (command == "set-name") {
+    wantArguments(1);
+    auto session = login(o);
+    sendConfiguration(*session, wirc::Dcfg{.name = o.positional[0]}, milliseconds(500));
+    std::printf("the device takes the name '%s' at its next restart\n", o.positional[0].c_str());
+    return 0;
+  }
+  if (command == "wifi") {
+    if (!o.ssid) usageError("wifi needs --ssid");
+    std::string password;
+    if (o.passwordStdin) std::getline(std::cin, password);
+    auto session = login(o);
+    sendConfiguration(*session,
+                      wirc::Wcfg{.ssid = *o.ssid, .password = password, .accessPoint = !o.station,
+                                 .secured = !password.empty(), .channel = static_cast<uint8_t>(o.channel),
+                                 .country = o.country.value_or("")},
+                      milliseconds(500));
+    std::printf("WiFi settings sent (password %s); they apply after the device restarts\n",
+                password.empty() ? "none: open network" : "set");
+    return 0;
+  }
+  if (command == "stream") return stream(o);
+  if (command == "drive") return drive(o);
+  if (command == "decode") return decodeCommand(o);
+  if (command == "encode") return encodeCommand(o);
+  usageError("unknown command '" + command + "'");
 }
