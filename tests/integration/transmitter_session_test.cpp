@@ -40,6 +40,8 @@ TEST(TransmitterSession, IsSharedByEveryUserOfTheSameDevice) {
   auto b = TransmitterSession::acquire(sessionFor(*device));
   EXPECT_EQ(a.get(), b.get());
   ASSERT_EQ(a->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  // The device publishes its counters just after it answers.
+  for (int i = 0; i < 100 && device->stats().logins == 0; ++i) std::this_thread::sleep_for(milliseconds(5));
   EXPECT_EQ(device->stats().logins, 1u);
 }
 

@@ -236,6 +236,9 @@ void Device::Impl::run() {
       if (index >= fds.size()) break;  // accepted during this turn
       if (fds[index++].revents & (POLLIN | POLLHUP | POLLERR)) readConnection(c);
     }
+    // Readers see the effect of a message as soon as its reply is out.
+    sweepClosed();
+    publish();
   }
   for (auto& [key, stream] : streams_) stream.flush();
   connections_.clear();
