@@ -93,6 +93,7 @@ struct WircSrcState {
 
   // Streaming-thread state, set up in start() and torn down in stop().
   std::shared_ptr<wirc::TransmitterSession> session;
+  int sessionListener = 0;
   std::unique_ptr<wirc::FrameAssembler> assembler;
   UniqueFd socket;
   UniqueFd wake;  // unlock() writes here to end a blocking receive
@@ -196,9 +197,10 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   socklen_t length = sizeof granted;
   getsockopt(state->socket.get(), SOL_SOCKET, SO_RCVBUF, &granted, &length);
   if (granted < kReceiveBufferBytes)
-    GST_WARNING_OBJECT(self, "the kernel capped the receive buffer at %d bytes (wanted %d): "
-                       "raise net.core.rmem_max to avoid losing packets in bursts",
-                       granted, kReceiveBufferBytes);
+    GST_ELEMENT_WARNING(self, RESOURCE, SETTINGS, ("Small UDP receive buffer"),
+                        ("The kernel capped it at %d bytes (wanted %d): frames may be lost in "
+                         "bursts. Raise it with: sysctl -w net.core.rmem_max=%d", granted,
+                         kReceiveBufferBytes, kReceiveBufferBytes));
   state->wake = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
   state->assembler = std::make_unique<wirc::FrameAssembler>(wirc::FrameAssemblerConfig{
       .frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)});
@@ -212,6 +214,15 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
     state->stats = {};
     state->foreignPackets = 0;
   }
+  // Session events (losses, reconnects, control changes, ERR) reach the
+  // application as "wirc-session" element messages.
+  state->sessionListener = state->session->addListener([self](const std::string& event) {
+    GST_INFO_OBJECT(self, "session: %s", event.c_str());
+    gst_element_post_message(
+        GST_ELEMENT(self),
+        gst_message_new_element(GST_OBJECT(self), gst_structure_new("wirc-session", "event",
+                                                                    G_TYPE_STRING, event.c_str(), nullptr)));
+  });
   uint16_t port = localAddress(state->socket.get()).port();
   state->session->startStream(static_cast<uint8_t>(settings.camera), port);
   GST_INFO_OBJECT(self, "logged in to %s, camera %u streaming to port %u",
@@ -223,6 +234,7 @@ static gboolean gst_wirc_src_stop(GstBaseSrc* base) {
   auto* self = GST_WIRC_SRC(base);
   auto* state = self->state;
   if (state->session) {
+    state->session->removeListener(state->sessionListener);
     state->session->stopStream(static_cast<uint8_t>(settingsOf(self).camera));
     state->session.reset();  // the last user's release logs out
   }

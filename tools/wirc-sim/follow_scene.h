@@ -115,7 +115,6 @@ class FollowScene : public wirc::DeviceScene {
   Pose2 car_;
   Pose2 target_;
   double speed_ = 0;
-  double pathAngle_ = 0;  // progress along a circle path
   double time_ = 0;
   std::optional<wirc::DeviceClock::time_point> lastAdvance_;
   FILE* truth_ = nullptr;

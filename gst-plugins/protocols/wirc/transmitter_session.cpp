@@ -86,6 +86,7 @@ class TransmitterSession::Impl {
   std::vector<Err> errors_;
   uint64_t failedAttempts_ = 0;
   std::map<int, Listener> listeners_;
+  std::mutex emitMutex_;
   int nextListener_ = 1;
 
   // The TCP connection; sendMutex_ serialises writers from any thread.
@@ -122,6 +123,9 @@ TransmitterSession::Impl::~Impl() {
 }
 
 void TransmitterSession::Impl::emit(const std::string& event) {
+  // Held while listeners run, so that once removeListener() returns its
+  // listener is never called again.
+  std::lock_guard emitting(emitMutex_);
   std::vector<Listener> listeners;
   {
     std::lock_guard lock(mutex_);
@@ -479,6 +483,7 @@ int TransmitterSession::addListener(Listener listener) {
 }
 
 void TransmitterSession::removeListener(int id) {
+  std::lock_guard emitting(impl_->emitMutex_);
   std::lock_guard lock(impl_->mutex_);
   impl_->listeners_.erase(id);
 }
