@@ -1,0 +1,246 @@
+/**
+ * SECTION:element-tjpegdec
+ *
+ * Decodes JPEG frames with libjpeg-turbo's TurboJPEG API into GRAY8 (luma
+ * only: the chroma is never transformed, the fastest input for
+ * apriltagdetect), I420 (from 4:2:0 or grayscale JPEGs), RGB or BGRx, in the
+ * format downstream prefers, optionally scaled by 1/2, 1/4 or 1/8 during
+ * decoding. Output buffers come from a pool. A corrupt frame is dropped with a
+ * warning; the stream goes on.
+ *
+ * ## Example launch lines
+ * |[
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=GRAY8 ! apriltagdetect ! fakesink
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec scale=1/2 ! videoconvert ! autovideosink
+ * ]|
+ */
+#include "gsttjpegdec.h"
+
+#include <turbojpeg.h>
+
+#include <memory>
+
+GST_DEBUG_CATEGORY_STATIC(tjpeg_dec_debug);
+#define GST_CAT_DEFAULT tjpeg_dec_debug
+
+namespace {
+
+enum Scale { kScale1 = 1, kScale2 = 2, kScale4 = 4, kScale8 = 8 };
+#define DEFAULT_SCALE kScale1
+
+enum { PROP_0, PROP_SCALE };
+
+GType scale_get_type() {
+  static GType type = 0;
+  static const GEnumValue values[] = {{kScale1, "Full size", "1"},
+                                      {kScale2, "Half size", "1/2"},
+                                      {kScale4, "Quarter size", "1/4"},
+                                      {kScale8, "One eighth", "1/8"},
+                                      {0, nullptr, nullptr}};
+  if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static("GstTjpegDecScale", values));
+  return type;
+}
+
+struct TjpegDecState {
+  int scale = DEFAULT_SCALE;  // guarded by the object lock
+  std::unique_ptr<void, decltype(&tjDestroy)> decoder{nullptr, tjDestroy};
+  GstVideoCodecState* input = nullptr;
+  int width = 0;
+  int height = 0;
+  GstVideoFormat format = GST_VIDEO_FORMAT_UNKNOWN;
+};
+
+}  // namespace
+
+struct _GstTjpegDec {
+  GstVideoDecoder parent;
+  TjpegDecState* state;
+};
+
+G_DEFINE_TYPE(GstTjpegDec, gst_tjpeg_dec, GST_TYPE_VIDEO_DECODER)
+
+static GstStaticPadTemplate sink_template =
+    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS("image/jpeg"));
+static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
+    "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ I420, GRAY8, RGB, BGRx }")));
+
+static gboolean gst_tjpeg_dec_start(GstVideoDecoder* decoder) {
+  auto* state = GST_TJPEG_DEC(decoder)->state;
+  state->decoder.reset(tjInitDecompress());
+  state->width = state->height = 0;
+  return state->decoder != nullptr;
+}
+
+static gboolean gst_tjpeg_dec_stop(GstVideoDecoder* decoder) {
+  auto* state = GST_TJPEG_DEC(decoder)->state;
+  state->decoder.reset();
+  g_clear_pointer(&state->input, gst_video_codec_state_unref);
+  return TRUE;
+}
+
+static gboolean gst_tjpeg_dec_set_format(GstVideoDecoder* decoder, GstVideoCodecState* input) {
+  auto* state = GST_TJPEG_DEC(decoder)->state;
+  g_clear_pointer(&state->input, gst_video_codec_state_unref);
+  state->input = gst_video_codec_state_ref(input);
+  state->width = state->height = 0;  // renegotiate with the next frame
+  return TRUE;
+}
+
+// The first of our formats in downstream's order of preference.
+static GstVideoFormat preferred_format(GstVideoDecoder* decoder) {
+  GstCaps* ours = gst_pad_get_pad_template_caps(GST_VIDEO_DECODER_SRC_PAD(decoder));
+  GstCaps* peer = gst_pad_peer_query_caps(GST_VIDEO_DECODER_SRC_PAD(decoder), nullptr);
+  GstCaps* both = gst_caps_intersect_full(peer, ours, GST_CAPS_INTERSECT_FIRST);
+  GstVideoFormat format = GST_VIDEO_FORMAT_I420;
+  if (!gst_caps_is_empty(both)) {
+    both = gst_caps_fixate(both);
+    if (const gchar* name = gst_structure_get_string(gst_caps_get_structure(both, 0), "format"))
+      format = gst_video_format_from_string(name);
+  }
+  gst_caps_unref(both);
+  gst_caps_unref(peer);
+  gst_caps_unref(ours);
+  return format;
+}
+
+static GstFlowReturn drop_with_warning(GstVideoDecoder* decoder, GstVideoCodecFrame* frame, const char* why) {
+  GST_ELEMENT_WARNING(decoder, STREAM, DECODE, ("Dropped a corrupt JPEG frame"), ("%s", why));
+  return gst_video_decoder_drop_frame(decoder, frame);
+}
+
+static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVideoCodecFrame* frame) {
+  auto* self = GST_TJPEG_DEC(decoder);
+  auto* state = self->state;
+  tjhandle tj = state->decoder.get();
+  GstMapInfo in;
+  if (!gst_buffer_map(frame->input_buffer, &in, GST_MAP_READ)) return drop_with_warning(decoder, frame, "unreadable buffer");
+
+  int width = 0, height = 0, subsampling = 0, colorspace = 0;
+  if (tjDecompressHeader3(tj, in.data, in.size, &width, &height, &subsampling, &colorspace) != 0) {
+    gst_buffer_unmap(frame->input_buffer, &in);
+    return drop_with_warning(decoder, frame, tjGetErrorStr2(tj));
+  }
+  int scale;
+  {
+    GST_OBJECT_LOCK(self);
+    scale = state->scale;
+    GST_OBJECT_UNLOCK(self);
+  }
+  tjscalingfactor factor{1, scale};
+  int outWidth = TJSCALED(width, factor), outHeight = TJSCALED(height, factor);
+
+  if (outWidth != state->width || outHeight != state->height || !gst_pad_has_current_caps(GST_VIDEO_DECODER_SRC_PAD(decoder))) {
+    state->format = preferred_format(decoder);
+    GstVideoCodecState* output = gst_video_decoder_set_output_state(decoder, state->format, outWidth, outHeight, state->input);
+    gst_video_codec_state_unref(output);
+    if (!gst_video_decoder_negotiate(decoder)) {
+      gst_buffer_unmap(frame->input_buffer, &in);
+      gst_video_decoder_drop_frame(decoder, frame);
+      return GST_FLOW_NOT_NEGOTIATED;
+    }
+    state->width = outWidth;
+    state->height = outHeight;
+  }
+  if (state->format == GST_VIDEO_FORMAT_I420 && subsampling != TJSAMP_420 && subsampling != TJSAMP_GRAY) {
+    gst_buffer_unmap(frame->input_buffer, &in);
+    gst_video_decoder_drop_frame(decoder, frame);
+    GST_ELEMENT_ERROR(decoder, STREAM, FORMAT, ("tjpegdec gives I420 only for 4:2:0 or grayscale JPEGs"),
+                      ("This stream has TurboJPEG subsampling %d: ask for GRAY8, RGB or BGRx instead "
+                       "(e.g. tjpegdec ! video/x-raw,format=RGB)", subsampling));
+    return GST_FLOW_NOT_NEGOTIATED;
+  }
+
+  GstFlowReturn flow = gst_video_decoder_allocate_output_frame(decoder, frame);
+  if (flow != GST_FLOW_OK) {
+    gst_buffer_unmap(frame->input_buffer, &in);
+    gst_video_decoder_drop_frame(decoder, frame);
+    return flow;
+  }
+  GstVideoCodecState* output = gst_video_decoder_get_output_state(decoder);
+  GstVideoFrame video;
+  gst_video_frame_map(&video, &output->info, frame->output_buffer, GST_MAP_WRITE);
+  int rc;
+  if (state->format == GST_VIDEO_FORMAT_I420) {
+    unsigned char* planes[3] = {static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 0)),
+                                static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 1)),
+                                static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 2))};
+    int strides[3] = {GST_VIDEO_FRAME_PLANE_STRIDE(&video, 0), GST_VIDEO_FRAME_PLANE_STRIDE(&video, 1),
+                      GST_VIDEO_FRAME_PLANE_STRIDE(&video, 2)};
+    rc = tjDecompressToYUVPlanes(tj, in.data, in.size, planes, outWidth, strides, outHeight, TJFLAG_FASTDCT);
+    if (subsampling == TJSAMP_GRAY) {  // a grayscale JPEG has no chroma: make it neutral
+      for (int p = 1; p < 3; ++p)
+        for (int y = 0; y < GST_VIDEO_FRAME_COMP_HEIGHT(&video, p); ++y)
+          memset(planes[p] + y * strides[p], 128, GST_VIDEO_FRAME_COMP_WIDTH(&video, p));
+    }
+  } else {
+    int pixelFormat = state->format == GST_VIDEO_FORMAT_GRAY8 ? TJPF_GRAY
+                      : state->format == GST_VIDEO_FORMAT_RGB ? TJPF_RGB
+                                                              : TJPF_BGRX;
+    rc = tjDecompress2(tj, in.data, in.size, static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 0)),
+                       outWidth, GST_VIDEO_FRAME_PLANE_STRIDE(&video, 0), outHeight, pixelFormat, TJFLAG_FASTDCT);
+  }
+  gst_video_frame_unmap(&video);
+  gst_video_codec_state_unref(output);
+  gst_buffer_unmap(frame->input_buffer, &in);
+  // TurboJPEG warnings (e.g. a few corrupt bytes) still give a full image.
+  if (rc != 0 && tjGetErrorCode(tj) == TJERR_FATAL) return drop_with_warning(decoder, frame, tjGetErrorStr2(tj));
+  if (rc != 0) GST_DEBUG_OBJECT(self, "decoded with a warning: %s", tjGetErrorStr2(tj));
+  return gst_video_decoder_finish_frame(decoder, frame);
+}
+
+static void gst_tjpeg_dec_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+  auto* self = GST_TJPEG_DEC(object);
+  if (id != PROP_SCALE) {
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+    return;
+  }
+  GST_OBJECT_LOCK(self);
+  self->state->scale = g_value_get_enum(value);
+  self->state->width = 0;  // renegotiate
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_tjpeg_dec_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
+  auto* self = GST_TJPEG_DEC(object);
+  if (id != PROP_SCALE) {
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+    return;
+  }
+  GST_OBJECT_LOCK(self);
+  g_value_set_enum(value, self->state->scale);
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_tjpeg_dec_finalize(GObject* object) {
+  delete GST_TJPEG_DEC(object)->state;
+  G_OBJECT_CLASS(gst_tjpeg_dec_parent_class)->finalize(object);
+}
+
+static void gst_tjpeg_dec_init(GstTjpegDec* self) {
+  self->state = new TjpegDecState();
+  gst_video_decoder_set_packetized(GST_VIDEO_DECODER(self), TRUE);
+  gst_video_decoder_set_use_default_pad_acceptcaps(GST_VIDEO_DECODER_CAST(self), TRUE);
+  GST_PAD_SET_ACCEPT_TEMPLATE(GST_VIDEO_DECODER_SINK_PAD(self));
+}
+
+static void gst_tjpeg_dec_class_init(GstTjpegDecClass* klass) {
+  auto* gobject = G_OBJECT_CLASS(klass);
+  auto* element = GST_ELEMENT_CLASS(klass);
+  auto* decoder = GST_VIDEO_DECODER_CLASS(klass);
+  gobject->set_property = gst_tjpeg_dec_set_property;
+  gobject->get_property = gst_tjpeg_dec_get_property;
+  gobject->finalize = gst_tjpeg_dec_finalize;
+  g_object_class_install_property(gobject, PROP_SCALE,
+      g_param_spec_enum("scale", "Scale", "Decode at this fraction of the JPEG's size (1, 1/2, 1/4, 1/8): "
+                        "smaller is much faster", scale_get_type(), DEFAULT_SCALE,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
+  gst_element_class_add_static_pad_template(element, &sink_template);
+  gst_element_class_add_static_pad_template(element, &src_template);
+  gst_element_class_set_static_metadata(element, "TurboJPEG decoder", "Codec/Decoder/Image",
+      "Decodes JPEG to GRAY8, I420, RGB or BGRx with libjpeg-turbo, optionally scaled", "wircam authors");
+  decoder->start = gst_tjpeg_dec_start;
+  decoder->stop = gst_tjpeg_dec_stop;
+  decoder->set_format = gst_tjpeg_dec_set_format;
+  decoder->handle_frame = gst_tjpeg_dec_handle_frame;
+  GST_DEBUG_CATEGORY_INIT(tjpeg_dec_debug, "tjpegdec", 0, "TurboJPEG decoder");
+}
