@@ -1,6 +1,10 @@
 #include "tag_detector.h"
 
 #include <apriltag/apriltag.h>
+#include <apriltag/apriltag_pose.h>
+
+#include <cmath>
+#include <cstdlib>
 
 namespace wircam::vision {
 
@@ -9,6 +13,8 @@ Expected<TagDetector, std::string> TagDetector::create(const DetectorOptions& op
   if (options.threads < 1) return unexpected(std::string("threads must be >= 1"));
   if (options.maxHamming < 0 || options.maxHamming > 3)
     return unexpected(std::string("max-hamming must be 0..3"));
+  if (options.pose && (options.pose->tagSize <= 0 || options.pose->fx <= 0 || options.pose->fy <= 0))
+    return unexpected(std::string("pose needs tag-size, fx and fy above 0"));
   auto family = TagFamily::create(options.family);
   if (!family) return unexpected(family.error());
   return TagDetector(options, std::move(*family));
@@ -44,6 +50,18 @@ std::vector<TagDetection> TagDetector::detect(const GrayView& image) {
     detection.center = {d->c[0], d->c[1]};
     for (int c = 0; c < 4; ++c) detection.corners[c] = {d->p[c][0], d->p[c][1]};
     for (int k = 0; k < 9; ++k) detection.homography[k] = d->H->data[k];
+    if (const auto& camera = options_.pose) {
+      apriltag_detection_info_t info{d, camera->tagSize, camera->fx, camera->fy, camera->cx, camera->cy};
+      apriltag_pose_t pose{};
+      estimate_tag_pose(&info, &pose);
+      // Yaw from the rotation's third column (the tag's normal) seen from above.
+      detection.pose = TagPose{MATD_EL(pose.t, 0, 0), MATD_EL(pose.t, 1, 0), MATD_EL(pose.t, 2, 0),
+                               std::atan2(MATD_EL(pose.R, 0, 2), MATD_EL(pose.R, 2, 2))};
+      // Debian's libapriltag does not export matd_destroy; a matd_t is one
+      // malloc'd block (common/matd.c), so free it as that would.
+      std::free(pose.R);
+      std::free(pose.t);
+    }
     detections.push_back(std::move(detection));
   }
   return detections;

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,15 @@ struct Point2 {
   double y = 0;
 };
 
+// Tag pose in the camera frame (x right, y down, z forward, metres); yaw is
+// the tag's rotation about the camera's vertical axis, radians.
+struct TagPose {
+  double x = 0;
+  double y = 0;
+  double z = 0;
+  double yaw = 0;
+};
+
 struct TagDetection {
   int id = 0;
   std::string family;
@@ -27,6 +37,13 @@ struct TagDetection {
   Point2 center;
   std::array<Point2, 4> corners;        // in the library's order, input pixels
   std::array<double, 9> homography{};   // row-major, tag [-1,1]² → image
+  std::optional<TagPose> pose;          // when the camera and tag size are known
+};
+
+// What pose estimation needs: the tag's edge and the camera's intrinsics.
+struct PoseConfig {
+  double tagSize = 0;  // m, edge of the black border square
+  double fx = 0, fy = 0, cx = 0, cy = 0;
 };
 
 struct DetectorOptions {
@@ -38,6 +55,7 @@ struct DetectorOptions {
   double decodeSharpening = 0.25;
   int maxHamming = 1;      // detections with more bit errors are dropped
   double minMargin = 0.0;  // detections less sure than this are dropped
+  std::optional<PoseConfig> pose;
 };
 
 // A grayscale image in memory the caller owns.
