@@ -1,12 +1,14 @@
 // The "wirc" GStreamer plugin: elements that speak the WiRC protocols.
 #include <gst/gst.h>
 
+#include "gstwirccontrol.h"
 #include "gstwircdepay.h"
 #include "gstwircsrc.h"
 
 static gboolean plugin_init(GstPlugin* plugin) {
   return gst_element_register(plugin, "wircsrc", GST_RANK_NONE, GST_TYPE_WIRC_SRC) &&
-         gst_element_register(plugin, "wircdepay", GST_RANK_NONE, GST_TYPE_WIRC_DEPAY);
+         gst_element_register(plugin, "wircdepay", GST_RANK_NONE, GST_TYPE_WIRC_DEPAY) &&
+         gst_element_register(plugin, "wirccontrol", GST_RANK_NONE, GST_TYPE_WIRC_CONTROL);
 }
 
 #define PACKAGE "wircam"
