@@ -212,7 +212,7 @@ std::vector<TagView> FollowScene::tagViews() const {
                     view.corners[i].x <= config_.width - 1 && view.corners[i].y <= config_.height - 1;
       view.visible = view.visible && front && inside;
     }
-    view.visible = view.visible && facesCamera(view.corners);
+    view.visible = view.visible && facesCamera(view.corners) && (&tag != &tags_[0] || !targetHidden_);
     views.push_back(view);
   }
   return views;
@@ -290,7 +290,8 @@ cv::Mat FollowScene::renderBgr() const {
   drawGround(image);
   // Far tags first, so nearer ones cover them.
   std::vector<const PlacedTag*> order;
-  for (const auto& tag : tags_) order.push_back(&tag);
+  for (const auto& tag : tags_)
+    if (&tag != &tags_[0] || !targetHidden_) order.push_back(&tag);
   auto range = [&](const PlacedTag* t) { return std::hypot(t->pose.x - car_.x, t->pose.y - car_.y); };
   std::sort(order.begin(), order.end(), [&](auto* a, auto* b) { return range(a) > range(b); });
   for (const auto* tag : order) drawTag(image, *tag);

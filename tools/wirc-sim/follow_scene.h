@@ -5,6 +5,7 @@
 // The scene knows the truth and can write it per frame as JSONL.
 #pragma once
 
+#include <atomic>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -77,6 +78,10 @@ class FollowScene : public wirc::DeviceScene {
   void advance(wirc::DeviceClock::time_point now, const wirc::ChannelOutputs& outputs) override;
   std::vector<uint8_t> renderJpeg(int camera) override;
 
+  // Hides the target's tag (as if something stood in front of it); safe to
+  // call from any thread while the device renders.
+  void setTargetHidden(bool hidden) { targetHidden_ = hidden; }
+
   // Advances by an explicit time step; advance() uses wall-clock time.
   void step(double seconds, const wirc::ChannelOutputs& outputs);
   cv::Mat renderBgr() const;
@@ -123,6 +128,7 @@ class FollowScene : public wirc::DeviceScene {
   double distanceErrorSum_ = 0;
   FollowSummary summary_;
   wirc::ChannelOutputs lastOutputs_;
+  std::atomic<bool> targetHidden_{false};
 };
 
 Expected<TargetPath, std::string> parseTargetPath(const std::string& name);
