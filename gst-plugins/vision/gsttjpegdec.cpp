@@ -19,6 +19,7 @@
 #include <turbojpeg.h>
 
 #include <memory>
+#include <string>
 
 GST_DEBUG_CATEGORY_STATIC(tjpeg_dec_debug);
 #define GST_CAT_DEFAULT tjpeg_dec_debug
@@ -105,6 +106,12 @@ static GstVideoFormat preferred_format(GstVideoDecoder* decoder) {
 
 static GstFlowReturn drop_with_warning(GstVideoDecoder* decoder, GstVideoCodecFrame* frame, const char* why) {
   GST_ELEMENT_WARNING(decoder, STREAM, DECODE, ("Dropped a corrupt JPEG frame"), ("%s", why));
+  // Before the first good frame there are no caps yet: dropping would push
+  // the pending segment without them, so the frame is only released.
+  if (!gst_pad_has_current_caps(GST_VIDEO_DECODER_SRC_PAD(decoder))) {
+    gst_video_decoder_release_frame(decoder, frame);
+    return GST_FLOW_OK;
+  }
   return gst_video_decoder_drop_frame(decoder, frame);
 }
 
@@ -116,9 +123,13 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVid
   if (!gst_buffer_map(frame->input_buffer, &in, GST_MAP_READ)) return drop_with_warning(decoder, frame, "unreadable buffer");
 
   int width = 0, height = 0, subsampling = 0, colorspace = 0;
-  if (tjDecompressHeader3(tj, in.data, in.size, &width, &height, &subsampling, &colorspace) != 0) {
+  if (tjDecompressHeader3(tj, in.data, in.size, &width, &height, &subsampling, &colorspace) != 0 ||
+      width <= 0 || height <= 0) {
     gst_buffer_unmap(frame->input_buffer, &in);
-    return drop_with_warning(decoder, frame, tjGetErrorStr2(tj));
+    std::string why = tjGetErrorStr2(tj);
+    // A failed call can leave the handle mid-frame: start the next on a new one.
+    state->decoder.reset(tjInitDecompress());
+    return drop_with_warning(decoder, frame, why.c_str());
   }
   int scale;
   {
@@ -183,7 +194,11 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVid
   gst_video_codec_state_unref(output);
   gst_buffer_unmap(frame->input_buffer, &in);
   // TurboJPEG warnings (e.g. a few corrupt bytes) still give a full image.
-  if (rc != 0 && tjGetErrorCode(tj) == TJERR_FATAL) return drop_with_warning(decoder, frame, tjGetErrorStr2(tj));
+  if (rc != 0 && tjGetErrorCode(tj) == TJERR_FATAL) {
+    std::string why = tjGetErrorStr2(tj);
+    state->decoder.reset(tjInitDecompress());
+    return drop_with_warning(decoder, frame, why.c_str());
+  }
   if (rc != 0) GST_DEBUG_OBJECT(self, "decoded with a warning: %s", tjGetErrorStr2(tj));
   return gst_video_decoder_finish_frame(decoder, frame);
 }

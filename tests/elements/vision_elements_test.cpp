@@ -1,0 +1,115 @@
+// tjpegdec and apriltagdetect in GstHarness, on frames rendered by the
+// simulator's scene.
+#include <gst/check/gstharness.h>
+#include <gst/video/video.h>
+#include <gtest/gtest.h>
+
+#include "scene_frames.h"
+#include "wirc_tag_meta.h"
+
+namespace {
+
+using wircam::testing::sceneFrames;
+
+GstBuffer* jpegBuffer(const std::vector<uint8_t>& jpeg) {
+  GstBuffer* buffer = gst_buffer_new_memdup(jpeg.data(), jpeg.size());
+  GST_BUFFER_PTS(buffer) = 0;
+  return buffer;
+}
+
+std::string formatOf(GstHarness* h) {
+  GstCaps* caps = gst_pad_get_current_caps(h->sinkpad);
+  std::string format = gst_structure_get_string(gst_caps_get_structure(caps, 0), "format");
+  gst_caps_unref(caps);
+  return format;
+}
+
+TEST(TjpegDec, DecodesToTheFormatDownstreamAsksFor) {
+  for (const char* format : {"GRAY8", "I420", "RGB", "BGRx"}) {
+    GstHarness* h = gst_harness_new("tjpegdec");
+    gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
+    std::string sinkCaps = std::string("video/x-raw,format=") + format;
+    gst_harness_set_sink_caps_str(h, sinkCaps.c_str());
+    ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
+    GstBuffer* out = gst_harness_pull(h);
+    ASSERT_NE(out, nullptr);
+    EXPECT_EQ(formatOf(h), format);
+    GstVideoInfo info;
+    GstCaps* caps = gst_pad_get_current_caps(h->sinkpad);
+    gst_video_info_from_caps(&info, caps);
+    gst_caps_unref(caps);
+    EXPECT_EQ(GST_VIDEO_INFO_WIDTH(&info), 352);
+    EXPECT_GE(gst_buffer_get_size(out), GST_VIDEO_INFO_SIZE(&info));
+    gst_buffer_unref(out);
+    gst_harness_teardown(h);
+  }
+}
+
+TEST(TjpegDec, ScalesWhileDecoding) {
+  GstHarness* h = gst_harness_new_parse("tjpegdec scale=1/4");
+  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
+  gst_harness_set_sink_caps_str(h, "video/x-raw,format=GRAY8");
+  ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
+  gst_buffer_unref(gst_harness_pull(h));
+  GstVideoInfo info;
+  GstCaps* caps = gst_pad_get_current_caps(h->sinkpad);
+  gst_video_info_from_caps(&info, caps);
+  gst_caps_unref(caps);
+  EXPECT_EQ(GST_VIDEO_INFO_WIDTH(&info), 88);
+  EXPECT_EQ(GST_VIDEO_INFO_HEIGHT(&info), 72);
+  gst_harness_teardown(h);
+}
+
+TEST(TjpegDec, DropsACorruptFrameAndGoesOn) {
+  GstHarness* h = gst_harness_new("tjpegdec");
+  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
+  gst_harness_set_sink_caps_str(h, "video/x-raw,format=GRAY8");
+  std::vector<uint8_t> garbage = {0xFF, 0xD8, 0x00, 0x01, 0x02, 0x03};
+  EXPECT_EQ(gst_harness_push(h, jpegBuffer(garbage)), GST_FLOW_OK);
+  EXPECT_EQ(gst_harness_buffers_in_queue(h), 0u);
+  EXPECT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[1])), GST_FLOW_OK);
+  EXPECT_EQ(gst_harness_buffers_in_queue(h), 1u);
+  // And once the stream runs: a frame cut short is dropped too.
+  const auto& whole = sceneFrames()[2];
+  std::vector<uint8_t> truncated(whole.begin(), whole.begin() + 600);
+  EXPECT_EQ(gst_harness_push(h, jpegBuffer(truncated)), GST_FLOW_OK);
+  EXPECT_EQ(gst_harness_push(h, jpegBuffer(whole)), GST_FLOW_OK);
+  EXPECT_GE(gst_harness_buffers_in_queue(h), 2u);
+  gst_harness_teardown(h);
+}
+
+TEST(ApriltagDetect, AttachesTheTagAndPostsAMessage) {
+  GstHarness* h = gst_harness_new_parse("tjpegdec ! apriltagdetect quad-decimate=1 tag-size=0.16 fx=304.8");
+  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
+  gst_harness_set_sink_caps_str(h, "video/x-raw,format=GRAY8");
+  GstBus* bus = gst_bus_new();
+  gst_element_set_bus(h->element, bus);
+  ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
+  GstBuffer* out = gst_harness_pull(h);
+  WircTagMeta* meta = gst_buffer_get_wirc_tag_meta(out);
+  ASSERT_NE(meta, nullptr);
+  ASSERT_EQ(meta->tags->len, 1u);
+  const WircTag& tag = g_array_index(meta->tags, WircTag, 0);
+  EXPECT_EQ(tag.id, 0);
+  EXPECT_STREQ(tag.family, "tag36h11");
+  EXPECT_NEAR(tag.cx, 176, 30);
+  EXPECT_TRUE(tag.has_pose);
+  EXPECT_NEAR(tag.z, 1.3, 0.3);  // the scene starts the target 1.2 m ahead
+  gst_buffer_unref(out);
+
+  GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ELEMENT);
+  ASSERT_NE(message, nullptr);
+  const GstStructure* s = gst_message_get_structure(message);
+  EXPECT_TRUE(gst_structure_has_name(s, "apriltag"));
+  const GValue* detections = gst_structure_get_value(s, "detections");
+  ASSERT_EQ(gst_value_list_get_size(detections), 1u);
+  const GstStructure* first = gst_value_get_structure(gst_value_list_get_value(detections, 0));
+  EXPECT_TRUE(gst_structure_has_field(first, "corners"));
+  EXPECT_EQ(gst_value_array_get_size(gst_structure_get_value(first, "corners")), 8u);
+  gst_message_unref(message);
+  gst_element_set_bus(h->element, nullptr);
+  gst_object_unref(bus);
+  gst_harness_teardown(h);
+}
+
+}  // namespace
