@@ -132,12 +132,3 @@ BENCHMARK(BM_WircamFrameAssembler)->Apply(Arguments)->Args({0, 64512})->Args({1,
 BENCHMARK(BM_GstRtpJpegDepay)->Apply(Arguments);
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}

@@ -60,12 +60,3 @@ BENCHMARK(BM_GstVideoTestSrcJpegEnc)->ArgNames({"w", "h"})->Args({352, 288})->Ar
     ->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}

@@ -110,15 +110,3 @@ BENCHMARK(BM_DetectLibraryDefaults)->ArgName("720p")->Arg(0)->Arg(1)->Unit(bench
 BENCHMARK(BM_DetectFullResolution)->ArgName("720p")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  // Our plugins from the build tree beside this program.
-  std::string plugins = std::string(WIRCAM_PLUGIN_DIR);
-  g_setenv("GST_PLUGIN_PATH", plugins.c_str(), FALSE);
-  gst_init(&argc, &argv);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}

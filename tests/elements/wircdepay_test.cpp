@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "buffer_bytes.h"
 #include "scene_frames.h"
 #include "wirc/mjpeg_packet.h"
 
@@ -30,10 +31,7 @@ class WircDepayTest : public ::testing::Test {
   std::vector<uint8_t> pullBytes(GstBuffer** keep = nullptr) {
     GstBuffer* buffer = gst_harness_try_pull(harness_);
     if (!buffer) return {};
-    GstMapInfo map;
-    gst_buffer_map(buffer, &map, GST_MAP_READ);
-    std::vector<uint8_t> bytes(map.data, map.data + map.size);
-    gst_buffer_unmap(buffer, &map);
+    auto bytes = bufferBytes(buffer);
     if (keep)
       *keep = buffer;
     else

@@ -5,6 +5,7 @@
 
 #include <thread>
 
+#include "buffer_bytes.h"
 #include "jpeg_sequence_scene.h"
 #include "scene_frames.h"
 #include "wirc/device.h"
@@ -83,10 +84,7 @@ class WircSrcHarness {
   std::vector<uint8_t> pullBytes(milliseconds timeout = milliseconds(3000)) {
     GstBuffer* buffer = pull(timeout);
     if (!buffer) return {};
-    GstMapInfo map;
-    gst_buffer_map(buffer, &map, GST_MAP_READ);
-    std::vector<uint8_t> bytes(map.data, map.data + map.size);
-    gst_buffer_unmap(buffer, &map);
+    auto bytes = bufferBytes(buffer);
     gst_buffer_unref(buffer);
     return bytes;
   }
