@@ -103,6 +103,11 @@ std::optional<std::string> FollowScene::writeTruthTo(const std::string& path) {
 void FollowScene::advance(wirc::DeviceClock::time_point now, const wirc::ChannelOutputs& outputs) {
   double seconds = lastAdvance_ ? std::chrono::duration<double>(now - *lastAdvance_).count() : 0;
   lastAdvance_ = now;
+  // On the device the world waits for its driver: nothing moves before the
+  // first PCD, so a slow start of the controlling pipeline is not held
+  // against it. (The static scene has no driver.)
+  if (!outputs.failsafe) driverReady_ = true;
+  if (!driverReady_ && !config_.carFixed) seconds = 0;
   step(seconds, outputs);
 }
 

@@ -60,7 +60,9 @@ struct TagView {
 
 struct FollowSummary {
   uint64_t ticks = 0;
-  double meanBearingDeg = 0;  // over ticks after the first 3 s
+  // Over the ticks after the first 3 s of driving (on the device the scene
+  // stands still until the first PCD arrives).
+  double meanBearingDeg = 0;
   double maxBearingDeg = 0;
   double meanDistanceError = 0;  // |distance - followDistance|, m
   double maxDistanceError = 0;
@@ -129,6 +131,7 @@ class FollowScene : public wirc::DeviceScene {
   FollowSummary summary_;
   wirc::ChannelOutputs lastOutputs_;
   std::atomic<bool> targetHidden_{false};
+  bool driverReady_ = false;
 };
 
 Expected<TargetPath, std::string> parseTargetPath(const std::string& name);
