@@ -2,11 +2,13 @@
 #include <gst/gst.h>
 
 #include "gstapriltagdetect.h"
+#include "gsttagoverlay.h"
 #include "gsttjpegdec.h"
 
 static gboolean plugin_init(GstPlugin* plugin) {
   return gst_element_register(plugin, "tjpegdec", GST_RANK_NONE, GST_TYPE_TJPEG_DEC) &&
-         gst_element_register(plugin, "apriltagdetect", GST_RANK_NONE, GST_TYPE_APRILTAG_DETECT);
+         gst_element_register(plugin, "apriltagdetect", GST_RANK_NONE, GST_TYPE_APRILTAG_DETECT) &&
+         gst_element_register(plugin, "tagoverlay", GST_RANK_NONE, GST_TYPE_TAG_OVERLAY);
 }
 
 #define PACKAGE "wircam"

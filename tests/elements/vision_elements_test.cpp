@@ -4,6 +4,8 @@
 #include <gst/video/video.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "scene_frames.h"
 #include "wirc_tag_meta.h"
 
@@ -109,6 +111,30 @@ TEST(ApriltagDetect, AttachesTheTagAndPostsAMessage) {
   gst_message_unref(message);
   gst_element_set_bus(h->element, nullptr);
   gst_object_unref(bus);
+  gst_harness_teardown(h);
+}
+
+TEST(TagOverlay, OutlinesTheDetectedTag) {
+  GstHarness* h = gst_harness_new_parse("tjpegdec ! apriltagdetect quad-decimate=1 ! tagoverlay");
+  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
+  gst_harness_set_sink_caps_str(h, "video/x-raw,format=I420");
+  ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
+  GstBuffer* out = gst_harness_pull(h);
+  WircTagMeta* meta = gst_buffer_get_wirc_tag_meta(out);
+  ASSERT_NE(meta, nullptr);
+  ASSERT_EQ(meta->tags->len, 1u);
+  const WircTag& tag = g_array_index(meta->tags, WircTag, 0);
+  // The target's outline is red: strong V (red chroma) at its first corner,
+  // where the tag itself is black or white (V near 128).
+  GstVideoInfo info;
+  gst_video_info_set_format(&info, GST_VIDEO_FORMAT_I420, 352, 288);
+  GstVideoFrame frame;
+  ASSERT_TRUE(gst_video_frame_map(&frame, &info, out, GST_MAP_READ));
+  int x = static_cast<int>(std::lround(tag.corners[0])) / 2, y = static_cast<int>(std::lround(tag.corners[1])) / 2;
+  auto* v = static_cast<const uint8_t*>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 2));
+  EXPECT_GT(v[y * GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 2) + x], 180);
+  gst_video_frame_unmap(&frame);
+  gst_buffer_unref(out);
   gst_harness_teardown(h);
 }
 
