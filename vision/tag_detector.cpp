@@ -32,7 +32,7 @@ TagDetector::TagDetector(DetectorOptions options, TagFamily family)
   detector_->decode_sharpening = options_.decodeSharpening;
 }
 
-std::vector<TagDetection> TagDetector::detect(const GrayView& image) {
+std::vector<TagDetection> TagDetector::detect(const GrayView& image, Point2 origin) {
   // The library takes a mutable buffer but only reads it.
   image_u8_t view{image.width, image.height, image.stride, const_cast<uint8_t*>(image.data)};
   std::unique_ptr<zarray_t, void (*)(zarray_t*)> found(
@@ -42,6 +42,21 @@ std::vector<TagDetection> TagDetector::detect(const GrayView& image) {
     apriltag_detection_t* d = nullptr;
     zarray_get(found.get(), i, &d);
     if (d->hamming > options_.maxHamming || d->decision_margin < options_.minMargin) continue;
+    if (origin.x != 0 || origin.y != 0) {
+      // Into the whole frame's pixels: shift the points, and the homography
+      // by the same translation (T·H), before anything (pose) reads them.
+      for (auto& p : d->p) {
+        p[0] += origin.x;
+        p[1] += origin.y;
+      }
+      d->c[0] += origin.x;
+      d->c[1] += origin.y;
+      double* h = d->H->data;
+      for (int column = 0; column < 3; ++column) {
+        h[column] += origin.x * h[6 + column];
+        h[3 + column] += origin.y * h[6 + column];
+      }
+    }
     TagDetection detection;
     detection.id = d->id;
     detection.family = family_.name();

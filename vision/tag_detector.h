@@ -70,7 +70,9 @@ class TagDetector {
  public:
   static Expected<TagDetector, std::string> create(const DetectorOptions& options);
 
-  std::vector<TagDetection> detect(const GrayView& image);
+  // `image` may be a window into a larger frame whose top-left corner sits
+  // at `origin`: the detections are given in the larger frame's pixels.
+  std::vector<TagDetection> detect(const GrayView& image, Point2 origin = {});
   const DetectorOptions& options() const { return options_; }
 
  private:

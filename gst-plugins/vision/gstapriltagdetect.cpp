@@ -8,7 +8,8 @@
  * `family`, `hamming`, `margin`, `cx`, `cy`, `corners` (x0 y0 ... x3 y3) and,
  * when `tag-size` and `fx`/`fy` are set, `x`, `y`, `z` (metres, camera frame)
  * and `yaw`. Coordinates are in the input frame's pixels whatever the
- * decimation.
+ * decimation. With `roi-tracking`, tags already found are searched for
+ * only in windows around where they are heading.
  *
  * ## Example launch line
  * |[
@@ -23,7 +24,7 @@
 #include <optional>
 #include <string>
 
-#include "tag_detector.h"
+#include "tag_tracker.h"
 #include "wirc_tag_meta.h"
 
 GST_DEBUG_CATEGORY_STATIC(apriltag_detect_debug);
@@ -42,20 +43,25 @@ using namespace wircam;
 #define DEFAULT_MAX_HAMMING 1
 #define DEFAULT_MIN_MARGIN 0.0
 #define DEFAULT_TAG_SIZE 0.0
+#define DEFAULT_ROI_TRACKING FALSE
+#define DEFAULT_FULL_FRAME_INTERVAL 10
 
 enum {
   PROP_0, PROP_FAMILY, PROP_QUAD_DECIMATE, PROP_QUAD_SIGMA, PROP_THREADS, PROP_REFINE_EDGES,
   PROP_DECODE_SHARPENING, PROP_MAX_HAMMING, PROP_MIN_MARGIN, PROP_TAG_SIZE, PROP_FX, PROP_FY,
-  PROP_CX, PROP_CY,
+  PROP_CX, PROP_CY, PROP_ROI_TRACKING, PROP_FULL_FRAME_INTERVAL,
 };
 
 struct ApriltagDetectState {
   // Guarded by the object lock; a change makes the detector be rebuilt.
   vision::DetectorOptions options;
   double tagSize = DEFAULT_TAG_SIZE, fx = 0, fy = 0, cx = 0, cy = 0;
+  gboolean roiTracking = DEFAULT_ROI_TRACKING;
+  gint fullFrameInterval = DEFAULT_FULL_FRAME_INTERVAL;
   bool dirty = true;
 
-  std::optional<vision::TagDetector> detector;  // streaming thread only
+  // Without roi-tracking the tracker searches the whole frame every time.
+  std::optional<vision::TagTracker> detector;  // streaming thread only
   guint64 frames = 0;
 };
 
@@ -79,8 +85,10 @@ static GstStaticPadTemplate src_template =
 static bool ensure_detector(GstApriltagDetect* self, const GstVideoInfo& info) {
   auto* state = self->state;
   vision::DetectorOptions options;
+  vision::TrackerOptions tracking;
   {
     GST_OBJECT_LOCK(self);
+    tracking.fullFrameInterval = state->roiTracking ? state->fullFrameInterval : 1;
     if (!state->dirty && state->detector) {
       GST_OBJECT_UNLOCK(self);
       return true;
@@ -96,7 +104,7 @@ static bool ensure_detector(GstApriltagDetect* self, const GstVideoInfo& info) {
     state->dirty = false;
     GST_OBJECT_UNLOCK(self);
   }
-  auto detector = vision::TagDetector::create(options);
+  auto detector = vision::TagTracker::create(options, tracking);
   if (!detector) {
     GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid apriltagdetect settings"), ("%s", detector.error().c_str()));
     return false;
@@ -200,6 +208,8 @@ static void gst_apriltag_detect_set_property(GObject* object, guint id, const GV
     case PROP_FY: state->fy = g_value_get_double(value); break;
     case PROP_CX: state->cx = g_value_get_double(value); break;
     case PROP_CY: state->cy = g_value_get_double(value); break;
+    case PROP_ROI_TRACKING: state->roiTracking = g_value_get_boolean(value); break;
+    case PROP_FULL_FRAME_INTERVAL: state->fullFrameInterval = g_value_get_int(value); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
   }
   state->dirty = true;
@@ -225,6 +235,8 @@ static void gst_apriltag_detect_get_property(GObject* object, guint id, GValue* 
     case PROP_FY: g_value_set_double(value, state->fy); break;
     case PROP_CX: g_value_set_double(value, state->cx); break;
     case PROP_CY: g_value_set_double(value, state->cy); break;
+    case PROP_ROI_TRACKING: g_value_set_boolean(value, state->roiTracking); break;
+    case PROP_FULL_FRAME_INTERVAL: g_value_set_int(value, state->fullFrameInterval); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
   }
   GST_OBJECT_UNLOCK(self);
@@ -285,6 +297,14 @@ static void gst_apriltag_detect_class_init(GstApriltagDetectClass* klass) {
   g_object_class_install_property(gobject, PROP_CY,
       g_param_spec_double("cy", "cy", "Principal point y in pixels (0 = image centre)", 0, 100000, 0, flags));
 
+  g_object_class_install_property(gobject, PROP_ROI_TRACKING,
+      g_param_spec_boolean("roi-tracking", "ROI tracking", "Once tags are found, search only windows around "
+                           "where they are heading, at full resolution; search the whole frame every "
+                           "full-frame-interval frames or when a tag is lost", DEFAULT_ROI_TRACKING, flags));
+  g_object_class_install_property(gobject, PROP_FULL_FRAME_INTERVAL,
+      g_param_spec_int("full-frame-interval", "Full-frame interval", "With roi-tracking: frames between "
+                       "whole-frame searches (new tags are found at these)", 1, 1000,
+                       DEFAULT_FULL_FRAME_INTERVAL, flags));
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);
   gst_element_class_set_static_metadata(element, "AprilTag detector", "Filter/Analyzer/Video",

@@ -2,8 +2,9 @@
 //  - tjpegdec (GRAY8, I420) against GStreamer's jpegdec (I420) on the same
 //    CIF and 720p JPEG frames, each in a GstHarness.
 //  - AprilTag detection per frame on the simulator's follow sequence, with
-//    recall beside each time: the library's defaults (quad_decimate 2) and
-//    full resolution (quad_decimate 1).
+//    recall beside each time: the library's defaults (quad_decimate 2),
+//    full resolution (quad_decimate 1), and ROI tracking (windows at full
+//    resolution, the whole frame every 10th frame).
 #include <benchmark/benchmark.h>
 #include <gst/check/gstharness.h>
 #include <gst/gst.h>
@@ -12,7 +13,7 @@
 #include <memory>
 
 #include "follow_scene.h"
-#include "tag_detector.h"
+#include "tag_tracker.h"
 
 namespace {
 
@@ -83,10 +84,10 @@ void BM_TjpegDecGray8(benchmark::State& state) { decode(state, "tjpegdec", "GRAY
 void BM_TjpegDecI420(benchmark::State& state) { decode(state, "tjpegdec", "I420"); }
 void BM_JpegDecI420(benchmark::State& state) { decode(state, "jpegdec", "I420"); }
 
-void detect(benchmark::State& state, float decimate) {
+void detect(benchmark::State& state, float decimate, int fullFrameInterval) {
   Size size = sizeArg(state.range(0));
   const auto& seq = sequence(size);
-  auto detector = vision::TagDetector::create({.quadDecimate = decimate});
+  auto detector = vision::TagTracker::create({.quadDecimate = decimate}, {.fullFrameInterval = fullFrameInterval});
   size_t i = 0, found = 0, visible = 0;
   for (auto _ : state) {
     size_t k = i++ % seq.grays.size();
@@ -100,13 +101,15 @@ void detect(benchmark::State& state, float decimate) {
   state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
-void BM_DetectLibraryDefaults(benchmark::State& state) { detect(state, 2.0f); }
-void BM_DetectFullResolution(benchmark::State& state) { detect(state, 1.0f); }
+void BM_DetectLibraryDefaults(benchmark::State& state) { detect(state, 2.0f, 1); }
+void BM_DetectFullResolution(benchmark::State& state) { detect(state, 1.0f, 1); }
+void BM_DetectRoiTracking(benchmark::State& state) { detect(state, 1.0f, 10); }
 
 BENCHMARK(BM_TjpegDecGray8)->ArgName("720p")->Arg(0)->Arg(1);
 BENCHMARK(BM_TjpegDecI420)->ArgName("720p")->Arg(0)->Arg(1);
 BENCHMARK(BM_JpegDecI420)->ArgName("720p")->Arg(0)->Arg(1);
 BENCHMARK(BM_DetectLibraryDefaults)->ArgName("720p")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DetectFullResolution)->ArgName("720p")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DetectRoiTracking)->ArgName("720p")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
