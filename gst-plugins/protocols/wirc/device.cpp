@@ -9,6 +9,7 @@
 #include <array>
 #include <atomic>
 #include <cerrno>
+#include <deque>
 #include <list>
 #include <map>
 #include <mutex>
@@ -80,6 +81,7 @@ class Device::Impl {
   DeviceStats stats_;
   ChannelOutputs outputs_;
   std::string publishedName_;
+  std::deque<DeviceClock::time_point> pcdArrivals_;
 
  private:
   void log(const std::string& text) {
@@ -587,6 +589,11 @@ void Device::Impl::readPcd(DeviceClock::time_point now) {
   }
   lastPcd_ = now;
   controlDeadline_ = now + config_.pcdTimeout;
+  {
+    std::lock_guard lock(mutex_);
+    pcdArrivals_.push_back(now);
+    if (pcdArrivals_.size() > 4096) pcdArrivals_.pop_front();
+  }
   ++localStats_.pcdReceived;
   if (localOutputs_.failsafe) log("PCD received: leaving failsafe");
   localOutputs_.pulses = std::get<Pcd>(*message).values;
@@ -714,6 +721,11 @@ DeviceStats Device::stats() const {
 ChannelOutputs Device::outputs() const {
   std::lock_guard lock(impl_->mutex_);
   return impl_->outputs_;
+}
+
+std::vector<DeviceClock::time_point> Device::pcdArrivals() const {
+  std::lock_guard lock(impl_->mutex_);
+  return {impl_->pcdArrivals_.begin(), impl_->pcdArrivals_.end()};
 }
 
 std::string Device::name() const {

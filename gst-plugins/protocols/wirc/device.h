@@ -86,6 +86,9 @@ class Device {
   uint16_t controlPort() const;  // where PCD goes (UDP), as sent in WST
   DeviceStats stats() const;
   ChannelOutputs outputs() const;
+  // When the most recent valid PCD arrived (up to the last 4096), oldest
+  // first: for measuring control latency from outside.
+  std::vector<DeviceClock::time_point> pcdArrivals() const;
   std::string name() const;
 
   // Stops the thread and closes every connection.
