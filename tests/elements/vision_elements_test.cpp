@@ -19,6 +19,14 @@ GstBuffer* jpegBuffer(const std::vector<uint8_t>& jpeg) {
   return buffer;
 }
 
+// A harness around `description` fed CIF JPEG frames, with `sinkCaps` asked for.
+GstHarness* jpegHarness(const char* description, const char* sinkCaps) {
+  GstHarness* h = gst_harness_new_parse(description);
+  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
+  gst_harness_set_sink_caps_str(h, sinkCaps);
+  return h;
+}
+
 std::string formatOf(GstHarness* h) {
   GstCaps* caps = gst_pad_get_current_caps(h->sinkpad);
   std::string format = gst_structure_get_string(gst_caps_get_structure(caps, 0), "format");
@@ -28,10 +36,8 @@ std::string formatOf(GstHarness* h) {
 
 TEST(TjpegDec, DecodesToTheFormatDownstreamAsksFor) {
   for (const char* format : {"GRAY8", "I420", "RGB", "BGRx"}) {
-    GstHarness* h = gst_harness_new("tjpegdec");
-    gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
     std::string sinkCaps = std::string("video/x-raw,format=") + format;
-    gst_harness_set_sink_caps_str(h, sinkCaps.c_str());
+    GstHarness* h = jpegHarness("tjpegdec", sinkCaps.c_str());
     ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
     GstBuffer* out = gst_harness_pull(h);
     ASSERT_NE(out, nullptr);
@@ -48,9 +54,7 @@ TEST(TjpegDec, DecodesToTheFormatDownstreamAsksFor) {
 }
 
 TEST(TjpegDec, ScalesWhileDecoding) {
-  GstHarness* h = gst_harness_new_parse("tjpegdec scale=1/4");
-  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
-  gst_harness_set_sink_caps_str(h, "video/x-raw,format=GRAY8");
+  GstHarness* h = jpegHarness("tjpegdec scale=1/4", "video/x-raw,format=GRAY8");
   ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
   gst_buffer_unref(gst_harness_pull(h));
   GstVideoInfo info;
@@ -63,9 +67,7 @@ TEST(TjpegDec, ScalesWhileDecoding) {
 }
 
 TEST(TjpegDec, DropsACorruptFrameAndGoesOn) {
-  GstHarness* h = gst_harness_new("tjpegdec");
-  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
-  gst_harness_set_sink_caps_str(h, "video/x-raw,format=GRAY8");
+  GstHarness* h = jpegHarness("tjpegdec", "video/x-raw,format=GRAY8");
   std::vector<uint8_t> garbage = {0xFF, 0xD8, 0x00, 0x01, 0x02, 0x03};
   EXPECT_EQ(gst_harness_push(h, jpegBuffer(garbage)), GST_FLOW_OK);
   EXPECT_EQ(gst_harness_buffers_in_queue(h), 0u);
@@ -81,9 +83,8 @@ TEST(TjpegDec, DropsACorruptFrameAndGoesOn) {
 }
 
 TEST(ApriltagDetect, AttachesTheTagAndPostsAMessage) {
-  GstHarness* h = gst_harness_new_parse("tjpegdec ! apriltagdetect quad-decimate=1 tag-size=0.16 fx=304.8");
-  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
-  gst_harness_set_sink_caps_str(h, "video/x-raw,format=GRAY8");
+  GstHarness* h = jpegHarness("tjpegdec ! apriltagdetect quad-decimate=1 tag-size=0.16 fx=304.8",
+                              "video/x-raw,format=GRAY8");
   GstBus* bus = gst_bus_new();
   gst_element_set_bus(h->element, bus);
   ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
@@ -115,9 +116,7 @@ TEST(ApriltagDetect, AttachesTheTagAndPostsAMessage) {
 }
 
 TEST(TagOverlay, OutlinesTheDetectedTag) {
-  GstHarness* h = gst_harness_new_parse("tjpegdec ! apriltagdetect quad-decimate=1 ! tagoverlay");
-  gst_harness_set_src_caps_str(h, "image/jpeg,width=352,height=288,framerate=15/1");
-  gst_harness_set_sink_caps_str(h, "video/x-raw,format=I420");
+  GstHarness* h = jpegHarness("tjpegdec ! apriltagdetect quad-decimate=1 ! tagoverlay", "video/x-raw,format=I420");
   ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
   GstBuffer* out = gst_harness_pull(h);
   WircTagMeta* meta = gst_buffer_get_wirc_tag_meta(out);
