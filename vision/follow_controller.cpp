@@ -31,13 +31,15 @@ double FollowController::slew(double previous, double wanted, double maxRate, do
 }
 
 FollowCommand FollowController::update(const TargetObservation& target, double dt) {
-  double fx = config_.fx > 0 ? config_.fx
-                             : target.imageWidth / 2.0 / std::tan(config_.horizontalFovDeg * kPi / 360.0);
+  double fx = config_.fx > 0
+                  ? config_.fx
+                  : target.imageWidth / 2.0 / std::tan(config_.horizontalFovDeg * kPi / 360.0);
   double centre = target.imageWidth / 2.0 - 0.5;
   // Image x grows to the right; a target on the left is a positive bearing.
   double bearing = std::atan2(centre - target.centerX, fx);
-  double distance = target.distance ? *target.distance
-                                    : (target.sizePx > 0 ? fx * config_.tagSize / target.sizePx : 0);
+  double distance = target.distance
+                        ? *target.distance
+                        : (target.sizePx > 0 ? fx * config_.tagSize / target.sizePx : 0);
 
   double bearingError = std::abs(bearing) < config_.steeringDeadbandRad ? 0 : bearing;
   double distanceError = distance - config_.targetDistance;
@@ -48,8 +50,12 @@ FollowCommand FollowController::update(const TargetObservation& target, double d
   double drive = throttlePid_.update(0, -distanceError, dt);
   steering_ = slew(steering_, steer, config_.maxSteeringRate, dt);
   throttle_ = slew(throttle_, drive, config_.maxThrottleRate, dt);
-  return {config_.steeringMap.toPulse(steering_), config_.throttleMap.toPulse(throttle_), bearing,
-          distance, steering_, throttle_};
+  return {config_.steeringMap.toPulse(steering_),
+          config_.throttleMap.toPulse(throttle_),
+          bearing,
+          distance,
+          steering_,
+          throttle_};
 }
 
 FollowCommand FollowController::neutral() {

@@ -13,7 +13,8 @@ Expected<TagDetector, std::string> TagDetector::create(const DetectorOptions& op
   if (options.threads < 1) return unexpected(std::string("threads must be >= 1"));
   if (options.maxHamming < 0 || options.maxHamming > 3)
     return unexpected(std::string("max-hamming must be 0..3"));
-  if (options.pose && (options.pose->tagSize <= 0 || options.pose->fx <= 0 || options.pose->fy <= 0))
+  if (options.pose &&
+      (options.pose->tagSize <= 0 || options.pose->fx <= 0 || options.pose->fy <= 0))
     return unexpected(std::string("pose needs tag-size, fx and fy above 0"));
   auto family = TagFamily::create(options.family);
   if (!family) return unexpected(family.error());
@@ -66,7 +67,8 @@ std::vector<TagDetection> TagDetector::detect(const GrayView& image, Point2 orig
     for (int c = 0; c < 4; ++c) detection.corners[c] = {d->p[c][0], d->p[c][1]};
     for (int k = 0; k < 9; ++k) detection.homography[k] = d->H->data[k];
     if (const auto& camera = options_.pose) {
-      apriltag_detection_info_t info{d, camera->tagSize, camera->fx, camera->fy, camera->cx, camera->cy};
+      apriltag_detection_info_t info{d,          camera->tagSize, camera->fx,
+                                     camera->fy, camera->cx,      camera->cy};
       apriltag_pose_t pose{};
       estimate_tag_pose(&info, &pose);
       // Yaw from the rotation's third column (the tag's normal) seen from above.

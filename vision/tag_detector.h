@@ -35,9 +35,9 @@ struct TagDetection {
   int hamming = 0;
   double margin = 0;  // decision margin: higher is surer
   Point2 center;
-  std::array<Point2, 4> corners;        // in the library's order, input pixels
-  std::array<double, 9> homography{};   // row-major, tag [-1,1]² → image
-  std::optional<TagPose> pose;          // when the camera and tag size are known
+  std::array<Point2, 4> corners;       // in the library's order, input pixels
+  std::array<double, 9> homography{};  // row-major, tag [-1,1]² → image
+  std::optional<TagPose> pose;         // when the camera and tag size are known
 };
 
 // What pose estimation needs: the tag's edge and the camera's intrinsics.

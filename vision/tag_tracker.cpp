@@ -16,8 +16,8 @@ double edgeLength(const TagDetection& d) {
 }
 
 // Where the tag should be now: its last box moved by its last motion.
-Window predict(const TagDetection& last, const TagDetection* before, const TrackerOptions& o, int width,
-               int height) {
+Window predict(const TagDetection& last, const TagDetection* before, const TrackerOptions& o,
+               int width, int height) {
   double dx = before ? last.center.x - before->center.x : 0;
   double dy = before ? last.center.y - before->center.y : 0;
   double minX = 1e9, minY = 1e9, maxX = -1e9, maxY = -1e9;
@@ -29,15 +29,18 @@ Window predict(const TagDetection& last, const TagDetection* before, const Track
   }
   double pad = std::max(o.margin * edgeLength(last), (o.minWindow - (maxX - minX)) / 2);
   double padY = std::max(o.margin * edgeLength(last), (o.minWindow - (maxY - minY)) / 2);
-  return {std::clamp(static_cast<int>(minX - pad), 0, width), std::clamp(static_cast<int>(minY - padY), 0, height),
+  return {std::clamp(static_cast<int>(minX - pad), 0, width),
+          std::clamp(static_cast<int>(minY - padY), 0, height),
           std::clamp(static_cast<int>(std::ceil(maxX + pad)), 0, width),
           std::clamp(static_cast<int>(std::ceil(maxY + padY)), 0, height)};
 }
 
 }  // namespace
 
-Expected<TagTracker, std::string> TagTracker::create(const DetectorOptions& options, TrackerOptions tracking) {
-  if (tracking.fullFrameInterval < 1) return unexpected(std::string("the full-frame interval must be >= 1"));
+Expected<TagTracker, std::string> TagTracker::create(const DetectorOptions& options,
+                                                     TrackerOptions tracking) {
+  if (tracking.fullFrameInterval < 1)
+    return unexpected(std::string("the full-frame interval must be >= 1"));
   auto full = TagDetector::create(options);
   if (!full) return unexpected(full.error());
   DetectorOptions windowOptions = options;
@@ -58,11 +61,12 @@ std::vector<TagDetection> TagTracker::searchWindows(const GrayView& image) {
       if (b.id == last.id) before = &b;
     Window w = predict(last, before, tracking_, image.width, image.height);
     if (w.x1 - w.x0 < 8 || w.y1 - w.y0 < 8) return {};
-    GrayView crop{image.data + static_cast<ptrdiff_t>(w.y0) * image.stride + w.x0, w.x1 - w.x0, w.y1 - w.y0,
-                  image.stride};
+    GrayView crop{image.data + static_cast<ptrdiff_t>(w.y0) * image.stride + w.x0, w.x1 - w.x0,
+                  w.y1 - w.y0, image.stride};
     bool seen = false;
     for (auto& d : window_.detect(crop, {static_cast<double>(w.x0), static_cast<double>(w.y0)})) {
-      bool duplicate = std::any_of(found.begin(), found.end(), [&](const TagDetection& f) { return f.id == d.id; });
+      bool duplicate = std::any_of(found.begin(), found.end(),
+                                   [&](const TagDetection& f) { return f.id == d.id; });
       seen = seen || d.id == last.id;
       if (!duplicate) found.push_back(std::move(d));
     }

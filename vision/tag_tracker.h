@@ -26,7 +26,8 @@ struct TrackerStats {
 
 class TagTracker {
  public:
-  static Expected<TagTracker, std::string> create(const DetectorOptions& options, TrackerOptions tracking = {});
+  static Expected<TagTracker, std::string> create(const DetectorOptions& options,
+                                                  TrackerOptions tracking = {});
 
   std::vector<TagDetection> detect(const GrayView& image);
   const TrackerStats& stats() const { return stats_; }

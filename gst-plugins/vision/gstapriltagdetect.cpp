@@ -47,9 +47,22 @@ using namespace wircam;
 #define DEFAULT_FULL_FRAME_INTERVAL 10
 
 enum {
-  PROP_0, PROP_FAMILY, PROP_QUAD_DECIMATE, PROP_QUAD_SIGMA, PROP_THREADS, PROP_REFINE_EDGES,
-  PROP_DECODE_SHARPENING, PROP_MAX_HAMMING, PROP_MIN_MARGIN, PROP_TAG_SIZE, PROP_FX, PROP_FY,
-  PROP_CX, PROP_CY, PROP_ROI_TRACKING, PROP_FULL_FRAME_INTERVAL,
+  PROP_0,
+  PROP_FAMILY,
+  PROP_QUAD_DECIMATE,
+  PROP_QUAD_SIGMA,
+  PROP_THREADS,
+  PROP_REFINE_EDGES,
+  PROP_DECODE_SHARPENING,
+  PROP_MAX_HAMMING,
+  PROP_MIN_MARGIN,
+  PROP_TAG_SIZE,
+  PROP_FX,
+  PROP_FY,
+  PROP_CX,
+  PROP_CY,
+  PROP_ROI_TRACKING,
+  PROP_FULL_FRAME_INTERVAL,
 };
 
 struct ApriltagDetectState {
@@ -106,7 +119,8 @@ static bool ensure_detector(GstApriltagDetect* self, const GstVideoInfo& info) {
   }
   auto detector = vision::TagTracker::create(options, tracking);
   if (!detector) {
-    GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid apriltagdetect settings"), ("%s", detector.error().c_str()));
+    GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid apriltagdetect settings"),
+                      ("%s", detector.error().c_str()));
     return false;
   }
   state->detector.emplace(std::move(*detector));
@@ -114,9 +128,10 @@ static bool ensure_detector(GstApriltagDetect* self, const GstVideoInfo& info) {
 }
 
 static GValue tag_structure_value(const vision::TagDetection& d) {
-  GstStructure* s = gst_structure_new("tag", "id", G_TYPE_INT, d.id, "family", G_TYPE_STRING, d.family.c_str(),
-                                      "hamming", G_TYPE_INT, d.hamming, "margin", G_TYPE_DOUBLE, d.margin,
-                                      "cx", G_TYPE_DOUBLE, d.center.x, "cy", G_TYPE_DOUBLE, d.center.y, nullptr);
+  GstStructure* s =
+      gst_structure_new("tag", "id", G_TYPE_INT, d.id, "family", G_TYPE_STRING, d.family.c_str(),
+                        "hamming", G_TYPE_INT, d.hamming, "margin", G_TYPE_DOUBLE, d.margin, "cx",
+                        G_TYPE_DOUBLE, d.center.x, "cy", G_TYPE_DOUBLE, d.center.y, nullptr);
   GValue corners = G_VALUE_INIT;
   gst_value_array_init(&corners, 8);
   for (const auto& c : d.corners) {
@@ -129,8 +144,8 @@ static GValue tag_structure_value(const vision::TagDetection& d) {
   }
   gst_structure_take_value(s, "corners", &corners);
   if (d.pose)
-    gst_structure_set(s, "x", G_TYPE_DOUBLE, d.pose->x, "y", G_TYPE_DOUBLE, d.pose->y, "z", G_TYPE_DOUBLE,
-                      d.pose->z, "yaw", G_TYPE_DOUBLE, d.pose->yaw, nullptr);
+    gst_structure_set(s, "x", G_TYPE_DOUBLE, d.pose->x, "y", G_TYPE_DOUBLE, d.pose->y, "z",
+                      G_TYPE_DOUBLE, d.pose->z, "yaw", G_TYPE_DOUBLE, d.pose->yaw, nullptr);
   GValue value = G_VALUE_INIT;
   g_value_init(&value, GST_TYPE_STRUCTURE);
   gst_value_set_structure(&value, s);
@@ -138,7 +153,8 @@ static GValue tag_structure_value(const vision::TagDetection& d) {
   return value;
 }
 
-static GstFlowReturn gst_apriltag_detect_transform_frame_ip(GstVideoFilter* filter, GstVideoFrame* frame) {
+static GstFlowReturn gst_apriltag_detect_transform_frame_ip(GstVideoFilter* filter,
+                                                            GstVideoFrame* frame) {
   auto* self = GST_APRILTAG_DETECT(filter);
   auto* state = self->state;
   if (!ensure_detector(self, frame->info)) return GST_FLOW_ERROR;
@@ -176,8 +192,9 @@ static GstFlowReturn gst_apriltag_detect_transform_frame_ip(GstVideoFilter* filt
     gst_value_list_append_and_take_value(&list, &value);
   }
 
-  GstStructure* message = gst_structure_new("apriltag", "timestamp", G_TYPE_UINT64, GST_BUFFER_PTS(frame->buffer),
-                                            "frame", G_TYPE_UINT64, state->frames++, nullptr);
+  GstStructure* message =
+      gst_structure_new("apriltag", "timestamp", G_TYPE_UINT64, GST_BUFFER_PTS(frame->buffer),
+                        "frame", G_TYPE_UINT64, state->frames++, nullptr);
   gst_structure_take_value(message, "detections", &list);
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), message));
   GST_LOG_OBJECT(self, "%zu tags", detections.size());
@@ -189,55 +206,121 @@ static gboolean gst_apriltag_detect_start(GstBaseTransform* transform) {
   return TRUE;
 }
 
-static void gst_apriltag_detect_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+static void gst_apriltag_detect_set_property(GObject* object, guint id, const GValue* value,
+                                             GParamSpec* pspec) {
   auto* self = GST_APRILTAG_DETECT(object);
   auto* state = self->state;
   GST_OBJECT_LOCK(self);
   auto& o = state->options;
   switch (id) {
-    case PROP_FAMILY: o.family = g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_FAMILY; break;
-    case PROP_QUAD_DECIMATE: o.quadDecimate = g_value_get_float(value); break;
-    case PROP_QUAD_SIGMA: o.quadSigma = g_value_get_float(value); break;
-    case PROP_THREADS: o.threads = g_value_get_int(value); break;
-    case PROP_REFINE_EDGES: o.refineEdges = g_value_get_boolean(value); break;
-    case PROP_DECODE_SHARPENING: o.decodeSharpening = g_value_get_double(value); break;
-    case PROP_MAX_HAMMING: o.maxHamming = g_value_get_int(value); break;
-    case PROP_MIN_MARGIN: o.minMargin = g_value_get_double(value); break;
-    case PROP_TAG_SIZE: state->tagSize = g_value_get_double(value); break;
-    case PROP_FX: state->fx = g_value_get_double(value); break;
-    case PROP_FY: state->fy = g_value_get_double(value); break;
-    case PROP_CX: state->cx = g_value_get_double(value); break;
-    case PROP_CY: state->cy = g_value_get_double(value); break;
-    case PROP_ROI_TRACKING: state->roiTracking = g_value_get_boolean(value); break;
-    case PROP_FULL_FRAME_INTERVAL: state->fullFrameInterval = g_value_get_int(value); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_FAMILY:
+      o.family = g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_FAMILY;
+      break;
+    case PROP_QUAD_DECIMATE:
+      o.quadDecimate = g_value_get_float(value);
+      break;
+    case PROP_QUAD_SIGMA:
+      o.quadSigma = g_value_get_float(value);
+      break;
+    case PROP_THREADS:
+      o.threads = g_value_get_int(value);
+      break;
+    case PROP_REFINE_EDGES:
+      o.refineEdges = g_value_get_boolean(value);
+      break;
+    case PROP_DECODE_SHARPENING:
+      o.decodeSharpening = g_value_get_double(value);
+      break;
+    case PROP_MAX_HAMMING:
+      o.maxHamming = g_value_get_int(value);
+      break;
+    case PROP_MIN_MARGIN:
+      o.minMargin = g_value_get_double(value);
+      break;
+    case PROP_TAG_SIZE:
+      state->tagSize = g_value_get_double(value);
+      break;
+    case PROP_FX:
+      state->fx = g_value_get_double(value);
+      break;
+    case PROP_FY:
+      state->fy = g_value_get_double(value);
+      break;
+    case PROP_CX:
+      state->cx = g_value_get_double(value);
+      break;
+    case PROP_CY:
+      state->cy = g_value_get_double(value);
+      break;
+    case PROP_ROI_TRACKING:
+      state->roiTracking = g_value_get_boolean(value);
+      break;
+    case PROP_FULL_FRAME_INTERVAL:
+      state->fullFrameInterval = g_value_get_int(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
   state->dirty = true;
   GST_OBJECT_UNLOCK(self);
 }
 
-static void gst_apriltag_detect_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
+static void gst_apriltag_detect_get_property(GObject* object, guint id, GValue* value,
+                                             GParamSpec* pspec) {
   auto* self = GST_APRILTAG_DETECT(object);
   auto* state = self->state;
   GST_OBJECT_LOCK(self);
   const auto& o = state->options;
   switch (id) {
-    case PROP_FAMILY: g_value_set_string(value, o.family.c_str()); break;
-    case PROP_QUAD_DECIMATE: g_value_set_float(value, o.quadDecimate); break;
-    case PROP_QUAD_SIGMA: g_value_set_float(value, o.quadSigma); break;
-    case PROP_THREADS: g_value_set_int(value, o.threads); break;
-    case PROP_REFINE_EDGES: g_value_set_boolean(value, o.refineEdges); break;
-    case PROP_DECODE_SHARPENING: g_value_set_double(value, o.decodeSharpening); break;
-    case PROP_MAX_HAMMING: g_value_set_int(value, o.maxHamming); break;
-    case PROP_MIN_MARGIN: g_value_set_double(value, o.minMargin); break;
-    case PROP_TAG_SIZE: g_value_set_double(value, state->tagSize); break;
-    case PROP_FX: g_value_set_double(value, state->fx); break;
-    case PROP_FY: g_value_set_double(value, state->fy); break;
-    case PROP_CX: g_value_set_double(value, state->cx); break;
-    case PROP_CY: g_value_set_double(value, state->cy); break;
-    case PROP_ROI_TRACKING: g_value_set_boolean(value, state->roiTracking); break;
-    case PROP_FULL_FRAME_INTERVAL: g_value_set_int(value, state->fullFrameInterval); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_FAMILY:
+      g_value_set_string(value, o.family.c_str());
+      break;
+    case PROP_QUAD_DECIMATE:
+      g_value_set_float(value, o.quadDecimate);
+      break;
+    case PROP_QUAD_SIGMA:
+      g_value_set_float(value, o.quadSigma);
+      break;
+    case PROP_THREADS:
+      g_value_set_int(value, o.threads);
+      break;
+    case PROP_REFINE_EDGES:
+      g_value_set_boolean(value, o.refineEdges);
+      break;
+    case PROP_DECODE_SHARPENING:
+      g_value_set_double(value, o.decodeSharpening);
+      break;
+    case PROP_MAX_HAMMING:
+      g_value_set_int(value, o.maxHamming);
+      break;
+    case PROP_MIN_MARGIN:
+      g_value_set_double(value, o.minMargin);
+      break;
+    case PROP_TAG_SIZE:
+      g_value_set_double(value, state->tagSize);
+      break;
+    case PROP_FX:
+      g_value_set_double(value, state->fx);
+      break;
+    case PROP_FY:
+      g_value_set_double(value, state->fy);
+      break;
+    case PROP_CX:
+      g_value_set_double(value, state->cx);
+      break;
+    case PROP_CY:
+      g_value_set_double(value, state->cy);
+      break;
+    case PROP_ROI_TRACKING:
+      g_value_set_boolean(value, state->roiTracking);
+      break;
+    case PROP_FULL_FRAME_INTERVAL:
+      g_value_set_int(value, state->fullFrameInterval);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -258,57 +341,91 @@ static void gst_apriltag_detect_class_init(GstApriltagDetectClass* klass) {
   gobject->set_property = gst_apriltag_detect_set_property;
   gobject->get_property = gst_apriltag_detect_get_property;
   gobject->finalize = gst_apriltag_detect_finalize;
-  auto flags = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING);
+  auto flags = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                        GST_PARAM_MUTABLE_PLAYING);
 
   std::string families;
-  for (const auto& name : vision::TagFamily::names()) families += (families.empty() ? "" : ", ") + name;
+  for (const auto& name : vision::TagFamily::names())
+    families += (families.empty() ? "" : ", ") + name;
   static std::string familyBlurb = "Tag family: " + families;
-  g_object_class_install_property(gobject, PROP_FAMILY,
+  g_object_class_install_property(
+      gobject, PROP_FAMILY,
       g_param_spec_string("family", "Family", familyBlurb.c_str(), DEFAULT_FAMILY, flags));
-  g_object_class_install_property(gobject, PROP_QUAD_DECIMATE,
-      g_param_spec_float("quad-decimate", "Quad decimate", "Find quads on an image this many times smaller "
-                         "(faster; corners are still refined at full size)", 1, 8, DEFAULT_QUAD_DECIMATE, flags));
-  g_object_class_install_property(gobject, PROP_QUAD_SIGMA,
-      g_param_spec_float("quad-sigma", "Quad sigma", "Gaussian blur before finding quads (0 = none; "
-                         "helps on noisy images)", 0, 10, DEFAULT_QUAD_SIGMA, flags));
+  g_object_class_install_property(
+      gobject, PROP_QUAD_DECIMATE,
+      g_param_spec_float("quad-decimate", "Quad decimate",
+                         "Find quads on an image this many times smaller "
+                         "(faster; corners are still refined at full size)",
+                         1, 8, DEFAULT_QUAD_DECIMATE, flags));
+  g_object_class_install_property(
+      gobject, PROP_QUAD_SIGMA,
+      g_param_spec_float("quad-sigma", "Quad sigma",
+                         "Gaussian blur before finding quads (0 = none; "
+                         "helps on noisy images)",
+                         0, 10, DEFAULT_QUAD_SIGMA, flags));
   g_object_class_install_property(gobject, PROP_THREADS,
-      g_param_spec_int("threads", "Threads", "Detector worker threads", 1, 64, DEFAULT_THREADS, flags));
+                                  g_param_spec_int("threads", "Threads", "Detector worker threads",
+                                                   1, 64, DEFAULT_THREADS, flags));
   g_object_class_install_property(gobject, PROP_REFINE_EDGES,
-      g_param_spec_boolean("refine-edges", "Refine edges", "Snap quad edges to strong gradients "
-                           "(more exact corners, little cost)", DEFAULT_REFINE_EDGES, flags));
+                                  g_param_spec_boolean("refine-edges", "Refine edges",
+                                                       "Snap quad edges to strong gradients "
+                                                       "(more exact corners, little cost)",
+                                                       DEFAULT_REFINE_EDGES, flags));
   g_object_class_install_property(gobject, PROP_DECODE_SHARPENING,
-      g_param_spec_double("decode-sharpening", "Decode sharpening", "Sharpening of the decoded bits "
-                          "(helps small tags)", 0, 10, DEFAULT_DECODE_SHARPENING, flags));
-  g_object_class_install_property(gobject, PROP_MAX_HAMMING,
+                                  g_param_spec_double("decode-sharpening", "Decode sharpening",
+                                                      "Sharpening of the decoded bits "
+                                                      "(helps small tags)",
+                                                      0, 10, DEFAULT_DECODE_SHARPENING, flags));
+  g_object_class_install_property(
+      gobject, PROP_MAX_HAMMING,
       g_param_spec_int("max-hamming", "Max Hamming", "Most bit errors a detection may have", 0, 3,
                        DEFAULT_MAX_HAMMING, flags));
-  g_object_class_install_property(gobject, PROP_MIN_MARGIN,
-      g_param_spec_double("min-margin", "Min margin", "Drop detections with a decision margin below this",
-                          0, 1000, DEFAULT_MIN_MARGIN, flags));
-  g_object_class_install_property(gobject, PROP_TAG_SIZE,
-      g_param_spec_double("tag-size", "Tag size", "Edge of the tag's black border in metres; with fx and "
-                          "fy it turns on pose (x, y, z, yaw)", 0, 100, DEFAULT_TAG_SIZE, flags));
-  g_object_class_install_property(gobject, PROP_FX,
+  g_object_class_install_property(
+      gobject, PROP_MIN_MARGIN,
+      g_param_spec_double("min-margin", "Min margin",
+                          "Drop detections with a decision margin below this", 0, 1000,
+                          DEFAULT_MIN_MARGIN, flags));
+  g_object_class_install_property(
+      gobject, PROP_TAG_SIZE,
+      g_param_spec_double("tag-size", "Tag size",
+                          "Edge of the tag's black border in metres; with fx and "
+                          "fy it turns on pose (x, y, z, yaw)",
+                          0, 100, DEFAULT_TAG_SIZE, flags));
+  g_object_class_install_property(
+      gobject, PROP_FX,
       g_param_spec_double("fx", "fx", "Focal length in pixels, x (for pose)", 0, 100000, 0, flags));
-  g_object_class_install_property(gobject, PROP_FY,
+  g_object_class_install_property(
+      gobject, PROP_FY,
       g_param_spec_double("fy", "fy", "Focal length in pixels, y (0 = fx)", 0, 100000, 0, flags));
-  g_object_class_install_property(gobject, PROP_CX,
-      g_param_spec_double("cx", "cx", "Principal point x in pixels (0 = image centre)", 0, 100000, 0, flags));
-  g_object_class_install_property(gobject, PROP_CY,
-      g_param_spec_double("cy", "cy", "Principal point y in pixels (0 = image centre)", 0, 100000, 0, flags));
+  g_object_class_install_property(
+      gobject, PROP_CX,
+      g_param_spec_double("cx", "cx", "Principal point x in pixels (0 = image centre)", 0, 100000,
+                          0, flags));
+  g_object_class_install_property(
+      gobject, PROP_CY,
+      g_param_spec_double("cy", "cy", "Principal point y in pixels (0 = image centre)", 0, 100000,
+                          0, flags));
 
-  g_object_class_install_property(gobject, PROP_ROI_TRACKING,
-      g_param_spec_boolean("roi-tracking", "ROI tracking", "Once tags are found, search only windows around "
-                           "where they are heading, at full resolution; search the whole frame every "
-                           "full-frame-interval frames or when a tag is lost", DEFAULT_ROI_TRACKING, flags));
-  g_object_class_install_property(gobject, PROP_FULL_FRAME_INTERVAL,
-      g_param_spec_int("full-frame-interval", "Full-frame interval", "With roi-tracking: frames between "
-                       "whole-frame searches (new tags are found at these)", 1, 1000,
-                       DEFAULT_FULL_FRAME_INTERVAL, flags));
+  g_object_class_install_property(
+      gobject, PROP_ROI_TRACKING,
+      g_param_spec_boolean(
+          "roi-tracking", "ROI tracking",
+          "Once tags are found, search only windows around "
+          "where they are heading, at full resolution; search the whole frame every "
+          "full-frame-interval frames or when a tag is lost",
+          DEFAULT_ROI_TRACKING, flags));
+  g_object_class_install_property(
+      gobject, PROP_FULL_FRAME_INTERVAL,
+      g_param_spec_int("full-frame-interval", "Full-frame interval",
+                       "With roi-tracking: frames between "
+                       "whole-frame searches (new tags are found at these)",
+                       1, 1000, DEFAULT_FULL_FRAME_INTERVAL, flags));
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);
-  gst_element_class_set_static_metadata(element, "AprilTag detector", "Filter/Analyzer/Video",
-      "Finds AprilTags in video frames; attaches WircTagMeta and posts apriltag messages", "wircam authors");
+  gst_element_class_set_static_metadata(
+      element, "AprilTag detector", "Filter/Analyzer/Video",
+      "Finds AprilTags in video frames; attaches WircTagMeta and posts apriltag messages",
+      "wircam authors");
   GST_BASE_TRANSFORM_CLASS(klass)->start = gst_apriltag_detect_start;
   GST_VIDEO_FILTER_CLASS(klass)->transform_frame_ip = gst_apriltag_detect_transform_frame_ip;
   GST_DEBUG_CATEGORY_INIT(apriltag_detect_debug, "apriltagdetect", 0, "AprilTag detector");

@@ -9,7 +9,8 @@
  *
  * ## Example launch line
  * |[
- * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=I420 ! apriltagdetect ! tagoverlay ! videoconvert ! autovideosink
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=I420 ! apriltagdetect !
+ * tagoverlay ! videoconvert ! autovideosink
  * ]|
  */
 #include "gsttagoverlay.h"
@@ -39,8 +40,10 @@ struct _GstTagOverlay {
 G_DEFINE_TYPE(GstTagOverlay, gst_tag_overlay, GST_TYPE_VIDEO_FILTER)
 
 #define CAPS GST_VIDEO_CAPS_MAKE("{ I420, RGB, BGRx }")
-static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(CAPS));
-static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(CAPS));
+static GstStaticPadTemplate sink_template =
+    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(CAPS));
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(CAPS));
 
 namespace {
 
@@ -60,8 +63,9 @@ struct Canvas {
 
 std::vector<Canvas> canvases(GstVideoFrame* frame, Colour c) {
   auto plane = [&](int i, int type) {
-    return cv::Mat(GST_VIDEO_FRAME_COMP_HEIGHT(frame, i), GST_VIDEO_FRAME_COMP_WIDTH(frame, i), type,
-                   GST_VIDEO_FRAME_PLANE_DATA(frame, i), GST_VIDEO_FRAME_PLANE_STRIDE(frame, i));
+    return cv::Mat(GST_VIDEO_FRAME_COMP_HEIGHT(frame, i), GST_VIDEO_FRAME_COMP_WIDTH(frame, i),
+                   type, GST_VIDEO_FRAME_PLANE_DATA(frame, i),
+                   GST_VIDEO_FRAME_PLANE_STRIDE(frame, i));
   };
   switch (GST_VIDEO_FRAME_FORMAT(frame)) {
     case GST_VIDEO_FORMAT_RGB:
@@ -79,7 +83,8 @@ std::vector<Canvas> canvases(GstVideoFrame* frame, Colour c) {
   }
 }
 
-void drawTag(GstVideoFrame* frame, const WircTag& tag, bool target, bool showId, double scaleX, double scaleY) {
+void drawTag(GstVideoFrame* frame, const WircTag& tag, bool target, bool showId, double scaleX,
+             double scaleY) {
   int width = GST_VIDEO_FRAME_WIDTH(frame), height = GST_VIDEO_FRAME_HEIGHT(frame);
   for (auto& canvas : canvases(frame, target ? kTargetColour : kTagColour)) {
     auto at = [&](double x, double y) {
@@ -90,19 +95,24 @@ void drawTag(GstVideoFrame* frame, const WircTag& tag, bool target, bool showId,
     for (int i = 0; i < 4; ++i) {
       int j = (i + 1) % 4;
       cv::line(canvas.plane, at(tag.corners[2 * i], tag.corners[2 * i + 1]),
-               at(tag.corners[2 * j], tag.corners[2 * j + 1]), canvas.colour, thickness, cv::LINE_AA);
+               at(tag.corners[2 * j], tag.corners[2 * j + 1]), canvas.colour, thickness,
+               cv::LINE_AA);
     }
-    if (target) cv::line(canvas.plane, at(width / 2.0, height / 2.0), at(tag.cx, tag.cy), canvas.colour, 1, cv::LINE_AA);
+    if (target)
+      cv::line(canvas.plane, at(width / 2.0, height / 2.0), at(tag.cx, tag.cy), canvas.colour, 1,
+               cv::LINE_AA);
     if (showId) {
-      cv::putText(canvas.plane, std::to_string(tag.id), at(tag.cx + 4, tag.cy - 4), cv::FONT_HERSHEY_SIMPLEX,
-                  0.5 * canvas.scale * std::max(1.0, width / 640.0), canvas.colour, thickness, cv::LINE_AA);
+      cv::putText(canvas.plane, std::to_string(tag.id), at(tag.cx + 4, tag.cy - 4),
+                  cv::FONT_HERSHEY_SIMPLEX, 0.5 * canvas.scale * std::max(1.0, width / 640.0),
+                  canvas.colour, thickness, cv::LINE_AA);
     }
   }
 }
 
 }  // namespace
 
-static GstFlowReturn gst_tag_overlay_transform_frame_ip(GstVideoFilter* filter, GstVideoFrame* frame) {
+static GstFlowReturn gst_tag_overlay_transform_frame_ip(GstVideoFilter* filter,
+                                                        GstVideoFrame* frame) {
   auto* self = GST_TAG_OVERLAY(filter);
   WircTagMeta* meta = gst_buffer_get_wirc_tag_meta(frame->buffer);
   if (!meta || meta->tags->len == 0 || meta->width == 0 || meta->height == 0) return GST_FLOW_OK;
@@ -133,21 +143,29 @@ static GstFlowReturn gst_tag_overlay_transform_frame_ip(GstVideoFilter* filter, 
   return GST_FLOW_OK;
 }
 
-static void gst_tag_overlay_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+static void gst_tag_overlay_set_property(GObject* object, guint id, const GValue* value,
+                                         GParamSpec* pspec) {
   auto* self = GST_TAG_OVERLAY(object);
   GST_OBJECT_LOCK(self);
-  if (id == PROP_TARGET_ID) self->targetId = g_value_get_int(value);
-  else if (id == PROP_SHOW_IDS) self->showIds = g_value_get_boolean(value);
-  else G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+  if (id == PROP_TARGET_ID)
+    self->targetId = g_value_get_int(value);
+  else if (id == PROP_SHOW_IDS)
+    self->showIds = g_value_get_boolean(value);
+  else
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
   GST_OBJECT_UNLOCK(self);
 }
 
-static void gst_tag_overlay_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
+static void gst_tag_overlay_get_property(GObject* object, guint id, GValue* value,
+                                         GParamSpec* pspec) {
   auto* self = GST_TAG_OVERLAY(object);
   GST_OBJECT_LOCK(self);
-  if (id == PROP_TARGET_ID) g_value_set_int(value, self->targetId);
-  else if (id == PROP_SHOW_IDS) g_value_set_boolean(value, self->showIds);
-  else G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+  if (id == PROP_TARGET_ID)
+    g_value_set_int(value, self->targetId);
+  else if (id == PROP_SHOW_IDS)
+    g_value_set_boolean(value, self->showIds);
+  else
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
   GST_OBJECT_UNLOCK(self);
 }
 
@@ -162,15 +180,22 @@ static void gst_tag_overlay_class_init(GstTagOverlayClass* klass) {
   auto* element = GST_ELEMENT_CLASS(klass);
   gobject->set_property = gst_tag_overlay_set_property;
   gobject->get_property = gst_tag_overlay_get_property;
-  auto flags = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING);
-  g_object_class_install_property(gobject, PROP_TARGET_ID, g_param_spec_int("target-id", "Target id",
-      "Tag drawn as the control target (-1 = the largest), as wirccontrol's target-id", -1, 65535,
-      DEFAULT_TARGET_ID, flags));
-  g_object_class_install_property(gobject, PROP_SHOW_IDS, g_param_spec_boolean("show-ids", "Show ids",
-      "Write each tag's id beside it", DEFAULT_SHOW_IDS, flags));
+  auto flags = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                        GST_PARAM_MUTABLE_PLAYING);
+  g_object_class_install_property(
+      gobject, PROP_TARGET_ID,
+      g_param_spec_int(
+          "target-id", "Target id",
+          "Tag drawn as the control target (-1 = the largest), as wirccontrol's target-id", -1,
+          65535, DEFAULT_TARGET_ID, flags));
+  g_object_class_install_property(
+      gobject, PROP_SHOW_IDS,
+      g_param_spec_boolean("show-ids", "Show ids", "Write each tag's id beside it",
+                           DEFAULT_SHOW_IDS, flags));
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);
-  gst_element_class_set_static_metadata(element, "AprilTag overlay", "Filter/Effect/Video",
+  gst_element_class_set_static_metadata(
+      element, "AprilTag overlay", "Filter/Effect/Video",
       "Draws the AprilTags found by apriltagdetect and the control target", "wircam authors");
   GST_VIDEO_FILTER_CLASS(klass)->transform_frame_ip = gst_tag_overlay_transform_frame_ip;
   GST_DEBUG_CATEGORY_INIT(tag_overlay_debug, "tagoverlay", 0, "AprilTag overlay");

@@ -10,8 +10,9 @@
  *
  * ## Example launch lines
  * |[
- * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=GRAY8 ! apriltagdetect ! fakesink
- * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec scale=1/2 ! videoconvert ! autovideosink
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=GRAY8 ! apriltagdetect !
+ * fakesink gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec scale=1/2 ! videoconvert !
+ * autovideosink
  * ]|
  */
 #include "gsttjpegdec.h"
@@ -38,7 +39,8 @@ GType scale_get_type() {
                                       {kScale4, "Quarter size", "1/4"},
                                       {kScale8, "One eighth", "1/8"},
                                       {0, nullptr, nullptr}};
-  if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static("GstTjpegDecScale", values));
+  if (g_once_init_enter(&type))
+    g_once_init_leave(&type, g_enum_register_static("GstTjpegDecScale", values));
   return type;
 }
 
@@ -62,8 +64,9 @@ G_DEFINE_TYPE(GstTjpegDec, gst_tjpeg_dec, GST_TYPE_VIDEO_DECODER)
 
 static GstStaticPadTemplate sink_template =
     GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS("image/jpeg"));
-static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
-    "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ I420, GRAY8, RGB, BGRx }")));
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS,
+                            GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ I420, GRAY8, RGB, BGRx }")));
 
 static gboolean gst_tjpeg_dec_start(GstVideoDecoder* decoder) {
   auto* state = GST_TJPEG_DEC(decoder)->state;
@@ -104,7 +107,8 @@ static GstVideoFormat preferred_format(GstVideoDecoder* decoder) {
   return format;
 }
 
-static GstFlowReturn drop_with_warning(GstVideoDecoder* decoder, GstVideoCodecFrame* frame, const char* why) {
+static GstFlowReturn drop_with_warning(GstVideoDecoder* decoder, GstVideoCodecFrame* frame,
+                                       const char* why) {
   GST_ELEMENT_WARNING(decoder, STREAM, DECODE, ("Dropped a corrupt JPEG frame"), ("%s", why));
   // Before the first good frame there are no caps yet: dropping would push
   // the pending segment without them, so the frame is only released.
@@ -115,12 +119,14 @@ static GstFlowReturn drop_with_warning(GstVideoDecoder* decoder, GstVideoCodecFr
   return gst_video_decoder_drop_frame(decoder, frame);
 }
 
-static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVideoCodecFrame* frame) {
+static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder,
+                                                GstVideoCodecFrame* frame) {
   auto* self = GST_TJPEG_DEC(decoder);
   auto* state = self->state;
   tjhandle tj = state->decoder.get();
   GstMapInfo in;
-  if (!gst_buffer_map(frame->input_buffer, &in, GST_MAP_READ)) return drop_with_warning(decoder, frame, "unreadable buffer");
+  if (!gst_buffer_map(frame->input_buffer, &in, GST_MAP_READ))
+    return drop_with_warning(decoder, frame, "unreadable buffer");
 
   int width = 0, height = 0, subsampling = 0, colorspace = 0;
   if (tjDecompressHeader3(tj, in.data, in.size, &width, &height, &subsampling, &colorspace) != 0 ||
@@ -140,9 +146,11 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVid
   tjscalingfactor factor{1, scale};
   int outWidth = TJSCALED(width, factor), outHeight = TJSCALED(height, factor);
 
-  if (outWidth != state->width || outHeight != state->height || !gst_pad_has_current_caps(GST_VIDEO_DECODER_SRC_PAD(decoder))) {
+  if (outWidth != state->width || outHeight != state->height ||
+      !gst_pad_has_current_caps(GST_VIDEO_DECODER_SRC_PAD(decoder))) {
     state->format = preferred_format(decoder);
-    GstVideoCodecState* output = gst_video_decoder_set_output_state(decoder, state->format, outWidth, outHeight, state->input);
+    GstVideoCodecState* output = gst_video_decoder_set_output_state(
+        decoder, state->format, outWidth, outHeight, state->input);
     gst_video_codec_state_unref(output);
     if (!gst_video_decoder_negotiate(decoder)) {
       gst_buffer_unmap(frame->input_buffer, &in);
@@ -152,12 +160,15 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVid
     state->width = outWidth;
     state->height = outHeight;
   }
-  if (state->format == GST_VIDEO_FORMAT_I420 && subsampling != TJSAMP_420 && subsampling != TJSAMP_GRAY) {
+  if (state->format == GST_VIDEO_FORMAT_I420 && subsampling != TJSAMP_420 &&
+      subsampling != TJSAMP_GRAY) {
     gst_buffer_unmap(frame->input_buffer, &in);
     gst_video_decoder_drop_frame(decoder, frame);
-    GST_ELEMENT_ERROR(decoder, STREAM, FORMAT, ("tjpegdec gives I420 only for 4:2:0 or grayscale JPEGs"),
-                      ("This stream has TurboJPEG subsampling %d: ask for GRAY8, RGB or BGRx instead "
-                       "(e.g. tjpegdec ! video/x-raw,format=RGB)", subsampling));
+    GST_ELEMENT_ERROR(
+        decoder, STREAM, FORMAT, ("tjpegdec gives I420 only for 4:2:0 or grayscale JPEGs"),
+        ("This stream has TurboJPEG subsampling %d: ask for GRAY8, RGB or BGRx instead "
+         "(e.g. tjpegdec ! video/x-raw,format=RGB)",
+         subsampling));
     return GST_FLOW_NOT_NEGOTIATED;
   }
 
@@ -175,9 +186,11 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVid
     unsigned char* planes[3] = {static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 0)),
                                 static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 1)),
                                 static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 2))};
-    int strides[3] = {GST_VIDEO_FRAME_PLANE_STRIDE(&video, 0), GST_VIDEO_FRAME_PLANE_STRIDE(&video, 1),
+    int strides[3] = {GST_VIDEO_FRAME_PLANE_STRIDE(&video, 0),
+                      GST_VIDEO_FRAME_PLANE_STRIDE(&video, 1),
                       GST_VIDEO_FRAME_PLANE_STRIDE(&video, 2)};
-    rc = tjDecompressToYUVPlanes(tj, in.data, in.size, planes, outWidth, strides, outHeight, TJFLAG_FASTDCT);
+    rc = tjDecompressToYUVPlanes(tj, in.data, in.size, planes, outWidth, strides, outHeight,
+                                 TJFLAG_FASTDCT);
     if (subsampling == TJSAMP_GRAY) {  // a grayscale JPEG has no chroma: make it neutral
       for (int p = 1; p < 3; ++p)
         for (int y = 0; y < GST_VIDEO_FRAME_COMP_HEIGHT(&video, p); ++y)
@@ -187,8 +200,9 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVid
     int pixelFormat = state->format == GST_VIDEO_FORMAT_GRAY8 ? TJPF_GRAY
                       : state->format == GST_VIDEO_FORMAT_RGB ? TJPF_RGB
                                                               : TJPF_BGRX;
-    rc = tjDecompress2(tj, in.data, in.size, static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 0)),
-                       outWidth, GST_VIDEO_FRAME_PLANE_STRIDE(&video, 0), outHeight, pixelFormat, TJFLAG_FASTDCT);
+    rc = tjDecompress2(
+        tj, in.data, in.size, static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 0)),
+        outWidth, GST_VIDEO_FRAME_PLANE_STRIDE(&video, 0), outHeight, pixelFormat, TJFLAG_FASTDCT);
   }
   gst_video_frame_unmap(&video);
   gst_video_codec_state_unref(output);
@@ -203,7 +217,8 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder, GstVid
   return gst_video_decoder_finish_frame(decoder, frame);
 }
 
-static void gst_tjpeg_dec_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+static void gst_tjpeg_dec_set_property(GObject* object, guint id, const GValue* value,
+                                       GParamSpec* pspec) {
   auto* self = GST_TJPEG_DEC(object);
   if (id != PROP_SCALE) {
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
@@ -215,7 +230,8 @@ static void gst_tjpeg_dec_set_property(GObject* object, guint id, const GValue* 
   GST_OBJECT_UNLOCK(self);
 }
 
-static void gst_tjpeg_dec_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
+static void gst_tjpeg_dec_get_property(GObject* object, guint id, GValue* value,
+                                       GParamSpec* pspec) {
   auto* self = GST_TJPEG_DEC(object);
   if (id != PROP_SCALE) {
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
@@ -245,14 +261,20 @@ static void gst_tjpeg_dec_class_init(GstTjpegDecClass* klass) {
   gobject->set_property = gst_tjpeg_dec_set_property;
   gobject->get_property = gst_tjpeg_dec_get_property;
   gobject->finalize = gst_tjpeg_dec_finalize;
-  g_object_class_install_property(gobject, PROP_SCALE,
-      g_param_spec_enum("scale", "Scale", "Decode at this fraction of the JPEG's size (1, 1/2, 1/4, 1/8): "
-                        "smaller is much faster", scale_get_type(), DEFAULT_SCALE,
-                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
+  g_object_class_install_property(
+      gobject, PROP_SCALE,
+      g_param_spec_enum("scale", "Scale",
+                        "Decode at this fraction of the JPEG's size (1, 1/2, 1/4, 1/8): "
+                        "smaller is much faster",
+                        scale_get_type(), DEFAULT_SCALE,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_PLAYING)));
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);
-  gst_element_class_set_static_metadata(element, "TurboJPEG decoder", "Codec/Decoder/Image",
-      "Decodes JPEG to GRAY8, I420, RGB or BGRx with libjpeg-turbo, optionally scaled", "wircam authors");
+  gst_element_class_set_static_metadata(
+      element, "TurboJPEG decoder", "Codec/Decoder/Image",
+      "Decodes JPEG to GRAY8, I420, RGB or BGRx with libjpeg-turbo, optionally scaled",
+      "wircam authors");
   decoder->start = gst_tjpeg_dec_start;
   decoder->stop = gst_tjpeg_dec_stop;
   decoder->set_format = gst_tjpeg_dec_set_format;

@@ -13,5 +13,5 @@ static gboolean plugin_init(GstPlugin* plugin) {
 
 #define PACKAGE "wircam"
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, wircvision,
-                  "JPEG decoding with libjpeg-turbo and AprilTag detection", plugin_init, WIRCAM_VERSION,
-                  "MIT/X11", "wircam", "wircam")
+                  "JPEG decoding with libjpeg-turbo and AprilTag detection", plugin_init,
+                  WIRCAM_VERSION, "MIT/X11", "wircam", "wircam")

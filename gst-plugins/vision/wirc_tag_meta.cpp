@@ -53,7 +53,8 @@ const GstMetaInfo* wirc_tag_meta_get_info(void) {
 }
 
 WircTagMeta* gst_buffer_add_wirc_tag_meta(GstBuffer* buffer, guint width, guint height) {
-  auto* meta = reinterpret_cast<WircTagMeta*>(gst_buffer_add_meta(buffer, wirc_tag_meta_get_info(), nullptr));
+  auto* meta = reinterpret_cast<WircTagMeta*>(
+      gst_buffer_add_meta(buffer, wirc_tag_meta_get_info(), nullptr));
   meta->width = width;
   meta->height = height;
   return meta;

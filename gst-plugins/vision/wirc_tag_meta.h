@@ -22,15 +22,15 @@ typedef struct {
 typedef struct {
   GstMeta meta;
   guint width, height; /* size of the frame the coordinates refer to */
-  GArray *tags;        /* of WircTag */
+  GArray* tags;        /* of WircTag */
 } WircTagMeta;
 
 GType wirc_tag_meta_api_get_type(void);
 #define WIRC_TAG_META_API_TYPE (wirc_tag_meta_api_get_type())
-const GstMetaInfo *wirc_tag_meta_get_info(void);
+const GstMetaInfo* wirc_tag_meta_get_info(void);
 
-WircTagMeta *gst_buffer_add_wirc_tag_meta(GstBuffer *buffer, guint width, guint height);
+WircTagMeta* gst_buffer_add_wirc_tag_meta(GstBuffer* buffer, guint width, guint height);
 #define gst_buffer_get_wirc_tag_meta(b) \
-  ((WircTagMeta *)gst_buffer_get_meta((b), WIRC_TAG_META_API_TYPE))
+  ((WircTagMeta*)gst_buffer_get_meta((b), WIRC_TAG_META_API_TYPE))
 
 G_END_DECLS

@@ -20,20 +20,19 @@ GstCaps* jpegCapsIfChanged(GstBuffer* frame, int& width, int& height) {
   width = info->width;
   height = info->height;
   // The device sends at its own pace: the frame rate is variable (0/1).
-  return gst_caps_new_simple("image/jpeg", "width", G_TYPE_INT, width, "height", G_TYPE_INT,
-                             height, "framerate", GST_TYPE_FRACTION, 0, 1, "parsed",
-                             G_TYPE_BOOLEAN, TRUE, nullptr);
+  return gst_caps_new_simple("image/jpeg", "width", G_TYPE_INT, width, "height", G_TYPE_INT, height,
+                             "framerate", GST_TYPE_FRACTION, 0, 1, "parsed", G_TYPE_BOOLEAN, TRUE,
+                             nullptr);
 }
 GstStructure* statsStructure(const wirc::AssemblerStats& s, uint64_t foreignPackets) {
   return gst_structure_new(
       "wirc-stats", "packets", G_TYPE_UINT64, s.packets, "bytes", G_TYPE_UINT64, s.payloadBytes,
       "frames-complete", G_TYPE_UINT64, s.framesComplete, "frames-incomplete", G_TYPE_UINT64,
-      s.framesDropped(), "frames-timed-out", G_TYPE_UINT64, s.framesTimedOut,
-      "frames-superseded", G_TYPE_UINT64, s.framesSuperseded, "frames-late", G_TYPE_UINT64,
-      s.packetsLate, "packets-duplicate", G_TYPE_UINT64, s.packetsDuplicate, "packets-invalid",
-      G_TYPE_UINT64, s.packetsInvalid, "packets-foreign", G_TYPE_UINT64, foreignPackets,
-      "keepalives", G_TYPE_UINT64, s.keepalives, "sender-restarts", G_TYPE_UINT64,
-      s.senderRestarts, nullptr);
+      s.framesDropped(), "frames-timed-out", G_TYPE_UINT64, s.framesTimedOut, "frames-superseded",
+      G_TYPE_UINT64, s.framesSuperseded, "frames-late", G_TYPE_UINT64, s.packetsLate,
+      "packets-duplicate", G_TYPE_UINT64, s.packetsDuplicate, "packets-invalid", G_TYPE_UINT64,
+      s.packetsInvalid, "packets-foreign", G_TYPE_UINT64, foreignPackets, "keepalives",
+      G_TYPE_UINT64, s.keepalives, "sender-restarts", G_TYPE_UINT64, s.senderRestarts, nullptr);
 }
 
 }  // namespace wircam::gst

@@ -15,7 +15,8 @@
  *
  * ## Example launch line
  * |[
- * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! apriltagdetect quad-decimate=1 ! wirccontrol host=127.0.0.1 target-id=0 target-distance=1.0 ! fakesink
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! apriltagdetect quad-decimate=1 ! wirccontrol
+ * host=127.0.0.1 target-id=0 target-distance=1.0 ! fakesink
  * ]|
  */
 #include "gstwirccontrol.h"
@@ -58,11 +59,33 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_ENABLED TRUE
 
 enum {
-  PROP_0, PROP_HOST, PROP_PORT, PROP_PROTOCOL, PROP_TARGET_ID, PROP_STEERING_CHANNEL,
-  PROP_THROTTLE_CHANNEL, PROP_STEERING_KP, PROP_STEERING_KI, PROP_STEERING_KD, PROP_THROTTLE_KP,
-  PROP_THROTTLE_KI, PROP_THROTTLE_KD, PROP_TARGET_DISTANCE, PROP_TAG_SIZE, PROP_FX,
-  PROP_HORIZONTAL_FOV, PROP_NEUTRAL, PROP_MIN, PROP_MAX, PROP_THROTTLE_DEADBAND, PROP_MAX_THROTTLE,
-  PROP_STEERING_REVERSED, PROP_THROTTLE_REVERSED, PROP_LOST_TIMEOUT, PROP_PCD_RATE, PROP_ENABLED,
+  PROP_0,
+  PROP_HOST,
+  PROP_PORT,
+  PROP_PROTOCOL,
+  PROP_TARGET_ID,
+  PROP_STEERING_CHANNEL,
+  PROP_THROTTLE_CHANNEL,
+  PROP_STEERING_KP,
+  PROP_STEERING_KI,
+  PROP_STEERING_KD,
+  PROP_THROTTLE_KP,
+  PROP_THROTTLE_KI,
+  PROP_THROTTLE_KD,
+  PROP_TARGET_DISTANCE,
+  PROP_TAG_SIZE,
+  PROP_FX,
+  PROP_HORIZONTAL_FOV,
+  PROP_NEUTRAL,
+  PROP_MIN,
+  PROP_MAX,
+  PROP_THROTTLE_DEADBAND,
+  PROP_MAX_THROTTLE,
+  PROP_STEERING_REVERSED,
+  PROP_THROTTLE_REVERSED,
+  PROP_LOST_TIMEOUT,
+  PROP_PCD_RATE,
+  PROP_ENABLED,
 };
 
 struct Settings {
@@ -131,7 +154,8 @@ double meanEdge(const WircTag& tag) {
   double total = 0;
   for (int i = 0; i < 4; ++i) {
     int j = (i + 1) % 4;
-    total += std::hypot(tag.corners[2 * j] - tag.corners[2 * i], tag.corners[2 * j + 1] - tag.corners[2 * i + 1]);
+    total += std::hypot(tag.corners[2 * j] - tag.corners[2 * i],
+                        tag.corners[2 * j + 1] - tag.corners[2 * i + 1]);
   }
   return total / 4;
 }
@@ -159,24 +183,30 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
     settings = state->settings;
   }
   if (settings.protocol != "wirc") {
-    GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("protocol '%s' is not available", settings.protocol.c_str()),
+    GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS,
+                      ("protocol '%s' is not available", settings.protocol.c_str()),
                       ("This build speaks protocol=wirc only; RCOIP and BTEMP are planned."));
     return FALSE;
   }
   if (settings.steeringChannel == settings.throttleChannel) {
-    GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("steering-channel and throttle-channel are both %u",
-                      settings.steeringChannel), ("Give them two different channels of 1..8."));
+    GST_ELEMENT_ERROR(
+        self, LIBRARY, SETTINGS,
+        ("steering-channel and throttle-channel are both %u", settings.steeringChannel),
+        ("Give them two different channels of 1..8."));
     return FALSE;
   }
   if (settings.min > settings.neutral || settings.neutral > settings.max) {
     GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Pulse limits out of order"),
-                      ("Need min <= neutral <= max (now %u, %u, %u).", settings.min, settings.neutral, settings.max));
+                      ("Need min <= neutral <= max (now %u, %u, %u).", settings.min,
+                       settings.neutral, settings.max));
     return FALSE;
   }
   // The first element to name the device sets the session's PCD pacing;
   // commands older than lost-timeout give way to neutral there too.
   state->session = wirc::TransmitterSession::acquire(
-      {.host = settings.host, .port = static_cast<uint16_t>(settings.port), .pcdRate = settings.pcdRate,
+      {.host = settings.host,
+       .port = static_cast<uint16_t>(settings.port),
+       .pcdRate = settings.pcdRate,
        .commandTtl = std::chrono::milliseconds(settings.lostTimeoutMs)});
   state->lastBuffer.reset();
   state->lastSeen.reset();
@@ -205,7 +235,8 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
   if (changed || !state->controller) state->controller.emplace(followConfig(settings));
 
   auto now = Clock::now();
-  double dt = state->lastBuffer ? std::chrono::duration<double>(now - *state->lastBuffer).count() : 0;
+  double dt =
+      state->lastBuffer ? std::chrono::duration<double>(now - *state->lastBuffer).count() : 0;
   dt = std::clamp(dt, 0.0, 0.5);
   state->lastBuffer = now;
 
@@ -215,8 +246,9 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
   if (!settings.enabled) {
     state->command = state->controller->neutral();
   } else if (target) {
-    vision::TargetObservation seen{target->cx, meanEdge(*target), static_cast<int>(meta->width),
-                                   target->has_pose ? std::optional<double>(target->z) : std::nullopt};
+    vision::TargetObservation seen{
+        target->cx, meanEdge(*target), static_cast<int>(meta->width),
+        target->has_pose ? std::optional<double>(target->z) : std::nullopt};
     state->command = state->controller->update(seen, dt);
     state->lastSeen = now;
   } else if (!state->lastSeen || now - *state->lastSeen > lostTimeout) {
@@ -232,86 +264,197 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
       GST_ELEMENT(self),
       gst_message_new_element(
           GST_OBJECT(self),
-          gst_structure_new("wirc-control", "timestamp", G_TYPE_UINT64, GST_BUFFER_PTS(buffer), "target-visible",
-                            G_TYPE_BOOLEAN, target != nullptr, "enabled", G_TYPE_BOOLEAN, settings.enabled,
-                            "bearing", G_TYPE_DOUBLE, state->command.bearingRad, "distance", G_TYPE_DOUBLE,
-                            state->command.distance, "steering", G_TYPE_DOUBLE, state->command.steering,
-                            "throttle", G_TYPE_DOUBLE, state->command.throttle, "steering-pulse", G_TYPE_UINT,
-                            static_cast<guint>(state->command.steeringPulse), "throttle-pulse", G_TYPE_UINT,
-                            static_cast<guint>(state->command.throttlePulse), nullptr)));
+          gst_structure_new(
+              "wirc-control", "timestamp", G_TYPE_UINT64, GST_BUFFER_PTS(buffer), "target-visible",
+              G_TYPE_BOOLEAN, target != nullptr, "enabled", G_TYPE_BOOLEAN, settings.enabled,
+              "bearing", G_TYPE_DOUBLE, state->command.bearingRad, "distance", G_TYPE_DOUBLE,
+              state->command.distance, "steering", G_TYPE_DOUBLE, state->command.steering,
+              "throttle", G_TYPE_DOUBLE, state->command.throttle, "steering-pulse", G_TYPE_UINT,
+              static_cast<guint>(state->command.steeringPulse), "throttle-pulse", G_TYPE_UINT,
+              static_cast<guint>(state->command.throttlePulse), nullptr)));
   return GST_FLOW_OK;
 }
 
-static void gst_wirc_control_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+static void gst_wirc_control_set_property(GObject* object, guint id, const GValue* value,
+                                          GParamSpec* pspec) {
   auto* self = GST_WIRC_CONTROL(object);
   gst::GLibLocker lock(self);
   auto& s = self->state->settings;
   auto& f = s.follow;
   switch (id) {
-    case PROP_HOST: s.host = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
-    case PROP_PORT: s.port = g_value_get_uint(value); break;
-    case PROP_PROTOCOL: s.protocol = g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_PROTOCOL; break;
-    case PROP_TARGET_ID: s.targetId = g_value_get_int(value); break;
-    case PROP_STEERING_CHANNEL: s.steeringChannel = g_value_get_uint(value); break;
-    case PROP_THROTTLE_CHANNEL: s.throttleChannel = g_value_get_uint(value); break;
-    case PROP_STEERING_KP: f.steering.kp = g_value_get_double(value); break;
-    case PROP_STEERING_KI: f.steering.ki = g_value_get_double(value); break;
-    case PROP_STEERING_KD: f.steering.kd = g_value_get_double(value); break;
-    case PROP_THROTTLE_KP: f.throttle.kp = g_value_get_double(value); break;
-    case PROP_THROTTLE_KI: f.throttle.ki = g_value_get_double(value); break;
-    case PROP_THROTTLE_KD: f.throttle.kd = g_value_get_double(value); break;
-    case PROP_TARGET_DISTANCE: f.targetDistance = g_value_get_double(value); break;
-    case PROP_TAG_SIZE: f.tagSize = g_value_get_double(value); break;
-    case PROP_FX: f.fx = g_value_get_double(value); break;
-    case PROP_HORIZONTAL_FOV: f.horizontalFovDeg = g_value_get_double(value); break;
-    case PROP_NEUTRAL: s.neutral = g_value_get_uint(value); break;
-    case PROP_MIN: s.min = g_value_get_uint(value); break;
-    case PROP_MAX: s.max = g_value_get_uint(value); break;
-    case PROP_THROTTLE_DEADBAND: s.throttleDeadband = g_value_get_uint(value); break;
-    case PROP_MAX_THROTTLE: s.maxThrottle = g_value_get_double(value); break;
-    case PROP_STEERING_REVERSED: s.steeringReversed = g_value_get_boolean(value); break;
-    case PROP_THROTTLE_REVERSED: s.throttleReversed = g_value_get_boolean(value); break;
-    case PROP_LOST_TIMEOUT: s.lostTimeoutMs = g_value_get_uint(value); break;
-    case PROP_PCD_RATE: s.pcdRate = g_value_get_double(value); break;
-    case PROP_ENABLED: s.enabled = g_value_get_boolean(value); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); return;
+    case PROP_HOST:
+      s.host = g_value_get_string(value) ? g_value_get_string(value) : "";
+      break;
+    case PROP_PORT:
+      s.port = g_value_get_uint(value);
+      break;
+    case PROP_PROTOCOL:
+      s.protocol = g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_PROTOCOL;
+      break;
+    case PROP_TARGET_ID:
+      s.targetId = g_value_get_int(value);
+      break;
+    case PROP_STEERING_CHANNEL:
+      s.steeringChannel = g_value_get_uint(value);
+      break;
+    case PROP_THROTTLE_CHANNEL:
+      s.throttleChannel = g_value_get_uint(value);
+      break;
+    case PROP_STEERING_KP:
+      f.steering.kp = g_value_get_double(value);
+      break;
+    case PROP_STEERING_KI:
+      f.steering.ki = g_value_get_double(value);
+      break;
+    case PROP_STEERING_KD:
+      f.steering.kd = g_value_get_double(value);
+      break;
+    case PROP_THROTTLE_KP:
+      f.throttle.kp = g_value_get_double(value);
+      break;
+    case PROP_THROTTLE_KI:
+      f.throttle.ki = g_value_get_double(value);
+      break;
+    case PROP_THROTTLE_KD:
+      f.throttle.kd = g_value_get_double(value);
+      break;
+    case PROP_TARGET_DISTANCE:
+      f.targetDistance = g_value_get_double(value);
+      break;
+    case PROP_TAG_SIZE:
+      f.tagSize = g_value_get_double(value);
+      break;
+    case PROP_FX:
+      f.fx = g_value_get_double(value);
+      break;
+    case PROP_HORIZONTAL_FOV:
+      f.horizontalFovDeg = g_value_get_double(value);
+      break;
+    case PROP_NEUTRAL:
+      s.neutral = g_value_get_uint(value);
+      break;
+    case PROP_MIN:
+      s.min = g_value_get_uint(value);
+      break;
+    case PROP_MAX:
+      s.max = g_value_get_uint(value);
+      break;
+    case PROP_THROTTLE_DEADBAND:
+      s.throttleDeadband = g_value_get_uint(value);
+      break;
+    case PROP_MAX_THROTTLE:
+      s.maxThrottle = g_value_get_double(value);
+      break;
+    case PROP_STEERING_REVERSED:
+      s.steeringReversed = g_value_get_boolean(value);
+      break;
+    case PROP_THROTTLE_REVERSED:
+      s.throttleReversed = g_value_get_boolean(value);
+      break;
+    case PROP_LOST_TIMEOUT:
+      s.lostTimeoutMs = g_value_get_uint(value);
+      break;
+    case PROP_PCD_RATE:
+      s.pcdRate = g_value_get_double(value);
+      break;
+    case PROP_ENABLED:
+      s.enabled = g_value_get_boolean(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      return;
   }
   self->state->settingsChanged = true;
 }
 
-static void gst_wirc_control_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
+static void gst_wirc_control_get_property(GObject* object, guint id, GValue* value,
+                                          GParamSpec* pspec) {
   auto* self = GST_WIRC_CONTROL(object);
   gst::GLibLocker lock(self);
   const auto& s = self->state->settings;
   const auto& f = s.follow;
   switch (id) {
-    case PROP_HOST: g_value_set_string(value, s.host.c_str()); break;
-    case PROP_PORT: g_value_set_uint(value, s.port); break;
-    case PROP_PROTOCOL: g_value_set_string(value, s.protocol.c_str()); break;
-    case PROP_TARGET_ID: g_value_set_int(value, s.targetId); break;
-    case PROP_STEERING_CHANNEL: g_value_set_uint(value, s.steeringChannel); break;
-    case PROP_THROTTLE_CHANNEL: g_value_set_uint(value, s.throttleChannel); break;
-    case PROP_STEERING_KP: g_value_set_double(value, f.steering.kp); break;
-    case PROP_STEERING_KI: g_value_set_double(value, f.steering.ki); break;
-    case PROP_STEERING_KD: g_value_set_double(value, f.steering.kd); break;
-    case PROP_THROTTLE_KP: g_value_set_double(value, f.throttle.kp); break;
-    case PROP_THROTTLE_KI: g_value_set_double(value, f.throttle.ki); break;
-    case PROP_THROTTLE_KD: g_value_set_double(value, f.throttle.kd); break;
-    case PROP_TARGET_DISTANCE: g_value_set_double(value, f.targetDistance); break;
-    case PROP_TAG_SIZE: g_value_set_double(value, f.tagSize); break;
-    case PROP_FX: g_value_set_double(value, f.fx); break;
-    case PROP_HORIZONTAL_FOV: g_value_set_double(value, f.horizontalFovDeg); break;
-    case PROP_NEUTRAL: g_value_set_uint(value, s.neutral); break;
-    case PROP_MIN: g_value_set_uint(value, s.min); break;
-    case PROP_MAX: g_value_set_uint(value, s.max); break;
-    case PROP_THROTTLE_DEADBAND: g_value_set_uint(value, s.throttleDeadband); break;
-    case PROP_MAX_THROTTLE: g_value_set_double(value, s.maxThrottle); break;
-    case PROP_STEERING_REVERSED: g_value_set_boolean(value, s.steeringReversed); break;
-    case PROP_THROTTLE_REVERSED: g_value_set_boolean(value, s.throttleReversed); break;
-    case PROP_LOST_TIMEOUT: g_value_set_uint(value, s.lostTimeoutMs); break;
-    case PROP_PCD_RATE: g_value_set_double(value, s.pcdRate); break;
-    case PROP_ENABLED: g_value_set_boolean(value, s.enabled); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_HOST:
+      g_value_set_string(value, s.host.c_str());
+      break;
+    case PROP_PORT:
+      g_value_set_uint(value, s.port);
+      break;
+    case PROP_PROTOCOL:
+      g_value_set_string(value, s.protocol.c_str());
+      break;
+    case PROP_TARGET_ID:
+      g_value_set_int(value, s.targetId);
+      break;
+    case PROP_STEERING_CHANNEL:
+      g_value_set_uint(value, s.steeringChannel);
+      break;
+    case PROP_THROTTLE_CHANNEL:
+      g_value_set_uint(value, s.throttleChannel);
+      break;
+    case PROP_STEERING_KP:
+      g_value_set_double(value, f.steering.kp);
+      break;
+    case PROP_STEERING_KI:
+      g_value_set_double(value, f.steering.ki);
+      break;
+    case PROP_STEERING_KD:
+      g_value_set_double(value, f.steering.kd);
+      break;
+    case PROP_THROTTLE_KP:
+      g_value_set_double(value, f.throttle.kp);
+      break;
+    case PROP_THROTTLE_KI:
+      g_value_set_double(value, f.throttle.ki);
+      break;
+    case PROP_THROTTLE_KD:
+      g_value_set_double(value, f.throttle.kd);
+      break;
+    case PROP_TARGET_DISTANCE:
+      g_value_set_double(value, f.targetDistance);
+      break;
+    case PROP_TAG_SIZE:
+      g_value_set_double(value, f.tagSize);
+      break;
+    case PROP_FX:
+      g_value_set_double(value, f.fx);
+      break;
+    case PROP_HORIZONTAL_FOV:
+      g_value_set_double(value, f.horizontalFovDeg);
+      break;
+    case PROP_NEUTRAL:
+      g_value_set_uint(value, s.neutral);
+      break;
+    case PROP_MIN:
+      g_value_set_uint(value, s.min);
+      break;
+    case PROP_MAX:
+      g_value_set_uint(value, s.max);
+      break;
+    case PROP_THROTTLE_DEADBAND:
+      g_value_set_uint(value, s.throttleDeadband);
+      break;
+    case PROP_MAX_THROTTLE:
+      g_value_set_double(value, s.maxThrottle);
+      break;
+    case PROP_STEERING_REVERSED:
+      g_value_set_boolean(value, s.steeringReversed);
+      break;
+    case PROP_THROTTLE_REVERSED:
+      g_value_set_boolean(value, s.throttleReversed);
+      break;
+    case PROP_LOST_TIMEOUT:
+      g_value_set_uint(value, s.lostTimeoutMs);
+      break;
+    case PROP_PCD_RATE:
+      g_value_set_double(value, s.pcdRate);
+      break;
+    case PROP_ENABLED:
+      g_value_set_boolean(value, s.enabled);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
 }
 
@@ -325,14 +468,16 @@ static void gst_wirc_control_init(GstWircControl* self) {
   gst_base_transform_set_passthrough(GST_BASE_TRANSFORM(self), TRUE);
 }
 
-static void install_double(GObjectClass* gobject, guint id, const char* name, const char* blurb, double min,
-                           double max, double value, GParamFlags flags) {
-  g_object_class_install_property(gobject, id, g_param_spec_double(name, name, blurb, min, max, value, flags));
+static void install_double(GObjectClass* gobject, guint id, const char* name, const char* blurb,
+                           double min, double max, double value, GParamFlags flags) {
+  g_object_class_install_property(gobject, id,
+                                  g_param_spec_double(name, name, blurb, min, max, value, flags));
 }
 
-static void install_uint(GObjectClass* gobject, guint id, const char* name, const char* blurb, guint min,
-                         guint max, guint value, GParamFlags flags) {
-  g_object_class_install_property(gobject, id, g_param_spec_uint(name, name, blurb, min, max, value, flags));
+static void install_uint(GObjectClass* gobject, guint id, const char* name, const char* blurb,
+                         guint min, guint max, guint value, GParamFlags flags) {
+  g_object_class_install_property(gobject, id,
+                                  g_param_spec_uint(name, name, blurb, min, max, value, flags));
 }
 
 static void gst_wirc_control_class_init(GstWircControlClass* klass) {
@@ -341,59 +486,96 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
   gobject->set_property = gst_wirc_control_set_property;
   gobject->get_property = gst_wirc_control_get_property;
   gobject->finalize = gst_wirc_control_finalize;
-  auto ready = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
-  auto live = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING |
-                                       GST_PARAM_CONTROLLABLE);
+  auto ready = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                        GST_PARAM_MUTABLE_READY);
+  auto live = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                       GST_PARAM_MUTABLE_PLAYING | GST_PARAM_CONTROLLABLE);
   vision::FollowConfig d;
 
-  g_object_class_install_property(gobject, PROP_HOST, g_param_spec_string("host", "Host",
-      "Address of the WiRC device (the same as wircsrc's: they share one login); empty = discover",
-      DEFAULT_HOST, ready));
-  install_uint(gobject, PROP_PORT, "port", "TCP control port of the device", 1, 65535, DEFAULT_PORT, ready);
-  g_object_class_install_property(gobject, PROP_PROTOCOL, g_param_spec_string("protocol", "Protocol",
-      "Vehicle protocol: wirc (rcoip and btemp are planned)", DEFAULT_PROTOCOL, ready));
-  g_object_class_install_property(gobject, PROP_TARGET_ID, g_param_spec_int("target-id", "Target id",
-      "Id of the tag to follow (-1 = the largest tag in view)", -1, 65535, DEFAULT_TARGET_ID, live));
-  install_uint(gobject, PROP_STEERING_CHANNEL, "steering-channel", "PCD channel of the steering servo (1..8)", 1,
-               8, DEFAULT_STEERING_CHANNEL, ready);
-  install_uint(gobject, PROP_THROTTLE_CHANNEL, "throttle-channel", "PCD channel of the motor controller (1..8)",
-               1, 8, DEFAULT_THROTTLE_CHANNEL, ready);
-  install_double(gobject, PROP_STEERING_KP, "steering-kp", "Steering PID: proportional gain (per radian of bearing)",
-                 0, 100, d.steering.kp, live);
-  install_double(gobject, PROP_STEERING_KI, "steering-ki", "Steering PID: integral gain", 0, 100, d.steering.ki, live);
-  install_double(gobject, PROP_STEERING_KD, "steering-kd", "Steering PID: derivative gain", 0, 100, d.steering.kd, live);
-  install_double(gobject, PROP_THROTTLE_KP, "throttle-kp", "Throttle PID: proportional gain (per metre of distance error)",
-                 0, 100, d.throttle.kp, live);
-  install_double(gobject, PROP_THROTTLE_KI, "throttle-ki", "Throttle PID: integral gain", 0, 100, d.throttle.ki, live);
-  install_double(gobject, PROP_THROTTLE_KD, "throttle-kd", "Throttle PID: derivative gain", 0, 100, d.throttle.kd, live);
-  install_double(gobject, PROP_TARGET_DISTANCE, "target-distance", "Distance to keep from the tag, metres", 0.05,
-                 100, DEFAULT_TARGET_DISTANCE, live);
-  install_double(gobject, PROP_TAG_SIZE, "tag-size", "Edge of the tag's black border, metres (distance from "
-                 "apparent size when apriltagdetect has no pose)", 0.001, 100, DEFAULT_TAG_SIZE, live);
-  install_double(gobject, PROP_FX, "fx", "Camera focal length in pixels (0 = from horizontal-fov)", 0, 100000, 0, live);
-  install_double(gobject, PROP_HORIZONTAL_FOV, "horizontal-fov", "Camera horizontal field of view, degrees", 1, 179,
-                 DEFAULT_HORIZONTAL_FOV, live);
-  install_uint(gobject, PROP_NEUTRAL, "neutral", "Neutral pulse, µs (straight, stopped)", 800, 2200, DEFAULT_NEUTRAL, ready);
-  install_uint(gobject, PROP_MIN, "min", "Smallest pulse ever sent, µs", 800, 2200, DEFAULT_MIN, ready);
-  install_uint(gobject, PROP_MAX, "max", "Largest pulse ever sent, µs", 800, 2200, DEFAULT_MAX, ready);
-  install_uint(gobject, PROP_THROTTLE_DEADBAND, "throttle-deadband", "µs either side of neutral where the motor "
-               "controller does not move: commands start beyond it", 0, 500, DEFAULT_THROTTLE_DEADBAND, live);
-  install_double(gobject, PROP_MAX_THROTTLE, "max-throttle", "Largest throttle command, 0..1 of the way to min/max",
-                 0, 1, DEFAULT_MAX_THROTTLE, live);
-  g_object_class_install_property(gobject, PROP_STEERING_REVERSED, g_param_spec_boolean("steering-reversed",
-      "Steering reversed", "Servo mounted the other way: higher pulses steer right", FALSE, live));
-  g_object_class_install_property(gobject, PROP_THROTTLE_REVERSED, g_param_spec_boolean("throttle-reversed",
-      "Throttle reversed", "Higher pulses drive backwards", FALSE, live));
-  install_uint(gobject, PROP_LOST_TIMEOUT, "lost-timeout", "Milliseconds without the target (or without any "
-               "buffer) before both channels go to neutral", 50, 10000, DEFAULT_LOST_TIMEOUT, ready);
-  install_double(gobject, PROP_PCD_RATE, "pcd-rate", "PCD messages per second while holding the control right",
-                 20, 200, DEFAULT_PCD_RATE, ready);
-  g_object_class_install_property(gobject, PROP_ENABLED, g_param_spec_boolean("enabled", "Enabled",
-      "Follow the tag; false = hold both channels at neutral", DEFAULT_ENABLED, live));
+  g_object_class_install_property(
+      gobject, PROP_HOST,
+      g_param_spec_string("host", "Host",
+                          "Address of the WiRC device (the same as wircsrc's: they share one "
+                          "login); empty = discover",
+                          DEFAULT_HOST, ready));
+  install_uint(gobject, PROP_PORT, "port", "TCP control port of the device", 1, 65535, DEFAULT_PORT,
+               ready);
+  g_object_class_install_property(
+      gobject, PROP_PROTOCOL,
+      g_param_spec_string("protocol", "Protocol",
+                          "Vehicle protocol: wirc (rcoip and btemp are planned)", DEFAULT_PROTOCOL,
+                          ready));
+  g_object_class_install_property(
+      gobject, PROP_TARGET_ID,
+      g_param_spec_int("target-id", "Target id",
+                       "Id of the tag to follow (-1 = the largest tag in view)", -1, 65535,
+                       DEFAULT_TARGET_ID, live));
+  install_uint(gobject, PROP_STEERING_CHANNEL, "steering-channel",
+               "PCD channel of the steering servo (1..8)", 1, 8, DEFAULT_STEERING_CHANNEL, ready);
+  install_uint(gobject, PROP_THROTTLE_CHANNEL, "throttle-channel",
+               "PCD channel of the motor controller (1..8)", 1, 8, DEFAULT_THROTTLE_CHANNEL, ready);
+  install_double(gobject, PROP_STEERING_KP, "steering-kp",
+                 "Steering PID: proportional gain (per radian of bearing)", 0, 100, d.steering.kp,
+                 live);
+  install_double(gobject, PROP_STEERING_KI, "steering-ki", "Steering PID: integral gain", 0, 100,
+                 d.steering.ki, live);
+  install_double(gobject, PROP_STEERING_KD, "steering-kd", "Steering PID: derivative gain", 0, 100,
+                 d.steering.kd, live);
+  install_double(gobject, PROP_THROTTLE_KP, "throttle-kp",
+                 "Throttle PID: proportional gain (per metre of distance error)", 0, 100,
+                 d.throttle.kp, live);
+  install_double(gobject, PROP_THROTTLE_KI, "throttle-ki", "Throttle PID: integral gain", 0, 100,
+                 d.throttle.ki, live);
+  install_double(gobject, PROP_THROTTLE_KD, "throttle-kd", "Throttle PID: derivative gain", 0, 100,
+                 d.throttle.kd, live);
+  install_double(gobject, PROP_TARGET_DISTANCE, "target-distance",
+                 "Distance to keep from the tag, metres", 0.05, 100, DEFAULT_TARGET_DISTANCE, live);
+  install_double(gobject, PROP_TAG_SIZE, "tag-size",
+                 "Edge of the tag's black border, metres (distance from "
+                 "apparent size when apriltagdetect has no pose)",
+                 0.001, 100, DEFAULT_TAG_SIZE, live);
+  install_double(gobject, PROP_FX, "fx", "Camera focal length in pixels (0 = from horizontal-fov)",
+                 0, 100000, 0, live);
+  install_double(gobject, PROP_HORIZONTAL_FOV, "horizontal-fov",
+                 "Camera horizontal field of view, degrees", 1, 179, DEFAULT_HORIZONTAL_FOV, live);
+  install_uint(gobject, PROP_NEUTRAL, "neutral", "Neutral pulse, µs (straight, stopped)", 800, 2200,
+               DEFAULT_NEUTRAL, ready);
+  install_uint(gobject, PROP_MIN, "min", "Smallest pulse ever sent, µs", 800, 2200, DEFAULT_MIN,
+               ready);
+  install_uint(gobject, PROP_MAX, "max", "Largest pulse ever sent, µs", 800, 2200, DEFAULT_MAX,
+               ready);
+  install_uint(gobject, PROP_THROTTLE_DEADBAND, "throttle-deadband",
+               "µs either side of neutral where the motor "
+               "controller does not move: commands start beyond it",
+               0, 500, DEFAULT_THROTTLE_DEADBAND, live);
+  install_double(gobject, PROP_MAX_THROTTLE, "max-throttle",
+                 "Largest throttle command, 0..1 of the way to min/max", 0, 1, DEFAULT_MAX_THROTTLE,
+                 live);
+  g_object_class_install_property(
+      gobject, PROP_STEERING_REVERSED,
+      g_param_spec_boolean("steering-reversed", "Steering reversed",
+                           "Servo mounted the other way: higher pulses steer right", FALSE, live));
+  g_object_class_install_property(
+      gobject, PROP_THROTTLE_REVERSED,
+      g_param_spec_boolean("throttle-reversed", "Throttle reversed",
+                           "Higher pulses drive backwards", FALSE, live));
+  install_uint(gobject, PROP_LOST_TIMEOUT, "lost-timeout",
+               "Milliseconds without the target (or without any "
+               "buffer) before both channels go to neutral",
+               50, 10000, DEFAULT_LOST_TIMEOUT, ready);
+  install_double(gobject, PROP_PCD_RATE, "pcd-rate",
+                 "PCD messages per second while holding the control right", 20, 200,
+                 DEFAULT_PCD_RATE, ready);
+  g_object_class_install_property(
+      gobject, PROP_ENABLED,
+      g_param_spec_boolean("enabled", "Enabled",
+                           "Follow the tag; false = hold both channels at neutral", DEFAULT_ENABLED,
+                           live));
 
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);
-  gst_element_class_set_static_metadata(element, "WiRC tag follower", "Filter/Control",
+  gst_element_class_set_static_metadata(
+      element, "WiRC tag follower", "Filter/Control",
       "Steers a WiRC vehicle towards an AprilTag found by apriltagdetect", "wircam authors");
   auto* base = GST_BASE_TRANSFORM_CLASS(klass);
   base->start = gst_wirc_control_start;

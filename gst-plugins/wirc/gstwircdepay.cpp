@@ -9,7 +9,8 @@
  *
  * ## Example launch line
  * |[
- * gst-launch-1.0 udpsrc port=5000 buffer-size=8388608 mtu=65536 caps=application/x-wirc-mjpeg ! wircdepay ! jpegdec ! videoconvert ! autovideosink
+ * gst-launch-1.0 udpsrc port=5000 buffer-size=8388608 mtu=65536 caps=application/x-wirc-mjpeg !
+ * wircdepay ! jpegdec ! videoconvert ! autovideosink
  * ]|
  */
 #include "gstwircdepay.h"
@@ -34,7 +35,7 @@ using Clock = std::chrono::steady_clock;
 enum { PROP_0, PROP_FRAME_TIMEOUT, PROP_STATS };
 
 struct WircDepayState {
-  guint frameTimeoutMs = DEFAULT_FRAME_TIMEOUT;  // guarded by the object lock
+  guint frameTimeoutMs = DEFAULT_FRAME_TIMEOUT;     // guarded by the object lock
   std::unique_ptr<wirc::FrameAssembler> assembler;  // streaming thread only
   int width = 0;
   int height = 0;
@@ -87,7 +88,8 @@ static GstFlowReturn push_frames(GstWircDepay* self, std::vector<wirc::Assembled
         std::chrono::duration_cast<std::chrono::nanoseconds>(now - frame.firstPacketTime).count());
     bool discont = frame.discont;
     GstBuffer* buffer = gst::wrapFrame(std::move(frame));
-    if (GST_CLOCK_TIME_IS_VALID(arrival)) GST_BUFFER_PTS(buffer) = arrival > age ? arrival - age : 0;
+    if (GST_CLOCK_TIME_IS_VALID(arrival))
+      GST_BUFFER_PTS(buffer) = arrival > age ? arrival - age : 0;
     if (discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
     if (GstCaps* caps = gst::jpegCapsIfChanged(buffer, state->width, state->height)) {
       gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
@@ -149,7 +151,8 @@ static gboolean gst_wirc_depay_sink_event(GstPad* pad, GstObject* parent, GstEve
   return gst_pad_event_default(pad, parent, event);
 }
 
-static GstStateChangeReturn gst_wirc_depay_change_state(GstElement* element, GstStateChange transition) {
+static GstStateChangeReturn gst_wirc_depay_change_state(GstElement* element,
+                                                        GstStateChange transition) {
   auto* self = GST_WIRC_DEPAY(element);
   auto result = GST_ELEMENT_CLASS(gst_wirc_depay_parent_class)->change_state(element, transition);
   if (transition == GST_STATE_CHANGE_PAUSED_TO_READY) {
@@ -160,7 +163,8 @@ static GstStateChangeReturn gst_wirc_depay_change_state(GstElement* element, Gst
   return result;
 }
 
-static void gst_wirc_depay_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+static void gst_wirc_depay_set_property(GObject* object, guint id, const GValue* value,
+                                        GParamSpec* pspec) {
   auto* self = GST_WIRC_DEPAY(object);
   gst::GLibLocker lock(self);
   if (id == PROP_FRAME_TIMEOUT)
@@ -169,7 +173,8 @@ static void gst_wirc_depay_set_property(GObject* object, guint id, const GValue*
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
 }
 
-static void gst_wirc_depay_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
+static void gst_wirc_depay_get_property(GObject* object, guint id, GValue* value,
+                                        GParamSpec* pspec) {
   auto* self = GST_WIRC_DEPAY(object);
   if (id == PROP_STATS) {
     std::lock_guard lock(self->state->statsMutex);
@@ -206,20 +211,26 @@ static void gst_wirc_depay_class_init(GstWircDepayClass* klass) {
   gobject->finalize = gst_wirc_depay_finalize;
   element->change_state = gst_wirc_depay_change_state;
 
-  g_object_class_install_property(gobject, PROP_FRAME_TIMEOUT,
-      g_param_spec_uint("frame-timeout", "Frame timeout", "Milliseconds an incomplete frame may "
-                        "wait for its missing packets before it is dropped", 10, 10000,
-                        DEFAULT_FRAME_TIMEOUT,
+  g_object_class_install_property(
+      gobject, PROP_FRAME_TIMEOUT,
+      g_param_spec_uint("frame-timeout", "Frame timeout",
+                        "Milliseconds an incomplete frame may "
+                        "wait for its missing packets before it is dropped",
+                        10, 10000, DEFAULT_FRAME_TIMEOUT,
                         static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                  GST_PARAM_MUTABLE_READY)));
-  g_object_class_install_property(gobject, PROP_STATS,
-      g_param_spec_boxed("stats", "Statistics", "Counters: packets, bytes, frames-complete, "
+  g_object_class_install_property(
+      gobject, PROP_STATS,
+      g_param_spec_boxed("stats", "Statistics",
+                         "Counters: packets, bytes, frames-complete, "
                          "frames-incomplete, packets-duplicate, packets-invalid, ...",
-                         GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+                         GST_TYPE_STRUCTURE,
+                         static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);
-  gst_element_class_set_static_metadata(element, "WiRC MJPEG depayloader", "Codec/Depayloader/Network",
+  gst_element_class_set_static_metadata(
+      element, "WiRC MJPEG depayloader", "Codec/Depayloader/Network",
       "Reassembles WiRC MJPEG-over-UDP packets into whole JPEG frames", "wircam authors");
   GST_DEBUG_CATEGORY_INIT(wirc_depay_debug, "wircdepay", 0, "WiRC MJPEG depayloader");
 }

@@ -52,7 +52,7 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_LOGIN_TIMEOUT 3000
 #define DEFAULT_STATS_INTERVAL 1000
 
-constexpr size_t kBatch = 16;             // datagrams per recvmmsg
+constexpr size_t kBatch = 16;  // datagrams per recvmmsg
 constexpr int kReceiveBufferBytes = 8 << 20;
 
 enum {
@@ -162,21 +162,22 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
                              .loginTimeout = std::chrono::milliseconds(settings.loginTimeoutMs),
                              .reconnect = settings.reconnect != FALSE};
   state->session = wirc::TransmitterSession::acquire(config);
-  if (auto error = state->session->waitLoggedIn(std::chrono::milliseconds(settings.loginTimeoutMs + 500))) {
+  if (auto error =
+          state->session->waitLoggedIn(std::chrono::milliseconds(settings.loginTimeoutMs + 500))) {
     state->session.reset();
-    GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
-                      ("Could not log in to the WiRC device %s",
-                       settings.host.empty() ? "(discovery)" : settings.host.c_str()),
-                      ("%s. Check host/port, or leave host empty to discover the device.",
-                       error->c_str()));
+    GST_ELEMENT_ERROR(
+        self, RESOURCE, OPEN_READ,
+        ("Could not log in to the WiRC device %s",
+         settings.host.empty() ? "(discovery)" : settings.host.c_str()),
+        ("%s. Check host/port, or leave host empty to discover the device.", error->c_str()));
     return FALSE;
   }
   auto status = state->session->status();
   if (settings.camera >= status.cameraCount) {
     state->session.reset();
-    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("The device has no camera %u", settings.camera),
-                      ("It reports %u camera(s): set camera=0..%d", status.cameraCount,
-                       status.cameraCount - 1));
+    GST_ELEMENT_ERROR(
+        self, RESOURCE, SETTINGS, ("The device has no camera %u", settings.camera),
+        ("It reports %u camera(s): set camera=0..%d", status.cameraCount, status.cameraCount - 1));
     return FALSE;
   }
 
@@ -199,8 +200,8 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   if (granted < kReceiveBufferBytes)
     GST_ELEMENT_WARNING(self, RESOURCE, SETTINGS, ("Small UDP receive buffer"),
                         ("The kernel capped it at %d bytes (wanted %d): frames may be lost in "
-                         "bursts. Raise it with: sysctl -w net.core.rmem_max=%d", granted,
-                         kReceiveBufferBytes, kReceiveBufferBytes));
+                         "bursts. Raise it with: sysctl -w net.core.rmem_max=%d",
+                         granted, kReceiveBufferBytes, kReceiveBufferBytes));
   state->wake = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
   state->assembler = std::make_unique<wirc::FrameAssembler>(wirc::FrameAssemblerConfig{
       .frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)});
@@ -220,8 +221,9 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
     GST_INFO_OBJECT(self, "session: %s", event.c_str());
     gst_element_post_message(
         GST_ELEMENT(self),
-        gst_message_new_element(GST_OBJECT(self), gst_structure_new("wirc-session", "event",
-                                                                    G_TYPE_STRING, event.c_str(), nullptr)));
+        gst_message_new_element(
+            GST_OBJECT(self),
+            gst_structure_new("wirc-session", "event", G_TYPE_STRING, event.c_str(), nullptr)));
   });
   uint16_t port = localAddress(state->socket.get()).port();
   state->session->startStream(static_cast<uint8_t>(settings.camera), port);
@@ -300,10 +302,9 @@ static void receive_batch(GstWircSrc* self) {
       continue;
     }
     if (!state->senderPort) state->senderPort = from.port();
-    state->assembler->pushDatagram({state->buffers[i].data(), headers[i].msg_len}, now,
-                                   [&](wirc::AssembledFrame&& frame) {
-                                     state->ready.push_back(std::move(frame));
-                                   });
+    state->assembler->pushDatagram(
+        {state->buffers[i].data(), headers[i].msg_len}, now,
+        [&](wirc::AssembledFrame&& frame) { state->ready.push_back(std::move(frame)); });
   }
 }
 
@@ -324,8 +325,12 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
     auto deadline = state->assembler->nextDeadline();
     int timeoutMs = 100;
     if (deadline)
-      timeoutMs = std::clamp<int>(static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(
-                                                       *deadline - Clock::now()).count()) + 1, 0, 100);
+      timeoutMs = std::clamp<int>(
+          static_cast<int>(
+              std::chrono::duration_cast<std::chrono::milliseconds>(*deadline - Clock::now())
+                  .count()) +
+              1,
+          0, 100);
     std::array<pollfd, 2> fds = {pollfd{state->socket.get(), POLLIN, 0},
                                  pollfd{state->wake.get(), POLLIN, 0}};
     ::poll(fds.data(), fds.size(), timeoutMs);
@@ -355,7 +360,8 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
   if (GstClock* clock = gst_element_get_clock(GST_ELEMENT(self))) {
     GstClockTime now = gst_clock_get_time(clock);
     GstClockTime base = gst_element_get_base_time(GST_ELEMENT(self));
-    auto ageNs = static_cast<GstClockTime>(std::chrono::duration_cast<std::chrono::nanoseconds>(age).count());
+    auto ageNs = static_cast<GstClockTime>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(age).count());
     GST_BUFFER_PTS(buffer) = now > base + ageNs ? now - base - ageNs : 0;
     gst_object_unref(clock);
   }
@@ -369,29 +375,53 @@ static gboolean gst_wirc_src_negotiate(GstBaseSrc*) {
   return TRUE;
 }
 
-static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* value, GParamSpec* pspec) {
+static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* value,
+                                      GParamSpec* pspec) {
   auto* self = GST_WIRC_SRC(object);
   gst::GLibLocker lock(self);
   auto& s = self->state->settings;
   switch (id) {
-    case PROP_HOST: s.host = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
-    case PROP_PORT: s.port = g_value_get_uint(value); break;
-    case PROP_DEVICE: s.device = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
-    case PROP_CAMERA: s.camera = g_value_get_uint(value); break;
-    case PROP_STREAM_PORT: s.streamPort = g_value_get_uint(value); break;
+    case PROP_HOST:
+      s.host = g_value_get_string(value) ? g_value_get_string(value) : "";
+      break;
+    case PROP_PORT:
+      s.port = g_value_get_uint(value);
+      break;
+    case PROP_DEVICE:
+      s.device = g_value_get_string(value) ? g_value_get_string(value) : "";
+      break;
+    case PROP_CAMERA:
+      s.camera = g_value_get_uint(value);
+      break;
+    case PROP_STREAM_PORT:
+      s.streamPort = g_value_get_uint(value);
+      break;
     case PROP_TRANSMITTER_NAME:
       s.transmitterName = g_value_get_string(value) ? g_value_get_string(value) : "";
       if (s.transmitterName.size() > 64) s.transmitterName.resize(64);
       break;
-    case PROP_PRIORITY: s.priority = g_value_get_uint(value); break;
-    case PROP_FRAME_TIMEOUT: s.frameTimeoutMs = g_value_get_uint(value); break;
-    case PROP_RECONNECT: s.reconnect = g_value_get_boolean(value); break;
-    case PROP_DISCOVERY_ADDRESS:
-      s.discoveryAddress = g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_DISCOVERY_ADDRESS;
+    case PROP_PRIORITY:
+      s.priority = g_value_get_uint(value);
       break;
-    case PROP_LOGIN_TIMEOUT: s.loginTimeoutMs = g_value_get_uint(value); break;
-    case PROP_STATS_INTERVAL: s.statsIntervalMs = g_value_get_uint(value); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_FRAME_TIMEOUT:
+      s.frameTimeoutMs = g_value_get_uint(value);
+      break;
+    case PROP_RECONNECT:
+      s.reconnect = g_value_get_boolean(value);
+      break;
+    case PROP_DISCOVERY_ADDRESS:
+      s.discoveryAddress =
+          g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_DISCOVERY_ADDRESS;
+      break;
+    case PROP_LOGIN_TIMEOUT:
+      s.loginTimeoutMs = g_value_get_uint(value);
+      break;
+    case PROP_STATS_INTERVAL:
+      s.statsIntervalMs = g_value_get_uint(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
 }
 
@@ -405,19 +435,45 @@ static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, 
   gst::GLibLocker lock(self);
   const auto& s = self->state->settings;
   switch (id) {
-    case PROP_HOST: g_value_set_string(value, s.host.c_str()); break;
-    case PROP_PORT: g_value_set_uint(value, s.port); break;
-    case PROP_DEVICE: g_value_set_string(value, s.device.c_str()); break;
-    case PROP_CAMERA: g_value_set_uint(value, s.camera); break;
-    case PROP_STREAM_PORT: g_value_set_uint(value, s.streamPort); break;
-    case PROP_TRANSMITTER_NAME: g_value_set_string(value, s.transmitterName.c_str()); break;
-    case PROP_PRIORITY: g_value_set_uint(value, s.priority); break;
-    case PROP_FRAME_TIMEOUT: g_value_set_uint(value, s.frameTimeoutMs); break;
-    case PROP_RECONNECT: g_value_set_boolean(value, s.reconnect); break;
-    case PROP_DISCOVERY_ADDRESS: g_value_set_string(value, s.discoveryAddress.c_str()); break;
-    case PROP_LOGIN_TIMEOUT: g_value_set_uint(value, s.loginTimeoutMs); break;
-    case PROP_STATS_INTERVAL: g_value_set_uint(value, s.statsIntervalMs); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_HOST:
+      g_value_set_string(value, s.host.c_str());
+      break;
+    case PROP_PORT:
+      g_value_set_uint(value, s.port);
+      break;
+    case PROP_DEVICE:
+      g_value_set_string(value, s.device.c_str());
+      break;
+    case PROP_CAMERA:
+      g_value_set_uint(value, s.camera);
+      break;
+    case PROP_STREAM_PORT:
+      g_value_set_uint(value, s.streamPort);
+      break;
+    case PROP_TRANSMITTER_NAME:
+      g_value_set_string(value, s.transmitterName.c_str());
+      break;
+    case PROP_PRIORITY:
+      g_value_set_uint(value, s.priority);
+      break;
+    case PROP_FRAME_TIMEOUT:
+      g_value_set_uint(value, s.frameTimeoutMs);
+      break;
+    case PROP_RECONNECT:
+      g_value_set_boolean(value, s.reconnect);
+      break;
+    case PROP_DISCOVERY_ADDRESS:
+      g_value_set_string(value, s.discoveryAddress.c_str());
+      break;
+    case PROP_LOGIN_TIMEOUT:
+      g_value_set_uint(value, s.loginTimeoutMs);
+      break;
+    case PROP_STATS_INTERVAL:
+      g_value_set_uint(value, s.statsIntervalMs);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
 }
 
@@ -445,53 +501,83 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
 
   constexpr auto kReady = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                    GST_PARAM_MUTABLE_READY);
-  g_object_class_install_property(gobject, PROP_HOST,
-      g_param_spec_string("host", "Host", "Address of the WiRC device; empty = discover it on the "
-                          "local network (see device, discovery-address)", DEFAULT_HOST, kReady));
-  g_object_class_install_property(gobject, PROP_PORT,
+  g_object_class_install_property(
+      gobject, PROP_HOST,
+      g_param_spec_string("host", "Host",
+                          "Address of the WiRC device; empty = discover it on the "
+                          "local network (see device, discovery-address)",
+                          DEFAULT_HOST, kReady));
+  g_object_class_install_property(
+      gobject, PROP_PORT,
       g_param_spec_uint("port", "Port", "TCP control / UDP discovery port of the device", 1, 65535,
                         DEFAULT_PORT, kReady));
-  g_object_class_install_property(gobject, PROP_DEVICE,
-      g_param_spec_string("device", "Device", "When discovering: the device name or serial to "
-                          "pick (empty = the only one that answers)", DEFAULT_DEVICE, kReady));
-  g_object_class_install_property(gobject, PROP_CAMERA,
-      g_param_spec_uint("camera", "Camera", "Camera index on the device (0 .. its camera count - 1)",
-                        0, 255, DEFAULT_CAMERA, kReady));
+  g_object_class_install_property(
+      gobject, PROP_DEVICE,
+      g_param_spec_string("device", "Device",
+                          "When discovering: the device name or serial to "
+                          "pick (empty = the only one that answers)",
+                          DEFAULT_DEVICE, kReady));
+  g_object_class_install_property(
+      gobject, PROP_CAMERA,
+      g_param_spec_uint("camera", "Camera",
+                        "Camera index on the device (0 .. its camera count - 1)", 0, 255,
+                        DEFAULT_CAMERA, kReady));
   g_object_class_install_property(gobject, PROP_STREAM_PORT,
-      g_param_spec_uint("stream-port", "Stream port", "Local UDP port for the video (0 = any free "
-                        "port)", 0, 65535, DEFAULT_STREAM_PORT, kReady));
-  g_object_class_install_property(gobject, PROP_TRANSMITTER_NAME,
-      g_param_spec_string("transmitter-name", "Transmitter name", "Name this transmitter logs in "
-                          "with (up to 64 ASCII characters; shown in TLST)", DEFAULT_TRANSMITTER_NAME, kReady));
+                                  g_param_spec_uint("stream-port", "Stream port",
+                                                    "Local UDP port for the video (0 = any free "
+                                                    "port)",
+                                                    0, 65535, DEFAULT_STREAM_PORT, kReady));
+  g_object_class_install_property(
+      gobject, PROP_TRANSMITTER_NAME,
+      g_param_spec_string("transmitter-name", "Transmitter name",
+                          "Name this transmitter logs in "
+                          "with (up to 64 ASCII characters; shown in TLST)",
+                          DEFAULT_TRANSMITTER_NAME, kReady));
   g_object_class_install_property(gobject, PROP_PRIORITY,
-      g_param_spec_uint("priority", "Priority", "Login priority: the highest may hand out the "
-                        "control right", 0, 255, DEFAULT_PRIORITY, kReady));
-  g_object_class_install_property(gobject, PROP_FRAME_TIMEOUT,
-      g_param_spec_uint("frame-timeout", "Frame timeout", "Milliseconds an incomplete frame may "
-                        "wait for its missing packets before it is dropped", 10, 10000,
-                        DEFAULT_FRAME_TIMEOUT, kReady));
+                                  g_param_spec_uint("priority", "Priority",
+                                                    "Login priority: the highest may hand out the "
+                                                    "control right",
+                                                    0, 255, DEFAULT_PRIORITY, kReady));
+  g_object_class_install_property(
+      gobject, PROP_FRAME_TIMEOUT,
+      g_param_spec_uint("frame-timeout", "Frame timeout",
+                        "Milliseconds an incomplete frame may "
+                        "wait for its missing packets before it is dropped",
+                        10, 10000, DEFAULT_FRAME_TIMEOUT, kReady));
   g_object_class_install_property(gobject, PROP_RECONNECT,
-      g_param_spec_boolean("reconnect", "Reconnect", "Log in again (with backoff) after the "
-                           "connection is lost, and restart the stream", DEFAULT_RECONNECT, kReady));
+                                  g_param_spec_boolean("reconnect", "Reconnect",
+                                                       "Log in again (with backoff) after the "
+                                                       "connection is lost, and restart the stream",
+                                                       DEFAULT_RECONNECT, kReady));
   g_object_class_install_property(gobject, PROP_DISCOVERY_ADDRESS,
-      g_param_spec_string("discovery-address", "Discovery address", "Where BCSD is sent when host "
-                          "is empty (broadcast by default)", DEFAULT_DISCOVERY_ADDRESS, kReady));
+                                  g_param_spec_string("discovery-address", "Discovery address",
+                                                      "Where BCSD is sent when host "
+                                                      "is empty (broadcast by default)",
+                                                      DEFAULT_DISCOVERY_ADDRESS, kReady));
   g_object_class_install_property(gobject, PROP_LOGIN_TIMEOUT,
-      g_param_spec_uint("login-timeout", "Login timeout", "Milliseconds to wait for discovery "
-                        "and login before failing", 100, 60000, DEFAULT_LOGIN_TIMEOUT, kReady));
-  g_object_class_install_property(gobject, PROP_STATS_INTERVAL,
-      g_param_spec_uint("stats-interval", "Stats interval", "Milliseconds between wirc-stats "
-                        "element messages (0 = none)", 0, 3600000, DEFAULT_STATS_INTERVAL,
+                                  g_param_spec_uint("login-timeout", "Login timeout",
+                                                    "Milliseconds to wait for discovery "
+                                                    "and login before failing",
+                                                    100, 60000, DEFAULT_LOGIN_TIMEOUT, kReady));
+  g_object_class_install_property(
+      gobject, PROP_STATS_INTERVAL,
+      g_param_spec_uint("stats-interval", "Stats interval",
+                        "Milliseconds between wirc-stats "
+                        "element messages (0 = none)",
+                        0, 3600000, DEFAULT_STATS_INTERVAL,
                         static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS)));
-  g_object_class_install_property(gobject, PROP_STATS,
-      g_param_spec_boxed("stats", "Statistics", "Counters: packets, bytes, frames-complete, "
-                         "frames-incomplete, packets-duplicate, packets-invalid, packets-foreign, ...",
-                         GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+  g_object_class_install_property(
+      gobject, PROP_STATS,
+      g_param_spec_boxed(
+          "stats", "Statistics",
+          "Counters: packets, bytes, frames-complete, "
+          "frames-incomplete, packets-duplicate, packets-invalid, packets-foreign, ...",
+          GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 
   gst_element_class_add_static_pad_template(element, &src_template);
-  gst_element_class_set_static_metadata(element, "WiRC camera source", "Source/Network",
-      "Receives the MJPEG stream of a WiRC device camera as whole JPEG frames",
-      "wircam authors");
+  gst_element_class_set_static_metadata(
+      element, "WiRC camera source", "Source/Network",
+      "Receives the MJPEG stream of a WiRC device camera as whole JPEG frames", "wircam authors");
 
   basesrc->start = gst_wirc_src_start;
   basesrc->stop = gst_wirc_src_stop;

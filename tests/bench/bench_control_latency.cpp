@@ -24,7 +24,7 @@ using Clock = std::chrono::steady_clock;
 
 struct Probes {
   std::mutex mutex;
-  std::map<GstClockTime, Clock::time_point> pushed;    // by PTS
+  std::map<GstClockTime, Clock::time_point> pushed;                        // by PTS
   std::vector<std::pair<Clock::time_point, Clock::time_point>> commanded;  // (pushed, commanded)
 };
 
@@ -50,16 +50,19 @@ GstPadProbeReturn onCommanded(GstPad*, GstPadProbeInfo* info, gpointer data) {
 double percentile(std::vector<double> values, double p) {
   if (values.empty()) return 0;
   std::sort(values.begin(), values.end());
-  return values[std::min(values.size() - 1, static_cast<size_t>(p * static_cast<double>(values.size())))];
+  return values[std::min(values.size() - 1,
+                         static_cast<size_t>(p * static_cast<double>(values.size())))];
 }
 
 void run(const char* decoder, double seconds) {
   auto scene = std::move(*sim::FollowScene::create({}));
   auto device = std::move(*wirc::Device::start({.port = 0}, std::move(scene)));
   auto port = std::to_string(device->port());
-  std::string description = "wircsrc name=src host=127.0.0.1 port=" + port + " ! " + decoder +
-                            " ! video/x-raw,format=I420 ! apriltagdetect quad-decimate=1 ! wirccontrol name=control "
-                            "host=127.0.0.1 port=" + port + " ! fakesink";
+  std::string description =
+      "wircsrc name=src host=127.0.0.1 port=" + port + " ! " + decoder +
+      " ! video/x-raw,format=I420 ! apriltagdetect quad-decimate=1 ! wirccontrol name=control "
+      "host=127.0.0.1 port=" +
+      port + " ! fakesink";
   GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
   Probes probes;
   auto attach = [&](const char* name, GstPadProbeCallback callback) {
@@ -84,9 +87,11 @@ void run(const char* decoder, double seconds) {
     processing.push_back(std::chrono::duration<double, std::milli>(commanded - pushed).count());
     total.push_back(std::chrono::duration<double, std::milli>(*pcd - pushed).count());
   }
-  std::printf("%-9s %6zu frames   processing median %5.2f ms p99 %5.2f ms   to PCD median %5.2f ms p99 %5.2f ms\n",
-              decoder, total.size(), percentile(processing, 0.5), percentile(processing, 0.99),
-              percentile(total, 0.5), percentile(total, 0.99));
+  std::printf(
+      "%-9s %6zu frames   processing median %5.2f ms p99 %5.2f ms   to PCD median %5.2f ms p99 "
+      "%5.2f ms\n",
+      decoder, total.size(), percentile(processing, 0.5), percentile(processing, 0.99),
+      percentile(total, 0.5), percentile(total, 0.99));
 }
 
 }  // namespace

@@ -62,7 +62,9 @@ Result receive(const std::string& description, double seconds) {
   static uint64_t frames;
   frames = 0;
   g_object_set(sink, "signal-handoffs", TRUE, nullptr);
-  g_signal_connect(sink, "handoff", G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, gpointer) { ++frames; }), nullptr);
+  g_signal_connect(sink, "handoff",
+                   G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, gpointer) { ++frames; }),
+                   nullptr);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // warm up, log in
   uint64_t startFrames = frames;
@@ -84,7 +86,8 @@ int main(int argc, char** argv) {
   fs::path self = fs::canonical("/proc/self/exe").parent_path();
   std::string sim = (self / "wirc-sim").string();
 
-  std::printf("%-16s %-28s %-28s %s\n", "stream", "wircsim→wircsrc µs CPU/frame", "rtpjpegpay→rtpjpegdepay", "ratio");
+  std::printf("%-16s %-28s %-28s %s\n", "stream", "wircsim→wircsrc µs CPU/frame",
+              "rtpjpegpay→rtpjpegdepay", "ratio");
   for (Case c : {Case{352, 288, 15}, Case{1280, 720, 30}}) {
     fs::path dir = fs::temp_directory_path() / ("wircam-e2e-" + std::to_string(c.width));
     fs::create_directories(dir);
@@ -92,7 +95,9 @@ int main(int argc, char** argv) {
       auto jpeg = wircam::bench::syntheticJpeg(c.width, c.height, i);
       char name[32];
       std::snprintf(name, sizeof name, "%05d.jpg", i);
-      std::ofstream(dir / name, std::ios::binary).write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
+      std::ofstream(dir / name, std::ios::binary)
+          .write(reinterpret_cast<const char*>(jpeg.data()),
+                 static_cast<std::streamsize>(jpeg.size()));
     }
     // Ports from the pid keep parallel runs apart.
     int port = 20000 + getpid() % 20000;
@@ -100,28 +105,32 @@ int main(int argc, char** argv) {
     pid_t sender = spawn(sim + " --bind 127.0.0.1 --port " + std::to_string(port) + " --fps " +
                          std::to_string(c.fps) + " --frames " + dir.string());
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    auto wircam = receive("wircsrc host=127.0.0.1 port=" + std::to_string(port) +
-                              " ! fakesink name=sink sync=false", seconds);
+    auto wircam = receive(
+        "wircsrc host=127.0.0.1 port=" + std::to_string(port) + " ! fakesink name=sink sync=false",
+        seconds);
     stop(sender);
 
     int rtpPort = port + 1;
     // multifilesrc does not timestamp: identity's sleep paces it instead.
     sender = spawn("gst-launch-1.0 multifilesrc location=" + (dir / "%05d.jpg").string() +
-                   " loop=true caps=image/jpeg,width=" + std::to_string(c.width) + ",height=" +
-                   std::to_string(c.height) + ",framerate=" + std::to_string(c.fps) +
+                   " loop=true caps=image/jpeg,width=" + std::to_string(c.width) +
+                   ",height=" + std::to_string(c.height) + ",framerate=" + std::to_string(c.fps) +
                    "/1 ! identity sleep-time=" + std::to_string(1000000 / c.fps) +
                    " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" + std::to_string(rtpPort));
-    auto rtp = receive("udpsrc port=" + std::to_string(rtpPort) + " buffer-size=8388608 "
-                       "caps=application/x-rtp,media=video,clock-rate=90000,encoding-name=JPEG,payload=26 "
-                       "! rtpjpegdepay ! fakesink name=sink sync=false", seconds);
+    auto rtp = receive(
+        "udpsrc port=" + std::to_string(rtpPort) +
+            " buffer-size=8388608 "
+            "caps=application/x-rtp,media=video,clock-rate=90000,encoding-name=JPEG,payload=26 "
+            "! rtpjpegdepay ! fakesink name=sink sync=false",
+        seconds);
     stop(sender);
     fs::remove_all(dir);
 
     char label[32];
     std::snprintf(label, sizeof label, "%dx%d@%d", c.width, c.height, c.fps);
     std::printf("%-16s %8.1f (%5llu frames)          %8.1f (%5llu frames)          %.2f×\n", label,
-                wircam.cpuPerFrameUs, static_cast<unsigned long long>(wircam.frames), rtp.cpuPerFrameUs,
-                static_cast<unsigned long long>(rtp.frames),
+                wircam.cpuPerFrameUs, static_cast<unsigned long long>(wircam.frames),
+                rtp.cpuPerFrameUs, static_cast<unsigned long long>(rtp.frames),
                 wircam.cpuPerFrameUs > 0 ? rtp.cpuPerFrameUs / wircam.cpuPerFrameUs : 0.0);
   }
   return 0;

@@ -31,19 +31,22 @@ const std::vector<std::vector<uint8_t>>& frames(Resolution r) {
   static std::vector<std::vector<uint8_t>> cif, hd;
   auto& set = r.width == 352 ? cif : hd;
   if (set.empty())
-    for (int i = 0; i < kFrames; ++i) set.push_back(wircam::bench::syntheticJpeg(r.width, r.height, i));
+    for (int i = 0; i < kFrames; ++i)
+      set.push_back(wircam::bench::syntheticJpeg(r.width, r.height, i));
   return set;
 }
 
-Resolution resolutionArg(int64_t index) { return index == 0 ? Resolution{352, 288} : Resolution{1280, 720}; }
+Resolution resolutionArg(int64_t index) {
+  return index == 0 ? Resolution{352, 288} : Resolution{1280, 720};
+}
 
 void reportRates(benchmark::State& state, size_t packets, size_t bytes, int64_t framesOut,
                  int framesPerIteration) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * packets));
   state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * bytes));
-  state.counters["ns_per_byte"] = benchmark::Counter(
-      static_cast<double>(state.iterations() * bytes) * 1e-9,
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_byte"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * bytes) * 1e-9,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["frames_per_iter"] = static_cast<double>(framesOut) / state.iterations();
   state.counters["packets_per_frame"] = static_cast<double>(packets) / framesPerIteration;
 }

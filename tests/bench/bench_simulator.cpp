@@ -14,8 +14,8 @@ namespace {
 using namespace wircam;
 
 void BM_WircSimRenderEncodeSend(benchmark::State& state) {
-  auto scene = sim::FollowScene::create({.width = static_cast<int>(state.range(0)),
-                                         .height = static_cast<int>(state.range(1))});
+  auto scene = sim::FollowScene::create(
+      {.width = static_cast<int>(state.range(0)), .height = static_cast<int>(state.range(1))});
   auto sink = bindUdp(SocketAddress::loopback(0));
   auto source = bindUdp(SocketAddress::loopback(0));
   wirc::StreamSender sender(source->get(), -1, localAddress(sink->get()), 64512, {});
@@ -26,8 +26,8 @@ void BM_WircSimRenderEncodeSend(benchmark::State& state) {
     bytes += jpeg.size();
     sender.sendFrame(jpeg);
   }
-  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()),
-                                             benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["jpeg_bytes"] = static_cast<double>(bytes) / state.iterations();
 }
 
@@ -41,8 +41,8 @@ void BM_GstVideoTestSrcJpegEnc(benchmark::State& state) {
     GstElement* pipeline = gst_parse_launch(description, nullptr);
     gst_element_set_state(pipeline, GST_STATE_PLAYING);
     GstBus* bus = gst_element_get_bus(pipeline);
-    GstMessage* done = gst_bus_timed_pop_filtered(bus, GST_CLOCK_TIME_NONE,
-                                                  static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
+    GstMessage* done = gst_bus_timed_pop_filtered(
+        bus, GST_CLOCK_TIME_NONE, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
     if (GST_MESSAGE_TYPE(done) == GST_MESSAGE_ERROR) state.SkipWithError("pipeline error");
     gst_message_unref(done);
     gst_object_unref(bus);
@@ -54,9 +54,16 @@ void BM_GstVideoTestSrcJpegEnc(benchmark::State& state) {
                                              benchmark::Counter::kIsRate);
 }
 
-BENCHMARK(BM_WircSimRenderEncodeSend)->ArgNames({"w", "h"})->Args({352, 288})->Args({1280, 720})
+BENCHMARK(BM_WircSimRenderEncodeSend)
+    ->ArgNames({"w", "h"})
+    ->Args({352, 288})
+    ->Args({1280, 720})
     ->UseRealTime();
-BENCHMARK(BM_GstVideoTestSrcJpegEnc)->ArgNames({"w", "h"})->Args({352, 288})->Args({1280, 720})
-    ->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GstVideoTestSrcJpegEnc)
+    ->ArgNames({"w", "h"})
+    ->Args({352, 288})
+    ->Args({1280, 720})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -37,15 +37,16 @@ const Sequence& sequence(Size size) {
   static std::map<int, Sequence> cache;
   auto& s = cache[size.width];
   if (!s.jpegs.empty()) return s;
-  auto scene = sim::FollowScene::create({.width = size.width, .height = size.height, .path = sim::TargetPath::Circle});
+  auto scene = sim::FollowScene::create(
+      {.width = size.width, .height = size.height, .path = sim::TargetPath::Circle});
   std::unique_ptr<void, decltype(&tjDestroy)> decoder(tjInitDecompress(), tjDestroy);
   for (int i = 0; i < 40; ++i) {
     (*scene)->step(0.25, {});
     s.jpegs.push_back((*scene)->renderJpeg(0));
     s.visible.push_back((*scene)->tagViews()[0].visible);
     std::vector<uint8_t> gray(static_cast<size_t>(size.width) * size.height);
-    tjDecompress2(decoder.get(), s.jpegs.back().data(), s.jpegs.back().size(), gray.data(), size.width, size.width,
-                  size.height, TJPF_GRAY, 0);
+    tjDecompress2(decoder.get(), s.jpegs.back().data(), s.jpegs.back().size(), gray.data(),
+                  size.width, size.width, size.height, TJPF_GRAY, 0);
     s.grays.push_back(std::move(gray));
   }
   return s;
@@ -55,7 +56,8 @@ void decode(benchmark::State& state, const char* element, const char* format) {
   Size size = sizeArg(state.range(0));
   const auto& jpegs = sequence(size).jpegs;
   GstHarness* h = gst_harness_new(element);
-  gchar* caps = g_strdup_printf("image/jpeg,width=%d,height=%d,framerate=15/1", size.width, size.height);
+  gchar* caps =
+      g_strdup_printf("image/jpeg,width=%d,height=%d,framerate=15/1", size.width, size.height);
   gst_harness_set_src_caps_str(h, caps);
   g_free(caps);
   gchar* sinkCaps = g_strdup_printf("video/x-raw,format=%s", format);
@@ -77,7 +79,8 @@ void decode(benchmark::State& state, const char* element, const char* format) {
   }
   for (GstBuffer* b : buffers) gst_buffer_unref(b);
   gst_harness_teardown(h);
-  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 void BM_TjpegDecGray8(benchmark::State& state) { decode(state, "tjpegdec", "GRAY8"); }
@@ -87,7 +90,8 @@ void BM_JpegDecI420(benchmark::State& state) { decode(state, "jpegdec", "I420");
 void detect(benchmark::State& state, float decimate, int fullFrameInterval) {
   Size size = sizeArg(state.range(0));
   const auto& seq = sequence(size);
-  auto detector = vision::TagTracker::create({.quadDecimate = decimate}, {.fullFrameInterval = fullFrameInterval});
+  auto detector = vision::TagTracker::create({.quadDecimate = decimate},
+                                             {.fullFrameInterval = fullFrameInterval});
   size_t i = 0, found = 0, visible = 0;
   for (auto _ : state) {
     size_t k = i++ % seq.grays.size();
@@ -97,8 +101,10 @@ void detect(benchmark::State& state, float decimate, int fullFrameInterval) {
       for (const auto& d : detections) found += d.id == 0;
     }
   }
-  state.counters["recall"] = visible ? static_cast<double>(found) / static_cast<double>(visible) : 0;
-  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["recall"] =
+      visible ? static_cast<double>(found) / static_cast<double>(visible) : 0;
+  state.counters["fps"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 void BM_DetectLibraryDefaults(benchmark::State& state) { detect(state, 2.0f, 1); }

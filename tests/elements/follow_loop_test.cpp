@@ -25,13 +25,15 @@ struct Loop {
 
   explicit Loop(wirc::Impairments impairments = {}) {
     scene = std::move(*sim::FollowScene::create({.path = sim::TargetPath::Circle}));
-    auto started = wirc::Device::start({.port = 0, .fragmentSize = 1400, .impairments = impairments}, scene);
+    auto started =
+        wirc::Device::start({.port = 0, .fragmentSize = 1400, .impairments = impairments}, scene);
     EXPECT_TRUE(started.has_value());
     device = std::move(*started);
     auto port = std::to_string(device->port());
-    std::string description = "wircsrc name=src host=127.0.0.1 port=" + port +
-                              " ! tjpegdec ! apriltagdetect quad-decimate=1 ! wirccontrol host=127.0.0.1 port=" +
-                              port + " lost-timeout=" + std::to_string(kLostTimeoutMs) + " ! fakesink";
+    std::string description =
+        "wircsrc name=src host=127.0.0.1 port=" + port +
+        " ! tjpegdec ! apriltagdetect quad-decimate=1 ! wirccontrol host=127.0.0.1 port=" + port +
+        " lost-timeout=" + std::to_string(kLostTimeoutMs) + " ! fakesink";
     pipeline = gst_parse_launch(description.c_str(), nullptr);
     EXPECT_NE(pipeline, nullptr);
     gst_element_set_state(pipeline, GST_STATE_PLAYING);
@@ -47,7 +49,8 @@ struct Loop {
     while (Clock::now() - start < limit) {
       auto outputs = device->outputs();
       if (outputs.pulses[1] == wirc::kPulseNeutral)
-        return static_cast<int>(std::chrono::duration_cast<milliseconds>(Clock::now() - start).count());
+        return static_cast<int>(
+            std::chrono::duration_cast<milliseconds>(Clock::now() - start).count());
       std::this_thread::sleep_for(milliseconds(2));
     }
     return -1;

@@ -116,7 +116,8 @@ TEST(ApriltagDetect, AttachesTheTagAndPostsAMessage) {
 }
 
 TEST(TagOverlay, OutlinesTheDetectedTag) {
-  GstHarness* h = jpegHarness("tjpegdec ! apriltagdetect quad-decimate=1 ! tagoverlay", "video/x-raw,format=I420");
+  GstHarness* h = jpegHarness("tjpegdec ! apriltagdetect quad-decimate=1 ! tagoverlay",
+                              "video/x-raw,format=I420");
   ASSERT_EQ(gst_harness_push(h, jpegBuffer(sceneFrames()[0])), GST_FLOW_OK);
   GstBuffer* out = gst_harness_pull(h);
   WircTagMeta* meta = gst_buffer_get_wirc_tag_meta(out);
@@ -129,7 +130,8 @@ TEST(TagOverlay, OutlinesTheDetectedTag) {
   gst_video_info_set_format(&info, GST_VIDEO_FORMAT_I420, 352, 288);
   GstVideoFrame frame;
   ASSERT_TRUE(gst_video_frame_map(&frame, &info, out, GST_MAP_READ));
-  int x = static_cast<int>(std::lround(tag.corners[0])) / 2, y = static_cast<int>(std::lround(tag.corners[1])) / 2;
+  int x = static_cast<int>(std::lround(tag.corners[0])) / 2,
+      y = static_cast<int>(std::lround(tag.corners[1])) / 2;
   auto* v = static_cast<const uint8_t*>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 2));
   EXPECT_GT(v[y * GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 2) + x], 180);
   gst_video_frame_unmap(&frame);

@@ -19,7 +19,8 @@ using wircam::testing::sceneFrames;
 
 std::unique_ptr<wirc::Device> startDevice(wirc::DeviceConfig config = {}) {
   config.fps = 30;
-  auto device = wirc::Device::start(config, std::make_shared<sim::JpegSequenceScene>(sceneFrames()));
+  auto device =
+      wirc::Device::start(config, std::make_shared<sim::JpegSequenceScene>(sceneFrames()));
   EXPECT_TRUE(device.has_value()) << device.error();
   return std::move(*device);
 }
@@ -39,7 +40,8 @@ GstElement* launch(const std::string& description) {
 // The first error on the bus within `timeout`, or "".
 std::string busError(GstElement* pipeline, milliseconds timeout) {
   GstBus* bus = gst_element_get_bus(pipeline);
-  GstMessage* message = gst_bus_timed_pop_filtered(bus, timeout.count() * GST_MSECOND, GST_MESSAGE_ERROR);
+  GstMessage* message =
+      gst_bus_timed_pop_filtered(bus, timeout.count() * GST_MSECOND, GST_MESSAGE_ERROR);
   std::string text;
   if (message) {
     GError* error = nullptr;
@@ -67,8 +69,8 @@ class WircSrcHarness {
  public:
   explicit WircSrcHarness(uint16_t port, int camera = 0) {
     harness_ = gst_harness_new("wircsrc");
-    g_object_set(harness_->element, "host", "127.0.0.1", "port", static_cast<guint>(port),
-                 "camera", static_cast<guint>(camera), nullptr);
+    g_object_set(harness_->element, "host", "127.0.0.1", "port", static_cast<guint>(port), "camera",
+                 static_cast<guint>(camera), nullptr);
     gst_harness_play(harness_);
   }
   ~WircSrcHarness() { gst_harness_teardown(harness_); }
@@ -112,7 +114,8 @@ TEST(WircSrc, DeliversTheSimulatorsFramesByteForByteWithCaps) {
 }
 
 TEST(WircSrc, DeliversAtLeast95PercentOfWholeFramesAtFivePercentLoss) {
-  auto device = startDevice(ephemeral({.fragmentSize = 1400, .impairments = {.loss = 0.05, .seed = 5}}));
+  auto device =
+      startDevice(ephemeral({.fragmentSize = 1400, .impairments = {.loss = 0.05, .seed = 5}}));
   WircSrcHarness src(device->port());
   uint64_t delivered = 0;
   auto end = std::chrono::steady_clock::now() + milliseconds(3000);
@@ -132,9 +135,9 @@ TEST(WircSrc, DeliversAtLeast95PercentOfWholeFramesAtFivePercentLoss) {
 TEST(WircSrc, TwoCamerasShareOneLoginAndStopSendsEst) {
   auto device = startDevice(ephemeral({.cameras = 2, .fragmentSize = 8000}));
   auto port = std::to_string(device->port());
-  GstElement* pipeline = launch("wircsrc name=a host=127.0.0.1 camera=0 port=" + port +
-                                " ! fakesink wircsrc name=b host=127.0.0.1 camera=1 port=" + port +
-                                " ! fakesink");
+  GstElement* pipeline =
+      launch("wircsrc name=a host=127.0.0.1 camera=0 port=" + port +
+             " ! fakesink wircsrc name=b host=127.0.0.1 camera=1 port=" + port + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   std::this_thread::sleep_for(milliseconds(1000));
   EXPECT_EQ(busError(pipeline, milliseconds(0)), "");
@@ -156,7 +159,8 @@ TEST(WircSrc, ReportsAnUnreachableDevice) {
   auto device = startDevice(ephemeral());
   auto port = std::to_string(device->port());
   device.reset();
-  GstElement* pipeline = launch("wircsrc host=127.0.0.1 reconnect=false port=" + port + " ! fakesink");
+  GstElement* pipeline =
+      launch("wircsrc host=127.0.0.1 reconnect=false port=" + port + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   auto error = busError(pipeline, milliseconds(5000));
   EXPECT_NE(error.find("Could not log in"), std::string::npos) << error;
@@ -166,8 +170,8 @@ TEST(WircSrc, ReportsAnUnreachableDevice) {
 
 TEST(WircSrc, ReportsACameraTheDeviceDoesNotHave) {
   auto device = startDevice(ephemeral({.cameras = 1}));
-  GstElement* pipeline =
-      launch("wircsrc host=127.0.0.1 camera=3 port=" + std::to_string(device->port()) + " ! fakesink");
+  GstElement* pipeline = launch(
+      "wircsrc host=127.0.0.1 camera=3 port=" + std::to_string(device->port()) + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   auto error = busError(pipeline, milliseconds(5000));
   EXPECT_NE(error.find("no camera 3"), std::string::npos) << error;
@@ -182,7 +186,8 @@ TEST(WircSrc, FollowsTheDeviceThroughARestart) {
   ASSERT_FALSE(src.pullBytes().empty());
   device.reset();
   std::this_thread::sleep_for(milliseconds(300));
-  while (gst_harness_buffers_in_queue(src.harness()) > 0) gst_buffer_unref(gst_harness_pull(src.harness()));
+  while (gst_harness_buffers_in_queue(src.harness()) > 0)
+    gst_buffer_unref(gst_harness_pull(src.harness()));
   device = startDevice({.port = port, .fragmentSize = 4000});
   auto frame = src.pullBytes(milliseconds(8000));
   ASSERT_FALSE(frame.empty());
@@ -191,8 +196,8 @@ TEST(WircSrc, FollowsTheDeviceThroughARestart) {
 
 TEST(WircSrc, PcdKeepsFlowingWhileThePipelineIsBlocked) {
   auto device = startDevice(ephemeral());
-  GstElement* pipeline =
-      launch("wircsrc name=src host=127.0.0.1 port=" + std::to_string(device->port()) + " ! fakesink");
+  GstElement* pipeline = launch(
+      "wircsrc name=src host=127.0.0.1 port=" + std::to_string(device->port()) + " ! fakesink");
   GstElement* src = gst_bin_get_by_name(GST_BIN(pipeline), "src");
   GstPad* pad = gst_element_get_static_pad(src, "src");
   // Every buffer waits 2 s: the streaming thread stalls as a busy pipeline would.

@@ -59,7 +59,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       uint32_t offset = input.readU16Be() % 2048;
       uint32_t length = input.readU16Be() % 1024;
       bool last = kind & 0x10;
-      MjpegPacketHeader header{kMjpegVersion | (last ? kLastPacketFlag : 0u), frame, offset, length};
+      MjpegPacketHeader header{kMjpegVersion | (last ? kLastPacketFlag : 0u), frame, offset,
+                               length};
       writeMjpegHeader(header, datagram);
       for (uint32_t i = 0; i < length; ++i) datagram.push_back(patternByte(frame, offset + i));
       if ((kind & 0x60) == 0x60 && length > 0) {

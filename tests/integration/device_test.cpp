@@ -17,8 +17,8 @@ namespace {
 
 using std::chrono::milliseconds;
 using testing::RawTransmitter;
-using testing::sceneFrames;
 using testing::receiveDatagram;
+using testing::sceneFrames;
 
 std::unique_ptr<Device> startDevice(DeviceConfig config = {},
                                     std::shared_ptr<DeviceScene> scene = nullptr) {
@@ -27,7 +27,6 @@ std::unique_ptr<Device> startDevice(DeviceConfig config = {},
   EXPECT_TRUE(device.has_value()) << device.error();
   return device.has_value() ? std::move(*device) : nullptr;
 }
-
 
 ChannelValues pulses(uint16_t steering, uint16_t throttle) {
   ChannelValues values = neutralChannels();
@@ -204,8 +203,8 @@ TEST(Device, PcdDrivesTheOutputsAndItsAbsenceMeansFailsafeAndDisconnect) {
   auto device = startDevice();
   RawTransmitter tx(device->port());
   ChannelValues failsafe = neutralChannels();
-  failsafe[1] = 1400;                  // throttle: a pulse
-  failsafe[0] = kFailsafeHoldLast;     // steering: hold
+  failsafe[1] = 1400;               // throttle: a pulse
+  failsafe[0] = kFailsafeHoldLast;  // steering: hold
   failsafe[2] = kFailsafeConstantLevel;
   ASSERT_TRUE(tx.login("driver", 1, failsafe).has_value());
   auto udp = bindUdp(SocketAddress::loopback(0));
@@ -313,7 +312,8 @@ struct StreamFixture {
     video = std::move(*bindUdp(SocketAddress::loopback(0)));
     int size = 8 << 20;
     setsockopt(video.get(), SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
-    tx->send(Stst{.camera = static_cast<uint8_t>(camera), .port = localAddress(video.get()).port()});
+    tx->send(
+        Stst{.camera = static_cast<uint8_t>(camera), .port = localAddress(video.get()).port()});
   }
   Received receive(milliseconds duration, FrameAssemblerConfig config = {}) {
     return receiveStream(video.get(), SocketAddress::loopback(0), duration, config);
@@ -363,8 +363,12 @@ TEST(DeviceStream, LossDropsFramesButNeverCorruptsOne) {
 
 TEST(DeviceStream, BurstLossDuplicationReorderingAndJitterAreSurvived) {
   StreamFixture s({.fragmentSize = 1000,
-                   .impairments = {.burstLoss = 0.01, .burstLength = 4, .duplication = 0.1,
-                                   .reorderDepth = 3, .fragmentJitter = 400, .seed = 3}});
+                   .impairments = {.burstLoss = 0.01,
+                                   .burstLength = 4,
+                                   .duplication = 0.1,
+                                   .reorderDepth = 3,
+                                   .fragmentJitter = 400,
+                                   .seed = 3}});
   auto got = s.receive(milliseconds(1000), {.reorderWindow = 1});
   ASSERT_GE(got.frames.size(), 5u);
   for (const auto& frame : got.frames) EXPECT_TRUE(isSentFrame(frame));

@@ -16,10 +16,12 @@ std::vector<uint8_t> decodeGray(const std::vector<uint8_t>& jpeg, int& width, in
   std::unique_ptr<void, decltype(&tjDestroy)> decoder(tjInitDecompress(), tjDestroy);
   int subsampling = 0, colorspace = 0;
   EXPECT_EQ(tjDecompressHeader3(decoder.get(), jpeg.data(), jpeg.size(), &width, &height,
-                                &subsampling, &colorspace), 0);
+                                &subsampling, &colorspace),
+            0);
   std::vector<uint8_t> gray(static_cast<size_t>(width) * height);
   EXPECT_EQ(tjDecompress2(decoder.get(), jpeg.data(), jpeg.size(), gray.data(), width, width,
-                          height, TJPF_GRAY, 0), 0);
+                          height, TJPF_GRAY, 0),
+            0);
   return gray;
 }
 

@@ -26,7 +26,8 @@ std::vector<Frame> followSequence(int width, int height, int count) {
     (*scene)->step(0.1, {});
     auto jpeg = (*scene)->renderJpeg(0);
     Frame f{std::vector<uint8_t>(static_cast<size_t>(width) * height), width, height};
-    tjDecompress2(decoder.get(), jpeg.data(), jpeg.size(), f.gray.data(), width, width, height, TJPF_GRAY, 0);
+    tjDecompress2(decoder.get(), jpeg.data(), jpeg.size(), f.gray.data(), width, width, height,
+                  TJPF_GRAY, 0);
     frames.push_back(std::move(f));
   }
   return frames;

@@ -41,7 +41,8 @@ TEST(TransmitterSession, IsSharedByEveryUserOfTheSameDevice) {
   EXPECT_EQ(a.get(), b.get());
   ASSERT_EQ(a->waitLoggedIn(milliseconds(3000)), std::nullopt);
   // The device publishes its counters just after it answers.
-  for (int i = 0; i < 100 && device->stats().logins == 0; ++i) std::this_thread::sleep_for(milliseconds(5));
+  for (int i = 0; i < 100 && device->stats().logins == 0; ++i)
+    std::this_thread::sleep_for(milliseconds(5));
   EXPECT_EQ(device->stats().logins, 1u);
 }
 
@@ -49,8 +50,8 @@ TEST(TransmitterSession, ReportsARefusedConnection) {
   auto device = startDevice({.port = 0});
   uint16_t port = device->port();
   device.reset();  // nothing listens there now
-  auto session = TransmitterSession::acquire(
-      {.host = "127.0.0.1", .port = port, .reconnect = false});
+  auto session =
+      TransmitterSession::acquire({.host = "127.0.0.1", .port = port, .reconnect = false});
   auto error = session->waitLoggedIn(milliseconds(3000));
   ASSERT_TRUE(error.has_value());
   EXPECT_NE(error->find("cannot connect"), std::string::npos) << *error;

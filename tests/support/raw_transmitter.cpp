@@ -56,7 +56,10 @@ std::optional<wirc::Message> RawTransmitter::receive(std::chrono::milliseconds t
 
 std::optional<wirc::Wst> RawTransmitter::login(const std::string& name, uint8_t priority,
                                                const wirc::ChannelValues& failsafe) {
-  send(wirc::Tl{.system = 0, .version = {1, 0}, .priority = priority, .name = name,
+  send(wirc::Tl{.system = 0,
+                .version = {1, 0},
+                .priority = priority,
+                .name = name,
                 .statusPort = statusPort()});
   wirc::ChannelValues periods{};
   periods.fill(20000);
@@ -77,8 +80,8 @@ std::vector<uint8_t> receiveDatagram(int fd, std::chrono::milliseconds timeout,
   std::vector<uint8_t> buffer(65536);
   sockaddr_in source{};
   socklen_t size = sizeof source;
-  ssize_t n = ::recvfrom(fd, buffer.data(), buffer.size(), 0, reinterpret_cast<sockaddr*>(&source),
-                         &size);
+  ssize_t n =
+      ::recvfrom(fd, buffer.data(), buffer.size(), 0, reinterpret_cast<sockaddr*>(&source), &size);
   if (n < 0) return {};
   buffer.resize(static_cast<size_t>(n));
   if (from) *from = SocketAddress(source);

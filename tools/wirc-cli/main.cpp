@@ -106,58 +106,130 @@ long integer(const char* text, const char* what, long min, long max) {
 }
 
 Options parse(int argc, char** argv) {
-  enum { kHost = 1000, kPort, kDevice, kDiscovery, kName, kPriority, kTimeout, kPeriods, kFailsafe,
-         kSsid, kPasswordStdin, kStation, kChannel, kCountry, kCamera, kOut, kFrames, kDuration,
-         kSteering, kThrottle, kRaw, kToPort };
-  static const option options[] = {
-      {"host", required_argument, nullptr, kHost}, {"port", required_argument, nullptr, kPort},
-      {"device", required_argument, nullptr, kDevice},
-      {"discovery-address", required_argument, nullptr, kDiscovery},
-      {"name", required_argument, nullptr, kName}, {"priority", required_argument, nullptr, kPriority},
-      {"timeout", required_argument, nullptr, kTimeout},
-      {"periods", required_argument, nullptr, kPeriods},
-      {"failsafe", required_argument, nullptr, kFailsafe},
-      {"ssid", required_argument, nullptr, kSsid},
-      {"password-stdin", no_argument, nullptr, kPasswordStdin},
-      {"station", no_argument, nullptr, kStation},
-      {"channel", required_argument, nullptr, kChannel},
-      {"country", required_argument, nullptr, kCountry},
-      {"camera", required_argument, nullptr, kCamera}, {"out", required_argument, nullptr, kOut},
-      {"frames", required_argument, nullptr, kFrames},
-      {"duration", required_argument, nullptr, kDuration},
-      {"steering", required_argument, nullptr, kSteering},
-      {"throttle", required_argument, nullptr, kThrottle}, {"raw", no_argument, nullptr, kRaw},
-      {"to-port", required_argument, nullptr, kToPort},
-      {"help", no_argument, nullptr, 'h'}, {nullptr, 0, nullptr, 0}};
+  enum {
+    kHost = 1000,
+    kPort,
+    kDevice,
+    kDiscovery,
+    kName,
+    kPriority,
+    kTimeout,
+    kPeriods,
+    kFailsafe,
+    kSsid,
+    kPasswordStdin,
+    kStation,
+    kChannel,
+    kCountry,
+    kCamera,
+    kOut,
+    kFrames,
+    kDuration,
+    kSteering,
+    kThrottle,
+    kRaw,
+    kToPort
+  };
+  static const option options[] = {{"host", required_argument, nullptr, kHost},
+                                   {"port", required_argument, nullptr, kPort},
+                                   {"device", required_argument, nullptr, kDevice},
+                                   {"discovery-address", required_argument, nullptr, kDiscovery},
+                                   {"name", required_argument, nullptr, kName},
+                                   {"priority", required_argument, nullptr, kPriority},
+                                   {"timeout", required_argument, nullptr, kTimeout},
+                                   {"periods", required_argument, nullptr, kPeriods},
+                                   {"failsafe", required_argument, nullptr, kFailsafe},
+                                   {"ssid", required_argument, nullptr, kSsid},
+                                   {"password-stdin", no_argument, nullptr, kPasswordStdin},
+                                   {"station", no_argument, nullptr, kStation},
+                                   {"channel", required_argument, nullptr, kChannel},
+                                   {"country", required_argument, nullptr, kCountry},
+                                   {"camera", required_argument, nullptr, kCamera},
+                                   {"out", required_argument, nullptr, kOut},
+                                   {"frames", required_argument, nullptr, kFrames},
+                                   {"duration", required_argument, nullptr, kDuration},
+                                   {"steering", required_argument, nullptr, kSteering},
+                                   {"throttle", required_argument, nullptr, kThrottle},
+                                   {"raw", no_argument, nullptr, kRaw},
+                                   {"to-port", required_argument, nullptr, kToPort},
+                                   {"help", no_argument, nullptr, 'h'},
+                                   {nullptr, 0, nullptr, 0}};
   Options o;
   optind = 2;
   int opt;
   while ((opt = getopt_long(argc, argv, "h", options, nullptr)) != -1) {
     switch (opt) {
-      case 'h': std::fputs(kUsage, stdout); std::exit(0);
-      case kHost: o.host = optarg; break;
-      case kPort: o.port = static_cast<uint16_t>(integer(optarg, "--port", 1, 65535)); break;
-      case kDevice: o.device = optarg; break;
-      case kDiscovery: o.discoveryAddress = optarg; break;
-      case kName: o.name = optarg; break;
-      case kPriority: o.priority = static_cast<uint8_t>(integer(optarg, "--priority", 0, 255)); break;
-      case kTimeout: o.timeout = milliseconds(integer(optarg, "--timeout", 10, 600000)); break;
-      case kPeriods: o.periods = optarg; break;
-      case kFailsafe: o.failsafe = optarg; break;
-      case kSsid: o.ssid = optarg; break;
-      case kPasswordStdin: o.passwordStdin = true; break;
-      case kStation: o.station = true; break;
-      case kChannel: o.channel = static_cast<int>(integer(optarg, "--channel", 1, 165)); break;
-      case kCountry: o.country = optarg; break;
-      case kCamera: o.camera = static_cast<int>(integer(optarg, "--camera", 0, 255)); break;
-      case kOut: o.out = optarg; break;
-      case kFrames: o.frames = static_cast<int>(integer(optarg, "--frames", 1, 100000000)); break;
-      case kDuration: o.duration = static_cast<double>(integer(optarg, "--duration", 0, 100000000)); break;
-      case kSteering: o.steering = static_cast<int>(integer(optarg, "--steering", 800, 2200)); break;
-      case kThrottle: o.throttle = static_cast<int>(integer(optarg, "--throttle", 800, 2200)); break;
-      case kRaw: o.raw = true; break;
-      case kToPort: o.toPort = static_cast<uint16_t>(integer(optarg, "--to-port", 1, 65535)); break;
-      default: usageError("unknown option");
+      case 'h':
+        std::fputs(kUsage, stdout);
+        std::exit(0);
+      case kHost:
+        o.host = optarg;
+        break;
+      case kPort:
+        o.port = static_cast<uint16_t>(integer(optarg, "--port", 1, 65535));
+        break;
+      case kDevice:
+        o.device = optarg;
+        break;
+      case kDiscovery:
+        o.discoveryAddress = optarg;
+        break;
+      case kName:
+        o.name = optarg;
+        break;
+      case kPriority:
+        o.priority = static_cast<uint8_t>(integer(optarg, "--priority", 0, 255));
+        break;
+      case kTimeout:
+        o.timeout = milliseconds(integer(optarg, "--timeout", 10, 600000));
+        break;
+      case kPeriods:
+        o.periods = optarg;
+        break;
+      case kFailsafe:
+        o.failsafe = optarg;
+        break;
+      case kSsid:
+        o.ssid = optarg;
+        break;
+      case kPasswordStdin:
+        o.passwordStdin = true;
+        break;
+      case kStation:
+        o.station = true;
+        break;
+      case kChannel:
+        o.channel = static_cast<int>(integer(optarg, "--channel", 1, 165));
+        break;
+      case kCountry:
+        o.country = optarg;
+        break;
+      case kCamera:
+        o.camera = static_cast<int>(integer(optarg, "--camera", 0, 255));
+        break;
+      case kOut:
+        o.out = optarg;
+        break;
+      case kFrames:
+        o.frames = static_cast<int>(integer(optarg, "--frames", 1, 100000000));
+        break;
+      case kDuration:
+        o.duration = static_cast<double>(integer(optarg, "--duration", 0, 100000000));
+        break;
+      case kSteering:
+        o.steering = static_cast<int>(integer(optarg, "--steering", 800, 2200));
+        break;
+      case kThrottle:
+        o.throttle = static_cast<int>(integer(optarg, "--throttle", 800, 2200));
+        break;
+      case kRaw:
+        o.raw = true;
+        break;
+      case kToPort:
+        o.toPort = static_cast<uint16_t>(integer(optarg, "--to-port", 1, 65535));
+        break;
+      default:
+        usageError("unknown option");
     }
   }
   for (int i = optind; i < argc; ++i) o.positional.emplace_back(argv[i]);
@@ -196,17 +268,20 @@ void sendConfiguration(wirc::TransmitterSession& session, const wirc::Message& m
   if (auto error = wirc::validate(message)) fail(error->message());
   if (auto err = session.sendConfiguration(message, timeout))
     fail("the device refused " + wirc::commandName(err->command) + " with ERR code " +
-         std::to_string(err->code) + (err->code == 2 ? " (denied: only the first transmitter may configure)" : ""));
+         std::to_string(err->code) +
+         (err->code == 2 ? " (denied: only the first transmitter may configure)" : ""));
 }
 
 int discover(const Options& o) {
-  auto found = wirc::discoverDevices(o.timeout, o.host.empty() ? o.discoveryAddress : o.host, o.port);
+  auto found =
+      wirc::discoverDevices(o.timeout, o.host.empty() ? o.discoveryAddress : o.host, o.port);
   if (!found) fail(found.error());
   std::printf("%-21s %-24s %-8s %-5s %-5s\n", "ADDRESS", "NAME", "SERIAL", "HW", "SW");
   for (const auto& d : *found) {
     const auto& a = d.advertisement;
     std::printf("%-21s %-24s %-8s %u.%-3u %u.%u\n", d.address.toString().c_str(), a.name.c_str(),
-                a.serial.c_str(), a.hardware.major, a.hardware.minor, a.software.major, a.software.minor);
+                a.serial.c_str(), a.hardware.major, a.hardware.minor, a.software.major,
+                a.software.minor);
   }
   return found->empty() ? 1 : 0;
 }
@@ -217,7 +292,8 @@ int info(const Options& o) {
   auto s = session->status();
   std::printf("device        %s %s\n", s.deviceAddress.c_str(), s.deviceName.c_str());
   std::printf("cameras       %u\n", s.cameraCount);
-  std::printf("connection    %u%s\n", s.connectionId, s.hasControl ? " (has the control right)" : "");
+  std::printf("connection    %u%s\n", s.connectionId,
+              s.hasControl ? " (has the control right)" : "");
   if (s.lastStatus) {
     const auto& p = *s.lastStatus;
     std::printf("battery       %.2f V\nanalog input  %.2f V\ninputs        %u %u %u %u\n",
@@ -234,7 +310,8 @@ int transmitters(const Options& o) {
   auto list = session->listTransmitters(o.timeout);
   if (!list) fail("no transmitter list from the device");
   std::printf("%-4s %-4s %s\n", "ID", "PRIO", "NAME");
-  for (const auto& t : *list) std::printf("%-4u %-4u %s\n", t.connectionId, t.priority, t.name.c_str());
+  for (const auto& t : *list)
+    std::printf("%-4u %-4u %s\n", t.connectionId, t.priority, t.name.c_str());
   return 0;
 }
 
@@ -242,7 +319,8 @@ int forwardStream(const Options& o) {
   if (o.duration <= 0) usageError("stream --to-port needs --duration S");
   auto session = login(o);
   session->startStream(static_cast<uint8_t>(o.camera), *o.toPort);
-  std::fprintf(stderr, "wirc-cli: camera %d streaming to port %u for %.0f s\n", o.camera, *o.toPort, o.duration);
+  std::fprintf(stderr, "wirc-cli: camera %d streaming to port %u for %.0f s\n", o.camera, *o.toPort,
+               o.duration);
   std::this_thread::sleep_for(std::chrono::duration<double>(o.duration));
   session->stopStream(static_cast<uint8_t>(o.camera));
   return 0;
@@ -261,7 +339,8 @@ int stream(const Options& o) {
   }
   auto session = login(o);
   if (o.camera >= session->status().cameraCount)
-    fail("the device has " + std::to_string(session->status().cameraCount) + " camera(s); use --camera 0..");
+    fail("the device has " + std::to_string(session->status().cameraCount) +
+         " camera(s); use --camera 0..");
   auto socket = bindUdp(*SocketAddress::resolve("", 0));
   if (!socket) fail(socket.error());
   int size = 8 << 20;
@@ -271,7 +350,8 @@ int stream(const Options& o) {
 
   wirc::FrameAssembler assembler;
   int saved = 0;
-  auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.duration > 0 ? o.duration : 1e9);
+  auto end = std::chrono::steady_clock::now() +
+             std::chrono::duration<double>(o.duration > 0 ? o.duration : 1e9);
   std::vector<uint8_t> buffer(wirc::kMaxDatagramSize);
   auto save = [&](wirc::AssembledFrame&& frame) {
     if (o.frames && saved >= *o.frames) return;
@@ -280,9 +360,11 @@ int stream(const Options& o) {
       char name[32];
       std::snprintf(name, sizeof name, "frame-%06d.jpg", saved);
       std::ofstream(fs::path(*o.out) / name, std::ios::binary)
-          .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+          .write(reinterpret_cast<const char*>(bytes.data()),
+                 static_cast<std::streamsize>(bytes.size()));
     } else {
-      file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      file.write(reinterpret_cast<const char*>(bytes.data()),
+                 static_cast<std::streamsize>(bytes.size()));
     }
     ++saved;
     assembler.recycle(std::move(frame.data));
@@ -295,25 +377,29 @@ int stream(const Options& o) {
       ssize_t n = ::recvfrom(socket->get(), buffer.data(), buffer.size(), 0,
                              reinterpret_cast<sockaddr*>(&from), &length);
       if (n > 0 && SocketAddress(from).sameHost(device))
-        assembler.pushDatagram({buffer.data(), static_cast<size_t>(n)}, std::chrono::steady_clock::now(), save);
+        assembler.pushDatagram({buffer.data(), static_cast<size_t>(n)},
+                               std::chrono::steady_clock::now(), save);
     }
     assembler.expire(std::chrono::steady_clock::now(), save);
     if (session->status().state == wirc::SessionState::Failed) fail("lost the device");
   }
   session->stopStream(static_cast<uint8_t>(o.camera));
   auto stats = assembler.stats();
-  std::fprintf(stderr, "wirc-cli: saved %d frames to %s (%llu incomplete dropped, %llu packets)\n", saved,
-               o.out->c_str(), static_cast<unsigned long long>(stats.framesDropped()),
+  std::fprintf(stderr, "wirc-cli: saved %d frames to %s (%llu incomplete dropped, %llu packets)\n",
+               saved, o.out->c_str(), static_cast<unsigned long long>(stats.framesDropped()),
                static_cast<unsigned long long>(stats.packets));
   return saved > 0 ? 0 : 1;
 }
 
 int drive(const Options& o) {
-  if (!o.steering || !o.throttle) usageError("drive needs --steering US and --throttle US (800..2200)");
+  if (!o.steering || !o.throttle)
+    usageError("drive needs --steering US and --throttle US (800..2200)");
   double seconds = std::min(o.duration > 0 ? o.duration : 1.0, 10.0);
   auto session = login(o);
-  for (int i = 0; i < 50 && !session->status().hasControl; ++i) std::this_thread::sleep_for(milliseconds(20));
-  if (!session->status().hasControl) fail("another transmitter has the control right (see transmitters, request-control)");
+  for (int i = 0; i < 50 && !session->status().hasControl; ++i)
+    std::this_thread::sleep_for(milliseconds(20));
+  if (!session->status().hasControl)
+    fail("another transmitter has the control right (see transmitters, request-control)");
   wirc::ChannelValues pulses = wirc::neutralChannels();
   pulses[0] = static_cast<uint16_t>(*o.steering);
   pulses[1] = static_cast<uint16_t>(*o.throttle);
@@ -335,11 +421,14 @@ std::vector<uint8_t> readStdin(bool raw) {
   std::vector<uint8_t> bytes;
   std::string digits;
   for (char c : input) {
-    if (std::isxdigit(static_cast<unsigned char>(c))) digits += c;
-    else if (!std::isspace(static_cast<unsigned char>(c)) && c != ',' && c != ':') usageError(std::string("not hex: '") + c + "'");
+    if (std::isxdigit(static_cast<unsigned char>(c)))
+      digits += c;
+    else if (!std::isspace(static_cast<unsigned char>(c)) && c != ',' && c != ':')
+      usageError(std::string("not hex: '") + c + "'");
   }
   if (digits.size() % 2) usageError("an odd number of hex digits");
-  for (size_t i = 0; i < digits.size(); i += 2) bytes.push_back(static_cast<uint8_t>(std::stoi(digits.substr(i, 2), nullptr, 16)));
+  for (size_t i = 0; i < digits.size(); i += 2)
+    bytes.push_back(static_cast<uint8_t>(std::stoi(digits.substr(i, 2), nullptr, 16)));
   return bytes;
 }
 
@@ -353,7 +442,8 @@ int decodeCommand(const Options& o) {
       ++errors;
       nlohmann::json error = {{"error", wirc::errorKindName(result.error().kind)},
                               {"command", wirc::commandName(result.error().command)},
-                              {"field", result.error().field}, {"message", result.error().message()}};
+                              {"field", result.error().field},
+                              {"message", result.error().message()}};
       std::cout << error.dump() << "\n";
     }
   });
@@ -373,7 +463,8 @@ int encodeCommand(const Options& o) {
     auto frame = wirc::encode(*message);
     if (!frame) fail("line " + std::to_string(lineNumber) + ": " + frame.error().message());
     if (o.raw) {
-      std::cout.write(reinterpret_cast<const char*>(frame->data()), static_cast<std::streamsize>(frame->size()));
+      std::cout.write(reinterpret_cast<const char*>(frame->data()),
+                      static_cast<std::streamsize>(frame->size()));
     } else {
       for (size_t i = 0; i < frame->size(); ++i) std::printf("%s%02X", i ? " " : "", (*frame)[i]);
       std::printf("\n");
@@ -392,7 +483,8 @@ int main(int argc, char** argv) {
   }
   Options o = parse(argc, argv);
   auto wantArguments = [&](size_t n) {
-    if (o.positional.size() != n) usageError(command + " takes " + std::to_string(n) + " argument(s)");
+    if (o.positional.size() != n)
+      usageError(command + " takes " + std::to_string(n) + " argument(s)");
   };
   if (command == "discover") return discover(o);
   if (command == "info") return info(o);
@@ -408,8 +500,12 @@ int main(int argc, char** argv) {
   if (command == "configure") {
     if (!o.periods && !o.failsafe) usageError("configure needs --periods and/or --failsafe");
     auto session = login(o);
-    if (o.periods) sendConfiguration(*session, wirc::Ccfg{channelList(*o.periods, "--periods")}, milliseconds(500));
-    if (o.failsafe) sendConfiguration(*session, wirc::Fcfg{channelList(*o.failsafe, "--failsafe")}, milliseconds(500));
+    if (o.periods)
+      sendConfiguration(*session, wirc::Ccfg{channelList(*o.periods, "--periods")},
+                        milliseconds(500));
+    if (o.failsafe)
+      sendConfiguration(*session, wirc::Fcfg{channelList(*o.failsafe, "--failsafe")},
+                        milliseconds(500));
     return 0;
   }
   if (command == "set-name") {
@@ -425,8 +521,11 @@ int main(int argc, char** argv) {
     if (o.passwordStdin) std::getline(std::cin, password);
     auto session = login(o);
     sendConfiguration(*session,
-                      wirc::Wcfg{.ssid = *o.ssid, .password = password, .accessPoint = !o.station,
-                                 .secured = !password.empty(), .channel = static_cast<uint8_t>(o.channel),
+                      wirc::Wcfg{.ssid = *o.ssid,
+                                 .password = password,
+                                 .accessPoint = !o.station,
+                                 .secured = !password.empty(),
+                                 .channel = static_cast<uint8_t>(o.channel),
                                  .country = o.country.value_or("")},
                       milliseconds(500));
     std::printf("WiFi settings sent (password %s); they apply after the device restarts\n",

@@ -3,21 +3,26 @@
 namespace wircam::wirc {
 
 // Field names as in the structs; nlohmann's macros write both directions.
-void to_json(nlohmann::json& j, const Version& v) { j = std::to_string(v.major) + "." + std::to_string(v.minor); }
+void to_json(nlohmann::json& j, const Version& v) {
+  j = std::to_string(v.major) + "." + std::to_string(v.minor);
+}
 void from_json(const nlohmann::json& j, Version& v) {
   unsigned major = 0, minor = 0;
-  if (std::sscanf(j.get<std::string>().c_str(), "%u.%u", &major, &minor) != 2 || major > 255 || minor > 255)
+  if (std::sscanf(j.get<std::string>().c_str(), "%u.%u", &major, &minor) != 2 || major > 255 ||
+      minor > 255)
     throw nlohmann::json::other_error::create(501, "a version is \"MAJOR.MINOR\"", &j);
   v = {static_cast<uint8_t>(major), static_cast<uint8_t>(minor)};
 }
-NLOHMANN_JSON_SERIALIZE_ENUM(AccessNotification, {{AccessNotification::Granted, "granted"},
-                                                  {AccessNotification::Denied, "denied"},
-                                                  {AccessNotification::Revoked, "revoked"},
-                                                  {AccessNotification::Notification, "notification"}})
+NLOHMANN_JSON_SERIALIZE_ENUM(AccessNotification,
+                             {{AccessNotification::Granted, "granted"},
+                              {AccessNotification::Denied, "denied"},
+                              {AccessNotification::Revoked, "revoked"},
+                              {AccessNotification::Notification, "notification"}})
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Bcsd, system, version)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Bcsa, hardware, software, name, serial)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Tl, system, version, priority, name, statusPort)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Dcfg, name, cameraOffMillivolts, deviceOffMillivolts)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Dcfg, name, cameraOffMillivolts,
+                                                deviceOffMillivolts)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Ccfg, periods)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Fcfg, values)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(Wst, connectionId, cameraCount, controlPort)
@@ -36,8 +41,12 @@ void from_json(const nlohmann::json&, Tlr&) {}
 void to_json(nlohmann::json&, const Tlend&) {}
 void from_json(const nlohmann::json&, Tlend&) {}
 void to_json(nlohmann::json& j, const Wcfg& m) {
-  j = {{"ssid", m.ssid}, {"passwordLength", m.password.size()}, {"accessPoint", m.accessPoint},
-       {"secured", m.secured}, {"channel", m.channel}, {"country", m.country}};
+  j = {{"ssid", m.ssid},
+       {"passwordLength", m.password.size()},
+       {"accessPoint", m.accessPoint},
+       {"secured", m.secured},
+       {"channel", m.channel},
+       {"country", m.country}};
 }
 void from_json(const nlohmann::json& j, Wcfg& m) {
   m.ssid = j.value("ssid", "");
@@ -55,12 +64,14 @@ namespace wircam::cli {
 namespace {
 
 template <size_t I = 0>
-Expected<wirc::Message, std::string> messageOfType(const std::string& type, const nlohmann::json& json) {
+Expected<wirc::Message, std::string> messageOfType(const std::string& type,
+                                                   const nlohmann::json& json) {
   if constexpr (I == std::variant_size_v<wirc::Message>) {
     return unexpected("unknown message type '" + type + "'");
   } else {
     using T = std::variant_alternative_t<I, wirc::Message>;
-    if (wirc::commandName(static_cast<uint8_t>(T::kCommand)) != type) return messageOfType<I + 1>(type, json);
+    if (wirc::commandName(static_cast<uint8_t>(T::kCommand)) != type)
+      return messageOfType<I + 1>(type, json);
     T message = json.get<T>();
     return wirc::Message{std::move(message)};
   }
@@ -77,7 +88,8 @@ nlohmann::json toJson(const wirc::Message& message) {
 
 Expected<wirc::Message, std::string> fromJson(const nlohmann::json& json) {
   try {
-    if (!json.is_object() || !json.contains("type")) return unexpected(std::string("each line needs a \"type\""));
+    if (!json.is_object() || !json.contains("type"))
+      return unexpected(std::string("each line needs a \"type\""));
     return messageOfType(json.at("type").get<std::string>(), json);
   } catch (const nlohmann::json::exception& error) {
     return unexpected(std::string(error.what()));

@@ -13,16 +13,17 @@ namespace wircam::sim {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kPatternScale = 16;        // pixels per tag cell before warping
-constexpr double kBoardScale = 1.6;      // white board around the tag, × tag size
-constexpr double kSettleSeconds = 3.0;   // the summary ignores the start
-constexpr double kMaxStep = 0.01;        // s, integration step
+constexpr int kPatternScale = 16;       // pixels per tag cell before warping
+constexpr double kBoardScale = 1.6;     // white board around the tag, × tag size
+constexpr double kSettleSeconds = 3.0;  // the summary ignores the start
+constexpr double kMaxStep = 0.01;       // s, integration step
 constexpr double kSpeedTimeConstant = 0.25;
 
 // Tag corners as (x right, y up) on the printed tag, in the order the AprilTag
 // detector reports p[0..3] for an upright tag: bottom-left, bottom-right,
 // top-right, top-left (checked by the render test).
-constexpr std::array<std::array<double, 2>, 4> kCornerOrder = {{{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}};
+constexpr std::array<std::array<double, 2>, 4> kCornerOrder = {
+    {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}};
 
 double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
@@ -80,7 +81,9 @@ FollowScene::FollowScene(FollowSceneConfig config, vision::TagFamily family)
     cv::resize(small, tag.pattern, {}, kPatternScale, kPatternScale, cv::INTER_NEAREST);
     if (i > 0) {
       // Landmarks on a ring around the start, facing it.
-      double angle = 2 * kPi * static_cast<double>(i - 1) / static_cast<double>(config_.tagIds.size() - 1) + kPi / 4;
+      double angle =
+          2 * kPi * static_cast<double>(i - 1) / static_cast<double>(config_.tagIds.size() - 1) +
+          kPi / 4;
       tag.pose = {6 * std::cos(angle), 6 * std::sin(angle), angle};
     }
     tags_.push_back(std::move(tag));
@@ -214,10 +217,12 @@ std::vector<TagView> FollowScene::tagViews() const {
     for (size_t i = 0; i < 4; ++i) {
       bool front = project(corners[i], view.corners[i]);
       bool inside = view.corners[i].x >= 0 && view.corners[i].y >= 0 &&
-                    view.corners[i].x <= config_.width - 1 && view.corners[i].y <= config_.height - 1;
+                    view.corners[i].x <= config_.width - 1 &&
+                    view.corners[i].y <= config_.height - 1;
       view.visible = view.visible && front && inside;
     }
-    view.visible = view.visible && facesCamera(view.corners) && (&tag != &tags_[0] || !targetHidden_);
+    view.visible =
+        view.visible && facesCamera(view.corners) && (&tag != &tags_[0] || !targetHidden_);
     views.push_back(view);
   }
   return views;
@@ -233,7 +238,8 @@ void FollowScene::drawGround(cv::Mat& image) const {
     if (down <= 0.002) {
       double k = std::clamp(v / cy_, 0.0, 1.0);
       cv::Vec3b sky;
-      for (int ch = 0; ch < 3; ++ch) sky[ch] = static_cast<uint8_t>(skyTop[ch] * (1 - k) + skyHorizon[ch] * k);
+      for (int ch = 0; ch < 3; ++ch)
+        sky[ch] = static_cast<uint8_t>(skyTop[ch] * (1 - k) + skyHorizon[ch] * k);
       std::fill(row, row + image.cols, sky);
       continue;
     }
@@ -245,7 +251,8 @@ void FollowScene::drawGround(cv::Mat& image) const {
     for (int u = 0; u < image.cols; ++u) {
       double dx = u - cx_;
       double gx = baseX + stepX * dx, gy = baseY + stepY * dx;
-      bool check = (static_cast<long>(std::floor(gx * 2)) + static_cast<long>(std::floor(gy * 2))) & 1;
+      bool check =
+          (static_cast<long>(std::floor(gx * 2)) + static_cast<long>(std::floor(gy * 2))) & 1;
       const cv::Vec3b& tile = check ? light : dark;
       for (int ch = 0; ch < 3; ++ch)
         row[u][ch] = static_cast<uint8_t>(tile[ch] * (1 - fog) + skyHorizon[ch] * fog);
@@ -265,8 +272,8 @@ void FollowScene::drawTag(cv::Mat& image, const PlacedTag& tag) const {
   bool front = facesCamera(border);
   std::vector<cv::Point> boardPolygon;
   for (const auto& p : board) boardPolygon.emplace_back(cvRound(p.x), cvRound(p.y));
-  cv::fillConvexPoly(image, boardPolygon, front ? cv::Scalar(245, 245, 245) : cv::Scalar(90, 90, 90),
-                     cv::LINE_AA);
+  cv::fillConvexPoly(image, boardPolygon,
+                     front ? cv::Scalar(245, 245, 245) : cv::Scalar(90, 90, 90), cv::LINE_AA);
   if (!front) return;
 
   // Map the tag's border square (in pattern pixels) onto its projection.
@@ -297,7 +304,9 @@ cv::Mat FollowScene::renderBgr() const {
   std::vector<const PlacedTag*> order;
   for (const auto& tag : tags_)
     if (&tag != &tags_[0] || !targetHidden_) order.push_back(&tag);
-  auto range = [&](const PlacedTag* t) { return std::hypot(t->pose.x - car_.x, t->pose.y - car_.y); };
+  auto range = [&](const PlacedTag* t) {
+    return std::hypot(t->pose.x - car_.x, t->pose.y - car_.y);
+  };
   std::sort(order.begin(), order.end(), [&](auto* a, auto* b) { return range(a) > range(b); });
   for (const auto* tag : order) drawTag(image, *tag);
   return image;

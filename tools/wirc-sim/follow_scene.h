@@ -8,10 +8,9 @@
 #include <atomic>
 #include <cstdio>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "common/expected.h"
 #include "tag_family.h"
@@ -31,14 +30,14 @@ struct FollowSceneConfig {
   double tagSize = 0.16;          // m, edge of the tag's black border square
   double cameraHeight = 0.25;     // m above the ground; the tag centre is as high
   TargetPath path = TargetPath::Circle;
-  double targetSpeed = 0.3;      // m/s
-  double circleRadius = 2.5;     // m
-  double startDistance = 1.2;    // m from camera to target at the start
-  double followDistance = 1.0;   // m, the set point the summary measures against
-  bool carFixed = false;         // static scene: PCD moves nothing
-  int steeringChannel = 1;       // 1-based, 2000 µs = full left
-  int throttleChannel = 2;       // 1-based, 1500 µs neutral
-  double wheelbase = 0.26;       // m
+  double targetSpeed = 0.3;     // m/s
+  double circleRadius = 2.5;    // m
+  double startDistance = 1.2;   // m from camera to target at the start
+  double followDistance = 1.0;  // m, the set point the summary measures against
+  bool carFixed = false;        // static scene: PCD moves nothing
+  int steeringChannel = 1;      // 1-based, 2000 µs = full left
+  int throttleChannel = 2;      // 1-based, 1500 µs neutral
+  double wheelbase = 0.26;      // m
   double maxSteerRad = 0.5;
   double maxSpeed = 1.2;         // m/s at full throttle
   double throttleDeadband = 50;  // µs around neutral with no drive

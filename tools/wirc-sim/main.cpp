@@ -77,11 +77,41 @@ received, the longest PCD gap, failsafe entries, and how well the car followed.
 )";
 
 enum Option {
-  kPort = 1000, kBind, kName, kSerial, kHwVersion, kSwVersion, kCameras, kFps, kSize, kQuality,
-  kFragment, kPcdTimeout, kDuration, kScene, kFrames, kFamily, kTags, kTagSize, kPath,
-  kTargetSpeed, kStartDistance, kFollowDistance, kSteeringChannel, kThrottleChannel, kTruth,
-  kLoss, kBurstLoss, kBurstLength, kDuplicate, kReorder, kJitter, kStartFrame, kReservedBits,
-  kStray, kSeed,
+  kPort = 1000,
+  kBind,
+  kName,
+  kSerial,
+  kHwVersion,
+  kSwVersion,
+  kCameras,
+  kFps,
+  kSize,
+  kQuality,
+  kFragment,
+  kPcdTimeout,
+  kDuration,
+  kScene,
+  kFrames,
+  kFamily,
+  kTags,
+  kTagSize,
+  kPath,
+  kTargetSpeed,
+  kStartDistance,
+  kFollowDistance,
+  kSteeringChannel,
+  kThrottleChannel,
+  kTruth,
+  kLoss,
+  kBurstLoss,
+  kBurstLength,
+  kDuplicate,
+  kReorder,
+  kJitter,
+  kStartFrame,
+  kReservedBits,
+  kStray,
+  kSeed,
 };
 
 const option kOptions[] = {
@@ -152,7 +182,8 @@ std::vector<int> idList(const char* text) {
   std::vector<int> ids;
   std::stringstream stream(text);
   std::string item;
-  while (std::getline(stream, item, ',')) ids.push_back(static_cast<int>(number(item.c_str(), "tags", 0, 1e6)));
+  while (std::getline(stream, item, ','))
+    ids.push_back(static_cast<int>(number(item.c_str(), "tags", 0, 1e6)));
   if (ids.empty()) usageError("--tags wants a list like 0,3,7");
   return ids;
 }
@@ -178,56 +209,125 @@ int main(int argc, char** argv) {
   int opt;
   while ((opt = getopt_long(argc, argv, "h", kOptions, nullptr)) != -1) {
     switch (opt) {
-      case 'h': std::fputs(kUsage, stdout); return 0;
-      case kPort: device.port = static_cast<uint16_t>(number(optarg, "port", 0, 65535)); break;
-      case kBind: device.bindAddress = optarg; break;
-      case kName: device.name = optarg; break;
-      case kSerial: device.serial = optarg; break;
-      case kHwVersion: device.hardware = version(optarg, "hw-version"); break;
-      case kSwVersion: device.software = version(optarg, "sw-version"); break;
-      case kCameras: device.cameras = static_cast<int>(number(optarg, "cameras", 1, 255)); break;
-      case kFps: device.fps = number(optarg, "fps", 0.1, 240); break;
+      case 'h':
+        std::fputs(kUsage, stdout);
+        return 0;
+      case kPort:
+        device.port = static_cast<uint16_t>(number(optarg, "port", 0, 65535));
+        break;
+      case kBind:
+        device.bindAddress = optarg;
+        break;
+      case kName:
+        device.name = optarg;
+        break;
+      case kSerial:
+        device.serial = optarg;
+        break;
+      case kHwVersion:
+        device.hardware = version(optarg, "hw-version");
+        break;
+      case kSwVersion:
+        device.software = version(optarg, "sw-version");
+        break;
+      case kCameras:
+        device.cameras = static_cast<int>(number(optarg, "cameras", 1, 255));
+        break;
+      case kFps:
+        device.fps = number(optarg, "fps", 0.1, 240);
+        break;
       case kSize:
         if (std::sscanf(optarg, "%dx%d", &scene.width, &scene.height) != 2)
           usageError(std::string("--size wants WIDTHxHEIGHT, not '") + optarg + "'");
         break;
-      case kQuality: scene.jpegQuality = static_cast<int>(number(optarg, "quality", 1, 100)); break;
-      case kFragment: device.fragmentSize = static_cast<size_t>(number(optarg, "fragment", 1, 65491)); break;
+      case kQuality:
+        scene.jpegQuality = static_cast<int>(number(optarg, "quality", 1, 100));
+        break;
+      case kFragment:
+        device.fragmentSize = static_cast<size_t>(number(optarg, "fragment", 1, 65491));
+        break;
       case kPcdTimeout:
-        device.pcdTimeout = std::chrono::milliseconds(static_cast<int>(number(optarg, "pcd-timeout", 200, 2000)));
+        device.pcdTimeout =
+            std::chrono::milliseconds(static_cast<int>(number(optarg, "pcd-timeout", 200, 2000)));
         break;
-      case kDuration: duration = number(optarg, "duration", 0, 1e7); break;
+      case kDuration:
+        duration = number(optarg, "duration", 0, 1e7);
+        break;
       case kScene:
-        if (std::string(optarg) == "static") scene.carFixed = true;
-        else if (std::string(optarg) != "follow") usageError("--scene is follow or static");
+        if (std::string(optarg) == "static")
+          scene.carFixed = true;
+        else if (std::string(optarg) != "follow")
+          usageError("--scene is follow or static");
         break;
-      case kFrames: framesDir = optarg; break;
-      case kFamily: scene.family = optarg; break;
-      case kTags: scene.tagIds = idList(optarg); break;
-      case kTagSize: scene.tagSize = number(optarg, "tag-size", 0.01, 10); break;
+      case kFrames:
+        framesDir = optarg;
+        break;
+      case kFamily:
+        scene.family = optarg;
+        break;
+      case kTags:
+        scene.tagIds = idList(optarg);
+        break;
+      case kTagSize:
+        scene.tagSize = number(optarg, "tag-size", 0.01, 10);
+        break;
       case kPath: {
         auto path = sim::parseTargetPath(optarg);
         if (!path) usageError(path.error());
         scene.path = *path;
         break;
       }
-      case kTargetSpeed: scene.targetSpeed = number(optarg, "target-speed", 0, 10); break;
-      case kStartDistance: scene.startDistance = number(optarg, "start-distance", 0.2, 100); break;
-      case kFollowDistance: scene.followDistance = number(optarg, "follow-distance", 0.1, 100); break;
-      case kSteeringChannel: scene.steeringChannel = static_cast<int>(number(optarg, "steering-channel", 1, 8)); break;
-      case kThrottleChannel: scene.throttleChannel = static_cast<int>(number(optarg, "throttle-channel", 1, 8)); break;
-      case kTruth: truthPath = optarg; break;
-      case kLoss: device.impairments.loss = number(optarg, "loss", 0, 1); break;
-      case kBurstLoss: device.impairments.burstLoss = number(optarg, "burst-loss", 0, 1); break;
-      case kBurstLength: device.impairments.burstLength = static_cast<int>(number(optarg, "burst-length", 1, 10000)); break;
-      case kDuplicate: device.impairments.duplication = number(optarg, "duplicate", 0, 1); break;
-      case kReorder: device.impairments.reorderDepth = static_cast<int>(number(optarg, "reorder", 0, 1000)); break;
-      case kJitter: device.impairments.fragmentJitter = static_cast<size_t>(number(optarg, "jitter", 0, 65000)); break;
-      case kStartFrame: device.impairments.startFrameNumber = static_cast<uint32_t>(number(optarg, "start-frame", 0, 4294967295.0)); break;
-      case kReservedBits: device.impairments.reservedBits = true; break;
-      case kStray: device.impairments.strayRate = number(optarg, "stray", 0, 1); break;
-      case kSeed: device.impairments.seed = static_cast<uint32_t>(number(optarg, "seed", 0, 4294967295.0)); break;
-      default: usageError("unknown option");
+      case kTargetSpeed:
+        scene.targetSpeed = number(optarg, "target-speed", 0, 10);
+        break;
+      case kStartDistance:
+        scene.startDistance = number(optarg, "start-distance", 0.2, 100);
+        break;
+      case kFollowDistance:
+        scene.followDistance = number(optarg, "follow-distance", 0.1, 100);
+        break;
+      case kSteeringChannel:
+        scene.steeringChannel = static_cast<int>(number(optarg, "steering-channel", 1, 8));
+        break;
+      case kThrottleChannel:
+        scene.throttleChannel = static_cast<int>(number(optarg, "throttle-channel", 1, 8));
+        break;
+      case kTruth:
+        truthPath = optarg;
+        break;
+      case kLoss:
+        device.impairments.loss = number(optarg, "loss", 0, 1);
+        break;
+      case kBurstLoss:
+        device.impairments.burstLoss = number(optarg, "burst-loss", 0, 1);
+        break;
+      case kBurstLength:
+        device.impairments.burstLength = static_cast<int>(number(optarg, "burst-length", 1, 10000));
+        break;
+      case kDuplicate:
+        device.impairments.duplication = number(optarg, "duplicate", 0, 1);
+        break;
+      case kReorder:
+        device.impairments.reorderDepth = static_cast<int>(number(optarg, "reorder", 0, 1000));
+        break;
+      case kJitter:
+        device.impairments.fragmentJitter = static_cast<size_t>(number(optarg, "jitter", 0, 65000));
+        break;
+      case kStartFrame:
+        device.impairments.startFrameNumber =
+            static_cast<uint32_t>(number(optarg, "start-frame", 0, 4294967295.0));
+        break;
+      case kReservedBits:
+        device.impairments.reservedBits = true;
+        break;
+      case kStray:
+        device.impairments.strayRate = number(optarg, "stray", 0, 1);
+        break;
+      case kSeed:
+        device.impairments.seed = static_cast<uint32_t>(number(optarg, "seed", 0, 4294967295.0));
+        break;
+      default:
+        usageError("unknown option");
     }
   }
   if (optind < argc) usageError(std::string("unexpected argument '") + argv[optind] + "'");
@@ -287,13 +387,15 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(stats.pcdReceived),
               static_cast<unsigned long long>(stats.pcdRejected));
   std::printf("  max PCD gap        %lld ms\n", static_cast<long long>(stats.maxPcdGap.count()));
-  std::printf("  failsafe entries   %llu\n", static_cast<unsigned long long>(stats.failsafeEntries));
+  std::printf("  failsafe entries   %llu\n",
+              static_cast<unsigned long long>(stats.failsafeEntries));
   if (follow) {
     auto s = follow->summary();
-    std::printf("  following error    bearing mean %.2f° max %.2f°, distance mean %.3f m max %.3f m"
-                " (after the first 3 s, %llu frames)\n",
-                s.meanBearingDeg, s.maxBearingDeg, s.meanDistanceError, s.maxDistanceError,
-                static_cast<unsigned long long>(s.measuredTicks));
+    std::printf(
+        "  following error    bearing mean %.2f° max %.2f°, distance mean %.3f m max %.3f m"
+        " (after the first 3 s, %llu frames)\n",
+        s.meanBearingDeg, s.maxBearingDeg, s.meanDistanceError, s.maxDistanceError,
+        static_cast<unsigned long long>(s.measuredTicks));
   }
   return 0;
 }

@@ -32,7 +32,9 @@ class ByteWriter {
     for (int shift = 0; shift <= 24; shift += 8) out_.push_back(static_cast<uint8_t>(v >> shift));
   }
 
-  void writeBytes(std::span<const uint8_t> bytes) { out_.insert(out_.end(), bytes.begin(), bytes.end()); }
+  void writeBytes(std::span<const uint8_t> bytes) {
+    out_.insert(out_.end(), bytes.begin(), bytes.end());
+  }
 
   // Callers check the length first; a longer text is cut at the field's width
   // so the layout can never be broken.

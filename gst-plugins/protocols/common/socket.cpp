@@ -19,7 +19,7 @@ void UniqueFd::reset(int fd) {
 std::string errnoText(int error) { return std::strerror(error); }
 
 Expected<SocketAddress, std::string> SocketAddress::resolve(const std::string& host,
-                                                             uint16_t port) {
+                                                            uint16_t port) {
   sockaddr_in address{.sin_family = AF_INET, .sin_port = htons(port)};
   if (host.empty()) {
     address.sin_addr.s_addr = htonl(INADDR_ANY);
@@ -29,8 +29,7 @@ Expected<SocketAddress, std::string> SocketAddress::resolve(const std::string& h
   addrinfo hints{.ai_family = AF_INET};
   addrinfo* found = nullptr;
   int rc = getaddrinfo(host.c_str(), nullptr, &hints, &found);
-  if (rc != 0 || !found)
-    return unexpected("cannot resolve '" + host + "': " + gai_strerror(rc));
+  if (rc != 0 || !found) return unexpected("cannot resolve '" + host + "': " + gai_strerror(rc));
   address.sin_addr = reinterpret_cast<sockaddr_in*>(found->ai_addr)->sin_addr;
   freeaddrinfo(found);
   return SocketAddress(address);

@@ -276,7 +276,8 @@ void Device::Impl::runTimers(DeviceClock::time_point now) {
   }
   if (now >= nextFrame_) {
     tickFrame(now);
-    auto period = duration_cast<DeviceClock::duration>(std::chrono::duration<double>(1.0 / config_.fps));
+    auto period =
+        duration_cast<DeviceClock::duration>(std::chrono::duration<double>(1.0 / config_.fps));
     nextFrame_ += period;
     if (nextFrame_ <= now) nextFrame_ = now + period;  // skip ticks we were too slow for
   }
@@ -367,16 +368,11 @@ void Device::Impl::handleMessage(Connection& c, const Expected<Message, Protocol
     if (error.kind != ErrorKind::BadCrc) sendError(c, error.command, ErrorCode::Format);
     return;
   }
-  std::visit(Overloaded{[&](const Tl& m) { handle(c, m); },
-                        [&](const Ccfg& m) { handle(c, m); },
-                        [&](const Fcfg& m) { handle(c, m); },
-                        [&](const Dcfg& m) { handle(c, m); },
-                        [&](const Wcfg& m) { handle(c, m); },
-                        [&](const Tlr& m) { handle(c, m); },
-                        [&](const Areq& m) { handle(c, m); },
-                        [&](const Fwup& m) { handle(c, m); },
-                        [&](const Stst& m) { handle(c, m); },
-                        [&](const Est& m) { handle(c, m); },
+  std::visit(Overloaded{[&](const Tl& m) { handle(c, m); }, [&](const Ccfg& m) { handle(c, m); },
+                        [&](const Fcfg& m) { handle(c, m); }, [&](const Dcfg& m) { handle(c, m); },
+                        [&](const Wcfg& m) { handle(c, m); }, [&](const Tlr& m) { handle(c, m); },
+                        [&](const Areq& m) { handle(c, m); }, [&](const Fwup& m) { handle(c, m); },
+                        [&](const Stst& m) { handle(c, m); }, [&](const Est& m) { handle(c, m); },
                         [&](const Extout& m) { handle(c, m); },
                         [&](const auto& m) {
                           // PCD belongs on UDP; the rest flow device → transmitter.
@@ -442,9 +438,9 @@ void Device::Impl::handle(Connection& c, const Dcfg& m) {
 void Device::Impl::handle(Connection& c, const Wcfg& m) {
   if (!requireFirst(c, Command::Wcfg)) return;
   // The password is never logged.
-  log("WiFi set to SSID '" + m.ssid + "', " + (m.accessPoint ? "access point" : "station") +
-      ", " + (m.secured ? "WPA" : "open") + ", channel " + std::to_string(m.channel) +
-      ", country '" + m.country + "' (after the next restart)");
+  log("WiFi set to SSID '" + m.ssid + "', " + (m.accessPoint ? "access point" : "station") + ", " +
+      (m.secured ? "WPA" : "open") + ", channel " + std::to_string(m.channel) + ", country '" +
+      m.country + "' (after the next restart)");
 }
 
 void Device::Impl::handle(Connection& c, const Tlr&) {
@@ -502,8 +498,7 @@ void Device::Impl::handle(Connection& c, const Stst& m) {
   impairments.seed += c.id * 31u + m.camera;  // distinct, repeatable per stream
   streams_.emplace(key, StreamSender(video_.get(), stray_.get(), c.peer.withPort(m.port),
                                      config_.fragmentSize, impairments));
-  log("camera " + std::to_string(m.camera) + " streaming to " +
-      c.peer.withPort(m.port).toString());
+  log("camera " + std::to_string(m.camera) + " streaming to " + c.peer.withPort(m.port).toString());
 }
 
 void Device::Impl::handle(Connection& c, const Est& m) {
@@ -542,7 +537,7 @@ void Device::Impl::giveControl(Connection& to) {
   Agr agr{to.id, to.login->priority, to.login->name, AccessNotification::Granted};
   for (auto& c : connections_) {
     if (!c.started || c.closing) continue;
-    agr.notification = &c == &to         ? AccessNotification::Granted
+    agr.notification = &c == &to        ? AccessNotification::Granted
                        : &c == previous ? AccessNotification::Revoked
                                         : AccessNotification::Notification;
     sendMessage(c, agr);
@@ -693,7 +688,8 @@ Expected<std::unique_ptr<Device>, std::string> Device::start(DeviceConfig config
                                                              Logger logger) {
   if (config.cameras < 1 || config.cameras > 255)
     return unexpected(std::string("cameras must be 1..255"));
-  if (config.fps <= 0 || config.fps > 240) return unexpected(std::string("fps must be in (0, 240]"));
+  if (config.fps <= 0 || config.fps > 240)
+    return unexpected(std::string("fps must be in (0, 240]"));
   auto impl = std::make_unique<Impl>(std::move(config), std::move(scene), std::move(logger));
   if (auto error = impl->open()) return unexpected(*error);
   impl->thread_ = std::thread([raw = impl.get()] { raw->run(); });

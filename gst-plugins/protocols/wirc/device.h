@@ -55,12 +55,12 @@ struct DeviceConfig {
 };
 
 struct DeviceStats {
-  uint64_t framesSent = 0;     // frames handed to streams (per receiver)
+  uint64_t framesSent = 0;       // frames handed to streams (per receiver)
   uint64_t framesSentWhole = 0;  // of those, frames no impairment took a packet from
   uint64_t activeStreams = 0;
   uint64_t datagramsSent = 0;
-  uint64_t pcdReceived = 0;    // valid PCD from the controller
-  uint64_t pcdRejected = 0;    // not from the controller, malformed or out of range
+  uint64_t pcdReceived = 0;  // valid PCD from the controller
+  uint64_t pcdRejected = 0;  // not from the controller, malformed or out of range
   uint64_t failsafeEntries = 0;
   uint64_t psdSent = 0;
   uint64_t errSent = 0;
@@ -76,13 +76,13 @@ class Device {
   // Binds every socket and starts the device thread; an error names the
   // address that could not be bound.
   static Expected<std::unique_ptr<Device>, std::string> start(DeviceConfig config,
-                                                               std::shared_ptr<DeviceScene> scene,
-                                                               Logger logger = {});
+                                                              std::shared_ptr<DeviceScene> scene,
+                                                              Logger logger = {});
   ~Device();
   Device(const Device&) = delete;
   Device& operator=(const Device&) = delete;
 
-  uint16_t port() const;  // control (TCP) and discovery (UDP)
+  uint16_t port() const;         // control (TCP) and discovery (UDP)
   uint16_t controlPort() const;  // where PCD goes (UDP), as sent in WST
   DeviceStats stats() const;
   ChannelOutputs outputs() const;

@@ -15,7 +15,8 @@ Expected<std::vector<DiscoveredDevice>, std::string> discoverDevices(
   if (!socket) return unexpected(socket.error());
   int on = 1;
   setsockopt(socket->get(), SOL_SOCKET, SO_BROADCAST, &on, sizeof on);
-  auto request = encode(Bcsd{.system = static_cast<uint8_t>(SystemType::PcClient), .version = {1, 0}});
+  auto request =
+      encode(Bcsd{.system = static_cast<uint8_t>(SystemType::PcClient), .version = {1, 0}});
   if (!sendDatagram(socket->get(), *destination, *request))
     return unexpected("cannot send discovery to " + destination->toString() + ": " +
                       errnoText(errno));
@@ -24,7 +25,8 @@ Expected<std::vector<DiscoveredDevice>, std::string> discoverDevices(
   auto deadline = std::chrono::steady_clock::now() + timeout;
   std::array<uint8_t, 512> buffer;
   for (;;) {
-    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) break;
     pollfd p{socket->get(), POLLIN, 0};
     if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
@@ -50,12 +52,13 @@ Expected<DiscoveredDevice, std::string> pickDevice(const std::vector<DiscoveredD
   for (const auto& device : found) {
     const auto& ad = device.advertisement;
     if (!wanted.empty() && (ad.name == wanted || ad.serial == wanted)) return device;
-    names += (names.empty() ? "" : ", ") + ad.name + " (" + ad.serial + ") at " +
-             device.address.host();
+    names +=
+        (names.empty() ? "" : ", ") + ad.name + " (" + ad.serial + ") at " + device.address.host();
   }
   if (wanted.empty() && found.size() == 1) return found[0];
-  return unexpected(wanted.empty() ? "several devices answered, pick one by name or serial: " + names
-                                   : "no device named '" + wanted + "'; found: " + names);
+  return unexpected(wanted.empty()
+                        ? "several devices answered, pick one by name or serial: " + names
+                        : "no device named '" + wanted + "'; found: " + names);
 }
 
 }  // namespace wircam::wirc

@@ -215,7 +215,8 @@ FrameAssembler::Slot* FrameAssembler::openSlot(uint32_t number, Clock::time_poin
   // A fresh buffer starts at the size of recent frames plus a margin, so a
   // caller that does not recycle still avoids regrowing (and recopying).
   if (slot->buffer.capacity() < largestRecentFrame_)
-    slot->buffer.reserve(std::min(largestRecentFrame_ + largestRecentFrame_ / 4, config_.maxFrameBytes));
+    slot->buffer.reserve(
+        std::min(largestRecentFrame_ + largestRecentFrame_ / 4, config_.maxFrameBytes));
   slot->active = true;
   slot->number = number;
   slot->firstPacketTime = now;

@@ -52,14 +52,14 @@ struct AssemblerStats {
   uint64_t packetsLate = 0;       // for a frame already emitted or dropped
   uint64_t packetsEmpty = 0;      // zero-length, not the last packet
   uint64_t framesComplete = 0;
-  uint64_t framesTimedOut = 0;         // missing packets after frameTimeout
-  uint64_t framesSuperseded = 0;       // a newer frame completed past reorderWindow
-  uint64_t framesEvicted = 0;          // too many frames in flight
-  uint64_t framesOversize = 0;         // offset + length beyond maxFrameBytes
-  uint64_t framesOverlapMismatch = 0;  // two copies of the same bytes differ
-  uint64_t framesLastFlagConflict = 0; // last-packet flags name different ends
-  uint64_t framesNotJpeg = 0;          // complete, but no JPEG SOI marker
-  uint64_t framesAbandoned = 0;        // in flight when the sender restarted
+  uint64_t framesTimedOut = 0;          // missing packets after frameTimeout
+  uint64_t framesSuperseded = 0;        // a newer frame completed past reorderWindow
+  uint64_t framesEvicted = 0;           // too many frames in flight
+  uint64_t framesOversize = 0;          // offset + length beyond maxFrameBytes
+  uint64_t framesOverlapMismatch = 0;   // two copies of the same bytes differ
+  uint64_t framesLastFlagConflict = 0;  // last-packet flags name different ends
+  uint64_t framesNotJpeg = 0;           // complete, but no JPEG SOI marker
+  uint64_t framesAbandoned = 0;         // in flight when the sender restarted
   uint64_t senderRestarts = 0;
 
   uint64_t framesDropped() const {

@@ -16,8 +16,8 @@ std::optional<JpegInfo> readJpegInfo(std::span<const uint8_t> jpeg) {
     uint16_t length = reader.readU16Be();
     if (length < 2) return std::nullopt;
     // SOF0..SOF15, except DHT (C4), JPG (C8) and DAC (CC).
-    bool startOfFrame = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
-                        marker != 0xCC;
+    bool startOfFrame =
+        marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
     if (startOfFrame) {
       ByteReader segment(reader.readBytes(length - 2u));
       segment.readU8();  // precision

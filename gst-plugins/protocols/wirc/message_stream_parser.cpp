@@ -60,7 +60,8 @@ void MessageStreamParser::feed(std::span<const uint8_t> bytes, const Handler& ha
       continue;
     }
 
-    auto message = decodeBody(command, frame.subspan(kHeaderSize, frameSize - kHeaderSize - kCrcSize));
+    auto message =
+        decodeBody(command, frame.subspan(kHeaderSize, frameSize - kHeaderSize - kCrcSize));
     if (message)
       ++stats_.messages;
     else if (message.error().kind == ErrorKind::UnknownCommand)

@@ -14,8 +14,8 @@
 namespace wircam::wirc {
 
 struct StreamParserStats {
-  uint64_t messages = 0;         // decoded and valid
-  uint64_t garbageBytes = 0;     // skipped while looking for AA BB
+  uint64_t messages = 0;      // decoded and valid
+  uint64_t garbageBytes = 0;  // skipped while looking for AA BB
   uint64_t badCrc = 0;
   uint64_t unknownCommands = 0;
   uint64_t invalidMessages = 0;  // wrong length or a field rule broken

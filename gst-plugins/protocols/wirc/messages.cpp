@@ -18,24 +18,42 @@ struct BodySize {
 // Body length per command, from the spec's LEN column.
 template <typename T>
 constexpr BodySize kBodySize = {0, 0};
-template <> constexpr BodySize kBodySize<Bcsd> = {3, 3};
-template <> constexpr BodySize kBodySize<Bcsa> = {75, 75};
-template <> constexpr BodySize kBodySize<Tl> = {70, 70};
-template <> constexpr BodySize kBodySize<Dcfg> = {68, 68};
-template <> constexpr BodySize kBodySize<Ccfg> = {24, 24};
-template <> constexpr BodySize kBodySize<Fcfg> = {24, 24};
-template <> constexpr BodySize kBodySize<Wst> = {4, 4};
-template <> constexpr BodySize kBodySize<Pcd> = {24, 24};
-template <> constexpr BodySize kBodySize<Psd> = {8, 8};
-template <> constexpr BodySize kBodySize<Wcfg> = {102, 102};
-template <> constexpr BodySize kBodySize<Tlst> = {66, 66};
-template <> constexpr BodySize kBodySize<Areq> = {1, 1};
-template <> constexpr BodySize kBodySize<Agr> = {67, 67};
-template <> constexpr BodySize kBodySize<Fwup> = {16, 16};
-template <> constexpr BodySize kBodySize<Stst> = {3, 3};
-template <> constexpr BodySize kBodySize<Est> = {1, 1};
-template <> constexpr BodySize kBodySize<Extout> = {1, 255};
-template <> constexpr BodySize kBodySize<Err> = {3, 3};
+template <>
+constexpr BodySize kBodySize<Bcsd> = {3, 3};
+template <>
+constexpr BodySize kBodySize<Bcsa> = {75, 75};
+template <>
+constexpr BodySize kBodySize<Tl> = {70, 70};
+template <>
+constexpr BodySize kBodySize<Dcfg> = {68, 68};
+template <>
+constexpr BodySize kBodySize<Ccfg> = {24, 24};
+template <>
+constexpr BodySize kBodySize<Fcfg> = {24, 24};
+template <>
+constexpr BodySize kBodySize<Wst> = {4, 4};
+template <>
+constexpr BodySize kBodySize<Pcd> = {24, 24};
+template <>
+constexpr BodySize kBodySize<Psd> = {8, 8};
+template <>
+constexpr BodySize kBodySize<Wcfg> = {102, 102};
+template <>
+constexpr BodySize kBodySize<Tlst> = {66, 66};
+template <>
+constexpr BodySize kBodySize<Areq> = {1, 1};
+template <>
+constexpr BodySize kBodySize<Agr> = {67, 67};
+template <>
+constexpr BodySize kBodySize<Fwup> = {16, 16};
+template <>
+constexpr BodySize kBodySize<Stst> = {3, 3};
+template <>
+constexpr BodySize kBodySize<Est> = {1, 1};
+template <>
+constexpr BodySize kBodySize<Extout> = {1, 255};
+template <>
+constexpr BodySize kBodySize<Err> = {3, 3};
 
 ProtocolError fieldError(Command command, std::string field, std::string detail) {
   return {ErrorKind::InvalidField, static_cast<uint8_t>(command), std::move(field),
@@ -158,8 +176,8 @@ std::optional<ProtocolError> check(const Ccfg& m) {
     if (m.periods[i] != m.periods[i + 1])
       return fieldError(Command::Ccfg, channelField(i + 1, "period"),
                         "ch" + std::to_string(i + 1) + " and ch" + std::to_string(i + 2) +
-                            " must have the same period (" + std::to_string(m.periods[i]) +
-                            " vs " + std::to_string(m.periods[i + 1]) + " µs)");
+                            " must have the same period (" + std::to_string(m.periods[i]) + " vs " +
+                            std::to_string(m.periods[i + 1]) + " µs)");
   }
   return std::nullopt;
 }
@@ -343,9 +361,9 @@ Expected<Message, ProtocolError> decodeAs(uint8_t command, std::span<const uint8
       std::string expected = size.min == size.max
                                  ? std::to_string(size.min)
                                  : std::to_string(size.min) + ".." + std::to_string(size.max);
-      return unexpected(ProtocolError{
-          ErrorKind::BadLength, command, "LEN",
-          "body is " + std::to_string(body.size()) + " bytes, expected " + expected});
+      return unexpected(
+          ProtocolError{ErrorKind::BadLength, command, "LEN",
+                        "body is " + std::to_string(body.size()) + " bytes, expected " + expected});
     }
     T message;
     ByteReader reader(body);
@@ -434,26 +452,46 @@ Expected<Message, ProtocolError> decode(std::span<const uint8_t> frame) {
 
 std::string commandName(uint8_t command) {
   switch (static_cast<Command>(command)) {
-    case Command::Bcsd: return "BCSD";
-    case Command::Bcsa: return "BCSA";
-    case Command::Tl: return "TL";
-    case Command::Dcfg: return "DCFG";
-    case Command::Ccfg: return "CCFG";
-    case Command::Fcfg: return "FCFG";
-    case Command::Wst: return "WST";
-    case Command::Pcd: return "PCD";
-    case Command::Psd: return "PSD";
-    case Command::Wcfg: return "WCFG";
-    case Command::Tlr: return "TLR";
-    case Command::Tlst: return "TLST";
-    case Command::Tlend: return "TLEND";
-    case Command::Areq: return "AREQ";
-    case Command::Agr: return "AGR";
-    case Command::Fwup: return "FWUP";
-    case Command::Stst: return "STST";
-    case Command::Est: return "EST";
-    case Command::Extout: return "EXTOUT";
-    case Command::Err: return "ERR";
+    case Command::Bcsd:
+      return "BCSD";
+    case Command::Bcsa:
+      return "BCSA";
+    case Command::Tl:
+      return "TL";
+    case Command::Dcfg:
+      return "DCFG";
+    case Command::Ccfg:
+      return "CCFG";
+    case Command::Fcfg:
+      return "FCFG";
+    case Command::Wst:
+      return "WST";
+    case Command::Pcd:
+      return "PCD";
+    case Command::Psd:
+      return "PSD";
+    case Command::Wcfg:
+      return "WCFG";
+    case Command::Tlr:
+      return "TLR";
+    case Command::Tlst:
+      return "TLST";
+    case Command::Tlend:
+      return "TLEND";
+    case Command::Areq:
+      return "AREQ";
+    case Command::Agr:
+      return "AGR";
+    case Command::Fwup:
+      return "FWUP";
+    case Command::Stst:
+      return "STST";
+    case Command::Est:
+      return "EST";
+    case Command::Extout:
+      return "EXTOUT";
+    case Command::Err:
+      return "ERR";
   }
   char text[8];
   std::snprintf(text, sizeof text, "0x%02X", command);

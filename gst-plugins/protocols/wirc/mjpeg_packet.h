@@ -42,10 +42,10 @@ struct MjpegPacketHeader {
 };
 
 enum class PacketError {
-  Keepalive,     // a 4-byte version-only datagram: not an error, not data
-  TooShort,      // shorter than the 16-byte header
-  BadVersion,    // low 16 bits of version are not 0x5503
-  BadLength,     // length larger than the bytes that follow the header
+  Keepalive,   // a 4-byte version-only datagram: not an error, not data
+  TooShort,    // shorter than the 16-byte header
+  BadVersion,  // low 16 bits of version are not 0x5503
+  BadLength,   // length larger than the bytes that follow the header
 };
 
 const char* packetErrorName(PacketError error);

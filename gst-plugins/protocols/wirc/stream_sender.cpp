@@ -6,8 +6,8 @@
 
 namespace wircam::wirc {
 
-StreamSender::StreamSender(int socket, int straySocket, SocketAddress receiver,
-                           size_t fragmentSize, const Impairments& impairments)
+StreamSender::StreamSender(int socket, int straySocket, SocketAddress receiver, size_t fragmentSize,
+                           const Impairments& impairments)
     : socket_(socket),
       straySocket_(straySocket),
       receiver_(receiver),
@@ -29,8 +29,9 @@ uint32_t StreamSender::sendFrame(std::span<const uint8_t> jpeg) {
     size_t fragment = fragmentSize_;
     if (impairments_.fragmentJitter > 0) {
       auto jitter = static_cast<long>(impairments_.fragmentJitter);
-      fragment = static_cast<size_t>(std::max<long>(
-          1, static_cast<long>(fragment) + std::uniform_int_distribution<long>(-jitter, jitter)(random_)));
+      fragment = static_cast<size_t>(
+          std::max<long>(1, static_cast<long>(fragment) +
+                                std::uniform_int_distribution<long>(-jitter, jitter)(random_)));
       fragment = std::min(fragment, kMaxDatagramSize - kMjpegHeaderSize);
     }
     size_t length = std::min(fragment, jpeg.size() - offset);

@@ -26,8 +26,8 @@ struct Impairments {
   uint32_t seed = 1;
 
   bool any() const {
-    return loss > 0 || burstLoss > 0 || duplication > 0 || reorderDepth > 0 ||
-           fragmentJitter > 0 || reservedBits || strayRate > 0;
+    return loss > 0 || burstLoss > 0 || duplication > 0 || reorderDepth > 0 || fragmentJitter > 0 ||
+           reservedBits || strayRate > 0;
   }
 };
 
@@ -35,7 +35,7 @@ struct StreamSenderStats {
   uint64_t frames = 0;
   uint64_t framesWhole = 0;  // frames none of whose packets was dropped on purpose
   uint64_t datagrams = 0;    // put on the wire, duplicates included
-  uint64_t dropped = 0;     // lost on purpose (loss, burst loss)
+  uint64_t dropped = 0;      // lost on purpose (loss, burst loss)
   uint64_t duplicated = 0;
   uint64_t stray = 0;
   uint64_t sendErrors = 0;  // the kernel refused a datagram

@@ -3,9 +3,8 @@
 #include <poll.h>
 #include <sys/eventfd.h>
 #include <sys/socket.h>
-#include <unistd.h>
-
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -46,11 +45,16 @@ std::string SessionConfig::key() const {
 
 const char* sessionStateName(SessionState state) {
   switch (state) {
-    case SessionState::Connecting: return "connecting";
-    case SessionState::LoggedIn: return "logged-in";
-    case SessionState::Reconnecting: return "reconnecting";
-    case SessionState::Failed: return "failed";
-    case SessionState::Closed: return "closed";
+    case SessionState::Connecting:
+      return "connecting";
+    case SessionState::LoggedIn:
+      return "logged-in";
+    case SessionState::Reconnecting:
+      return "reconnecting";
+    case SessionState::Failed:
+      return "failed";
+    case SessionState::Closed:
+      return "closed";
   }
   return "unknown";
 }
@@ -223,8 +227,10 @@ std::optional<std::string> TransmitterSession::Impl::connectAndLogin() {
     status_.deviceName = deviceName;
   }
 
-  sendControl(Tl{.system = static_cast<uint8_t>(SystemType::PcClient), .version = {1, 0},
-                 .priority = config_.priority, .name = config_.transmitterName,
+  sendControl(Tl{.system = static_cast<uint8_t>(SystemType::PcClient),
+                 .version = {1, 0},
+                 .priority = config_.priority,
+                 .name = config_.transmitterName,
                  .statusPort = localAddress(psdSocket_.get()).port()});
   sendControl(Ccfg{config_.periods});
   sendControl(Fcfg{config_.failsafe});
@@ -265,8 +271,8 @@ std::optional<std::string> TransmitterSession::Impl::connectAndLogin() {
     streams = streamPorts_;
   }
   changed_.notify_all();
-  emit("logged in to " + device.toString() + " as connection " +
-       std::to_string(wst->connectionId) + " (" + std::to_string(wst->cameraCount) + " cameras)");
+  emit("logged in to " + device.toString() + " as connection " + std::to_string(wst->connectionId) +
+       " (" + std::to_string(wst->cameraCount) + " cameras)");
   for (const auto& message : early) handle(message);
   for (auto [camera, port] : streams) sendControl(Stst{camera, port});
   return std::nullopt;
@@ -330,7 +336,8 @@ void TransmitterSession::Impl::handle(const Message& message) {
       ++status_.errorsReceived;
       errors_.push_back(*err);
       if (errors_.size() > 16) errors_.erase(errors_.begin());
-      event = "device answered ERR " + std::to_string(err->code) + " to " + commandName(err->command);
+      event =
+          "device answered ERR " + std::to_string(err->code) + " to " + commandName(err->command);
     } else if (auto* tlst = std::get_if<Tlst>(&message)) {
       if (listComplete_) transmitters_.clear();
       listComplete_ = false;
@@ -384,7 +391,8 @@ std::shared_ptr<TransmitterSession> TransmitterSession::acquire(const SessionCon
   std::lock_guard lock(registryMutex);
   auto& entry = registry[config.key()];
   if (auto existing = entry.lock()) return existing;
-  std::shared_ptr<TransmitterSession> session(new TransmitterSession(std::make_unique<Impl>(config)));
+  std::shared_ptr<TransmitterSession> session(
+      new TransmitterSession(std::make_unique<Impl>(config)));
   entry = session;
   return session;
 }

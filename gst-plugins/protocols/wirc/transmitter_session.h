@@ -31,8 +31,8 @@ struct SessionConfig {
     return p;
   }();
   ChannelValues failsafe = neutralChannels();
-  double pcdRate = 50;                         // Hz while holding the control right
-  std::chrono::milliseconds commandTtl{250};   // older commands give way to neutral
+  double pcdRate = 50;                        // Hz while holding the control right
+  std::chrono::milliseconds commandTtl{250};  // older commands give way to neutral
   std::chrono::milliseconds loginTimeout{3000};
   bool reconnect = true;
 

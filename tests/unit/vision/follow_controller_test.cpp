@@ -24,8 +24,8 @@ TEST(PidController, IntegralRemovesASteadyErrorWithoutWindingUp) {
 TEST(PidController, DerivativeActsOnTheMeasurementNotTheSetPoint) {
   PidController pid({.kd = 1, .outputMin = -10, .outputMax = 10});
   pid.update(0, 0, 0.1);
-  EXPECT_DOUBLE_EQ(pid.update(5, 0, 0.1), 0);   // set point jump: no kick
-  EXPECT_DOUBLE_EQ(pid.update(5, 1, 0.1), -10); // measurement moved up fast
+  EXPECT_DOUBLE_EQ(pid.update(5, 0, 0.1), 0);    // set point jump: no kick
+  EXPECT_DOUBLE_EQ(pid.update(5, 1, 0.1), -10);  // measurement moved up fast
 }
 
 TEST(PulseMap, StaysWithinItsLimitsAndTheWircRange) {
@@ -44,7 +44,8 @@ TEST(FollowController, SteersTowardsATagOnTheLeftAndDrivesWhenFar) {
   FollowController control({});
   // A tag left of centre, small (far): steer left (> 1500), drive forward.
   FollowCommand command{};
-  for (int i = 0; i < 10; ++i) command = control.update({.centerX = 100, .sizePx = 20, .imageWidth = 352}, 0.066);
+  for (int i = 0; i < 10; ++i)
+    command = control.update({.centerX = 100, .sizePx = 20, .imageWidth = 352}, 0.066);
   EXPECT_GT(command.bearingRad, 0);
   EXPECT_GT(command.steeringPulse, 1500);
   EXPECT_GT(command.throttlePulse, 1500);

@@ -126,7 +126,7 @@ TEST_F(FrameAssemblerTest, AcceptsOverlappingFragmentsThatAgree) {
   std::span<const uint8_t> all(jpeg);
   push(packet(1, 0, all.subspan(0, 1500), false));
   push(packet(1, 1000, all.subspan(1000, 1500), false));  // overlaps 1000..1500
-  push(packet(1, 2000, all.subspan(2000), true));          // overlaps 2000..2500
+  push(packet(1, 2000, all.subspan(2000), true));         // overlaps 2000..2500
   ASSERT_EQ(frames_.size(), 1u);
   EXPECT_EQ(frames_[0], jpeg);
   EXPECT_EQ(stats().framesOverlapMismatch, 0u);
@@ -347,8 +347,8 @@ TEST_F(FrameAssemblerTest, SurvivesLossDuplicationAndReorderingWithoutACorruptFr
   for (uint32_t n = 0; n < 200; ++n) {
     sent.push_back(fakeJpeg(800 + random() % 6000, n));
     for (auto& d : packetizeFrame(sent.back(), n, 700)) {
-      if (random() % 100 < 3) continue;                      // loss
-      if (random() % 100 < 3) stream.push_back(d);           // duplicate
+      if (random() % 100 < 3) continue;             // loss
+      if (random() % 100 < 3) stream.push_back(d);  // duplicate
       stream.push_back(std::move(d));
     }
   }

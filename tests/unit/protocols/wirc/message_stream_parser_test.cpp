@@ -37,8 +37,8 @@ Bytes concat(std::initializer_list<Bytes> parts) {
 }
 
 const Message kWst = Wst{.connectionId = 1, .cameraCount = 2, .controlPort = 4000};
-const Message kAgr = Agr{.connectionId = 1, .priority = 3, .name = "me",
-                         .notification = AccessNotification::Granted};
+const Message kAgr = Agr{
+    .connectionId = 1, .priority = 3, .name = "me", .notification = AccessNotification::Granted};
 const Message kPsd = Psd{.batteryMillivolts = 7200, .analogMillivolts = 0, .inputs = {}};
 
 TEST_F(MessageStreamParserTest, SplitsSeveralMessagesInOneRead) {

@@ -62,7 +62,8 @@ TEST(Messages, EveryMessageRoundTrips) {
   failsafe[4] = kFailsafeHoldLast;
 
   EXPECT_EQ(roundTrip(Bcsd{.system = 2, .version = {1, 3}}), (Bcsd{2, {1, 3}}));
-  Bcsa bcsa{.hardware = {2, 1}, .software = {1, 30}, .name = std::string(64, 'n'), .serial = "SN12345"};
+  Bcsa bcsa{
+      .hardware = {2, 1}, .software = {1, 30}, .name = std::string(64, 'n'), .serial = "SN12345"};
   EXPECT_EQ(roundTrip(bcsa), bcsa);
   Tl tl{.system = 0, .version = {0, 1}, .priority = 200, .name = "wircam", .statusPort = 50123};
   EXPECT_EQ(roundTrip(tl), tl);
@@ -73,15 +74,20 @@ TEST(Messages, EveryMessageRoundTrips) {
   EXPECT_EQ(roundTrip(Pcd{pulses}), Pcd{pulses});
   Psd psd{.batteryMillivolts = 7400, .analogMillivolts = 1234, .inputs = {1, 0, 1, 0}};
   EXPECT_EQ(roundTrip(psd), psd);
-  Wcfg wcfg{.ssid = "Dension WiRC", .password = "secret", .accessPoint = false, .secured = true,
-            .channel = 11, .country = "HU"};
+  Wcfg wcfg{.ssid = "Dension WiRC",
+            .password = "secret",
+            .accessPoint = false,
+            .secured = true,
+            .channel = 11,
+            .country = "HU"};
   EXPECT_EQ(roundTrip(wcfg), wcfg);
   EXPECT_EQ(roundTrip(Tlr{}), Tlr{});
   Tlst tlst{.connectionId = 3, .priority = 9, .name = "phone"};
   EXPECT_EQ(roundTrip(tlst), tlst);
   EXPECT_EQ(roundTrip(Tlend{}), Tlend{});
   EXPECT_EQ(roundTrip(Areq{.connectionId = 7}), Areq{7});
-  Agr agr{.connectionId = 2, .priority = 5, .name = "pc", .notification = AccessNotification::Revoked};
+  Agr agr{
+      .connectionId = 2, .priority = 5, .name = "pc", .notification = AccessNotification::Revoked};
   EXPECT_EQ(roundTrip(agr), agr);
   Fwup fwup;
   for (size_t i = 0; i < fwup.md5.size(); ++i) fwup.md5[i] = static_cast<uint8_t>(0xF0 + i);
@@ -100,11 +106,25 @@ TEST(Messages, BodyLengthsMatchTheSpec) {
     size_t length;
   };
   std::vector<Case> cases = {
-      {Bcsd{}, 3},  {Bcsa{}, 75}, {Tl{}, 70},  {Dcfg{}, 68},
-      {Ccfg{filled(10000)}, 24},  {Fcfg{filled(1500)}, 24},   {Wst{}, 4},
-      {Pcd{filled(1500)}, 24},    {Psd{}, 8},  {Wcfg{}, 102}, {Tlr{}, 0},
-      {Tlst{}, 66}, {Tlend{}, 0}, {Areq{}, 1}, {Agr{}, 67},   {Fwup{}, 16},
-      {Stst{}, 3},  {Est{}, 1},   {Err{}, 3},
+      {Bcsd{}, 3},
+      {Bcsa{}, 75},
+      {Tl{}, 70},
+      {Dcfg{}, 68},
+      {Ccfg{filled(10000)}, 24},
+      {Fcfg{filled(1500)}, 24},
+      {Wst{}, 4},
+      {Pcd{filled(1500)}, 24},
+      {Psd{}, 8},
+      {Wcfg{}, 102},
+      {Tlr{}, 0},
+      {Tlst{}, 66},
+      {Tlend{}, 0},
+      {Areq{}, 1},
+      {Agr{}, 67},
+      {Fwup{}, 16},
+      {Stst{}, 3},
+      {Est{}, 1},
+      {Err{}, 3},
   };
   for (const auto& c : cases) {
     auto frame = encode(c.message);
@@ -214,9 +234,9 @@ TEST(Messages, PasswordErrorsNeverQuoteThePassword) {
 
 TEST(Messages, FullWidthTextWithoutTerminatorDecodes) {
   Bytes body(70, 'z');
-  body[0] = 0;          // sys
-  body[3] = 1;          // prio
-  body[68] = 0x13;      // status port
+  body[0] = 0;      // sys
+  body[3] = 1;      // prio
+  body[68] = 0x13;  // status port
   body[69] = 0x88;
   auto decoded = decode(frameRaw(0x11, body));
   ASSERT_TRUE(decoded.has_value());
