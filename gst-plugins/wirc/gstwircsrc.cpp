@@ -6,7 +6,9 @@
  * for camera `camera` with STST, reassembles the MJPEG-over-UDP packets and
  * pushes whole JPEG frames. Never pushes a corrupt or partial frame; every
  * dropped packet or frame is counted in `stats` and in a periodic
- * `wirc-stats` element message. Stopping sends EST and logs out.
+ * `wirc-stats` element message (which also carries the session state and
+ * the device's last status report: battery-mv, analog-mv, inputs as bits).
+ * Stopping sends EST and logs out.
  *
  * ## Example launch line
  * |[
@@ -142,6 +144,18 @@ void postStats(GstWircSrc* self) {
   {
     std::lock_guard lock(state->statsMutex);
     stats = gst::statsStructure(state->stats, state->foreignPackets);
+  }
+  // The device's latest status report rides along, for recorders and UIs.
+  auto session = state->session->status();
+  gst_structure_set(stats, "session", G_TYPE_STRING, wirc::sessionStateName(session.state),
+                    nullptr);
+  if (const auto& psd = session.lastStatus) {
+    gst_structure_set(stats, "battery-mv", G_TYPE_UINT, static_cast<guint>(psd->batteryMillivolts),
+                      "analog-mv", G_TYPE_UINT, static_cast<guint>(psd->analogMillivolts), "inputs",
+                      G_TYPE_UINT,
+                      static_cast<guint>(psd->inputs[0] | psd->inputs[1] << 1 |
+                                         psd->inputs[2] << 2 | psd->inputs[3] << 3),
+                      nullptr);
   }
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), stats));
 }

@@ -2,6 +2,7 @@
 // needs, spelled the same way so the switch to <expected> is a rename.
 #pragma once
 
+#include <type_traits>
 #include <utility>
 #include <variant>
 
@@ -22,6 +23,10 @@ class Expected {
  public:
   Expected(T value) : storage_(std::in_place_index<0>, std::move(value)) {}
   Expected(Unexpected<E> failure) : storage_(std::in_place_index<1>, std::move(failure.error)) {}
+  // unexpected("text") where E is std::string, as std::expected allows.
+  template <typename U>
+  requires(!std::is_same_v<U, E> && std::is_constructible_v<E, U>) Expected(Unexpected<U> failure)
+      : storage_(std::in_place_index<1>, E(std::move(failure.error))) {}
 
   bool has_value() const { return storage_.index() == 0; }
   explicit operator bool() const { return has_value(); }

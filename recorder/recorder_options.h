@@ -1,0 +1,38 @@
+// What wirc-recorder was asked to do, read from its command line.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/expected.h"
+
+namespace wircam::recorder {
+
+struct DeviceTarget {
+  std::string host;  // empty: discover
+  uint16_t port = 1984;
+  std::string label;  // in file names: the host, or "discovered"
+};
+
+enum class Container { Matroska, Mp4 };
+
+struct RecorderOptions {
+  std::vector<DeviceTarget> devices;
+  std::vector<int> cameras;  // default {0}
+  std::string outDir = ".";
+  double segmentSeconds = 60;
+  Container container = Container::Matroska;
+  std::string detectFamily;  // empty: no detection
+  bool follow = false;       // needs detectFamily
+  std::optional<double> duration;
+  double statusSeconds = 1;
+};
+
+// The options, or an error message naming the bad argument; --help text in
+// `usage()`.
+Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv);
+const char* usage();
+
+}  // namespace wircam::recorder

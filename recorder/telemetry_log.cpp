@@ -1,0 +1,25 @@
+#include "telemetry_log.h"
+
+namespace wircam::recorder {
+
+bool TelemetryLog::open(const std::string& segment) {
+  close();
+  auto dot = segment.rfind('.');
+  path_ = (dot == std::string::npos ? segment : segment.substr(0, dot)) + ".jsonl";
+  file_ = std::fopen(path_.c_str(), "w");
+  return file_ != nullptr;
+}
+
+void TelemetryLog::close() {
+  if (file_) std::fclose(file_);
+  file_ = nullptr;
+}
+
+void TelemetryLog::write(const std::string& json) {
+  if (!file_) return;
+  std::fputs(json.c_str(), file_);
+  std::fputc('\n', file_);
+  std::fflush(file_);
+}
+
+}  // namespace wircam::recorder

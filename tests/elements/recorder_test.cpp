@@ -1,0 +1,128 @@
+// wirc-recorder as users run it (a separate process), against the simulated
+// device: segments that play, telemetry beside them, clean finish on SIGINT.
+#include <gst/gst.h>
+#include <gst/pbutils/pbutils.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "jpeg_sequence_scene.h"
+#include "scene_frames.h"
+#include "wirc/device.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using std::chrono::milliseconds;
+
+struct Recorder {
+  fs::path out;
+  pid_t pid = -1;
+
+  Recorder(uint16_t port, std::vector<std::string> extra) {
+    out = fs::temp_directory_path() /
+          ("wirc-recorder-test-" + std::to_string(getpid()) + "-" + std::to_string(port));
+    fs::remove_all(out);
+    std::vector<std::string> args = {
+        WIRC_RECORDER, "--device", "127.0.0.1:" + std::to_string(port), "--out", out.string(),
+        "--status",    "0.5"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    pid = fork();
+    if (pid == 0) {
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      if (!freopen("/dev/null", "w", stdout)) _exit(126);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+  }
+  ~Recorder() { fs::remove_all(out); }
+
+  int wait() {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+
+  std::vector<fs::path> files(const std::string& extension) const {
+    std::vector<fs::path> found;
+    for (const auto& entry : fs::directory_iterator(out))
+      if (entry.path().extension() == extension) found.push_back(entry.path());
+    std::sort(found.begin(), found.end());
+    return found;
+  }
+};
+
+GstClockTime durationOf(const fs::path& file) {
+  GstDiscoverer* discoverer = gst_discoverer_new(10 * GST_SECOND, nullptr);
+  std::string uri = "file://" + fs::absolute(file).string();
+  GstDiscovererInfo* info = gst_discoverer_discover_uri(discoverer, uri.c_str(), nullptr);
+  GstClockTime duration = info ? gst_discoverer_info_get_duration(info) : GST_CLOCK_TIME_NONE;
+  if (info) gst_discoverer_info_unref(info);
+  g_object_unref(discoverer);
+  return duration;
+}
+
+std::unique_ptr<wirc::Device> startDevice() {
+  auto device =
+      wirc::Device::start({.port = 0, .fragmentSize = 8000},
+                          std::make_shared<sim::JpegSequenceScene>(wircam::testing::sceneFrames()));
+  EXPECT_TRUE(device.has_value());
+  return std::move(*device);
+}
+
+TEST(WircRecorder, RecordsPlayableSegmentsWithTelemetry) {
+  auto device = startDevice();
+  Recorder recorder(device->port(), {"--segment", "2", "--duration", "5"});
+  ASSERT_EQ(recorder.wait(), 0);
+  auto videos = recorder.files(".mkv");
+  ASSERT_GE(videos.size(), 2u);
+  GstClockTime total = 0;
+  for (const auto& video : videos) {
+    GstClockTime duration = durationOf(video);
+    ASSERT_TRUE(GST_CLOCK_TIME_IS_VALID(duration)) << video;
+    total += duration;
+    auto telemetry = video;
+    telemetry.replace_extension(".jsonl");
+    ASSERT_TRUE(fs::exists(telemetry)) << telemetry;
+  }
+  // About the 5 s asked for, less the start-up before the first frame.
+  EXPECT_GT(total, 3 * GST_SECOND);
+  EXPECT_LT(total, 6 * GST_SECOND);
+  std::ifstream first(recorder.files(".jsonl")[0]);
+  std::string line;
+  bool stats = false;
+  while (std::getline(first, line))
+    stats = stats || line.find("\"type\":\"stats\"") != std::string::npos;
+  EXPECT_TRUE(stats);
+}
+
+TEST(WircRecorder, SigintFinishesEveryFileAndExitsZero) {
+  auto device = startDevice();
+  Recorder recorder(device->port(), {"--segment", "60"});
+  std::this_thread::sleep_for(milliseconds(3000));
+  kill(recorder.pid, SIGINT);
+  ASSERT_EQ(recorder.wait(), 0);
+  auto videos = recorder.files(".mkv");
+  ASSERT_EQ(videos.size(), 1u);
+  GstClockTime duration = durationOf(videos[0]);
+  ASSERT_TRUE(GST_CLOCK_TIME_IS_VALID(duration));
+  EXPECT_GT(duration, GST_SECOND);
+}
+
+TEST(WircRecorder, ReportsAnUnreachableDevice) {
+  auto device = startDevice();
+  uint16_t port = device->port();
+  device.reset();
+  Recorder recorder(port, {"--duration", "3"});
+  EXPECT_EQ(recorder.wait(), 1);
+}
+
+}  // namespace
