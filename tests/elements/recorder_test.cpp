@@ -117,6 +117,20 @@ TEST(WircRecorder, SigintFinishesEveryFileAndExitsZero) {
   EXPECT_GT(duration, GST_SECOND);
 }
 
+TEST(WircRecorder, AfterKill9TheOpenSegmentPlaysUpToItsLastSecond) {
+  auto device = startDevice();
+  Recorder recorder(device->port(), {"--segment", "60"});
+  std::this_thread::sleep_for(milliseconds(4000));
+  kill(recorder.pid, SIGKILL);
+  recorder.wait();
+  auto videos = recorder.files(".mkv");
+  ASSERT_EQ(videos.size(), 1u);
+  GstClockTime duration = durationOf(videos[0]);
+  ASSERT_TRUE(GST_CLOCK_TIME_IS_VALID(duration));
+  // About 3.5 s were streamed; clusters of 1 s lose at most the last one.
+  EXPECT_GT(duration, 2 * GST_SECOND);
+}
+
 TEST(WircRecorder, ReportsAnUnreachableDevice) {
   auto device = startDevice();
   uint16_t port = device->port();
