@@ -104,6 +104,7 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
                        (stream->name + "-" + start + "-%03d." + (mp4 ? "mp4" : "mkv")))
                           .string();
       auto i = std::to_string(index++);
+      stream->muxer = "mux" + i;
       std::string host = device.host.empty() ? "" : " host=" + device.host;
       std::string port = " port=" + std::to_string(device.port);
       description += "wircsrc name=src" + i + host + port + " camera=" + std::to_string(camera) +
@@ -176,6 +177,22 @@ void Recording::handleElementMessage(GstMessage* message) {
   if (GstClock* clock = gst_element_get_clock(pipeline_)) {
     now = gst_clock_get_time(clock) - gst_element_get_base_time(pipeline_);
     gst_object_unref(clock);
+  }
+  if (type == "wirc-session") {
+    // Losses and logins of the device's session. A new login after a loss
+    // starts a new segment, so the gap falls between two files.
+    std::string event = gst_structure_get_string(s, "event");
+    std::fprintf(stderr, "\nwirc-recorder: %s: %s\n", stream->name.c_str(), event.c_str());
+    line["type"] = "session";
+    line["pts"] = now;
+    stream->telemetry.write(line.dump());
+    if (event.rfind("logged in", 0) == 0) {
+      if (GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline_), stream->muxer.c_str())) {
+        g_signal_emit_by_name(sink, "split-now");
+        gst_object_unref(sink);
+      }
+    }
+    return;
   }
   if (type == "wirc-stats") {
     gst_structure_get_uint64(s, "frames-complete", &stream->frames);

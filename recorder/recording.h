@@ -28,6 +28,7 @@ class Recording {
  private:
   struct Stream {
     std::string name;  // "<device>-cam<N>"
+    std::string muxer;  // its splitmuxsink's element name
     TelemetryLog telemetry;
     std::string segment;
     guint64 frames = 0, incomplete = 0, bytes = 0;

@@ -131,6 +131,28 @@ TEST(WircRecorder, AfterKill9TheOpenSegmentPlaysUpToItsLastSecond) {
   EXPECT_GT(duration, 2 * GST_SECOND);
 }
 
+TEST(WircRecorder, StartsANewSegmentWhenTheDeviceComesBack) {
+  auto device = startDevice();
+  uint16_t port = device->port();
+  Recorder recorder(port, {"--segment", "60"});
+  std::this_thread::sleep_for(milliseconds(2500));
+  device.reset();  // the vehicle goes away...
+  std::this_thread::sleep_for(milliseconds(1000));
+  device =
+      wirc::Device::start({.port = port, .fragmentSize = 8000},
+                          std::make_shared<sim::JpegSequenceScene>(wircam::testing::sceneFrames()))
+          .value();  // ...and comes back
+  std::this_thread::sleep_for(milliseconds(4000));
+  kill(recorder.pid, SIGINT);
+  ASSERT_EQ(recorder.wait(), 0);
+  auto videos = recorder.files(".mkv");
+  ASSERT_EQ(videos.size(), 2u);
+  for (const auto& video : videos) EXPECT_TRUE(GST_CLOCK_TIME_IS_VALID(durationOf(video))) << video;
+  std::ifstream first(recorder.files(".jsonl")[0]);
+  std::string text((std::istreambuf_iterator<char>(first)), {});
+  EXPECT_NE(text.find("connection to the device lost"), std::string::npos);
+}
+
 TEST(WircRecorder, ReportsAnUnreachableDevice) {
   auto device = startDevice();
   uint16_t port = device->port();
