@@ -23,6 +23,10 @@ JPEG frames muxed as they arrive (no re-encoding), with a telemetry sidecar
   --follow               steer the vehicle after the largest tag (needs --detect)
   --duration S           stop after S seconds
   --status S             seconds between status updates (default 1)
+  --max-bytes SIZE       keep the recordings under SIZE (e.g. 500M, 20G) by
+                         deleting the oldest finished segments
+  --min-free SIZE        delete the oldest finished segments while the disk
+                         has less than SIZE free
   -h, --help             this text
 
 Files: DIR/<device>-cam<N>-<start time>-<segment>.<mkv|mp4> and, beside each,
@@ -32,6 +36,22 @@ Files: DIR/<device>-cam<N>-<start time>-<segment>.<mkv|mp4> and, beside each,
 }
 
 namespace {
+
+// "500M", "20G", "1048576": bytes.
+std::optional<uint64_t> size(const char* text) {
+  char* end = nullptr;
+  double value = std::strtod(text, &end);
+  if (end == text || value < 0) return std::nullopt;
+  std::string unit = end;
+  double scale = unit.empty()  ? 1
+                 : unit == "K" ? 1e3
+                 : unit == "M" ? 1e6
+                 : unit == "G" ? 1e9
+                 : unit == "T" ? 1e12
+                               : 0;
+  if (scale == 0) return std::nullopt;
+  return static_cast<uint64_t>(value * scale);
+}
 
 std::optional<double> number(const char* text) {
   char* end = nullptr;
@@ -58,7 +78,19 @@ Expected<DeviceTarget, std::string> deviceTarget(const std::string& text) {
 }  // namespace
 
 Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
-  enum { kDevice = 1000, kCamera, kOut, kSegment, kFormat, kDetect, kFollow, kDuration, kStatus };
+  enum {
+    kDevice = 1000,
+    kCamera,
+    kOut,
+    kSegment,
+    kFormat,
+    kDetect,
+    kFollow,
+    kDuration,
+    kStatus,
+    kMaxBytes,
+    kMinFree
+  };
   static const option options[] = {{"device", required_argument, nullptr, kDevice},
                                    {"camera", required_argument, nullptr, kCamera},
                                    {"out", required_argument, nullptr, kOut},
@@ -68,6 +100,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"follow", no_argument, nullptr, kFollow},
                                    {"duration", required_argument, nullptr, kDuration},
                                    {"status", required_argument, nullptr, kStatus},
+                                   {"max-bytes", required_argument, nullptr, kMaxBytes},
+                                   {"min-free", required_argument, nullptr, kMinFree},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};
   RecorderOptions o;
@@ -127,6 +161,14 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
         auto seconds = number(optarg);
         if (!seconds || *seconds <= 0) return unexpected(std::string("--status wants seconds > 0"));
         o.statusSeconds = *seconds;
+        break;
+      }
+      case kMaxBytes:
+      case kMinFree: {
+        auto bytes = size(optarg);
+        if (!bytes)
+          return unexpected(std::string("a size is a number with K, M, G or T, like 500M"));
+        (opt == kMaxBytes ? o.maxBytes : o.minFree) = *bytes;
         break;
       }
       default:

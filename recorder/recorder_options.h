@@ -28,6 +28,8 @@ struct RecorderOptions {
   bool follow = false;       // needs detectFamily
   std::optional<double> duration;
   double statusSeconds = 1;
+  uint64_t maxBytes = 0;  // retention: 0 = unlimited
+  uint64_t minFree = 0;
 };
 
 // The options, or an error message naming the bad argument; --help text in

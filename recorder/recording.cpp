@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <set>
 
 namespace wircam::recorder {
 
@@ -73,7 +74,12 @@ std::string fileSafe(std::string text) {
 
 }  // namespace
 
-Recording::Recording(RecorderOptions options) : options_(std::move(options)) {}
+Recording::Recording(RecorderOptions options)
+    : options_(std::move(options)),
+      retention_(options_.outDir, {options_.maxBytes, options_.minFree},
+                 [](const std::string& line) {
+                   std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str());
+                 }) {}
 
 Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     const RecorderOptions& options) {
@@ -170,7 +176,12 @@ void Recording::handleElementMessage(GstMessage* message) {
       std::fprintf(stderr, "wirc-recorder: cannot write %s\n", stream->telemetry.path().c_str());
     return;
   }
-  if (type == "splitmuxsink-fragment-closed") return;
+  if (type == "splitmuxsink-fragment-closed") {
+    std::set<std::string> open;
+    for (const auto& s : streams_) open.insert(s->segment);
+    retention_.enforce(open);
+    return;
+  }
 
   nlohmann::json line = toJson(s);
   GstClockTime now = GST_CLOCK_TIME_NONE;

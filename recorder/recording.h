@@ -12,6 +12,7 @@
 
 #include "common/expected.h"
 #include "recorder_options.h"
+#include "retention.h"
 #include "telemetry_log.h"
 
 namespace wircam::recorder {
@@ -27,7 +28,7 @@ class Recording {
 
  private:
   struct Stream {
-    std::string name;  // "<device>-cam<N>"
+    std::string name;   // "<device>-cam<N>"
     std::string muxer;  // its splitmuxsink's element name
     TelemetryLog telemetry;
     std::string segment;
@@ -45,6 +46,7 @@ class Recording {
   Stream* streamOf(GstMessage* message);
 
   RecorderOptions options_;
+  Retention retention_;
   GstElement* pipeline_ = nullptr;
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Stream>> streams_;

@@ -153,6 +153,26 @@ TEST(WircRecorder, StartsANewSegmentWhenTheDeviceComesBack) {
   EXPECT_NE(text.find("connection to the device lost"), std::string::npos);
 }
 
+TEST(WircRecorder, DeletesTheOldestSegmentsToStayUnderMaxBytes) {
+  auto device = startDevice();
+  Recorder recorder(device->port(), {"--segment", "1", "--duration", "6", "--max-bytes", "400K"});
+  ASSERT_EQ(recorder.wait(), 0);
+  uint64_t total = 0, largest = 0;
+  for (const auto& entry : fs::directory_iterator(recorder.out)) {
+    total += entry.file_size();
+    largest = std::max<uint64_t>(largest, entry.file_size());
+  }
+  auto videos = recorder.files(".mkv");
+  ASSERT_FALSE(videos.empty());
+  EXPECT_LT(videos.size(), 5u);  // about 6 one-second segments were made
+  // Checked when a segment closes: at most the newest one beyond the cap.
+  EXPECT_LE(total, 400000 + 2 * largest);
+  // The oldest went first: segment 000 is gone.
+  EXPECT_EQ(videos.front().string().find("-000.mkv"), std::string::npos) << videos.front();
+  for (const auto& video : videos)
+    EXPECT_TRUE(fs::exists(fs::path(video).replace_extension(".jsonl")));
+}
+
 TEST(WircRecorder, ReportsAnUnreachableDevice) {
   auto device = startDevice();
   uint16_t port = device->port();

@@ -1,0 +1,61 @@
+#include "retention.h"
+
+#include <sys/statvfs.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <vector>
+
+namespace wircam::recorder {
+
+namespace fs = std::filesystem;
+
+Retention::Retention(std::string folder, RetentionLimits limits, Logger logger)
+    : folder_(std::move(folder)), limits_(limits), logger_(std::move(logger)) {}
+
+namespace {
+
+uint64_t freeBytes(const std::string& folder) {
+  struct statvfs info {};
+  if (statvfs(folder.c_str(), &info) != 0) return UINT64_MAX;
+  return static_cast<uint64_t>(info.f_bavail) * info.f_frsize;
+}
+
+struct Segment {
+  fs::path video;
+  fs::file_time_type written;
+  uint64_t bytes;  // video and telemetry
+};
+
+}  // namespace
+
+void Retention::enforce(const std::set<std::string>& open) {
+  if (!active()) return;
+  std::vector<Segment> segments;
+  uint64_t total = 0;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(folder_, error)) {
+    auto extension = entry.path().extension();
+    if (extension != ".mkv" && extension != ".mp4") continue;
+    auto sidecar = fs::path(entry.path()).replace_extension(".jsonl");
+    uint64_t bytes =
+        entry.file_size(error) + (fs::exists(sidecar) ? fs::file_size(sidecar, error) : 0);
+    total += bytes;
+    if (!open.count(entry.path().string()))
+      segments.push_back({entry.path(), entry.last_write_time(error), bytes});
+  }
+  std::sort(segments.begin(), segments.end(),
+            [](const Segment& a, const Segment& b) { return a.written < b.written; });
+  for (const auto& segment : segments) {
+    bool overSize = limits_.maxBytes > 0 && total > limits_.maxBytes;
+    bool underFree = limits_.minFree > 0 && freeBytes(folder_) < limits_.minFree;
+    if (!overSize && !underFree) break;
+    fs::remove(segment.video, error);
+    fs::remove(fs::path(segment.video).replace_extension(".jsonl"), error);
+    total -= segment.bytes;
+    logger_("deleted " + segment.video.filename().string() +
+            (overSize ? " (over --max-bytes)" : " (under --min-free)"));
+  }
+}
+
+}  // namespace wircam::recorder
