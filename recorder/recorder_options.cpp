@@ -1,8 +1,10 @@
 #include "recorder_options.h"
 
 #include <getopt.h>
+#include <glib.h>
 
 #include <cstdlib>
+#include <memory>
 
 namespace wircam::recorder {
 
@@ -15,6 +17,7 @@ JPEG frames muxed as they arrive (no re-encoding), with a telemetry sidecar
 
   --device HOST[:PORT]   a device to record (default port 1984); repeatable.
                          Without --device the device is found by discovery.
+  --config FILE          read devices and options from an INI file (below)
   --camera N             camera to record (default 0); repeatable
   --out DIR              where the files go (created if missing)
   --segment S            seconds per segment (default 60)
@@ -28,6 +31,18 @@ JPEG frames muxed as they arrive (no re-encoding), with a telemetry sidecar
   --min-free SIZE        delete the oldest finished segments while the disk
                          has less than SIZE free
   -h, --help             this text
+
+Config file (GKeyFile/INI): a [recorder] group with the long options as keys
+(out, segment, format, detect, follow, max-bytes, min-free, status), and one
+[device NAME] group per vehicle with host, port, cameras (e.g. 0;1) and follow:
+
+  [recorder]
+  out=recordings
+  detect=tag36h11
+  [device rover]
+  host=192.168.1.1
+  cameras=0;1
+  follow=true
 
 Files: DIR/<device>-cam<N>-<start time>-<segment>.<mkv|mp4> and, beside each,
 <same name>.jsonl with one JSON object per event: {"pts": running time in ns,
@@ -75,112 +90,178 @@ Expected<DeviceTarget, std::string> deviceTarget(const std::string& text) {
   return target;
 }
 
+// Applies one option given by its long name (from the command line or the
+// config file's [recorder] group).
+std::optional<std::string> applyOption(RecorderOptions& o, const std::string& name,
+                                       const char* value);
+
+Expected<std::vector<DeviceTarget>, std::string> loadConfig(const char* path, RecorderOptions& o) {
+  std::unique_ptr<GKeyFile, decltype(&g_key_file_free)> file(g_key_file_new(), g_key_file_free);
+  GError* error = nullptr;
+  if (!g_key_file_load_from_file(file.get(), path, G_KEY_FILE_NONE, &error)) {
+    std::string message = std::string("cannot read --config ") + path + ": " + error->message;
+    g_error_free(error);
+    return unexpected(message);
+  }
+  std::vector<DeviceTarget> devices;
+  gsize count = 0;
+  std::unique_ptr<gchar*, decltype(&g_strfreev)> groups(g_key_file_get_groups(file.get(), &count),
+                                                        g_strfreev);
+  for (gsize g = 0; g < count; ++g) {
+    std::string group = groups.get()[g];
+    gsize keyCount = 0;
+    std::unique_ptr<gchar*, decltype(&g_strfreev)> keys(
+        g_key_file_get_keys(file.get(), group.c_str(), &keyCount, nullptr), g_strfreev);
+    auto value = [&](const char* key) -> std::string {
+      gchar* text = g_key_file_get_string(file.get(), group.c_str(), key, nullptr);
+      std::string out = text ? text : "";
+      g_free(text);
+      return out;
+    };
+    if (group == "recorder") {
+      for (gsize k = 0; k < keyCount; ++k) {
+        std::string key = keys.get()[k];
+        if (auto problem = applyOption(o, key, value(key.c_str()).c_str()))
+          return unexpected(std::string(path) + " [recorder] " + key + ": " + *problem);
+      }
+    } else if (group.rfind("device ", 0) == 0) {
+      DeviceTarget device;
+      device.label = group.substr(7);
+      for (gsize k = 0; k < keyCount; ++k) {
+        std::string key = keys.get()[k];
+        std::string text = value(key.c_str());
+        auto where = std::string(path) + " [" + group + "] " + key;
+        if (key == "host") {
+          device.host = text;
+        } else if (key == "port") {
+          auto port = number(text.c_str());
+          if (!port || *port < 1 || *port > 65535)
+            return unexpected(where + ": a port is 1..65535");
+          device.port = static_cast<uint16_t>(*port);
+        } else if (key == "cameras") {
+          gsize n = 0;
+          std::unique_ptr<gint, decltype(&g_free)> list(
+              g_key_file_get_integer_list(file.get(), group.c_str(), "cameras", &n, nullptr),
+              g_free);
+          if (!list) return unexpected(where + ": a list like 0;1");
+          for (gsize i = 0; i < n; ++i) device.cameras.push_back(list.get()[i]);
+        } else if (key == "follow") {
+          device.follow = text == "true" || text == "1";
+        } else {
+          return unexpected(where + ": unknown key (host, port, cameras, follow)");
+        }
+      }
+      if (device.host.empty()) return unexpected(std::string(path) + " [" + group + "] needs host");
+      devices.push_back(std::move(device));
+    } else {
+      return unexpected(std::string(path) + ": unknown group [" + group +
+                        "] ([recorder] or [device NAME])");
+    }
+  }
+  return devices;
+}
+
+std::optional<std::string> applyOption(RecorderOptions& o, const std::string& name,
+                                       const char* value) {
+  if (name == "out") {
+    o.outDir = value;
+  } else if (name == "segment") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 1) return "seconds >= 1";
+    o.segmentSeconds = *seconds;
+  } else if (name == "format") {
+    if (std::string(value) == "mkv")
+      o.container = Container::Matroska;
+    else if (std::string(value) == "mp4")
+      o.container = Container::Mp4;
+    else
+      return "mkv or mp4";
+  } else if (name == "detect") {
+    o.detectFamily = value;
+  } else if (name == "follow") {
+    o.follow = std::string(value) != "false" && std::string(value) != "0";
+  } else if (name == "duration") {
+    auto seconds = number(value);
+    if (!seconds || *seconds <= 0) return "seconds > 0";
+    o.duration = *seconds;
+  } else if (name == "status") {
+    auto seconds = number(value);
+    if (!seconds || *seconds <= 0) return "seconds > 0";
+    o.statusSeconds = *seconds;
+  } else if (name == "max-bytes" || name == "min-free") {
+    auto bytes = size(value);
+    if (!bytes) return "a size like 500M or 20G";
+    (name == "max-bytes" ? o.maxBytes : o.minFree) = *bytes;
+  } else if (name == "camera") {
+    auto camera = number(value);
+    if (!camera || *camera < 0 || *camera > 255) return "0..255";
+    o.cameras.push_back(static_cast<int>(*camera));
+  } else {
+    return "unknown option";
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
-  enum {
-    kDevice = 1000,
-    kCamera,
-    kOut,
-    kSegment,
-    kFormat,
-    kDetect,
-    kFollow,
-    kDuration,
-    kStatus,
-    kMaxBytes,
-    kMinFree
-  };
+  enum { kDevice = 1000, kConfig, kValue };
+  // Every other long option is applied by applyOption() under its own name.
   static const option options[] = {{"device", required_argument, nullptr, kDevice},
-                                   {"camera", required_argument, nullptr, kCamera},
-                                   {"out", required_argument, nullptr, kOut},
-                                   {"segment", required_argument, nullptr, kSegment},
-                                   {"format", required_argument, nullptr, kFormat},
-                                   {"detect", required_argument, nullptr, kDetect},
-                                   {"follow", no_argument, nullptr, kFollow},
-                                   {"duration", required_argument, nullptr, kDuration},
-                                   {"status", required_argument, nullptr, kStatus},
-                                   {"max-bytes", required_argument, nullptr, kMaxBytes},
-                                   {"min-free", required_argument, nullptr, kMinFree},
+                                   {"config", required_argument, nullptr, kConfig},
+                                   {"camera", required_argument, nullptr, kValue},
+                                   {"out", required_argument, nullptr, kValue},
+                                   {"segment", required_argument, nullptr, kValue},
+                                   {"format", required_argument, nullptr, kValue},
+                                   {"detect", required_argument, nullptr, kValue},
+                                   {"follow", no_argument, nullptr, kValue},
+                                   {"duration", required_argument, nullptr, kValue},
+                                   {"status", required_argument, nullptr, kValue},
+                                   {"max-bytes", required_argument, nullptr, kValue},
+                                   {"min-free", required_argument, nullptr, kValue},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};
   RecorderOptions o;
-  bool outGiven = false;
+  o.outDir.clear();
   optind = 1;
-  int opt;
-  while ((opt = getopt_long(argc, argv, "h", options, nullptr)) != -1) {
+  int opt, index = 0;
+  while ((opt = getopt_long(argc, argv, "h", options, &index)) != -1) {
     switch (opt) {
       case 'h':
-        return unexpected(std::string("help"));
+        return unexpected("help");
       case kDevice: {
         auto target = deviceTarget(optarg);
         if (!target) return unexpected(target.error());
         o.devices.push_back(*target);
         break;
       }
-      case kCamera: {
-        auto camera = number(optarg);
-        if (!camera || *camera < 0 || *camera > 255)
-          return unexpected(std::string("--camera wants 0..255"));
-        o.cameras.push_back(static_cast<int>(*camera));
+      case kConfig: {
+        auto devices = loadConfig(optarg, o);
+        if (!devices) return unexpected(devices.error());
+        o.devices.insert(o.devices.end(), devices->begin(), devices->end());
         break;
       }
-      case kOut:
-        o.outDir = optarg;
-        outGiven = true;
-        break;
-      case kSegment: {
-        auto seconds = number(optarg);
-        if (!seconds || *seconds < 1)
-          return unexpected(std::string("--segment wants seconds >= 1"));
-        o.segmentSeconds = *seconds;
-        break;
-      }
-      case kFormat:
-        if (std::string(optarg) == "mkv")
-          o.container = Container::Matroska;
-        else if (std::string(optarg) == "mp4")
-          o.container = Container::Mp4;
-        else
-          return unexpected(std::string("--format is mkv or mp4"));
-        break;
-      case kDetect:
-        o.detectFamily = optarg;
-        break;
-      case kFollow:
-        o.follow = true;
-        break;
-      case kDuration: {
-        auto seconds = number(optarg);
-        if (!seconds || *seconds <= 0)
-          return unexpected(std::string("--duration wants seconds > 0"));
-        o.duration = *seconds;
-        break;
-      }
-      case kStatus: {
-        auto seconds = number(optarg);
-        if (!seconds || *seconds <= 0) return unexpected(std::string("--status wants seconds > 0"));
-        o.statusSeconds = *seconds;
-        break;
-      }
-      case kMaxBytes:
-      case kMinFree: {
-        auto bytes = size(optarg);
-        if (!bytes)
-          return unexpected(std::string("a size is a number with K, M, G or T, like 500M"));
-        (opt == kMaxBytes ? o.maxBytes : o.minFree) = *bytes;
+      case kValue: {
+        std::string name = options[index].name;
+        if (auto problem = applyOption(o, name, optarg ? optarg : "true"))
+          return unexpected("--" + name + ": " + *problem);
         break;
       }
       default:
-        return unexpected(std::string("unknown option"));
+        return unexpected("unknown option");
     }
   }
   if (optind < argc) return unexpected(std::string("unexpected argument '") + argv[optind] + "'");
-  if (!outGiven) return unexpected(std::string("--out DIR is needed"));
-  if (o.follow && o.detectFamily.empty())
-    return unexpected(std::string("--follow needs --detect FAMILY"));
+  if (o.outDir.empty()) return unexpected("--out DIR (or out= in the config) is needed");
+  if (o.follow && o.detectFamily.empty()) return unexpected("--follow needs --detect FAMILY");
   if (o.devices.empty()) o.devices.push_back({"", 1984, "discovered"});
   if (o.cameras.empty()) o.cameras.push_back(0);
+  for (auto& device : o.devices) {
+    if (device.cameras.empty()) device.cameras = o.cameras;
+    if (!device.follow) device.follow = o.follow;
+    if (*device.follow && o.detectFamily.empty())
+      return unexpected("device " + device.label + " follows, which needs detect=FAMILY");
+  }
   return o;
 }
 

@@ -13,7 +13,9 @@ namespace wircam::recorder {
 struct DeviceTarget {
   std::string host;  // empty: discover
   uint16_t port = 1984;
-  std::string label;  // in file names: the host, or "discovered"
+  std::string label;           // in file names: the host, or the config section's name
+  std::vector<int> cameras;    // empty: the recorder-wide --camera list
+  std::optional<bool> follow;  // unset: the recorder-wide --follow
 };
 
 enum class Container { Matroska, Mp4 };
@@ -33,7 +35,8 @@ struct RecorderOptions {
 };
 
 // The options, or an error message naming the bad argument; --help text in
-// `usage()`.
+// `usage()`. `--config FILE` reads a GKeyFile first; options given on the
+// command line after it override its [recorder] group.
 Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv);
 const char* usage();
 

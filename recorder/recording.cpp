@@ -103,7 +103,7 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
   size_t index = 0;
   for (const auto& device : options.devices) {
     bool controlled = false;
-    for (int camera : options.cameras) {
+    for (int camera : device.cameras) {
       auto stream = std::make_unique<Stream>();
       stream->name = fileSafe(device.label) + "-cam" + std::to_string(camera);
       auto location = (std::filesystem::path(options.outDir) /
@@ -125,7 +125,7 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
             "t" + i +
             ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=det" +
             i + " quad-decimate=1 family=" + options.detectFamily;
-        if (options.follow && !controlled) {
+        if (*device.follow && !controlled) {
           description += " ! wirccontrol name=ctl" + i + host + port;
           controlled = true;  // one controller per vehicle: the first camera's
         }

@@ -25,13 +25,17 @@ struct Recorder {
   fs::path out;
   pid_t pid = -1;
 
+  // Records from 127.0.0.1:port into a fresh folder; with port 0 the
+  // device and the folder come from `extra` alone.
   Recorder(uint16_t port, std::vector<std::string> extra) {
     out = fs::temp_directory_path() /
           ("wirc-recorder-test-" + std::to_string(getpid()) + "-" + std::to_string(port));
     fs::remove_all(out);
-    std::vector<std::string> args = {
-        WIRC_RECORDER, "--device", "127.0.0.1:" + std::to_string(port), "--out", out.string(),
-        "--status",    "0.5"};
+    std::vector<std::string> args = {WIRC_RECORDER, "--status", "0.5"};
+    if (port != 0) {
+      args.insert(args.end(),
+                  {"--device", "127.0.0.1:" + std::to_string(port), "--out", out.string()});
+    }
     args.insert(args.end(), extra.begin(), extra.end());
     pid = fork();
     if (pid == 0) {
@@ -171,6 +175,34 @@ TEST(WircRecorder, DeletesTheOldestSegmentsToStayUnderMaxBytes) {
   EXPECT_EQ(videos.front().string().find("-000.mkv"), std::string::npos) << videos.front();
   for (const auto& video : videos)
     EXPECT_TRUE(fs::exists(fs::path(video).replace_extension(".jsonl")));
+}
+
+TEST(WircRecorder, TakesItsDevicesFromAConfigFile) {
+  auto device = startDevice();
+  auto folder = fs::temp_directory_path() / ("wirc-recorder-config-" + std::to_string(getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  auto config = folder / "recorder.ini";
+  std::ofstream(config) << "[recorder]\nout=" << (folder / "out").string()
+                        << "\nsegment=60\n\n[device rover]\nhost=127.0.0.1\nport=" << device->port()
+                        << "\ncameras=0\n";
+  Recorder recorder(0, {"--config", config.string(), "--duration", "3"});
+  ASSERT_EQ(recorder.wait(), 0);
+  std::vector<fs::path> videos;
+  for (const auto& entry : fs::directory_iterator(folder / "out"))
+    if (entry.path().extension() == ".mkv") videos.push_back(entry.path());
+  ASSERT_EQ(videos.size(), 1u);
+  EXPECT_EQ(videos[0].filename().string().rfind("rover-cam0-", 0), 0u) << videos[0];
+  fs::remove_all(folder);
+}
+
+TEST(WircRecorder, RejectsABadConfigFileNamingTheProblem) {
+  auto config =
+      fs::temp_directory_path() / ("wirc-recorder-bad-" + std::to_string(getpid()) + ".ini");
+  std::ofstream(config) << "[device rover]\nport=99999\n";
+  Recorder recorder(0, {"--config", config.string(), "--out", "/tmp"});
+  EXPECT_EQ(recorder.wait(), 2);
+  fs::remove(config);
 }
 
 TEST(WircRecorder, ReportsAnUnreachableDevice) {
