@@ -21,7 +21,7 @@ JPEG frames muxed as they arrive (no re-encoding), with a telemetry sidecar
   --camera N             camera to record (default 0); repeatable
   --out DIR              where the files go (created if missing)
   --segment S            seconds per segment (default 60)
-  --format mkv|mp4       container (default mkv: Matroska)
+  --format mkv           container: Matroska (MP4 waits for H.264 transcoding)
   --detect FAMILY        find AprilTags (e.g. tag36h11); detections go to telemetry
   --follow               steer the vehicle after the largest tag (needs --detect)
   --duration S           stop after S seconds
@@ -44,7 +44,7 @@ Config file (GKeyFile/INI): a [recorder] group with the long options as keys
   cameras=0;1
   follow=true
 
-Files: DIR/<device>-cam<N>-<start time>-<segment>.<mkv|mp4> and, beside each,
+Files: DIR/<device>-cam<N>-<start time>-<segment>.mkv and, beside each,
 <same name>.jsonl with one JSON object per event: {"pts": running time in ns,
 "type": "psd"|"detections"|"control"|"stats", ...}.
 )";
@@ -170,12 +170,10 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     if (!seconds || *seconds < 1) return "seconds >= 1";
     o.segmentSeconds = *seconds;
   } else if (name == "format") {
-    if (std::string(value) == "mkv")
-      o.container = Container::Matroska;
-    else if (std::string(value) == "mp4")
-      o.container = Container::Mp4;
-    else
-      return "mkv or mp4";
+    if (std::string(value) == "mp4")
+      return "MP4 cannot carry the camera's JPEG frames as they are: it waits for H.264 "
+             "transcoding, which is not built yet; use mkv";
+    if (std::string(value) != "mkv") return "mkv (mp4 comes with H.264 transcoding)";
   } else if (name == "detect") {
     o.detectFamily = value;
   } else if (name == "follow") {

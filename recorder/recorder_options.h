@@ -18,14 +18,11 @@ struct DeviceTarget {
   std::optional<bool> follow;  // unset: the recorder-wide --follow
 };
 
-enum class Container { Matroska, Mp4 };
-
 struct RecorderOptions {
   std::vector<DeviceTarget> devices;
   std::vector<int> cameras;  // default {0}
   std::string outDir = ".";
   double segmentSeconds = 60;
-  Container container = Container::Matroska;
   std::string detectFamily;  // empty: no detection
   bool follow = false;       // needs detectFamily
   std::optional<double> duration;

@@ -90,14 +90,11 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     return unexpected("cannot write into '" + options.outDir + "'");
 
   std::unique_ptr<Recording> recording(new Recording(options));
-  bool mp4 = options.container == Container::Mp4;
-  // Crash safety: Matroska clusters of at most 1 s, or MP4 fragments of 1 s,
-  // so a killed recorder leaves every closed segment whole and the open one
-  // playable up to its last second.
+  // Crash safety: clusters of at most 1 s, so a killed recorder leaves every
+  // closed segment whole and the open one playable up to its last second.
   std::string muxer =
-      mp4 ? "muxer-factory=mp4mux muxer-properties=\"properties,fragment-duration=(uint)1000\""
-          : "muxer-factory=matroskamux "
-            "muxer-properties=\"properties,max-cluster-duration=(gint64)1000000000\"";
+      "muxer-factory=matroskamux "
+      "muxer-properties=\"properties,max-cluster-duration=(gint64)1000000000\"";
   std::string start = startTime();
   std::string description;
   size_t index = 0;
@@ -106,9 +103,9 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     for (int camera : device.cameras) {
       auto stream = std::make_unique<Stream>();
       stream->name = fileSafe(device.label) + "-cam" + std::to_string(camera);
-      auto location = (std::filesystem::path(options.outDir) /
-                       (stream->name + "-" + start + "-%03d." + (mp4 ? "mp4" : "mkv")))
-                          .string();
+      auto location =
+          (std::filesystem::path(options.outDir) / (stream->name + "-" + start + "-%03d.mkv"))
+              .string();
       auto i = std::to_string(index++);
       stream->muxer = "mux" + i;
       std::string host = device.host.empty() ? "" : " host=" + device.host;

@@ -36,7 +36,7 @@ void Retention::enforce(const std::set<std::string>& open) {
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(folder_, error)) {
     auto extension = entry.path().extension();
-    if (extension != ".mkv" && extension != ".mp4") continue;
+    if (extension != ".mkv") continue;
     auto sidecar = fs::path(entry.path()).replace_extension(".jsonl");
     uint64_t bytes =
         entry.file_size(error) + (fs::exists(sidecar) ? fs::file_size(sidecar, error) : 0);
