@@ -194,7 +194,11 @@ void Recording::handleElementMessage(GstMessage* message) {
     line["type"] = "session";
     line["pts"] = now;
     stream->telemetry.write(line.dump());
-    if (event.rfind("logged in", 0) == 0) {
+    // Only a login after a loss splits: the first login's event may or may
+    // not arrive, depending on when wircsrc began listening.
+    if (event.find("lost") != std::string::npos) stream->lost = true;
+    if (event.rfind("logged in", 0) == 0 && stream->lost) {
+      stream->lost = false;
       if (GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline_), stream->muxer.c_str())) {
         g_signal_emit_by_name(sink, "split-now");
         gst_object_unref(sink);

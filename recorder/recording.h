@@ -35,6 +35,7 @@ class Recording {
     guint64 frames = 0, incomplete = 0, bytes = 0;
     guint64 lastFrames = 0, lastBytes = 0;
     guint batteryMv = 0;
+    bool lost = false;  // the device went away; the next login starts a segment
   };
 
   explicit Recording(RecorderOptions options);
