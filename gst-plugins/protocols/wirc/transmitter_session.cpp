@@ -81,7 +81,6 @@ class TransmitterSession::Impl {
   SessionStatus status_;
   std::optional<SocketAddress> device_;
   std::optional<SocketAddress> controlAddress_;
-  std::set<uint8_t> cameras_;
   std::map<uint8_t, uint16_t> streamPorts_;
   ChannelValues command_ = neutralChannels();
   Clock::time_point commandTime_{};
@@ -183,7 +182,7 @@ void TransmitterSession::Impl::run() {
   std::set<uint8_t> cameras;
   {
     std::lock_guard lock(mutex_);
-    cameras = cameras_;
+    for (const auto& [camera, port] : streamPorts_) cameras.insert(camera);
   }
   for (uint8_t camera : cameras) sendControl(Est{camera});
   {
@@ -426,7 +425,6 @@ void TransmitterSession::startStream(uint8_t camera, uint16_t port) {
   {
     std::lock_guard lock(impl_->mutex_);
     impl_->streamPorts_[camera] = port;
-    impl_->cameras_.insert(camera);
   }
   impl_->sendControl(Stst{camera, port});
 }
@@ -435,7 +433,6 @@ void TransmitterSession::stopStream(uint8_t camera) {
   {
     std::lock_guard lock(impl_->mutex_);
     impl_->streamPorts_.erase(camera);
-    impl_->cameras_.erase(camera);
   }
   impl_->sendControl(Est{camera});
 }
