@@ -113,6 +113,7 @@ struct WircControlState {
   bool settingsChanged = true;
 
   // Streaming thread only.
+  Settings active;  // the settings in use, refreshed when one changes
   std::shared_ptr<wirc::TransmitterSession> session;
   std::optional<vision::FollowController> controller;
   std::optional<Clock::time_point> lastBuffer;
@@ -224,15 +225,18 @@ static gboolean gst_wirc_control_stop(GstBaseTransform* transform) {
 static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, GstBuffer* buffer) {
   auto* self = GST_WIRC_CONTROL(transform);
   auto* state = self->state;
-  Settings settings;
-  bool changed;
+  bool changed = !state->controller;
   {
+    // Copied only when a property changed, not per frame.
     gst::GLibLocker lock(self);
-    settings = state->settings;
-    changed = state->settingsChanged;
-    state->settingsChanged = false;
+    if (state->settingsChanged || changed) {
+      state->active = state->settings;
+      state->settingsChanged = false;
+      changed = true;
+    }
   }
-  if (changed || !state->controller) state->controller.emplace(followConfig(settings));
+  const Settings& settings = state->active;
+  if (changed) state->controller.emplace(followConfig(settings));
 
   auto now = Clock::now();
   double dt =

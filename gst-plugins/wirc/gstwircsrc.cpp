@@ -329,7 +329,7 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
 
   while (state->ready.empty()) {
     // After a reconnect the device streams from a new port.
-    auto logins = state->session->status().logins;
+    auto logins = state->session->logins();
     if (logins != state->sessionLogins) {
       state->sessionLogins = logins;
       state->senderPort.reset();

@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "child_process.h"
 #include "synthetic_jpeg.h"
 
 namespace {
@@ -35,20 +36,9 @@ double cpuSeconds() {
          (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6;
 }
 
-pid_t spawn(const std::string& command) {
-  pid_t pid = fork();
-  if (pid == 0) {
-    setpgid(0, 0);
-    execl("/bin/sh", "sh", "-c", ("exec " + command + " >/dev/null 2>&1").c_str(), nullptr);
-    _exit(127);
-  }
-  return pid;
-}
+using wircam::bench::spawn;
 
-void stop(pid_t pid) {
-  kill(-pid, SIGTERM);
-  waitpid(pid, nullptr, 0);
-}
+void stop(pid_t pid) { wircam::bench::stopGroup(pid, SIGTERM); }
 
 struct Result {
   double cpuPerFrameUs = 0;

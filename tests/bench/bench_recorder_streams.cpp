@@ -19,21 +19,14 @@
 #include <thread>
 #include <vector>
 
+#include "child_process.h"
 #include "synthetic_jpeg.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-pid_t spawn(const std::string& command, const std::string& output = "/dev/null") {
-  pid_t pid = fork();
-  if (pid == 0) {
-    setpgid(0, 0);
-    execl("/bin/sh", "sh", "-c", ("exec " + command + " >" + output + " 2>/dev/null").c_str(), nullptr);
-    _exit(127);
-  }
-  return pid;
-}
+using wircam::bench::spawn;
 
 struct Usage {
   double cpuSeconds = 0;
@@ -44,22 +37,26 @@ Usage waitFor(pid_t pid) {
   int status = 0;
   rusage usage{};
   wait4(pid, &status, 0, &usage);
-  return {usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6,
+  return {usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
+              (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6,
           usage.ru_maxrss};
 }
 
 int framesIn(const fs::path& file) {
-  std::string description = "filesrc location=\"" + file.string() + "\" ! matroskademux ! fakesink name=sink";
+  std::string description =
+      "filesrc location=\"" + file.string() + "\" ! matroskademux ! fakesink name=sink";
   GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
   GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
   static int count;
   count = 0;
   g_object_set(sink, "signal-handoffs", TRUE, nullptr);
-  g_signal_connect(sink, "handoff", G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, gpointer) { ++count; }), nullptr);
+  g_signal_connect(sink, "handoff",
+                   G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, gpointer) { ++count; }),
+                   nullptr);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   GstBus* bus = gst_element_get_bus(pipeline);
-  if (GstMessage* m = gst_bus_timed_pop_filtered(bus, 30 * GST_SECOND,
-                                                 static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR)))
+  if (GstMessage* m = gst_bus_timed_pop_filtered(
+          bus, 30 * GST_SECOND, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR)))
     gst_message_unref(m);
   gst_object_unref(bus);
   gst_element_set_state(pipeline, GST_STATE_NULL);
@@ -80,7 +77,8 @@ int framesSent(const fs::path& summary) {
   std::ifstream in(summary);
   std::string line;
   while (std::getline(in, line))
-    if (line.find("frames sent") != std::string::npos) return std::atoi(line.substr(line.find("sent") + 4).c_str());
+    if (line.find("frames sent") != std::string::npos)
+      return std::atoi(line.substr(line.find("sent") + 4).c_str());
   return 0;
 }
 
@@ -101,7 +99,8 @@ int main(int argc, char** argv) {
     char name[16];
     std::snprintf(name, sizeof name, "%05d.jpg", i);
     std::ofstream(work / "frames" / name, std::ios::binary)
-        .write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
+        .write(reinterpret_cast<const char*>(jpeg.data()),
+               static_cast<std::streamsize>(jpeg.size()));
   }
   int basePort = 21000 + getpid() % 20000;
 
@@ -114,19 +113,17 @@ int main(int argc, char** argv) {
     std::string devices;
     for (int i = 0; i < n; ++i) {
       int port = basePort + 2 * i;
-      sims.push_back(spawn((bin / "wirc-sim").string() + " --port " + std::to_string(port) + " --frames " +
-                               (work / "frames").string(),
+      sims.push_back(spawn((bin / "wirc-sim").string() + " --port " + std::to_string(port) +
+                               " --frames " + (work / "frames").string(),
                            (work / ("sim" + std::to_string(i) + ".txt")).string()));
       devices += " --device 127.0.0.1:" + std::to_string(port);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    pid_t recorder = spawn((bin / "wirc-recorder").string() + devices + " --out " + (work / "rec").string() +
-                           " --segment 600 --duration " + std::to_string(seconds));
+    pid_t recorder =
+        spawn((bin / "wirc-recorder").string() + devices + " --out " + (work / "rec").string() +
+              " --segment 600 --duration " + std::to_string(seconds));
     Usage ours = waitFor(recorder);
-    for (pid_t sim : sims) {
-      kill(-sim, SIGINT);
-      waitpid(sim, nullptr, 0);
-    }
+    for (pid_t sim : sims) wircam::bench::stopGroup(sim, SIGINT);
     int sent = 0;
     for (int i = 0; i < n; ++i) sent += framesSent(work / ("sim" + std::to_string(i) + ".txt"));
     int recorded = framesInFolder(work / "rec");
@@ -137,28 +134,35 @@ int main(int argc, char** argv) {
     std::string receivers;
     for (int i = 0; i < n; ++i) {
       int port = basePort + 2 * i + 1;
-      receivers += " udpsrc port=" + std::to_string(port) +
-                   " buffer-size=8388608 caps=application/x-rtp,media=video,clock-rate=90000,encoding-name=JPEG,payload=26"
-                   " ! rtpjpegdepay ! matroskamux ! filesink location=" + (work / "rtp" / (std::to_string(i) + ".mkv")).string();
+      receivers +=
+          " udpsrc port=" + std::to_string(port) +
+          " buffer-size=8388608 "
+          "caps=application/x-rtp,media=video,clock-rate=90000,encoding-name=JPEG,payload=26"
+          " ! rtpjpegdepay ! matroskamux ! filesink location=" +
+          (work / "rtp" / (std::to_string(i) + ".mkv")).string();
     }
-    pid_t receiver = spawn("timeout -s INT " + std::to_string(seconds + 1) + " gst-launch-1.0 -e" + receivers);
+    pid_t receiver =
+        spawn("timeout -s INT " + std::to_string(seconds + 1) + " gst-launch-1.0 -e" + receivers);
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     int rtpFrames = static_cast<int>(seconds * 15);
     std::vector<pid_t> senders;
     for (int i = 0; i < n; ++i)
-      senders.push_back(spawn("gst-launch-1.0 multifilesrc location=" + (work / "frames" / "%05d.jpg").string() +
-                              " loop=true num-buffers=" + std::to_string(rtpFrames) +
-                              " caps=image/jpeg,width=352,height=288,framerate=15/1 ! identity sleep-time=66666"
-                              " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" + std::to_string(basePort + 2 * i + 1)));
+      senders.push_back(
+          spawn("gst-launch-1.0 multifilesrc location=" + (work / "frames" / "%05d.jpg").string() +
+                " loop=true num-buffers=" + std::to_string(rtpFrames) +
+                " caps=image/jpeg,width=352,height=288,framerate=15/1 ! identity sleep-time=66666"
+                " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" +
+                std::to_string(basePort + 2 * i + 1)));
     for (pid_t s : senders) waitpid(s, nullptr, 0);
     Usage theirs = waitFor(receiver);
     int rtpRecorded = framesInFolder(work / "rtp");
     int rtpSent = rtpFrames * n;
 
-    std::printf("%-8d | lost %4d of %5d, %5.2f %%, %5.1f MB     | lost %4d of %5d, %5.2f %%, %5.1f MB\n", n,
-                sent - recorded, sent, 100 * ours.cpuSeconds / seconds / n, ours.maxRssKb / 1024.0 / n,
-                rtpSent - rtpRecorded, rtpSent, 100 * theirs.cpuSeconds / (seconds + 1) / n,
-                theirs.maxRssKb / 1024.0 / n);
+    std::printf(
+        "%-8d | lost %4d of %5d, %5.2f %%, %5.1f MB     | lost %4d of %5d, %5.2f %%, %5.1f MB\n", n,
+        sent - recorded, sent, 100 * ours.cpuSeconds / seconds / n, ours.maxRssKb / 1024.0 / n,
+        rtpSent - rtpRecorded, rtpSent, 100 * theirs.cpuSeconds / (seconds + 1) / n,
+        theirs.maxRssKb / 1024.0 / n);
     std::fflush(stdout);
   }
   fs::remove_all(work);

@@ -67,7 +67,9 @@ Expected<std::unique_ptr<FollowScene>, std::string> FollowScene::create(FollowSc
 }
 
 FollowScene::FollowScene(FollowSceneConfig config, vision::TagFamily family)
-    : config_(std::move(config)), family_(std::move(family)) {
+    : config_(std::move(config)),
+      family_(std::move(family)),
+      encoder_(tjInitCompress(), tjDestroy) {
   fx_ = config_.width / 2.0 / std::tan(config_.horizontalFovDeg * kPi / 360.0);
   cx_ = config_.width / 2.0 - 0.5;
   cy_ = config_.height / 2.0 - 0.5;
@@ -78,7 +80,9 @@ FollowScene::FollowScene(FollowSceneConfig config, vision::TagFamily family)
     int cells = family_.totalWidth();
     auto cellValues = family_.image(tag.id);
     cv::Mat small(cells, cells, CV_8UC1, cellValues.data());
-    cv::resize(small, tag.pattern, {}, kPatternScale, kPatternScale, cv::INTER_NEAREST);
+    cv::Mat scaled;
+    cv::resize(small, scaled, {}, kPatternScale, kPatternScale, cv::INTER_NEAREST);
+    cv::cvtColor(scaled, tag.pattern, cv::COLOR_GRAY2BGR);
     if (i > 0) {
       // Landmarks on a ring around the start, facing it.
       double angle =
@@ -290,10 +294,8 @@ void FollowScene::drawTag(cv::Mat& image, const PlacedTag& tag) const {
   cv::Rect box = cv::boundingRect(boardPolygon) & cv::Rect(0, 0, image.cols, image.rows);
   if (box.empty()) return;
   cv::Mat shift = (cv::Mat_<double>(3, 3) << 1, 0, -box.x, 0, 1, -box.y, 0, 0, 1);
-  cv::Mat pattern;
-  cv::cvtColor(tag.pattern, pattern, cv::COLOR_GRAY2BGR);
   cv::Mat roi = image(box);
-  cv::warpPerspective(pattern, roi, shift * homography, roi.size(), cv::INTER_LINEAR,
+  cv::warpPerspective(tag.pattern, roi, shift * homography, roi.size(), cv::INTER_LINEAR,
                       cv::BORDER_TRANSPARENT);
 }
 
@@ -317,10 +319,9 @@ std::vector<uint8_t> FollowScene::renderJpeg(int camera) {
   // side by side, which is what the multi-camera tests need.
   (void)camera;
   cv::Mat image = renderBgr();
-  std::unique_ptr<void, decltype(&tjDestroy)> encoder(tjInitCompress(), tjDestroy);
   unsigned char* jpeg = nullptr;
   unsigned long size = 0;
-  if (tjCompress2(encoder.get(), image.data, image.cols, static_cast<int>(image.step), image.rows,
+  if (tjCompress2(encoder_.get(), image.data, image.cols, static_cast<int>(image.step), image.rows,
                   TJPF_BGR, &jpeg, &size, TJSAMP_420, config_.jpegQuality, TJFLAG_FASTDCT) != 0)
     return {};
   std::vector<uint8_t> bytes(jpeg, jpeg + size);

@@ -100,7 +100,7 @@ class FollowScene : public wirc::DeviceScene {
 
   struct PlacedTag {
     int id;
-    cv::Mat pattern;  // the tag image, scaled up
+    cv::Mat pattern;  // the tag image, scaled up, in BGR like the frame
     Pose2 pose;       // the tag faces along pose.theta + π (towards -heading)
   };
 
@@ -124,6 +124,7 @@ class FollowScene : public wirc::DeviceScene {
   double time_ = 0;
   std::optional<wirc::DeviceClock::time_point> lastAdvance_;
   FILE* truth_ = nullptr;
+  std::unique_ptr<void, int (*)(void*)> encoder_;  // TurboJPEG, kept across frames
   uint64_t ticks_ = 0;
   double bearingSum_ = 0;
   double distanceErrorSum_ = 0;

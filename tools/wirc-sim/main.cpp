@@ -389,6 +389,7 @@ int main(int argc, char** argv) {
   std::printf("  max PCD gap        %lld ms\n", static_cast<long long>(stats.maxPcdGap.count()));
   std::printf("  failsafe entries   %llu\n",
               static_cast<unsigned long long>(stats.failsafeEntries));
+  std::printf("  ERR sent           %llu\n", static_cast<unsigned long long>(stats.errSent));
   if (follow) {
     auto s = follow->summary();
     std::printf(

@@ -7,20 +7,6 @@
 
 namespace wircam::wirc {
 
-const char* packetErrorName(PacketError error) {
-  switch (error) {
-    case PacketError::Keepalive:
-      return "keepalive";
-    case PacketError::TooShort:
-      return "too-short";
-    case PacketError::BadVersion:
-      return "bad-version";
-    case PacketError::BadLength:
-      return "bad-length";
-  }
-  return "unknown";
-}
-
 Expected<MjpegPacket, PacketError> parseMjpegPacket(std::span<const uint8_t> datagram) {
   ByteReader reader(datagram);
   MjpegPacket packet;

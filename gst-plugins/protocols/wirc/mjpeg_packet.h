@@ -48,8 +48,6 @@ enum class PacketError {
   BadLength,   // length larger than the bytes that follow the header
 };
 
-const char* packetErrorName(PacketError error);
-
 struct MjpegPacket {
   MjpegPacketHeader header;
   std::span<const uint8_t> payload;  // exactly header.length bytes

@@ -24,11 +24,6 @@ struct Impairments {
   double strayRate = 0;       // per frame: a forged datagram from another port
   uint32_t startFrameNumber = 0;
   uint32_t seed = 1;
-
-  bool any() const {
-    return loss > 0 || burstLoss > 0 || duplication > 0 || reorderDepth > 0 || fragmentJitter > 0 ||
-           reservedBits || strayRate > 0;
-  }
 };
 
 struct StreamSenderStats {

@@ -414,6 +414,11 @@ SessionStatus TransmitterSession::status() const {
   return impl_->status_;
 }
 
+uint64_t TransmitterSession::logins() const {
+  std::lock_guard lock(impl_->mutex_);
+  return impl_->status_.logins;
+}
+
 const SessionConfig& TransmitterSession::config() const { return impl_->config_; }
 
 std::optional<SocketAddress> TransmitterSession::deviceAddress() const {

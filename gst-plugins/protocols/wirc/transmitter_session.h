@@ -77,6 +77,8 @@ class TransmitterSession {
   // Blocks until logged in; the error says why not (no device, refused...).
   std::optional<std::string> waitLoggedIn(std::chrono::milliseconds timeout);
   SessionStatus status() const;
+  // status().logins without copying the rest: cheap enough for every packet.
+  uint64_t logins() const;
   const SessionConfig& config() const;
   // The device's address once known (for filtering the stream's sender).
   std::optional<SocketAddress> deviceAddress() const;

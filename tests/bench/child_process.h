@@ -1,0 +1,17 @@
+// Sender and receiver processes for the real-time bench tools.
+#pragma once
+
+#include <sys/types.h>
+
+#include <string>
+
+namespace wircam::bench {
+
+// Runs `command` through sh in a process group of its own, its stdout to
+// `output`, its stderr discarded.
+pid_t spawn(const std::string& command, const std::string& output = "/dev/null");
+
+// Signals the whole group and waits for its leader.
+void stopGroup(pid_t pid, int signal);
+
+}  // namespace wircam::bench
