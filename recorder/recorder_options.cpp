@@ -12,8 +12,9 @@ const char* usage() {
   return R"(Usage: wirc-recorder --device HOST[:PORT] [--device ...] --out DIR [OPTIONS]
 
 Records the cameras of one or more WiRC devices into segmented files, the
-JPEG frames muxed as they arrive (no re-encoding), with a telemetry sidecar
-(JSON lines) per segment. SIGINT or SIGTERM finishes every file and exits 0.
+JPEG frames muxed as they arrive (no re-encoding) or transcoded to H.264, with
+the telemetry as a text track in the file and in a JSON-lines sidecar per
+segment. SIGINT or SIGTERM finishes every file and exits 0.
 
   --device HOST[:PORT]   a device to record (default port 1984); repeatable.
                          Without --device the device is found by discovery.
@@ -21,7 +22,11 @@ JPEG frames muxed as they arrive (no re-encoding), with a telemetry sidecar
   --camera N             camera to record (default 0); repeatable
   --out DIR              where the files go (created if missing)
   --segment S            seconds per segment (default 60)
-  --format mkv           container: Matroska (MP4 waits for H.264 transcoding)
+  --segment-size SIZE    also end a segment at SIZE (e.g. 100M)
+  --format mkv|mp4       container (default mkv); mp4 needs --codec h264
+  --codec jpeg|h264      jpeg: the camera's frames as they are (default);
+                         h264: transcoded with x264enc (gstreamer1.0-plugins-ugly)
+  --bitrate KBPS         H.264 bit rate (default 2000)
   --detect FAMILY        find AprilTags (e.g. tag36h11); detections go to telemetry
   --follow               steer the vehicle after the largest tag (needs --detect)
   --duration S           stop after S seconds
@@ -30,10 +35,14 @@ JPEG frames muxed as they arrive (no re-encoding), with a telemetry sidecar
                          deleting the oldest finished segments
   --min-free SIZE        delete the oldest finished segments while the disk
                          has less than SIZE free
+  --http [HOST]:PORT     web server: live view at /, status at /api/status,
+                         recordings at /recordings (e.g. --http :8080)
+  --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>
   -h, --help             this text
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
-(out, segment, format, detect, follow, max-bytes, min-free, status), and one
+(out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
+min-free, status, http, rtsp), and one
 [device NAME] group per vehicle with host, port, cameras (e.g. 0;1) and follow:
 
   [recorder]
@@ -44,10 +53,30 @@ Config file (GKeyFile/INI): a [recorder] group with the long options as keys
   cameras=0;1
   follow=true
 
-Files: DIR/<device>-cam<N>-<start time>-<segment>.mkv and, beside each,
-<same name>.jsonl with one JSON object per event: {"pts": running time in ns,
-"type": "psd"|"detections"|"control"|"stats", ...}.
+Files: DIR/<device>-cam<N>-<start time>-<segment>.mkv (or .mp4) and, beside
+each, <same name>.jsonl with one JSON object per event: {"pts": running time
+in ns, "type": "stats"|"detections"|"control"|"session", ...}. The same
+objects are the file's text track.
+
+Exit status: 0 finished cleanly, 1 error, 2 bad arguments, 3 the disk filled
+(the open segments were finished first).
 )";
+}
+
+const char* extensionOf(Container container) {
+  return container == Container::kMp4 ? ".mp4" : ".mkv";
+}
+
+namespace {
+std::optional<double> number(const char* text);
+}  // namespace
+
+std::optional<ServerAddress> parseServerAddress(const std::string& text) {
+  auto colon = text.rfind(':');
+  if (colon == std::string::npos) return std::nullopt;
+  auto port = number(text.substr(colon + 1).c_str());
+  if (!port || *port < 0 || *port > 65535) return std::nullopt;
+  return ServerAddress{text.substr(0, colon), static_cast<uint16_t>(*port)};
 }
 
 namespace {
@@ -169,11 +198,26 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto seconds = number(value);
     if (!seconds || *seconds < 1) return "seconds >= 1";
     o.segmentSeconds = *seconds;
+  } else if (name == "segment-size") {
+    auto bytes = size(value);
+    if (!bytes || *bytes < 100000) return "a size of at least 100K, like 100M";
+    o.segmentBytes = *bytes;
   } else if (name == "format") {
-    if (std::string(value) == "mp4")
-      return "MP4 cannot carry the camera's JPEG frames as they are: it waits for H.264 "
-             "transcoding, which is not built yet; use mkv";
-    if (std::string(value) != "mkv") return "mkv (mp4 comes with H.264 transcoding)";
+    std::string format = value;
+    if (format != "mkv" && format != "mp4") return "mkv or mp4";
+    o.container = format == "mp4" ? Container::kMp4 : Container::kMatroska;
+  } else if (name == "codec") {
+    std::string codec = value;
+    if (codec != "jpeg" && codec != "h264") return "jpeg or h264";
+    o.codec = codec == "h264" ? Codec::kH264 : Codec::kJpeg;
+  } else if (name == "bitrate") {
+    auto kbps = number(value);
+    if (!kbps || *kbps < 50 || *kbps > 100000) return "kbit/s, 50..100000";
+    o.h264Kbps = static_cast<unsigned>(*kbps);
+  } else if (name == "http" || name == "rtsp") {
+    auto address = parseServerAddress(value);
+    if (!address) return "[HOST]:PORT, as in :8080 or 127.0.0.1:8080";
+    (name == "http" ? o.http : o.rtsp) = *address;
   } else if (name == "detect") {
     o.detectFamily = value;
   } else if (name == "follow") {
@@ -210,7 +254,12 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"camera", required_argument, nullptr, kValue},
                                    {"out", required_argument, nullptr, kValue},
                                    {"segment", required_argument, nullptr, kValue},
+                                   {"segment-size", required_argument, nullptr, kValue},
                                    {"format", required_argument, nullptr, kValue},
+                                   {"codec", required_argument, nullptr, kValue},
+                                   {"bitrate", required_argument, nullptr, kValue},
+                                   {"http", required_argument, nullptr, kValue},
+                                   {"rtsp", required_argument, nullptr, kValue},
                                    {"detect", required_argument, nullptr, kValue},
                                    {"follow", no_argument, nullptr, kValue},
                                    {"duration", required_argument, nullptr, kValue},
@@ -252,6 +301,10 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   if (optind < argc) return unexpected(std::string("unexpected argument '") + argv[optind] + "'");
   if (o.outDir.empty()) return unexpected("--out DIR (or out= in the config) is needed");
   if (o.follow && o.detectFamily.empty()) return unexpected("--follow needs --detect FAMILY");
+  if (o.container == Container::kMp4 && o.codec == Codec::kJpeg)
+    return unexpected(
+        "--format mp4 needs --codec h264: GStreamer's mp4mux cannot carry the camera's JPEG "
+        "frames as they are (use mkv to keep them untouched)");
   if (o.devices.empty()) o.devices.push_back({"", 1984, "discovered"});
   if (o.cameras.empty()) o.cameras.push_back(0);
   for (auto& device : o.devices) {

@@ -18,18 +18,39 @@ struct DeviceTarget {
   std::optional<bool> follow;  // unset: the recorder-wide --follow
 };
 
+// Where a server listens: "[HOST]:PORT"; no host means every interface,
+// port 0 one the system picks (the recorder prints it).
+struct ServerAddress {
+  std::string host;
+  uint16_t port = 0;
+};
+std::optional<ServerAddress> parseServerAddress(const std::string& text);
+
+// How the frames are stored: as the camera sent them, or re-encoded.
+enum class Codec { kJpeg, kH264 };
+enum class Container { kMatroska, kMp4 };
+
 struct RecorderOptions {
   std::vector<DeviceTarget> devices;
   std::vector<int> cameras;  // default {0}
   std::string outDir = ".";
   double segmentSeconds = 60;
+  uint64_t segmentBytes = 0;  // 0: segments end by time only
+  Container container = Container::kMatroska;
+  Codec codec = Codec::kJpeg;
+  unsigned h264Kbps = 2000;
   std::string detectFamily;  // empty: no detection
   bool follow = false;       // needs detectFamily
   std::optional<double> duration;
   double statusSeconds = 1;
   uint64_t maxBytes = 0;  // retention: 0 = unlimited
   uint64_t minFree = 0;
+  std::optional<ServerAddress> http;  // unset: no web server
+  std::optional<ServerAddress> rtsp;  // unset: no RTSP server
 };
+
+// The file name extension of a container, with its dot.
+const char* extensionOf(Container container);
 
 // The options, or an error message naming the bad argument; --help text in
 // `usage()`. `--config FILE` reads a GKeyFile first; options given on the

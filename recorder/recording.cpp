@@ -6,57 +6,13 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
-#include <nlohmann/json.hpp>
 #include <set>
+
+#include "gst_json.h"
 
 namespace wircam::recorder {
 
 namespace {
-
-// GstStructure fields as JSON, recursively (lists, arrays, structures).
-nlohmann::json toJson(const GValue* value) {
-  GType type = G_VALUE_TYPE(value);
-  if (type == G_TYPE_UINT64) return g_value_get_uint64(value);
-  if (type == G_TYPE_INT64) return g_value_get_int64(value);
-  if (type == G_TYPE_UINT) return g_value_get_uint(value);
-  if (type == G_TYPE_INT) return g_value_get_int(value);
-  if (type == G_TYPE_DOUBLE) return g_value_get_double(value);
-  if (type == G_TYPE_BOOLEAN) return static_cast<bool>(g_value_get_boolean(value));
-  if (type == G_TYPE_STRING) return g_value_get_string(value) ? g_value_get_string(value) : "";
-  if (type == GST_TYPE_LIST || type == GST_TYPE_ARRAY) {
-    nlohmann::json array = nlohmann::json::array();
-    guint size =
-        type == GST_TYPE_LIST ? gst_value_list_get_size(value) : gst_value_array_get_size(value);
-    for (guint i = 0; i < size; ++i)
-      array.push_back(toJson(type == GST_TYPE_LIST ? gst_value_list_get_value(value, i)
-                                                   : gst_value_array_get_value(value, i)));
-    return array;
-  }
-  if (type == GST_TYPE_STRUCTURE) {
-    nlohmann::json object = nlohmann::json::object();
-    gst_structure_foreach(
-        gst_value_get_structure(value),
-        [](GQuark field, const GValue* v, gpointer data) -> gboolean {
-          (*static_cast<nlohmann::json*>(data))[g_quark_to_string(field)] = toJson(v);
-          return TRUE;
-        },
-        &object);
-    return object;
-  }
-  gchar* text = gst_value_serialize(value);
-  std::string serialized = text ? text : "";
-  g_free(text);
-  return serialized;
-}
-
-nlohmann::json toJson(const GstStructure* structure) {
-  GValue value = G_VALUE_INIT;
-  g_value_init(&value, GST_TYPE_STRUCTURE);
-  gst_value_set_structure(&value, structure);
-  auto json = toJson(&value);
-  g_value_unset(&value);
-  return json;
-}
 
 std::string startTime() {
   std::time_t now = std::time(nullptr);
@@ -65,21 +21,14 @@ std::string startTime() {
   return text;
 }
 
-// A file name part made of safe characters only.
-std::string fileSafe(std::string text) {
-  for (char& c : text)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
-  return text;
-}
+void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
 
 }  // namespace
 
 Recording::Recording(RecorderOptions options)
     : options_(std::move(options)),
-      retention_(options_.outDir, {options_.maxBytes, options_.minFree},
-                 [](const std::string& line) {
-                   std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str());
-                 }) {}
+      retention_(options_.outDir, {options_.maxBytes, options_.minFree}, log),
+      disk_(options_.outDir) {}
 
 Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     const RecorderOptions& options) {
@@ -88,78 +37,110 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
   if (error) return unexpected("cannot create '" + options.outDir + "': " + error.message());
   if (access(options.outDir.c_str(), W_OK) != 0)
     return unexpected("cannot write into '" + options.outDir + "'");
+  if (options.codec == Codec::kH264 && !gst_registry_check_feature_version(
+                                           gst_registry_get(), "x264enc", 1, 0, 0))
+    return unexpected(
+        "--codec h264 needs x264enc, from Debian's gstreamer1.0-plugins-ugly "
+        "(tools/install-deps installs it)");
 
   std::unique_ptr<Recording> recording(new Recording(options));
-  // Crash safety: clusters of at most 1 s, so a killed recorder leaves every
-  // closed segment whole and the open one playable up to its last second.
-  std::string muxer =
-      "muxer-factory=matroskamux "
-      "muxer-properties=\"properties,max-cluster-duration=(gint64)1000000000\"";
-  std::string start = startTime();
-  std::string description;
-  size_t index = 0;
-  for (const auto& device : options.devices) {
-    bool controlled = false;
-    for (int camera : device.cameras) {
-      auto stream = std::make_unique<Stream>();
-      stream->name = fileSafe(device.label) + "-cam" + std::to_string(camera);
-      auto location =
-          (std::filesystem::path(options.outDir) / (stream->name + "-" + start + "-%03d.mkv"))
-              .string();
-      auto i = std::to_string(index++);
-      stream->muxer = "mux" + i;
-      std::string host = device.host.empty() ? "" : " host=" + device.host;
-      std::string port = " port=" + std::to_string(device.port);
-      description += "wircsrc name=src" + i + host + port + " camera=" + std::to_string(camera) +
-                     " ! tee name=t" + i + " t" + i +
-                     ". ! queue max-size-time=3000000000 ! splitmuxsink name=mux" + i +
-                     " async-finalize=true " + muxer + " max-size-time=" +
-                     std::to_string(static_cast<guint64>(options.segmentSeconds * 1e9)) +
-                     " location=\"" + location + "\" ";
-      if (!options.detectFamily.empty()) {
-        // Detection must never hold the recording back: its queue drops.
-        description +=
-            "t" + i +
-            ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=det" +
-            i + " quad-decimate=1 family=" + options.detectFamily;
-        if (*device.follow && !controlled) {
-          description += " ! wirccontrol name=ctl" + i + host + port;
-          controlled = true;  // one controller per vehicle: the first camera's
-        }
-        description += " ! fakesink sync=false ";
-      }
-      recording->streams_.push_back(std::move(stream));
-    }
-  }
+  auto plan = planPipeline(options, startTime());
   GError* parseError = nullptr;
-  recording->pipeline_ = gst_parse_launch(description.c_str(), &parseError);
+  recording->pipeline_ = gst_parse_launch(plan.description.c_str(), &parseError);
   if (parseError) {
     std::string message = parseError->message;
     g_error_free(parseError);
     return unexpected("cannot build the pipeline (are the wircam plugins on GST_PLUGIN_PATH?): " +
                       message);
   }
+  for (auto& streamPlan : plan.streams) {
+    auto stream = std::make_unique<Stream>();
+    stream->plan = streamPlan;
+    GstElement* source = gst_bin_get_by_name(GST_BIN(recording->pipeline_),
+                                             streamPlan.telemetrySource.c_str());
+    stream->track.emplace(source);
+    gst_object_unref(source);  // the pipeline keeps it
+    if (!streamPlan.liveSink.empty()) {
+      GstElement* sink =
+          gst_bin_get_by_name(GST_BIN(recording->pipeline_), streamPlan.liveSink.c_str());
+      stream->frames = std::make_unique<FrameTap>(sink);
+      gst_object_unref(sink);
+    }
+    recording->streams_.push_back(std::move(stream));
+  }
+  if (auto problem = recording->startServers()) return unexpected(*problem);
   return recording;
 }
 
+std::optional<std::string> Recording::startServers() {
+  if (options_.http) {
+    HttpServer::Content content;
+    for (auto& s : streams_) content.cameras.push_back({s->plan.name, s->frames.get()});
+    content.recordingsFolder = options_.outDir;
+    content.status = [this] { return status(); };
+    content.openSegments = [this] { return openSegments(); };
+    auto server = HttpServer::start(*options_.http, std::move(content));
+    if (!server) return server.error();
+    http_ = std::move(*server);
+    log("live view at " + http_->url());
+  }
+  if (options_.rtsp) {
+    std::vector<RtspServer::Camera> cameras;
+    for (auto& s : streams_)
+      cameras.push_back(
+          {"/" + s->plan.device + "/cam" + std::to_string(s->plan.camera), s->frames.get()});
+    auto server = RtspServer::start(*options_.rtsp, cameras);
+    if (!server) return server.error();
+    rtsp_ = std::move(*server);
+    for (auto& camera : cameras) log("RTSP at " + rtsp_->url() + camera.path);
+  }
+  return std::nullopt;
+}
+
 Recording::~Recording() {
+  // The servers first: they listen to the pipeline's frames.
+  http_.reset();
+  rtsp_.reset();
   if (pipeline_) {
     gst_element_set_state(pipeline_, GST_STATE_NULL);
+    streams_.clear();
     gst_object_unref(pipeline_);
   }
   if (loop_) g_main_loop_unref(loop_);
 }
 
 Recording::Stream* Recording::streamOf(GstMessage* message) {
-  const gchar* name = GST_OBJECT_NAME(GST_MESSAGE_SRC(message));
-  size_t digits = 0;
-  std::string text = name ? name : "";
-  while (digits < text.size() &&
-         std::isdigit(static_cast<unsigned char>(text[text.size() - 1 - digits])))
-    ++digits;
-  if (digits == 0) return nullptr;
-  size_t index = std::stoul(text.substr(text.size() - digits));
-  return index < streams_.size() ? streams_[index].get() : nullptr;
+  // Element names end in the stream's index ("src3", "det3"); elements
+  // inside a splitmuxsink are found through their parent "mux3".
+  for (GstObject* object = GST_MESSAGE_SRC(message); object; object = GST_OBJECT_PARENT(object)) {
+    std::string name = GST_OBJECT_NAME(object) ? GST_OBJECT_NAME(object) : "";
+    size_t digits = 0;
+    while (digits < name.size() &&
+           std::isdigit(static_cast<unsigned char>(name[name.size() - 1 - digits])))
+      ++digits;
+    if (digits == 0 || digits == name.size()) continue;
+    std::string prefix = name.substr(0, name.size() - digits);
+    if (prefix != "src" && prefix != "mux" && prefix != "det" && prefix != "ctl") continue;
+    size_t index = std::stoul(name.substr(name.size() - digits));
+    return index < streams_.size() ? streams_[index].get() : nullptr;
+  }
+  return nullptr;
+}
+
+GstClockTime Recording::runningTime() const {
+  GstClockTime now = GST_CLOCK_TIME_NONE;
+  if (GstClock* clock = gst_element_get_clock(pipeline_)) {
+    now = gst_clock_get_time(clock) - gst_element_get_base_time(pipeline_);
+    gst_object_unref(clock);
+  }
+  return now;
+}
+
+void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime pts) {
+  line["pts"] = pts;
+  std::string text = line.dump();
+  stream.sidecar.write(text);
+  stream.track->write(text, pts);
 }
 
 void Recording::handleElementMessage(GstMessage* message) {
@@ -169,62 +150,75 @@ void Recording::handleElementMessage(GstMessage* message) {
   std::string type = gst_structure_get_name(s);
   if (type == "splitmuxsink-fragment-opened") {
     stream->segment = gst_structure_get_string(s, "location");
-    if (!stream->telemetry.open(stream->segment))
-      std::fprintf(stderr, "wirc-recorder: cannot write %s\n", stream->telemetry.path().c_str());
+    if (!stream->sidecar.open(stream->segment))
+      log("cannot write " + stream->sidecar.path());
     return;
   }
   if (type == "splitmuxsink-fragment-closed") {
-    std::set<std::string> open;
-    for (const auto& s : streams_) open.insert(s->segment);
-    retention_.enforce(open);
+    auto open = openSegments();
+    retention_.enforce({open.begin(), open.end()});
     return;
   }
 
   nlohmann::json line = toJson(s);
-  GstClockTime now = GST_CLOCK_TIME_NONE;
-  if (GstClock* clock = gst_element_get_clock(pipeline_)) {
-    now = gst_clock_get_time(clock) - gst_element_get_base_time(pipeline_);
-    gst_object_unref(clock);
-  }
   if (type == "wirc-session") {
     // Losses and logins of the device's session. A new login after a loss
     // starts a new segment, so the gap falls between two files.
     std::string event = gst_structure_get_string(s, "event");
-    std::fprintf(stderr, "\nwirc-recorder: %s: %s\n", stream->name.c_str(), event.c_str());
+    log(stream->plan.name + ": " + event);
     line["type"] = "session";
-    line["pts"] = now;
-    stream->telemetry.write(line.dump());
+    writeTelemetry(*stream, line, runningTime());
     // Only a login after a loss splits: the first login's event may or may
     // not arrive, depending on when wircsrc began listening.
     if (event.find("lost") != std::string::npos) stream->lost = true;
     if (event.rfind("logged in", 0) == 0 && stream->lost) {
       stream->lost = false;
-      if (GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline_), stream->muxer.c_str())) {
-        g_signal_emit_by_name(sink, "split-now");
-        gst_object_unref(sink);
-      }
+      GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline_), stream->plan.muxer.c_str());
+      g_signal_emit_by_name(sink, "split-now");
+      gst_object_unref(sink);
     }
     return;
   }
   if (type == "wirc-stats") {
-    gst_structure_get_uint64(s, "frames-complete", &stream->frames);
+    gst_structure_get_uint64(s, "frames-complete", &stream->frameCount);
     gst_structure_get_uint64(s, "frames-incomplete", &stream->incomplete);
     gst_structure_get_uint64(s, "bytes", &stream->bytes);
     gst_structure_get_uint(s, "battery-mv", &stream->batteryMv);
     line["type"] = "stats";
-    line["pts"] = now;
-  } else if (type == "apriltag") {
-    line["type"] = "detections";
-    line["pts"] = line["timestamp"];
-    line.erase("timestamp");
-  } else if (type == "wirc-control") {
-    line["type"] = "control";
-    line["pts"] = line["timestamp"];
-    line.erase("timestamp");
-  } else {
+    writeTelemetry(*stream, line, runningTime());
     return;
   }
-  stream->telemetry.write(line.dump());
+  if (type != "apriltag" && type != "wirc-control") return;
+  // Detections and commands belong to a frame: its timestamp is their time.
+  line["type"] = type == "apriltag" ? "detections" : "control";
+  GstClockTime pts = line["timestamp"].get<GstClockTime>();
+  line.erase("timestamp");
+  if (http_ && type == "apriltag") http_->publishDetections(stream->plan.name, line["detections"]);
+  writeTelemetry(*stream, line, pts);
+}
+
+void Recording::handleError(GstMessage* message) {
+  GError* error = nullptr;
+  gchar* debug = nullptr;
+  gst_message_parse_error(message, &error, &debug);
+  bool diskFull = g_error_matches(error, GST_RESOURCE_ERROR, GST_RESOURCE_ERROR_NO_SPACE_LEFT);
+  log(std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + error->message + "\n" +
+      (debug ? debug : ""));
+  g_error_free(error);
+  g_free(debug);
+  if (diskFull && !stopping_) {
+    // A write failed: the other streams can still be finished.
+    exitCode_ = kExitDiskFull;
+    log("the disk is full: finishing the other files; earlier segments are untouched");
+    stop(nullptr);
+    // The failed stream never reaches EOS: give the rest 5 s.
+    g_timeout_add_seconds(
+        5, [](gpointer loop) { return g_main_loop_quit(static_cast<GMainLoop*>(loop)), FALSE; },
+        loop_);
+    return;
+  }
+  if (exitCode_ == 0) exitCode_ = kExitError;
+  g_main_loop_quit(loop_);
 }
 
 gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
@@ -237,24 +231,15 @@ gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
       GError* error = nullptr;
       gchar* debug = nullptr;
       gst_message_parse_warning(message, &error, &debug);
-      std::fprintf(stderr, "\nwirc-recorder: warning from %s: %s (%s)\n",
-                   GST_OBJECT_NAME(GST_MESSAGE_SRC(message)), error->message, debug ? debug : "");
+      log(std::string("warning from ") + GST_OBJECT_NAME(GST_MESSAGE_SRC(message)) + ": " +
+          error->message + " (" + (debug ? debug : "") + ")");
       g_error_free(error);
       g_free(debug);
       break;
     }
-    case GST_MESSAGE_ERROR: {
-      GError* error = nullptr;
-      gchar* debug = nullptr;
-      gst_message_parse_error(message, &error, &debug);
-      std::fprintf(stderr, "\nwirc-recorder: %s: %s\n%s\n",
-                   GST_OBJECT_NAME(GST_MESSAGE_SRC(message)), error->message, debug ? debug : "");
-      g_error_free(error);
-      g_free(debug);
-      self->exitCode_ = 1;
-      g_main_loop_quit(self->loop_);
+    case GST_MESSAGE_ERROR:
+      self->handleError(message);
       break;
-    }
     case GST_MESSAGE_EOS:
       g_main_loop_quit(self->loop_);
       break;
@@ -264,25 +249,59 @@ gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
   return TRUE;
 }
 
+void Recording::stop(const char* why) {
+  stopping_ = true;
+  if (why) log(std::string(why) + ": finishing the files (a second signal stops at once)");
+  // EOS from every source: each splitmuxsink closes its last segment cleanly.
+  gst_element_send_event(pipeline_, gst_event_new_eos());
+}
+
 gboolean Recording::onStop(gpointer data) {
   auto* self = static_cast<Recording*>(data);
   if (self->stopping_) {
-    std::fprintf(stderr, "\nwirc-recorder: stopping now, without finishing the files\n");
-    self->exitCode_ = 1;
+    log("stopping now, without finishing the files");
+    if (self->exitCode_ == 0) self->exitCode_ = kExitError;
     g_main_loop_quit(self->loop_);
     return G_SOURCE_CONTINUE;
   }
-  self->stopping_ = true;
-  std::fprintf(stderr,
-               "\nwirc-recorder: finishing the files (send the signal again to stop at once)\n");
-  // EOS from every source: each splitmuxsink closes its last segment cleanly.
-  gst_element_send_event(self->pipeline_, gst_event_new_eos());
+  self->stop("stopping");
   return G_SOURCE_CONTINUE;
 }
 
-gboolean Recording::onStatus(gpointer data) {
-  static_cast<Recording*>(data)->printStatus();
+gboolean Recording::onTick(gpointer data) {
+  auto* self = static_cast<Recording*>(data);
+  self->updateRates();
+  self->printStatus();
+  self->guardDisk();
   return G_SOURCE_CONTINUE;
+}
+
+void Recording::guardDisk() {
+  if (stopping_) return;
+  uint64_t rate = 0;
+  for (auto& s : streams_) rate += static_cast<uint64_t>(s->kbps * 1000 / 8);
+  if (!disk_.nearlyFull(rate)) return;
+  // Old segments may make room (--max-bytes/--min-free); if not, stop while
+  // the open segments can still be finished.
+  auto open = openSegments();
+  retention_.enforce({open.begin(), open.end()});
+  if (!disk_.nearlyFull(rate)) return;
+  log("the disk under " + options_.outDir + " is full (" + std::to_string(disk_.free() >> 20) +
+      " MiB free, " + std::to_string(DiskGuard::reserveFor(rate) >> 20) +
+      " MiB kept to finish the files); stopping. Free some space or use --max-bytes / "
+      "--min-free to delete old segments as you go");
+  exitCode_ = kExitDiskFull;
+  stop(nullptr);
+}
+
+void Recording::updateRates() {
+  double seconds = options_.statusSeconds;
+  for (auto& s : streams_) {
+    s->fps = static_cast<double>(s->frameCount - s->lastFrames) / seconds;
+    s->kbps = static_cast<double>(s->bytes - s->lastBytes) * 8 / 1000 / seconds;
+    s->lastFrames = s->frameCount;
+    s->lastBytes = s->bytes;
+  }
 }
 
 void Recording::printStatus() {
@@ -290,20 +309,47 @@ void Recording::printStatus() {
   // On a terminal the lines are redrawn in place; in a log, appended.
   if (terminal && statusShown_) std::printf("\033[%zuA", streams_.size());
   for (auto& s : streams_) {
-    double seconds = options_.statusSeconds;
-    double fps = static_cast<double>(s->frames - s->lastFrames) / seconds;
-    double kbps = static_cast<double>(s->bytes - s->lastBytes) * 8 / 1000 / seconds;
-    double total = static_cast<double>(s->frames + s->incomplete);
+    double total = static_cast<double>(s->frameCount + s->incomplete);
     double loss = total > 0 ? 100.0 * static_cast<double>(s->incomplete) / total : 0;
-    s->lastFrames = s->frames;
-    s->lastBytes = s->bytes;
     std::printf("%s%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V  %s\n",
-                terminal ? "\033[K" : "", s->name.c_str(),
-                static_cast<unsigned long long>(s->frames), fps, loss, kbps, s->batteryMv / 1000.0,
-                std::filesystem::path(s->segment).filename().c_str());
+                terminal ? "\033[K" : "", s->plan.name.c_str(),
+                static_cast<unsigned long long>(s->frameCount), s->fps, loss, s->kbps,
+                s->batteryMv / 1000.0, std::filesystem::path(s->segment).filename().c_str());
   }
   std::fflush(stdout);
   statusShown_ = true;
+}
+
+nlohmann::json Recording::status() const {
+  nlohmann::json streams = nlohmann::json::array();
+  for (const auto& s : streams_) {
+    double total = static_cast<double>(s->frameCount + s->incomplete);
+    nlohmann::json stream = {
+        {"name", s->plan.name},
+        {"device", s->plan.device},
+        {"camera", s->plan.camera},
+        {"frames", s->frameCount},
+        {"fps", s->fps},
+        {"loss_percent", total > 0 ? 100.0 * static_cast<double>(s->incomplete) / total : 0.0},
+        {"kbps", s->kbps},
+        {"battery_v", s->batteryMv / 1000.0},
+        {"segment", std::filesystem::path(s->segment).filename().string()},
+        {"live", "/live/" + s->plan.name + ".mjpg"}};
+    if (rtsp_)
+      stream["rtsp"] = rtsp_->url() + "/" + s->plan.device + "/cam" + std::to_string(s->plan.camera);
+    streams.push_back(stream);
+  }
+  return {{"out", options_.outDir},
+          {"free_bytes", disk_.free()},
+          {"stopping", stopping_},
+          {"streams", streams}};
+}
+
+std::vector<std::string> Recording::openSegments() const {
+  std::vector<std::string> open;
+  for (const auto& s : streams_)
+    if (!s->segment.empty()) open.push_back(s->segment);
+  return open;
 }
 
 int Recording::run() {
@@ -313,25 +359,24 @@ int Recording::run() {
   g_unix_signal_add(SIGINT, onStop, this);
   g_unix_signal_add(SIGTERM, onStop, this);
   if (options_.duration) g_timeout_add(static_cast<guint>(*options_.duration * 1000), onStop, this);
-  g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onStatus, this);
+  g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this);
 
   if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE) {
     // The error itself comes on the bus; show it.
-    GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
-    if (message) {
-      onBusMessage(bus, message, this);
+    if (GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR)) {
+      handleError(message);
       gst_message_unref(message);
     }
     gst_bus_remove_watch(bus);
     gst_object_unref(bus);
-    return 1;
+    return kExitError;
   }
   g_main_loop_run(loop_);
   gst_bus_remove_watch(bus);
   gst_object_unref(bus);
   gst_element_set_state(pipeline_, GST_STATE_NULL);
   printStatus();
-  for (auto& s : streams_) s->telemetry.close();
+  for (auto& s : streams_) s->sidecar.close();
   return exitCode_;
 }
 

@@ -1,56 +1,81 @@
-// One wirc-recorder run: a GStreamer pipeline with, per device and camera,
-// wircsrc → splitmuxsink (JPEG frames muxed as they arrive) and, with
-// --detect, a branch through tjpegdec → apriltagdetect (→ wirccontrol),
-// plus the telemetry sidecars and the status display fed from the bus.
+// One wirc-recorder run: the pipeline of pipeline_plan.h, its bus turned
+// into telemetry (sidecar and text track), the status display, the disk
+// guard, and the web and RTSP servers when asked for.
 #pragma once
 
 #include <gst/gst.h>
 
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/expected.h"
+#include "disk_guard.h"
+#include "frame_tap.h"
+#include "http_server.h"
+#include "pipeline_plan.h"
 #include "recorder_options.h"
 #include "retention.h"
+#include "rtsp_server.h"
 #include "telemetry_log.h"
+#include "telemetry_track.h"
 
 namespace wircam::recorder {
+
+// Exit codes besides 0 (finished) and 2 (bad arguments, in main).
+inline constexpr int kExitError = 1;
+inline constexpr int kExitDiskFull = 3;
 
 class Recording {
  public:
   static Expected<std::unique_ptr<Recording>, std::string> create(const RecorderOptions& options);
   ~Recording();
 
-  // Records until SIGINT/SIGTERM, --duration or an error; every file is
-  // finished before it returns. The process exit code.
+  // Records until SIGINT/SIGTERM, --duration, a full disk or an error;
+  // every file is finished before it returns. The process exit code.
   int run();
 
  private:
   struct Stream {
-    std::string name;   // "<device>-cam<N>"
-    std::string muxer;  // its splitmuxsink's element name
-    TelemetryLog telemetry;
+    StreamPlan plan;
+    TelemetryLog sidecar;
+    std::optional<TelemetryTrack> track;
+    std::unique_ptr<FrameTap> frames;  // with --http or --rtsp
     std::string segment;
-    guint64 frames = 0, incomplete = 0, bytes = 0;
+    guint64 frameCount = 0, incomplete = 0, bytes = 0;
     guint64 lastFrames = 0, lastBytes = 0;
+    double fps = 0, kbps = 0;
     guint batteryMv = 0;
     bool lost = false;  // the device went away; the next login starts a segment
   };
 
   explicit Recording(RecorderOptions options);
+  std::optional<std::string> startServers();  // the problem, if any
   static gboolean onBusMessage(GstBus* bus, GstMessage* message, gpointer self);
   static gboolean onStop(gpointer self);
-  static gboolean onStatus(gpointer self);
+  static gboolean onTick(gpointer self);
+  void stop(const char* why);
   void handleElementMessage(GstMessage* message);
+  void handleError(GstMessage* message);
+  void writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime pts);
+  GstClockTime runningTime() const;
+  void updateRates();
   void printStatus();
+  void guardDisk();
+  nlohmann::json status() const;
+  std::vector<std::string> openSegments() const;
   Stream* streamOf(GstMessage* message);
 
   RecorderOptions options_;
   Retention retention_;
+  DiskGuard disk_;
   GstElement* pipeline_ = nullptr;
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Stream>> streams_;
+  std::unique_ptr<HttpServer> http_;
+  std::unique_ptr<RtspServer> rtsp_;
   bool stopping_ = false;
   int exitCode_ = 0;
   bool statusShown_ = false;

@@ -1,10 +1,10 @@
 #include "retention.h"
 
-#include <sys/statvfs.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <vector>
+
+#include "disk_guard.h"
 
 namespace wircam::recorder {
 
@@ -14,12 +14,6 @@ Retention::Retention(std::string folder, RetentionLimits limits, Logger logger)
     : folder_(std::move(folder)), limits_(limits), logger_(std::move(logger)) {}
 
 namespace {
-
-uint64_t freeBytes(const std::string& folder) {
-  struct statvfs info {};
-  if (statvfs(folder.c_str(), &info) != 0) return UINT64_MAX;
-  return static_cast<uint64_t>(info.f_bavail) * info.f_frsize;
-}
 
 struct Segment {
   fs::path video;
@@ -36,7 +30,7 @@ void Retention::enforce(const std::set<std::string>& open) {
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(folder_, error)) {
     auto extension = entry.path().extension();
-    if (extension != ".mkv") continue;
+    if (extension != ".mkv" && extension != ".mp4") continue;
     auto sidecar = fs::path(entry.path()).replace_extension(".jsonl");
     uint64_t bytes =
         entry.file_size(error) + (fs::exists(sidecar) ? fs::file_size(sidecar, error) : 0);

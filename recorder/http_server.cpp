@@ -1,0 +1,337 @@
+#include "http_server.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+
+#include "live_view_page.h"
+#include "wirc/jpeg_info.h"
+
+namespace wircam::recorder {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr char kBoundary[] = "wircframe";
+// A client this many frames behind is skipped until it catches up, so a
+// slow viewer never makes the recorder hold frames for it.
+constexpr int kMaxFramesInFlight = 3;
+
+void respond(SoupServerMessage* message, guint status, const char* type, const std::string& body) {
+  soup_server_message_set_status(message, status, nullptr);
+  soup_server_message_set_response(message, type, SOUP_MEMORY_COPY, body.data(), body.size());
+}
+
+void respondError(SoupServerMessage* message, guint status, const std::string& text) {
+  respond(message, status, "text/plain; charset=utf-8", text + "\n");
+}
+
+const char* contentTypeOf(const fs::path& file) {
+  auto extension = file.extension();
+  if (extension == ".mkv") return "video/x-matroska";
+  if (extension == ".mp4") return "video/mp4";
+  if (extension == ".jsonl") return "application/x-ndjson";
+  return nullptr;  // not a recording
+}
+
+}  // namespace
+
+// One open streaming response: an MJPEG viewer or an event listener.
+struct HttpServer::Client {
+  SoupServerMessage* message;
+  int inFlight = 0;  // chunks appended but not yet written to the socket
+  gulong wroteHandler = 0, finishedHandler = 0;
+};
+
+struct HttpServer::CameraFeed {
+  std::string name;
+  FrameTap* frames;
+  int listener = 0;
+  std::vector<std::unique_ptr<Client>> clients;
+  std::atomic<int> clientCount{0};  // read on the streaming thread
+  std::atomic<int> width{0}, height{0};  // of the last frame, for the overlay
+  nlohmann::json detections = nlohmann::json::array();  // the last ones
+};
+
+HttpServer::HttpServer(Content content) : content_(std::move(content)) {}
+
+Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(const ServerAddress& address,
+                                                                     Content content) {
+  std::unique_ptr<HttpServer> self(new HttpServer(std::move(content)));
+  self->server_ = soup_server_new("server-header", "wirc-recorder", nullptr);
+  GError* error = nullptr;
+  gboolean listening;
+  if (address.host.empty()) {
+    listening = soup_server_listen_all(self->server_, address.port, SoupServerListenOptions(0),
+                                       &error);
+  } else {
+    GSocketAddress* socket = g_inet_socket_address_new_from_string(address.host.c_str(),
+                                                                   address.port);
+    if (!socket) return unexpected("--http: '" + address.host + "' is not an IP address");
+    listening = soup_server_listen(self->server_, socket, SoupServerListenOptions(0), &error);
+    g_object_unref(socket);
+  }
+  if (!listening) {
+    std::string text = "--http: cannot listen on port " + std::to_string(address.port) + ": " +
+                       error->message;
+    g_error_free(error);
+    return unexpected(text);
+  }
+  // The port actually bound (the system's choice for port 0).
+  GSList* uris = soup_server_get_uris(self->server_);
+  int port = uris ? g_uri_get_port(static_cast<GUri*>(uris->data)) : address.port;
+  g_slist_free_full(uris, reinterpret_cast<GDestroyNotify>(g_uri_unref));
+  self->url_ = "http://" + (address.host.empty() ? std::string("localhost") : address.host) + ":" +
+               std::to_string(port) + "/";
+
+  soup_server_add_handler(self->server_, nullptr, onRequest, self.get(), nullptr);
+  for (size_t i = 0; i < self->content_.cameras.size(); ++i) {
+    auto feed = std::make_unique<CameraFeed>();
+    feed->name = self->content_.cameras[i].name;
+    feed->frames = self->content_.cameras[i].frames;
+    CameraFeed* raw = feed.get();
+    HttpServer* server = self.get();
+    // Frames come on the streaming thread; clients live on the main loop.
+    feed->listener = feed->frames->listen([server, raw, i](GstSample* sample) {
+      GstBuffer* jpeg = gst_sample_get_buffer(sample);
+      GstMapInfo map;
+      if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
+        if (auto info = wirc::readJpegInfo({map.data, map.size})) {
+          raw->width = info->width;
+          raw->height = info->height;
+        }
+        gst_buffer_unmap(jpeg, &map);
+      }
+      if (raw->clientCount.load() == 0) return;
+      struct Delivery {
+        HttpServer* server;
+        size_t camera;
+        GstBuffer* jpeg;
+        std::weak_ptr<bool> alive;
+      };
+      auto* delivery = new Delivery{server, i, gst_buffer_ref(jpeg), server->alive_};
+      g_main_context_invoke_full(
+          nullptr, G_PRIORITY_DEFAULT,
+          [](gpointer data) -> gboolean {
+            auto* d = static_cast<Delivery*>(data);
+            if (!d->alive.expired()) d->server->sendFrame(d->camera, d->jpeg);
+            return G_SOURCE_REMOVE;
+          },
+          delivery,
+          [](gpointer data) {
+            auto* d = static_cast<Delivery*>(data);
+            gst_buffer_unref(d->jpeg);
+            delete d;
+          });
+    });
+    self->feeds_.push_back(std::move(feed));
+  }
+  return self;
+}
+
+HttpServer::~HttpServer() {
+  for (auto& feed : feeds_) feed->frames->forget(feed->listener);
+  alive_.reset();
+  auto release = [](std::vector<std::unique_ptr<Client>>& clients) {
+    for (auto& client : clients) {
+      g_signal_handler_disconnect(client->message, client->wroteHandler);
+      g_signal_handler_disconnect(client->message, client->finishedHandler);
+    }
+    clients.clear();
+  };
+  for (auto& feed : feeds_) release(feed->clients);
+  release(eventClients_);
+  if (server_) {
+    soup_server_disconnect(server_);
+    g_object_unref(server_);
+  }
+}
+
+void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
+                           gpointer data) {
+  auto* self = static_cast<HttpServer*>(data);
+  std::string method = soup_server_message_get_method(message);
+  if (method != "GET" && method != "HEAD") {
+    respondError(message, SOUP_STATUS_METHOD_NOT_ALLOWED, "only GET and HEAD");
+    return;
+  }
+  std::string route = path;
+  if (route == "/" || route == "/index.html") {
+    respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", self->page());
+  } else if (route == "/api/status") {
+    respond(message, SOUP_STATUS_OK, "application/json", self->content_.status().dump());
+  } else if (route == "/api/events") {
+    self->serveEvents(message);
+  } else if (route.rfind("/live/", 0) == 0 && route.size() > 11 &&
+             route.compare(route.size() - 5, 5, ".mjpg") == 0) {
+    self->serveLive(message, route.substr(6, route.size() - 11));
+  } else if (route == "/recordings" || route == "/recordings/") {
+    self->serveRecordings(message, "");
+  } else if (route.rfind("/recordings/", 0) == 0) {
+    self->serveRecordings(message, route.substr(12));
+  } else {
+    respondError(message, SOUP_STATUS_NOT_FOUND,
+                 "not found; try /, /api/status, /api/events, /live/CAMERA.mjpg or /recordings");
+  }
+}
+
+void HttpServer::openStream(SoupServerMessage* message, const char* contentType,
+                            std::vector<std::unique_ptr<Client>>& clients) {
+  soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
+  SoupMessageHeaders* headers = soup_server_message_get_response_headers(message);
+  soup_message_headers_set_encoding(headers, SOUP_ENCODING_CHUNKED);
+  soup_message_headers_set_content_type(headers, contentType, nullptr);
+  soup_message_headers_replace(headers, "Cache-Control", "no-cache, no-store");
+  // Written chunks are freed, not kept for the whole life of the response.
+  soup_message_body_set_accumulate(soup_server_message_get_response_body(message), FALSE);
+
+  auto client = std::make_unique<Client>();
+  client->message = message;
+  Client* raw = client.get();
+  client->wroteHandler = g_signal_connect(
+      message, "wrote-chunk",
+      G_CALLBACK(+[](SoupServerMessage*, guint, gpointer c) { --static_cast<Client*>(c)->inFlight; }),
+      raw);
+  struct Finished {
+    std::vector<std::unique_ptr<Client>>* clients;
+    Client* client;
+  };
+  client->finishedHandler = g_signal_connect_data(
+      message, "finished",
+      G_CALLBACK(+[](SoupServerMessage*, gpointer data) {
+        // The viewer went away: forget it.
+        auto* f = static_cast<Finished*>(data);
+        auto& list = *f->clients;
+        auto it = std::find_if(list.begin(), list.end(),
+                               [&](const auto& c) { return c.get() == f->client; });
+        if (it != list.end()) {
+          g_signal_handler_disconnect(f->client->message, f->client->wroteHandler);
+          list.erase(it);  // the finished handler itself stays until the message dies
+        }
+      }),
+      new Finished{&clients, raw},
+      [](gpointer data, GClosure*) { delete static_cast<Finished*>(data); }, GConnectFlags(0));
+  clients.push_back(std::move(client));
+  soup_server_message_pause(message);
+}
+
+void HttpServer::send(std::vector<std::unique_ptr<Client>>& clients, GBytes* chunk) {
+  for (auto& client : clients) {
+    if (client->inFlight >= kMaxFramesInFlight) continue;
+    ++client->inFlight;
+    soup_message_body_append_bytes(soup_server_message_get_response_body(client->message), chunk);
+    soup_server_message_unpause(client->message);
+  }
+}
+
+void HttpServer::serveLive(SoupServerMessage* message, const std::string& camera) {
+  auto feed = std::find_if(feeds_.begin(), feeds_.end(),
+                           [&](const auto& f) { return f->name == camera; });
+  if (feed == feeds_.end()) {
+    respondError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+    return;
+  }
+  std::string type = std::string("multipart/x-mixed-replace; boundary=") + kBoundary;
+  openStream(message, type.c_str(), (*feed)->clients);
+  (*feed)->clientCount = static_cast<int>((*feed)->clients.size());
+}
+
+void HttpServer::sendFrame(size_t camera, GstBuffer* jpeg) {
+  auto& feed = *feeds_[camera];
+  feed.clientCount = static_cast<int>(feed.clients.size());
+  if (feed.clients.empty()) return;
+  GstMapInfo map;
+  if (!gst_buffer_map(jpeg, &map, GST_MAP_READ)) return;
+  std::string part = std::string("--") + kBoundary +
+                     "\r\nContent-Type: image/jpeg\r\nContent-Length: " +
+                     std::to_string(map.size) + "\r\n\r\n";
+  part.append(reinterpret_cast<const char*>(map.data), map.size);
+  part += "\r\n";
+  gst_buffer_unmap(jpeg, &map);
+  GBytes* chunk = g_bytes_new(part.data(), part.size());
+  send(feed.clients, chunk);
+  g_bytes_unref(chunk);
+}
+
+void HttpServer::serveEvents(SoupServerMessage* message) {
+  openStream(message, "text/event-stream", eventClients_);
+  GBytes* hello = g_bytes_new_static("retry: 2000\n\n", 13);
+  send(eventClients_, hello);
+  g_bytes_unref(hello);
+}
+
+std::string HttpServer::page() const {
+  nlohmann::json cameras = nlohmann::json::array();
+  for (const auto& feed : feeds_)
+    cameras.push_back({{"name", feed->name},
+                       {"width", feed->width.load()},
+                       {"height", feed->height.load()},
+                       {"detections", feed->detections}});
+  std::string state = nlohmann::json{{"cameras", cameras}}.dump();
+  // Inside <script>, "</" could end it early.
+  for (size_t at = state.find("</"); at != std::string::npos; at = state.find("</", at))
+    state.replace(at, 2, "<\\/");
+  std::string html = kLiveViewPage;
+  html.replace(html.find("INITIAL_STATE"), 13, state);
+  return html;
+}
+
+void HttpServer::publishDetections(const std::string& camera, const nlohmann::json& detections) {
+  for (auto& feed : feeds_)
+    if (feed->name == camera) feed->detections = detections;
+  if (eventClients_.empty()) return;
+  nlohmann::json event = {{"stream", camera}, {"detections", detections}};
+  std::string text = "event: detections\ndata: " + event.dump() + "\n\n";
+  GBytes* chunk = g_bytes_new(text.data(), text.size());
+  send(eventClients_, chunk);
+  g_bytes_unref(chunk);
+}
+
+void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& name) {
+  fs::path folder = content_.recordingsFolder;
+  if (name.empty()) {
+    auto open = content_.openSegments();
+    std::set<std::string> openNames;
+    for (const auto& path : open) {
+      openNames.insert(fs::path(path).filename().string());
+      openNames.insert(fs::path(path).replace_extension(".jsonl").filename().string());
+    }
+    nlohmann::json files = nlohmann::json::array();
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(folder, error)) {
+      if (!entry.is_regular_file(error) || !contentTypeOf(entry.path())) continue;
+      auto file = entry.path().filename().string();
+      files.push_back({{"name", file},
+                       {"bytes", entry.file_size(error)},
+                       {"recording", openNames.count(file) > 0}});
+    }
+    std::sort(files.begin(), files.end(),
+              [](const auto& a, const auto& b) { return a["name"] < b["name"]; });
+    respond(message, SOUP_STATUS_OK, "application/json", files.dump());
+    return;
+  }
+  // Only plain names of recordings in the folder: no way out of it.
+  fs::path file = folder / name;
+  if (name.find('/') != std::string::npos || name[0] == '.' || !contentTypeOf(file) ||
+      !fs::is_regular_file(file)) {
+    respondError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
+    return;
+  }
+  GError* error = nullptr;
+  GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &error);
+  if (!mapped) {
+    respondError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR, error->message);
+    g_error_free(error);
+    return;
+  }
+  GBytes* bytes = g_mapped_file_get_bytes(mapped);
+  g_mapped_file_unref(mapped);
+  soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
+  soup_message_headers_set_content_type(soup_server_message_get_response_headers(message),
+                                        contentTypeOf(file), nullptr);
+  soup_message_body_append_bytes(soup_server_message_get_response_body(message), bytes);
+  g_bytes_unref(bytes);
+}
+
+}  // namespace wircam::recorder

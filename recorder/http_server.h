@@ -1,0 +1,71 @@
+// wirc-recorder's web server (libsoup): the live view page, each camera as
+// MJPEG over HTTP (multipart/x-mixed-replace, the camera's frames as they
+// are), detections as server-sent events, the status as JSON, and the
+// recordings to list and download. Runs on the main loop's context.
+#pragma once
+
+#include <libsoup/soup.h>
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "common/expected.h"
+#include "frame_tap.h"
+#include "recorder_options.h"
+
+namespace wircam::recorder {
+
+class HttpServer {
+ public:
+  struct Camera {
+    std::string name;
+    FrameTap* frames;  // borrowed; outlives the server
+  };
+  struct Content {
+    std::vector<Camera> cameras;
+    std::string recordingsFolder;
+    std::function<nlohmann::json()> status;  // called on the main thread
+    std::function<std::vector<std::string>()> openSegments;
+  };
+
+  static Expected<std::unique_ptr<HttpServer>, std::string> start(const ServerAddress& address,
+                                                                  Content content);
+  ~HttpServer();
+
+  // "http://HOST:PORT/", with the port the system picked for port 0.
+  const std::string& url() const { return url_; }
+
+  // Sends one camera's detections to every open page (main thread).
+  void publishDetections(const std::string& camera, const nlohmann::json& detections);
+
+ private:
+  struct Client;
+  struct CameraFeed;
+  explicit HttpServer(Content content);
+
+  static void onRequest(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
+                        gpointer self);
+  std::string page() const;  // the live view page with the current state
+  void serveLive(SoupServerMessage* message, const std::string& camera);
+  void serveEvents(SoupServerMessage* message);
+  void serveRecordings(SoupServerMessage* message, const std::string& name);
+  // Keeps `message` open as a stream of chunks in `clients`.
+  void openStream(SoupServerMessage* message, const char* contentType,
+                  std::vector<std::unique_ptr<Client>>& clients);
+  void send(std::vector<std::unique_ptr<Client>>& clients, GBytes* chunk);
+  void sendFrame(size_t camera, GstBuffer* jpeg);
+
+  Content content_;
+  SoupServer* server_ = nullptr;
+  std::string url_;
+  std::vector<std::unique_ptr<CameraFeed>> feeds_;
+  std::vector<std::unique_ptr<Client>> eventClients_;
+  // Frames queued for the main loop check it: the server may be gone.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace wircam::recorder

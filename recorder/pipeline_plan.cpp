@@ -1,0 +1,92 @@
+#include "pipeline_plan.h"
+
+#include <cctype>
+#include <cstdint>
+#include <filesystem>
+
+namespace wircam::recorder {
+
+namespace {
+
+// A file name part made of safe characters only.
+std::string fileSafe(std::string text) {
+  for (char& c : text)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
+  return text;
+}
+
+// The muxer inside splitmuxsink. Crash safety: Matroska clusters of at most
+// 1 s, MP4 fragments of 1 s, so a killed recorder leaves the open segment
+// playable up to its last second.
+std::string muxerSettings(Container container) {
+  if (container == Container::kMp4)
+    return "muxer-factory=mp4mux "
+           "muxer-properties=\"properties,fragment-duration=(guint)1000\"";
+  return "muxer-factory=matroskamux "
+         "muxer-properties=\"properties,max-cluster-duration=(gint64)1000000000\"";
+}
+
+// What the frames pass through between the tee and the muxer.
+std::string encoder(const RecorderOptions& options) {
+  if (options.codec == Codec::kJpeg) return "";
+  // zerolatency: no B-frames and no look-ahead, so the live recording does
+  // not lag; a key frame every 30 frames lets segments end near their length.
+  return "tjpegdec ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
+         std::to_string(options.h264Kbps) + " key-int-max=30 ! h264parse ! ";
+}
+
+}  // namespace
+
+PipelinePlan planPipeline(const RecorderOptions& options, const std::string& startTime) {
+  PipelinePlan plan;
+  std::string& d = plan.description;
+  bool live = options.http || options.rtsp;
+  size_t index = 0;
+  for (const auto& device : options.devices) {
+    bool controlled = false;
+    std::string host = device.host.empty() ? "" : " host=" + device.host;
+    std::string port = " port=" + std::to_string(device.port);
+    for (int camera : device.cameras) {
+      auto i = std::to_string(index++);
+      StreamPlan stream{fileSafe(device.label), camera,
+                        fileSafe(device.label) + "-cam" + std::to_string(camera),
+                        "mux" + i,
+                        "tel" + i,
+                        live ? "live" + i : ""};
+      auto location = (std::filesystem::path(options.outDir) /
+                       (stream.name + "-" + startTime + "-%03d" + extensionOf(options.container)))
+                          .string();
+      d += "wircsrc name=src" + i + host + port + " camera=" + std::to_string(camera) +
+           " ! tee name=t" + i + " t" + i + ". ! queue max-size-time=3000000000 ! " +
+           encoder(options) + "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
+           muxerSettings(options.container) +
+           " max-size-time=" + std::to_string(static_cast<uint64_t>(options.segmentSeconds * 1e9)) +
+           " max-size-bytes=" + std::to_string(options.segmentBytes) + " location=\"" + location +
+           "\" ";
+      // The telemetry never blocks the main loop: past 1 MB waiting it drops.
+      d += "appsrc name=" + stream.telemetrySource +
+           " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
+           "caps=\"text/x-raw,format=(string)utf8\" ! " +
+           stream.muxer + ".subtitle_%u ";
+      if (!options.detectFamily.empty()) {
+        // Detection must never hold the recording back: its queue drops.
+        d += "t" + i +
+             ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=det" +
+             i + " quad-decimate=1 family=" + options.detectFamily;
+        if (*device.follow && !controlled) {
+          d += " ! wirccontrol name=ctl" + i + host + port;
+          controlled = true;  // one controller per vehicle: the first camera's
+        }
+        d += " ! fakesink sync=false async=false ";
+      }
+      if (live) {
+        d += "t" + i + ". ! queue leaky=downstream max-size-buffers=2 ! appsink name=" +
+             stream.liveSink + " sync=false async=false max-buffers=2 drop=true ";
+      }
+      plan.streams.push_back(std::move(stream));
+    }
+  }
+  return plan;
+}
+
+}  // namespace wircam::recorder
