@@ -30,9 +30,10 @@ std::string muxerSettings(Container container) {
 std::string encoder(const RecorderOptions& options) {
   if (options.codec == Codec::kJpeg) return "";
   // zerolatency: no B-frames and no look-ahead, so the live recording does
-  // not lag; a key frame every 30 frames lets segments end near their length.
+  // not lag; a key frame every 15 frames (1 s at 15 fps) lets segments end near
+  // their length and bounds what a crash can lose.
   return "tjpegdec ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
-         std::to_string(options.h264Kbps) + " key-int-max=30 ! h264parse ! ";
+         std::to_string(options.h264Kbps) + " key-int-max=15 ! h264parse ! ";
 }
 
 }  // namespace
@@ -56,18 +57,28 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
       auto location = (std::filesystem::path(options.outDir) /
                        (stream.name + "-" + startTime + "-%03d" + extensionOf(options.container)))
                           .string();
+      // The telemetry track is sparse: splitmuxsink lets it run up to 2 s
+      // ahead of the video rather than hold the video for it (at 0, the
+      // default, the two wait on each other).
       d += "wircsrc name=src" + i + host + port + " camera=" + std::to_string(camera) +
            " ! tee name=t" + i + " t" + i + ". ! queue max-size-time=3000000000 ! " +
-           encoder(options) + "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
+           encoder(options) + "splitmuxsink name=" + stream.muxer +
+           " async-finalize=true alignment-threshold=2000000000 " +
            muxerSettings(options.container) +
            " max-size-time=" + std::to_string(static_cast<uint64_t>(options.segmentSeconds * 1e9)) +
            " max-size-bytes=" + std::to_string(options.segmentBytes) + " location=\"" + location +
            "\" ";
-      // The telemetry never blocks the main loop: past 1 MB waiting it drops.
-      d += "appsrc name=" + stream.telemetrySource +
-           " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
-           "caps=\"text/x-raw,format=(string)utf8\" ! " +
-           stream.muxer + ".subtitle_%u ";
+      if (options.container == Container::kMatroska) {
+        // The telemetry never blocks the main loop: past 1 MB waiting it
+        // drops. (mp4mux would hold every fragment until the sparse text
+        // track has data, so MP4 keeps its telemetry in the sidecar only.)
+        d += "appsrc name=" + stream.telemetrySource +
+             " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
+             "caps=\"text/x-raw,format=(string)utf8\" ! " +
+             stream.muxer + ".subtitle_%u ";
+      } else {
+        stream.telemetrySource.clear();
+      }
       if (!options.detectFamily.empty()) {
         // Detection must never hold the recording back: its queue drops.
         d += "t" + i +

@@ -15,7 +15,7 @@ struct StreamPlan {
   int camera = 0;
   std::string name;  // "<device>-cam<N>", also in file names and the live view
   std::string muxer;            // splitmuxsink
-  std::string telemetrySource;  // appsrc feeding the file's text track
+  std::string telemetrySource;  // appsrc feeding the file's text track; empty for MP4
   std::string liveSink;         // appsink of the frames as they arrive, or empty
 };
 

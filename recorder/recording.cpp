@@ -56,10 +56,12 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
   for (auto& streamPlan : plan.streams) {
     auto stream = std::make_unique<Stream>();
     stream->plan = streamPlan;
-    GstElement* source = gst_bin_get_by_name(GST_BIN(recording->pipeline_),
-                                             streamPlan.telemetrySource.c_str());
-    stream->track.emplace(source);
-    gst_object_unref(source);  // the pipeline keeps it
+    if (!streamPlan.telemetrySource.empty()) {
+      GstElement* source = gst_bin_get_by_name(GST_BIN(recording->pipeline_),
+                                               streamPlan.telemetrySource.c_str());
+      stream->track.emplace(source);
+      gst_object_unref(source);  // the pipeline keeps it
+    }
     if (!streamPlan.liveSink.empty()) {
       GstElement* sink =
           gst_bin_get_by_name(GST_BIN(recording->pipeline_), streamPlan.liveSink.c_str());
@@ -140,7 +142,7 @@ void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime
   line["pts"] = pts;
   std::string text = line.dump();
   stream.sidecar.write(text);
-  stream.track->write(text, pts);
+  if (stream.track) stream.track->write(text, pts);
 }
 
 void Recording::handleElementMessage(GstMessage* message) {
@@ -180,12 +182,21 @@ void Recording::handleElementMessage(GstMessage* message) {
     return;
   }
   if (type == "wirc-stats") {
+    guint64 frames = stream->frameCount, bytes = stream->bytes;
     gst_structure_get_uint64(s, "frames-complete", &stream->frameCount);
     gst_structure_get_uint64(s, "frames-incomplete", &stream->incomplete);
     gst_structure_get_uint64(s, "bytes", &stream->bytes);
     gst_structure_get_uint(s, "battery-mv", &stream->batteryMv);
+    // Rates over the time between two reports, whatever their interval.
+    GstClockTime now = runningTime();
+    if (GST_CLOCK_TIME_IS_VALID(stream->statsTime) && now > stream->statsTime) {
+      double seconds = static_cast<double>(now - stream->statsTime) / GST_SECOND;
+      stream->fps = static_cast<double>(stream->frameCount - frames) / seconds;
+      stream->kbps = static_cast<double>(stream->bytes - bytes) * 8 / 1000 / seconds;
+    }
+    stream->statsTime = now;
     line["type"] = "stats";
-    writeTelemetry(*stream, line, runningTime());
+    writeTelemetry(*stream, line, now);
     return;
   }
   if (type != "apriltag" && type != "wirc-control") return;
@@ -270,7 +281,6 @@ gboolean Recording::onStop(gpointer data) {
 
 gboolean Recording::onTick(gpointer data) {
   auto* self = static_cast<Recording*>(data);
-  self->updateRates();
   self->printStatus();
   self->guardDisk();
   return G_SOURCE_CONTINUE;
@@ -292,16 +302,6 @@ void Recording::guardDisk() {
       "--min-free to delete old segments as you go");
   exitCode_ = kExitDiskFull;
   stop(nullptr);
-}
-
-void Recording::updateRates() {
-  double seconds = options_.statusSeconds;
-  for (auto& s : streams_) {
-    s->fps = static_cast<double>(s->frameCount - s->lastFrames) / seconds;
-    s->kbps = static_cast<double>(s->bytes - s->lastBytes) * 8 / 1000 / seconds;
-    s->lastFrames = s->frameCount;
-    s->lastBytes = s->bytes;
-  }
 }
 
 void Recording::printStatus() {

@@ -45,7 +45,7 @@ class Recording {
     std::unique_ptr<FrameTap> frames;  // with --http or --rtsp
     std::string segment;
     guint64 frameCount = 0, incomplete = 0, bytes = 0;
-    guint64 lastFrames = 0, lastBytes = 0;
+    GstClockTime statsTime = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
     double fps = 0, kbps = 0;
     guint batteryMv = 0;
     bool lost = false;  // the device went away; the next login starts a segment
@@ -61,7 +61,6 @@ class Recording {
   void handleError(GstMessage* message);
   void writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime pts);
   GstClockTime runningTime() const;
-  void updateRates();
   void printStatus();
   void guardDisk();
   nlohmann::json status() const;

@@ -1,0 +1,239 @@
+// wirc-recorder --http: what a browser or a script gets from it, through a
+// real HTTP client (libsoup) and a real browser (headless Chromium).
+#include <gst/app/gstappsink.h>
+#include <gst/video/video.h>
+#include <gtest/gtest.h>
+#include <libsoup/soup.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "recorder_process.h"
+#include "simulated_device.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+
+struct Response {
+  guint status = 0;
+  std::string contentType;
+  std::string body;
+};
+
+Response fetch(const std::string& url, const char* method = "GET") {
+  SoupSession* session = soup_session_new();
+  SoupMessage* message = soup_message_new(method, url.c_str());
+  Response response;
+  GBytes* body = soup_session_send_and_read(session, message, nullptr, nullptr);
+  response.status = soup_message_get_status(message);
+  const char* type = soup_message_headers_get_content_type(
+      soup_message_get_response_headers(message), nullptr);
+  response.contentType = type ? type : "";
+  if (body) {
+    gsize size = 0;
+    auto* data = static_cast<const char*>(g_bytes_get_data(body, &size));
+    response.body.assign(data, size);
+    g_bytes_unref(body);
+  }
+  g_object_unref(message);
+  g_object_unref(session);
+  return response;
+}
+
+// Reads an endless response (MJPEG, events) until `enough` says so or
+// `limit` bytes arrived.
+std::string readStream(const std::string& url, const std::function<bool(const std::string&)>& enough,
+                       size_t limit = 8 << 20) {
+  SoupSession* session = soup_session_new_with_options("timeout", 10, nullptr);
+  SoupMessage* message = soup_message_new("GET", url.c_str());
+  std::string received;
+  if (GInputStream* stream = soup_session_send(session, message, nullptr, nullptr)) {
+    char chunk[16384];
+    while (received.size() < limit && !enough(received)) {
+      gssize n = g_input_stream_read(stream, chunk, sizeof chunk, nullptr, nullptr);
+      if (n <= 0) break;
+      received.append(chunk, static_cast<size_t>(n));
+    }
+    g_object_unref(stream);
+  }
+  g_object_unref(message);
+  g_object_unref(session);
+  return received;
+}
+
+// The JPEG parts of a multipart/x-mixed-replace body.
+std::vector<std::vector<uint8_t>> jpegParts(const std::string& body) {
+  std::vector<std::vector<uint8_t>> parts;
+  size_t at = 0;
+  const std::string length = "Content-Length: ";
+  while ((at = body.find(length, at)) != std::string::npos) {
+    size_t size = std::stoul(body.substr(at + length.size()));
+    size_t start = body.find("\r\n\r\n", at);
+    if (start == std::string::npos || start + 4 + size > body.size()) break;
+    parts.emplace_back(body.begin() + static_cast<long>(start + 4),
+                       body.begin() + static_cast<long>(start + 4 + size));
+    at = start + 4 + size;
+  }
+  return parts;
+}
+
+struct LiveRecorder {
+  std::unique_ptr<wircam::wirc::Device> device;
+  std::unique_ptr<RecorderProcess> recorder;
+  std::string url;  // "http://127.0.0.1:PORT/"
+
+  explicit LiveRecorder(std::unique_ptr<wircam::wirc::Device> d, std::vector<std::string> extra)
+      : device(std::move(d)) {
+    extra.insert(extra.end(), {"--http", "127.0.0.1:0", "--duration", "60"});
+    recorder = std::make_unique<RecorderProcess>(device->port(), extra);
+    url = recorder->waitForLog("http://", milliseconds(10000)).value_or("");
+  }
+  std::string camera() const { return "127.0.0.1-" + std::to_string(device->port()) + "-cam0"; }
+};
+
+TEST(WircRecorderHttp, StatusIsJsonWithEachStream) {
+  LiveRecorder live(startSequenceDevice(), {});
+  ASSERT_FALSE(live.url.empty()) << live.recorder->log();
+  // Rates need two statistics reports, a second apart.
+  Response response;
+  nlohmann::json status;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    std::this_thread::sleep_for(milliseconds(100));
+    response = fetch(live.url + "api/status");
+    ASSERT_EQ(response.status, 200u);
+    status = nlohmann::json::parse(response.body);
+    if (status["streams"][0]["fps"].get<double>() > 0) break;
+  }
+  EXPECT_EQ(response.contentType, "application/json");
+  ASSERT_EQ(status["streams"].size(), 1u);
+  auto stream = status["streams"][0];
+  EXPECT_EQ(stream["name"], live.camera());
+  EXPECT_GT(stream["frames"].get<int>(), 10);
+  EXPECT_GT(stream["fps"].get<double>(), 10);
+  EXPECT_NEAR(stream["battery_v"].get<double>(), 8.4, 0.2);
+}
+
+TEST(WircRecorderHttp, LiveMjpegCarriesTheCamerasFramesUntouched) {
+  LiveRecorder live(startSequenceDevice(), {});
+  ASSERT_FALSE(live.url.empty()) << live.recorder->log();
+  auto body = readStream(live.url + "live/" + live.camera() + ".mjpg",
+                         [](const std::string& b) { return jpegParts(b).size() >= 6; });
+  auto parts = jpegParts(body);
+  ASSERT_GE(parts.size(), 6u);
+  for (const auto& part : parts) EXPECT_TRUE(isSceneFrame(part));
+  EXPECT_EQ(fetch(live.url + "live/no-such-camera.mjpg").status, 404u);
+}
+
+TEST(WircRecorderHttp, ListsAndServesTheRecordings) {
+  LiveRecorder live(startSequenceDevice(), {"--segment", "1"});
+  ASSERT_FALSE(live.url.empty()) << live.recorder->log();
+  std::this_thread::sleep_for(milliseconds(3500));
+  auto files = nlohmann::json::parse(fetch(live.url + "recordings").body);
+  const nlohmann::json* finished = nullptr;
+  bool recording = false;
+  for (const auto& file : files) {
+    if (file["recording"]) recording = true;
+    std::string name = file["name"];
+    if (!file["recording"] && name.ends_with(".mkv")) finished = &file;
+  }
+  EXPECT_TRUE(recording);
+  ASSERT_NE(finished, nullptr) << files.dump();
+  auto download = fetch(live.url + "recordings/" + (*finished)["name"].get<std::string>());
+  ASSERT_EQ(download.status, 200u);
+  EXPECT_EQ(download.contentType, "video/x-matroska");
+  std::ifstream file(live.recorder->out() / (*finished)["name"].get<std::string>(),
+                     std::ios::binary);
+  std::string onDisk((std::istreambuf_iterator<char>(file)), {});
+  EXPECT_EQ(download.body, onDisk);
+  // Nothing outside the recordings folder, nothing but recordings: refused
+  // by libsoup (400) or by the server (404).
+  for (const char* path : {"recordings/..%2Fstderr.log", "recordings/%2Fetc%2Fpasswd",
+                           "recordings/..%2F..%2Fetc%2Fpasswd", "recordings/stderr.log"}) {
+    auto refused = fetch(live.url + path);
+    EXPECT_TRUE(refused.status == 400u || refused.status == 404u) << path << refused.status;
+  }
+  EXPECT_EQ(fetch(live.url + "api/status", "POST").status, 405u);
+}
+
+TEST(WircRecorderHttp, EventsCarryTheDetections) {
+  LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11"});
+  ASSERT_FALSE(live.url.empty()) << live.recorder->log();
+  auto body = readStream(live.url + "api/events", [](const std::string& b) {
+    return b.find("\"id\":0") != std::string::npos && b.find("\n\n", b.find("\"id\":0")) != b.npos;
+  });
+  auto start = body.find("event: detections\ndata: ");
+  ASSERT_NE(start, std::string::npos) << body;
+  auto data = body.substr(start + 24, body.find('\n', start + 24) - start - 24);
+  auto event = nlohmann::json::parse(data);
+  EXPECT_EQ(event["stream"], live.camera());
+  ASSERT_FALSE(event["detections"].empty());
+  EXPECT_EQ(event["detections"][0]["corners"].size(), 8u);
+}
+
+// Pixels of a PNG as RGB, decoded by GStreamer's pngdec.
+struct Picture {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+
+Picture readPng(const fs::path& file) {
+  std::string description = "filesrc location=\"" + file.string() +
+                            "\" ! pngdec ! videoconvert ! video/x-raw,format=RGB ! "
+                            "appsink name=sink";
+  GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
+  GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  Picture picture;
+  if (GstSample* sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), 10 * GST_SECOND)) {
+    GstVideoInfo info;
+    gst_video_info_from_caps(&info, gst_sample_get_caps(sample));
+    picture.width = GST_VIDEO_INFO_WIDTH(&info);
+    picture.height = GST_VIDEO_INFO_HEIGHT(&info);
+    GstMapInfo map;
+    gst_buffer_map(gst_sample_get_buffer(sample), &map, GST_MAP_READ);
+    int stride = GST_VIDEO_INFO_PLANE_STRIDE(&info, 0);
+    for (int y = 0; y < picture.height; ++y)
+      picture.rgb.insert(picture.rgb.end(), map.data + y * stride,
+                         map.data + y * stride + picture.width * 3);
+    gst_buffer_unmap(gst_sample_get_buffer(sample), &map);
+    gst_sample_unref(sample);
+  }
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(sink);
+  gst_object_unref(pipeline);
+  return picture;
+}
+
+TEST(WircRecorderHttp, LiveViewShowsTheCameraWithTheTagOverlayInChromium) {
+  if (system("command -v chromium > /dev/null") != 0)
+    GTEST_SKIP() << "chromium is not installed (tools/install-deps test installs it)";
+  LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11"});
+  ASSERT_FALSE(live.url.empty()) << live.recorder->log();
+  std::this_thread::sleep_for(milliseconds(2000));  // detections have come
+  auto shot = live.recorder->out().parent_path() / "live-view.png";
+  auto profile = live.recorder->out().parent_path() / "chromium-profile";
+  std::string command =
+      "timeout 60 chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage "
+      "--disable-quic --no-first-run --disable-background-networking --disable-component-update "
+      "--disable-sync --user-data-dir=" + profile.string() +
+      " --window-size=800,600 --timeout=10000 --screenshot=" + shot.string() + " " + live.url +
+      " > /dev/null 2>&1";
+  ASSERT_EQ(system(command.c_str()), 0) << command;
+  auto picture = readPng(shot);
+  ASSERT_EQ(picture.width, 800);
+  // The camera's picture (its sky) and the overlay's green outline.
+  int sky = 0, overlay = 0;
+  for (size_t i = 0; i + 2 < picture.rgb.size(); i += 3) {
+    int r = picture.rgb[i], g = picture.rgb[i + 1], b = picture.rgb[i + 2];
+    if (b > 200 && r > 120 && r < 210 && g > 170) ++sky;
+    if (g > 200 && r < 90 && b < 90) ++overlay;
+  }
+  EXPECT_GT(sky, 20000) << "no camera picture in " << shot;
+  EXPECT_GT(overlay, 100) << "no tag overlay in " << shot;
+}
+
+}  // namespace

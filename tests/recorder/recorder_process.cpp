@@ -1,0 +1,183 @@
+#include "recorder_process.h"
+
+#include <gst/pbutils/pbutils.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+namespace wircam::testing {
+
+namespace fs = std::filesystem;
+
+RecorderProcess::RecorderProcess(uint16_t port, std::vector<std::string> extra,
+                                 std::vector<std::string> wrapper) {
+  static int count = 0;
+  folder_ = fs::temp_directory_path() / ("wirc-recorder-test-" + std::to_string(getpid()) + "-" +
+                                         std::to_string(++count));
+  fs::remove_all(folder_);
+  fs::create_directories(folder_);
+  out_ = folder_ / "out";
+  std::vector<std::string> args = wrapper;
+  args.insert(args.end(), {WIRC_RECORDER, "--status", "0.5"});
+  if (port != 0)
+    args.insert(args.end(), {"--device", "127.0.0.1:" + std::to_string(port), "--out", out_});
+  args.insert(args.end(), extra.begin(), extra.end());
+  std::string log = folder_ / "stderr.log";
+  pid_ = fork();
+  if (pid_ == 0) {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (!freopen("/dev/null", "w", stdout) || !freopen(log.c_str(), "w", stderr)) _exit(126);
+    execvp(argv[0], argv.data());
+    _exit(127);
+  }
+}
+
+RecorderProcess::~RecorderProcess() {
+  if (!exited_) {
+    kill(pid_, SIGKILL);
+    wait();
+  }
+  fs::remove_all(folder_);
+}
+
+int RecorderProcess::wait() {
+  if (!exited_) waitpid(pid_, &status_, 0);
+  exited_ = true;
+  return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
+}
+
+void RecorderProcess::signal(int number) { kill(pid_, number); }
+
+std::vector<fs::path> RecorderProcess::files(const std::string& extension) const {
+  std::vector<fs::path> found;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(out_, error))
+    if (entry.path().extension() == extension) found.push_back(entry.path());
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+std::string RecorderProcess::log() const {
+  std::ifstream file(folder_ / "stderr.log");
+  return std::string((std::istreambuf_iterator<char>(file)), {});
+}
+
+std::optional<std::string> RecorderProcess::waitForLog(const std::string& prefix,
+                                                       std::chrono::milliseconds timeout) {
+  auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::istringstream words(log());
+    std::string word;
+    while (words >> word)
+      if (word.rfind(prefix, 0) == 0) return word;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return std::nullopt;
+}
+
+GstClockTime durationOf(const fs::path& file) {
+  GstDiscoverer* discoverer = gst_discoverer_new(10 * GST_SECOND, nullptr);
+  std::string uri = "file://" + fs::absolute(file).string();
+  GstDiscovererInfo* info = gst_discoverer_discover_uri(discoverer, uri.c_str(), nullptr);
+  GstClockTime duration = info ? gst_discoverer_info_get_duration(info) : GST_CLOCK_TIME_NONE;
+  if (info) gst_discoverer_info_unref(info);
+  g_object_unref(discoverer);
+  return duration;
+}
+
+namespace {
+
+struct Reading {
+  Contents contents;
+  GstClockTime last = GST_CLOCK_TIME_NONE;
+  GstElement* pipeline;
+};
+
+GstPadProbeReturn onVideo(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  auto* r = static_cast<Reading*>(data);
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  GstClockTime pts = GST_BUFFER_PTS(buffer);
+  if (GST_CLOCK_TIME_IS_VALID(r->last) && pts <= r->last) r->contents.monotonic = false;
+  r->last = pts;
+  ++r->contents.frames;
+  r->contents.framePts.push_back(pts);
+  if (r->contents.videoCaps.empty()) {
+    GstCaps* caps = gst_pad_get_current_caps(pad);
+    r->contents.videoCaps = gst_structure_get_name(gst_caps_get_structure(caps, 0));
+    gst_caps_unref(caps);
+  }
+  return GST_PAD_PROBE_OK;
+}
+
+// matroskademux gives UTF-8 text as Pango markup: the JSON's quotes come
+// out as &quot; and so on.
+std::string unescapeMarkup(std::string text) {
+  for (auto [entity, plain] : {std::pair{"&quot;", "\""}, {"&apos;", "'"}, {"&lt;", "<"},
+                               {"&gt;", ">"}, {"&amp;", "&"}}) {
+    std::string e = entity;
+    for (size_t at = text.find(e); at != std::string::npos; at = text.find(e, at + 1))
+      text.replace(at, e.size(), plain);
+  }
+  return text;
+}
+
+GstPadProbeReturn onText(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  GstCaps* caps = gst_pad_get_current_caps(pad);
+  const char* format = gst_structure_get_string(gst_caps_get_structure(caps, 0), "format");
+  bool markup = format && std::string(format) == "pango-markup";
+  gst_caps_unref(caps);
+  GstMapInfo map;
+  if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    std::string text(reinterpret_cast<const char*>(map.data), map.size);
+    static_cast<Reading*>(data)->contents.telemetry.push_back(markup ? unescapeMarkup(text)
+                                                                     : text);
+    gst_buffer_unmap(buffer, &map);
+  }
+  return GST_PAD_PROBE_OK;
+}
+
+// Each demuxed stream ends in a fakesink; a probe counts what passes.
+void onPadAdded(GstElement*, GstPad* pad, gpointer data) {
+  auto* r = static_cast<Reading*>(data);
+  GstElement* sink = gst_element_factory_make("fakesink", nullptr);
+  g_object_set(sink, "sync", FALSE, "async", FALSE, nullptr);
+  gst_bin_add(GST_BIN(r->pipeline), sink);
+  gst_element_sync_state_with_parent(sink);
+  GstPad* sinkPad = gst_element_get_static_pad(sink, "sink");
+  gst_pad_link(pad, sinkPad);
+  gst_object_unref(sinkPad);
+  bool text = std::string(GST_PAD_NAME(pad)).rfind("subtitle", 0) == 0;
+  gst_pad_add_probe(pad, GST_PAD_PROBE_TYPE_BUFFER, text ? onText : onVideo, r, nullptr);
+}
+
+}  // namespace
+
+Contents contentsOf(const fs::path& file) {
+  const char* demuxer = file.extension() == ".mp4" ? "qtdemux" : "matroskademux";
+  std::string description =
+      "filesrc location=\"" + file.string() + "\" ! " + demuxer + " name=demux";
+  Reading reading;
+  reading.pipeline = gst_parse_launch(description.c_str(), nullptr);
+  GstElement* demux = gst_bin_get_by_name(GST_BIN(reading.pipeline), "demux");
+  g_signal_connect(demux, "pad-added", G_CALLBACK(onPadAdded), &reading);
+  gst_object_unref(demux);
+  gst_element_set_state(reading.pipeline, GST_STATE_PLAYING);
+  GstBus* bus = gst_element_get_bus(reading.pipeline);
+  if (GstMessage* message = gst_bus_timed_pop_filtered(
+          bus, 20 * GST_SECOND, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR)))
+    gst_message_unref(message);
+  gst_object_unref(bus);
+  gst_element_set_state(reading.pipeline, GST_STATE_NULL);
+  gst_object_unref(reading.pipeline);
+  return reading.contents;
+}
+
+}  // namespace wircam::testing

@@ -1,0 +1,61 @@
+// wirc-recorder as users run it: a separate process with its own folder,
+// and what the tests read back from its files.
+#pragma once
+
+#include <gst/gst.h>
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace wircam::testing {
+
+class RecorderProcess {
+ public:
+  // Records from 127.0.0.1:port into a fresh folder (`out()`); with port 0
+  // the device and the folder come from `extra` alone. `wrapper` runs in
+  // front of the recorder (e.g. a shell that mounts a small file system).
+  RecorderProcess(uint16_t port, std::vector<std::string> extra,
+                  std::vector<std::string> wrapper = {});
+  ~RecorderProcess();
+  RecorderProcess(const RecorderProcess&) = delete;
+  RecorderProcess& operator=(const RecorderProcess&) = delete;
+
+  // The exit code, or 128 + signal.
+  int wait();
+  void signal(int number);
+  pid_t pid() const { return pid_; }
+  const std::filesystem::path& out() const { return out_; }
+  // The recordings with this extension (".mkv"), sorted by name.
+  std::vector<std::filesystem::path> files(const std::string& extension) const;
+  // Everything the recorder wrote to stderr so far.
+  std::string log() const;
+  // The first word starting with `prefix` in the log (e.g. "http://"), or
+  // nullopt after `timeout`.
+  std::optional<std::string> waitForLog(const std::string& prefix,
+                                        std::chrono::milliseconds timeout);
+
+ private:
+  std::filesystem::path folder_;  // out_ and the log
+  std::filesystem::path out_;
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  int status_ = 0;
+};
+
+GstClockTime durationOf(const std::filesystem::path& file);
+
+// What one recorded file holds, read back through its demuxer.
+struct Contents {
+  int frames = 0;
+  bool monotonic = true;  // the frames' timestamps rise
+  std::vector<GstClockTime> framePts;
+  std::string videoCaps;  // the video stream's media type, e.g. "image/jpeg"
+  std::vector<std::string> telemetry;  // the text track, one JSON per buffer
+};
+Contents contentsOf(const std::filesystem::path& file);
+
+}  // namespace wircam::testing

@@ -1,0 +1,242 @@
+// What wirc-recorder writes: segments that play, every frame in order, the
+// telemetry in the file and beside it, and the files finished whatever
+// happens (SIGINT, kill -9, the device going away).
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+
+#include "recorder_process.h"
+#include "simulated_device.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+
+std::vector<std::string> linesOf(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(WircRecorder, RecordsPlayableSegmentsWithTelemetry) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(), {"--segment", "2", "--duration", "5"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto videos = recorder.files(".mkv");
+  ASSERT_GE(videos.size(), 2u);
+  GstClockTime total = 0;
+  for (const auto& video : videos) {
+    GstClockTime duration = durationOf(video);
+    ASSERT_TRUE(GST_CLOCK_TIME_IS_VALID(duration)) << video;
+    total += duration;
+    ASSERT_TRUE(fs::exists(fs::path(video).replace_extension(".jsonl"))) << video;
+  }
+  // About the 5 s asked for, less the start-up before the first frame.
+  EXPECT_GT(total, 3 * GST_SECOND);
+  EXPECT_LT(total, 6 * GST_SECOND);
+  bool stats = false;
+  for (const auto& line : linesOf(recorder.files(".jsonl")[0]))
+    stats = stats || nlohmann::json::parse(line)["type"] == "stats";
+  EXPECT_TRUE(stats);
+}
+
+TEST(WircRecorder, RecordsEveryFrameDeliveredInOrder) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(), {"--segment", "2", "--duration", "5"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  std::this_thread::sleep_for(milliseconds(100));
+  uint64_t sent = device->stats().framesSent;  // to this receiver, none lost on loopback
+  int recorded = 0;
+  for (const auto& video : recorder.files(".mkv")) {
+    auto contents = contentsOf(video);
+    EXPECT_TRUE(contents.monotonic) << video;
+    EXPECT_EQ(contents.videoCaps, "image/jpeg");
+    recorded += contents.frames;
+  }
+  ASSERT_GT(sent, 40u);
+  // The frame in flight when the stream stopped may be missing.
+  EXPECT_LE(static_cast<uint64_t>(recorded), sent);
+  EXPECT_GE(static_cast<uint64_t>(recorded) + 2, sent);
+}
+
+TEST(WircRecorder, TheFileCarriesTheTelemetryAsATextTrack) {
+  auto device = startFollowDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess recorder(device->port(),
+                           {"--segment", "2", "--duration", "5", "--detect", "tag36h11"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  std::multiset<std::string> sidecar, track;
+  int detections = 0, onAFrame = 0;
+  for (const auto& video : recorder.files(".mkv")) {
+    for (const auto& line : linesOf(fs::path(video).replace_extension(".jsonl")))
+      sidecar.insert(line);
+    auto contents = contentsOf(video);
+    std::set<GstClockTime> frames;  // Matroska keeps milliseconds
+    for (GstClockTime pts : contents.framePts) frames.insert(pts / GST_MSECOND);
+    for (const auto& line : contents.telemetry) {
+      track.insert(line);
+      auto event = nlohmann::json::parse(line);
+      if (event["type"] != "detections") continue;
+      ++detections;
+      // A detection's pts is the time of the frame it was found in.
+      GstClockTime ms = event["pts"].get<GstClockTime>() / GST_MSECOND;
+      onAFrame += frames.count(ms) || frames.count(ms + 1);  // rounded to the nearest
+    }
+  }
+  // The sidecars also hold what came after the end of the stream.
+  for (const auto& line : track) EXPECT_TRUE(sidecar.count(line)) << line;
+  EXPECT_GT(track.size(), sidecar.size() * 8 / 10);
+  EXPECT_GT(detections, 30);
+  EXPECT_GE(onAFrame, detections - 2);  // the frames in flight at a cut
+}
+
+TEST(WircRecorder, TranscodesToH264InFragmentedMp4) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(), {"--segment", "2", "--duration", "5", "--codec",
+                                            "h264", "--format", "mp4"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto videos = recorder.files(".mp4");
+  ASSERT_GE(videos.size(), 2u);
+  int frames = 0;
+  for (const auto& video : videos) {
+    EXPECT_TRUE(GST_CLOCK_TIME_IS_VALID(durationOf(video))) << video;
+    auto contents = contentsOf(video);
+    EXPECT_EQ(contents.videoCaps, "video/x-h264");
+    EXPECT_TRUE(contents.monotonic);
+    EXPECT_TRUE(fs::exists(fs::path(video).replace_extension(".jsonl")));
+    frames += contents.frames;
+  }
+  uint64_t sent = device->stats().framesSent;
+  EXPECT_GE(static_cast<uint64_t>(frames) + 3, sent);
+}
+
+TEST(WircRecorder, RefusesMp4WithoutTranscoding) {
+  RecorderProcess recorder(0, {"--out", "/tmp", "--format", "mp4"});
+  EXPECT_EQ(recorder.wait(), 2);
+  EXPECT_NE(recorder.log().find("--codec h264"), std::string::npos) << recorder.log();
+}
+
+TEST(WircRecorder, SigintFinishesEveryFileAndExitsZero) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(), {"--segment", "60"});
+  std::this_thread::sleep_for(milliseconds(3000));
+  recorder.signal(SIGINT);
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto videos = recorder.files(".mkv");
+  ASSERT_EQ(videos.size(), 1u);
+  GstClockTime duration = durationOf(videos[0]);
+  ASSERT_TRUE(GST_CLOCK_TIME_IS_VALID(duration));
+  EXPECT_GT(duration, GST_SECOND);
+}
+
+// About 7.5 s were streamed. Clusters (Matroska) or fragments (MP4) of 1 s,
+// a GOP of 1 s (H.264) and what splitmuxsink holds back lose at most the
+// last 4 s.
+void expectPlayableAfterKill9(const std::vector<std::string>& options, const char* extension) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(), options);
+  std::this_thread::sleep_for(milliseconds(8000));
+  recorder.signal(SIGKILL);
+  recorder.wait();
+  auto videos = recorder.files(extension);
+  ASSERT_EQ(videos.size(), 1u);
+  auto contents = contentsOf(videos[0]);
+  EXPECT_GT(contents.frames, 3 * 15);
+  EXPECT_TRUE(contents.monotonic);
+}
+
+TEST(WircRecorder, AfterKill9TheOpenMatroskaSegmentPlaysUpToItsLastSecond) {
+  expectPlayableAfterKill9({"--segment", "60"}, ".mkv");
+}
+
+TEST(WircRecorder, AfterKill9TheOpenMp4SegmentPlaysUpToItsLastSecond) {
+  expectPlayableAfterKill9({"--segment", "60", "--codec", "h264", "--format", "mp4"}, ".mp4");
+}
+
+TEST(WircRecorder, StartsANewSegmentWhenTheDeviceComesBack) {
+  auto device = startSequenceDevice();
+  uint16_t port = device->port();
+  RecorderProcess recorder(port, {"--segment", "60"});
+  std::this_thread::sleep_for(milliseconds(2500));
+  device.reset();  // the vehicle goes away...
+  std::this_thread::sleep_for(milliseconds(1000));
+  device = startSequenceDevice(port);  // ...and comes back
+  ASSERT_TRUE(device);
+  std::this_thread::sleep_for(milliseconds(4000));
+  recorder.signal(SIGINT);
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto videos = recorder.files(".mkv");
+  ASSERT_EQ(videos.size(), 2u);
+  for (const auto& video : videos) EXPECT_TRUE(GST_CLOCK_TIME_IS_VALID(durationOf(video))) << video;
+  std::string text;
+  for (const auto& line : linesOf(recorder.files(".jsonl")[0])) text += line;
+  EXPECT_NE(text.find("connection to the device lost"), std::string::npos);
+}
+
+TEST(WircRecorder, DeletesTheOldestSegmentsToStayUnderMaxBytes) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(),
+                           {"--segment", "1", "--duration", "6", "--max-bytes", "400K"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  uint64_t total = 0, largest = 0;
+  for (const auto& entry : fs::directory_iterator(recorder.out())) {
+    total += entry.file_size();
+    largest = std::max<uint64_t>(largest, entry.file_size());
+  }
+  auto videos = recorder.files(".mkv");
+  ASSERT_FALSE(videos.empty());
+  EXPECT_LT(videos.size(), 5u);  // about 6 one-second segments were made
+  // Checked when a segment closes: at most the newest one beyond the cap.
+  EXPECT_LE(total, 400000 + 2 * largest);
+  // The oldest went first: segment 000 is gone.
+  EXPECT_EQ(videos.front().string().find("-000.mkv"), std::string::npos) << videos.front();
+  for (const auto& video : videos)
+    EXPECT_TRUE(fs::exists(fs::path(video).replace_extension(".jsonl")));
+}
+
+TEST(WircRecorder, TakesItsDevicesFromAConfigFile) {
+  auto device = startSequenceDevice();
+  auto folder = fs::temp_directory_path() / ("wirc-recorder-config-" + std::to_string(getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  auto config = folder / "recorder.ini";
+  std::ofstream(config) << "[recorder]\nout=" << (folder / "out").string()
+                        << "\nsegment=60\n\n[device rover]\nhost=127.0.0.1\nport=" << device->port()
+                        << "\ncameras=0\n";
+  RecorderProcess recorder(0, {"--config", config.string(), "--duration", "3"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  std::vector<fs::path> videos;
+  for (const auto& entry : fs::directory_iterator(folder / "out"))
+    if (entry.path().extension() == ".mkv") videos.push_back(entry.path());
+  ASSERT_EQ(videos.size(), 1u);
+  EXPECT_EQ(videos[0].filename().string().rfind("rover-cam0-", 0), 0u) << videos[0];
+  fs::remove_all(folder);
+}
+
+TEST(WircRecorder, RejectsABadConfigFileNamingTheProblem) {
+  auto config =
+      fs::temp_directory_path() / ("wirc-recorder-bad-" + std::to_string(getpid()) + ".ini");
+  std::ofstream(config) << "[device rover]\nport=99999\n";
+  RecorderProcess recorder(0, {"--config", config.string(), "--out", "/tmp"});
+  EXPECT_EQ(recorder.wait(), 2);
+  EXPECT_NE(recorder.log().find("port"), std::string::npos) << recorder.log();
+  fs::remove(config);
+}
+
+TEST(WircRecorder, ReportsAnUnreachableDevice) {
+  auto device = startSequenceDevice();
+  uint16_t port = device->port();
+  device.reset();
+  RecorderProcess recorder(port, {"--duration", "3"});
+  EXPECT_EQ(recorder.wait(), 1);
+}
+
+}  // namespace

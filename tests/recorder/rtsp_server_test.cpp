@@ -1,0 +1,46 @@
+// wirc-recorder --rtsp: a GStreamer RTSP client plays each camera.
+#include <gst/app/gstappsink.h>
+#include <gst/video/video.h>
+#include <gtest/gtest.h>
+
+#include "recorder_process.h"
+#include "simulated_device.h"
+
+namespace {
+
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+
+TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(), {"--rtsp", "127.0.0.1:0", "--duration", "60"});
+  auto url = recorder.waitForLog("rtsp://", milliseconds(10000));
+  ASSERT_TRUE(url) << recorder.log();
+  EXPECT_NE(url->find("/127.0.0.1-" + std::to_string(device->port()) + "/cam0"),
+            std::string::npos);
+  for (const char* protocols : {"udp", "tcp"}) {
+    std::string description = "rtspsrc location=" + *url + " protocols=" + protocols +
+                              " ! rtpjpegdepay ! jpegdec ! appsink name=sink";
+    GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
+    GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
+    gst_element_set_state(pipeline, GST_STATE_PLAYING);
+    int frames = 0;
+    int width = 0;
+    while (frames < 15) {
+      GstSample* sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), 10 * GST_SECOND);
+      if (!sample) break;
+      GstVideoInfo info;
+      gst_video_info_from_caps(&info, gst_sample_get_caps(sample));
+      width = GST_VIDEO_INFO_WIDTH(&info);
+      gst_sample_unref(sample);
+      ++frames;
+    }
+    gst_element_set_state(pipeline, GST_STATE_NULL);
+    gst_object_unref(sink);
+    gst_object_unref(pipeline);
+    EXPECT_EQ(frames, 15) << protocols;
+    EXPECT_EQ(width, 352) << protocols;  // the scene's CIF frames, decoded
+  }
+}
+
+}  // namespace
