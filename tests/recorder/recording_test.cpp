@@ -55,10 +55,19 @@ TEST(WircRecorder, RecordsEveryFrameDeliveredInOrder) {
   std::this_thread::sleep_for(milliseconds(100));
   uint64_t sent = device->stats().framesSent;  // to this receiver, none lost on loopback
   int recorded = 0;
+  constexpr GstClockTime kFramePeriod = GST_SECOND / 15;
   for (const auto& video : recorder.files(".mkv")) {
     auto contents = contentsOf(video);
     EXPECT_TRUE(contents.monotonic) << video;
     EXPECT_EQ(contents.videoCaps, "image/jpeg");
+    // The file says it lasts as long as its frames span, and they span
+    // their number of frame periods (no gap), each to within one period.
+    ASSERT_GT(contents.frames, 1);
+    auto period = static_cast<GstClockTimeDiff>(kFramePeriod);
+    auto duration = static_cast<GstClockTimeDiff>(durationOf(video));
+    auto span = static_cast<GstClockTimeDiff>(contents.framePts.back() - contents.framePts.front());
+    EXPECT_LE(std::abs(duration - span), period) << video;
+    EXPECT_LE(std::abs(span - (contents.frames - 1) * period), period) << video;
     recorded += contents.frames;
   }
   ASSERT_GT(sent, 40u);
