@@ -12,9 +12,9 @@ const char* usage() {
   return R"(Usage: wirc-recorder --device HOST[:PORT] [--device ...] --out DIR [OPTIONS]
 
 Records the cameras of one or more WiRC devices into segmented files, the
-JPEG frames muxed as they arrive (no re-encoding) or transcoded to H.264, with
-the telemetry as a text track in the file and in a JSON-lines sidecar per
-segment. SIGINT or SIGTERM finishes every file and exits 0.
+JPEG frames muxed as they arrive (no re-encoding) or transcoded to H.264,
+with the telemetry in a JSON-lines sidecar per segment and, in Matroska, as a
+text track in the file. SIGINT or SIGTERM finishes every file and exits 0.
 
   --device HOST[:PORT]   a device to record (default port 1984); repeatable.
                          Without --device the device is found by discovery.
@@ -56,7 +56,7 @@ min-free, status, http, rtsp), and one
 Files: DIR/<device>-cam<N>-<start time>-<segment>.mkv (or .mp4) and, beside
 each, <same name>.jsonl with one JSON object per event: {"pts": running time
 in ns, "type": "stats"|"detections"|"control"|"session", ...}. The same
-objects are the file's text track.
+objects are a Matroska file's text track (MP4: the sidecar only).
 
 Exit status: 0 finished cleanly, 1 error, 2 bad arguments, 3 the disk filled
 (the open segments were finished first).
