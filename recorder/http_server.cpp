@@ -5,7 +5,6 @@
 #include <set>
 
 #include "live_view_page.h"
-#include "wirc/jpeg_info.h"
 
 namespace wircam::recorder {
 
@@ -94,16 +93,16 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(const Serve
     HttpServer* server = self.get();
     // Frames come on the streaming thread; clients live on the main loop.
     feed->listener = feed->frames->listen([server, raw, i](GstSample* sample) {
-      GstBuffer* jpeg = gst_sample_get_buffer(sample);
-      GstMapInfo map;
-      if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
-        if (auto info = wirc::readJpegInfo({map.data, map.size})) {
-          raw->width = info->width;
-          raw->height = info->height;
-        }
-        gst_buffer_unmap(jpeg, &map);
+      // wircsrc puts the frame size (from the JPEG's SOF) in the caps.
+      const GstStructure* caps = gst_caps_get_structure(gst_sample_get_caps(sample), 0);
+      int width = 0, height = 0;
+      if (gst_structure_get_int(caps, "width", &width) &&
+          gst_structure_get_int(caps, "height", &height)) {
+        raw->width = width;
+        raw->height = height;
       }
       if (raw->clientCount.load() == 0) return;
+      GstBuffer* jpeg = gst_sample_get_buffer(sample);
       struct Delivery {
         HttpServer* server;
         size_t camera;
@@ -243,13 +242,17 @@ void HttpServer::sendFrame(size_t camera, GstBuffer* jpeg) {
   if (feed.clients.empty()) return;
   GstMapInfo map;
   if (!gst_buffer_map(jpeg, &map, GST_MAP_READ)) return;
-  std::string part = std::string("--") + kBoundary +
-                     "\r\nContent-Type: image/jpeg\r\nContent-Length: " +
-                     std::to_string(map.size) + "\r\n\r\n";
-  part.append(reinterpret_cast<const char*>(map.data), map.size);
-  part += "\r\n";
+  // One part, built in place: a single copy of the frame per delivery.
+  std::string header = std::string("--") + kBoundary +
+                       "\r\nContent-Type: image/jpeg\r\nContent-Length: " +
+                       std::to_string(map.size) + "\r\n\r\n";
+  GByteArray* part = g_byte_array_sized_new(static_cast<guint>(header.size() + map.size + 2));
+  g_byte_array_append(part, reinterpret_cast<const guint8*>(header.data()),
+                      static_cast<guint>(header.size()));
+  g_byte_array_append(part, map.data, static_cast<guint>(map.size));
+  g_byte_array_append(part, reinterpret_cast<const guint8*>("\r\n"), 2);
   gst_buffer_unmap(jpeg, &map);
-  GBytes* chunk = g_bytes_new(part.data(), part.size());
+  GBytes* chunk = g_byte_array_free_to_bytes(part);
   send(feed.clients, chunk);
   g_bytes_unref(chunk);
 }

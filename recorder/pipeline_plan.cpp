@@ -49,18 +49,26 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
     std::string port = " port=" + std::to_string(device.port);
     for (int camera : device.cameras) {
       auto i = std::to_string(index++);
-      StreamPlan stream{fileSafe(device.label), camera,
-                        fileSafe(device.label) + "-cam" + std::to_string(camera),
-                        "mux" + i,
-                        "tel" + i,
-                        live ? "live" + i : ""};
+      StreamPlan stream;
+      stream.device = fileSafe(device.label);
+      stream.camera = camera;
+      stream.name = stream.device + "-cam" + std::to_string(camera);
+      stream.source = "src" + i;
+      stream.muxer = "mux" + i;
+      if (options.container == Container::kMatroska) stream.telemetrySource = "tel" + i;
+      if (!options.detectFamily.empty()) stream.detector = "det" + i;
+      if (!options.detectFamily.empty() && *device.follow && !controlled) {
+        stream.controller = "ctl" + i;
+        controlled = true;  // one controller per vehicle: the first camera's
+      }
+      if (live) stream.liveSink = "live" + i;
       auto location = (std::filesystem::path(options.outDir) /
                        (stream.name + "-" + startTime + "-%03d" + extensionOf(options.container)))
                           .string();
       // The telemetry track is sparse: splitmuxsink lets it run up to 2 s
       // ahead of the video rather than hold the video for it (at 0, the
       // default, the two wait on each other).
-      d += "wircsrc name=src" + i + host + port + " camera=" + std::to_string(camera) +
+      d += "wircsrc name=" + stream.source + host + port + " camera=" + std::to_string(camera) +
            " ! tee name=t" + i + " t" + i + ". ! queue max-size-time=3000000000 ! " +
            encoder(options) + "splitmuxsink name=" + stream.muxer +
            " async-finalize=true alignment-threshold=2000000000 " +
@@ -68,7 +76,7 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
            " max-size-time=" + std::to_string(static_cast<uint64_t>(options.segmentSeconds * 1e9)) +
            " max-size-bytes=" + std::to_string(options.segmentBytes) + " location=\"" + location +
            "\" ";
-      if (options.container == Container::kMatroska) {
+      if (!stream.telemetrySource.empty()) {
         // The telemetry never blocks the main loop: past 1 MB waiting it
         // drops. (mp4mux would hold every fragment until the sparse text
         // track has data, so MP4 keeps its telemetry in the sidecar only.)
@@ -76,21 +84,16 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
              " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
              "caps=\"text/x-raw,format=(string)utf8\" ! " +
              stream.muxer + ".subtitle_%u ";
-      } else {
-        stream.telemetrySource.clear();
       }
-      if (!options.detectFamily.empty()) {
+      if (!stream.detector.empty()) {
         // Detection must never hold the recording back: its queue drops.
         d += "t" + i +
-             ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=det" +
-             i + " quad-decimate=1 family=" + options.detectFamily;
-        if (*device.follow && !controlled) {
-          d += " ! wirccontrol name=ctl" + i + host + port;
-          controlled = true;  // one controller per vehicle: the first camera's
-        }
+             ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=" +
+             stream.detector + " quad-decimate=1 family=" + options.detectFamily;
+        if (!stream.controller.empty()) d += " ! wirccontrol name=" + stream.controller + host + port;
         d += " ! fakesink sync=false async=false ";
       }
-      if (live) {
+      if (!stream.liveSink.empty()) {
         d += "t" + i + ". ! queue leaky=downstream max-size-buffers=2 ! appsink name=" +
              stream.liveSink + " sync=false async=false max-buffers=2 drop=true ";
       }

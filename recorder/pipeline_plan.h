@@ -9,14 +9,17 @@
 
 namespace wircam::recorder {
 
-// One device camera: its branches are named after `index`.
+// One device camera and the names of its elements (empty: not in this run).
 struct StreamPlan {
   std::string device;  // the device's label, made safe for file names
   int camera = 0;
   std::string name;  // "<device>-cam<N>", also in file names and the live view
+  std::string source;           // wircsrc
   std::string muxer;            // splitmuxsink
-  std::string telemetrySource;  // appsrc feeding the file's text track; empty for MP4
-  std::string liveSink;         // appsink of the frames as they arrive, or empty
+  std::string telemetrySource;  // appsrc feeding the file's text track (Matroska only)
+  std::string detector;         // apriltagdetect, with --detect
+  std::string controller;       // wirccontrol, on the first camera of a following device
+  std::string liveSink;         // appsink of the frames as they arrive, with --http/--rtsp
 };
 
 struct PipelinePlan {
@@ -25,7 +28,7 @@ struct PipelinePlan {
 };
 
 // Per stream: wircsrc → tee → queue → [decode → x264enc →] splitmuxsink,
-// an appsrc of telemetry text into the same splitmuxsink, and, when asked
+// an appsrc of telemetry text into the same splitmuxsink (Matroska), and, when asked
 // for, a leaky branch to AprilTag detection (→ wirccontrol) and one to an
 // appsink for the live view and RTSP. `startTime` goes into file names.
 PipelinePlan planPipeline(const RecorderOptions& options, const std::string& startTime);

@@ -68,6 +68,9 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
       stream->frames = std::make_unique<FrameTap>(sink);
       gst_object_unref(sink);
     }
+    for (const auto* element : {&streamPlan.source, &streamPlan.muxer, &streamPlan.detector,
+                                &streamPlan.controller})
+      if (!element->empty()) recording->streamByElement_[*element] = stream.get();
     recording->streams_.push_back(std::move(stream));
   }
   if (auto problem = recording->startServers()) return unexpected(*problem);
@@ -112,19 +115,10 @@ Recording::~Recording() {
 }
 
 Recording::Stream* Recording::streamOf(GstMessage* message) {
-  // Element names end in the stream's index ("src3", "det3"); elements
-  // inside a splitmuxsink are found through their parent "mux3".
+  // Elements inside a splitmuxsink (its filesink) are found by their parent.
   for (GstObject* object = GST_MESSAGE_SRC(message); object; object = GST_OBJECT_PARENT(object)) {
-    std::string name = GST_OBJECT_NAME(object) ? GST_OBJECT_NAME(object) : "";
-    size_t digits = 0;
-    while (digits < name.size() &&
-           std::isdigit(static_cast<unsigned char>(name[name.size() - 1 - digits])))
-      ++digits;
-    if (digits == 0 || digits == name.size()) continue;
-    std::string prefix = name.substr(0, name.size() - digits);
-    if (prefix != "src" && prefix != "mux" && prefix != "det" && prefix != "ctl") continue;
-    size_t index = std::stoul(name.substr(name.size() - digits));
-    return index < streams_.size() ? streams_[index].get() : nullptr;
+    auto found = streamByElement_.find(GST_OBJECT_NAME(object) ? GST_OBJECT_NAME(object) : "");
+    if (found != streamByElement_.end()) return found->second;
   }
   return nullptr;
 }

@@ -5,6 +5,7 @@
 
 #include <gst/gst.h>
 
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -73,6 +74,7 @@ class Recording {
   GstElement* pipeline_ = nullptr;
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Stream>> streams_;
+  std::map<std::string, Stream*> streamByElement_;  // element name → its stream
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<RtspServer> rtsp_;
   bool stopping_ = false;
