@@ -4,14 +4,23 @@
  * Visual servoing: reads the WircTagMeta that apriltagdetect attached to each
  * passing buffer and turns the target tag's bearing and distance into
  * steering and throttle pulses (PID per axis, deadband, slew-rate limit,
- * pulse limits), which the device's shared session sends as PCD at
- * `pcd-rate`. Buffers pass through untouched, so it can sit before a tee.
+ * pulse limits). The device's shared link sends a command the moment it
+ * changes (at most `pcd-rate` per second) and repeats it every `keepalive`
+ * ms otherwise, so the device's watchdog stays fed. Buffers pass through
+ * untouched, so it can sit before a tee.
  *
  * Safety: when the target has not been seen for `lost-timeout`, or
  * `enabled` is false, both channels go to `neutral`; when no buffer comes at
- * all (a stalled pipeline) the session falls back to neutral after the same
- * time; every pulse stays inside `min`..`max` and 800..2200 µs. A
- * `wirc-control` element message reports each command.
+ * all (a stalled pipeline) the link falls back to the failsafe after the
+ * same time, and keeps the link up; every pulse stays inside `min`..`max`
+ * and 800..2200 µs. A `wirc-control` element message reports each command.
+ *
+ * The control right: only the transmitter holding it steers. `has-control`
+ * says whether this one does; a `wirc-control-right` message reports each
+ * change (`has-control`, `holder`) and the answer to a request (`request`:
+ * granted or denied, `reason`). Steering without the right posts a warning
+ * once. The `request-control` action signal (or `take-control=true`, at each
+ * login) asks the device for it with AREQ.
  *
  * ## Example launch line
  * |[
@@ -21,14 +30,16 @@
  */
 #include "gstwirccontrol.h"
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <vector>
 #include <memory>
 #include <optional>
 #include <string>
 
-#include "follow_controller.h"
 #include "glib_locker.h"
+#include "target_follower.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_tag_meta.h"
 
@@ -56,7 +67,9 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_MAX_THROTTLE 0.8
 #define DEFAULT_LOST_TIMEOUT 500
 #define DEFAULT_PCD_RATE 50.0
+#define DEFAULT_KEEPALIVE 100
 #define DEFAULT_ENABLED TRUE
+#define DEFAULT_TAKE_CONTROL FALSE
 
 enum {
   PROP_0,
@@ -85,8 +98,15 @@ enum {
   PROP_THROTTLE_REVERSED,
   PROP_LOST_TIMEOUT,
   PROP_PCD_RATE,
+  PROP_KEEPALIVE,
   PROP_ENABLED,
+  PROP_TAKE_CONTROL,
+  PROP_HAS_CONTROL,
 };
+
+enum { SIGNAL_REQUEST_CONTROL, SIGNAL_COUNT };
+guint signals[SIGNAL_COUNT];
+GParamSpec* hasControlSpec;
 
 struct Settings {
   std::string host = DEFAULT_HOST;
@@ -105,7 +125,9 @@ struct Settings {
   gboolean throttleReversed = FALSE;
   guint lostTimeoutMs = DEFAULT_LOST_TIMEOUT;
   double pcdRate = DEFAULT_PCD_RATE;
+  guint keepaliveMs = DEFAULT_KEEPALIVE;
   gboolean enabled = DEFAULT_ENABLED;
+  gboolean takeControl = DEFAULT_TAKE_CONTROL;
 };
 
 struct WircControlState {
@@ -114,11 +136,14 @@ struct WircControlState {
 
   // Streaming thread only.
   Settings active;  // the settings in use, refreshed when one changes
+  std::optional<vision::TargetFollower> follower;
+  std::vector<vision::TagSighting> sightings;  // reused per frame
+  bool warnedWithoutControl = false;
+
+  // Set in start(), cleared in stop(); the link's listener runs on the event loop.
   std::shared_ptr<wirc::TransmitterSession> session;
-  std::optional<vision::FollowController> controller;
-  std::optional<Clock::time_point> lastBuffer;
-  std::optional<Clock::time_point> lastSeen;
-  vision::FollowCommand command{};
+  int sessionListener = 0;
+  std::atomic<bool> hasControl{false};
 };
 
 vision::FollowConfig followConfig(const Settings& s) {
@@ -134,21 +159,10 @@ vision::FollowConfig followConfig(const Settings& s) {
   return config;
 }
 
-// The tag to follow: target-id, or the largest in view when it is -1.
-const WircTag* pickTarget(WircTagMeta* meta, int targetId) {
-  if (!meta) return nullptr;
-  const WircTag* best = nullptr;
-  double bestSize = 0;
-  for (guint i = 0; i < meta->tags->len; ++i) {
-    const auto* tag = &g_array_index(meta->tags, WircTag, i);
-    if (targetId >= 0 && tag->id != targetId) continue;
-    double size = std::hypot(tag->corners[2] - tag->corners[0], tag->corners[3] - tag->corners[1]);
-    if (!best || size > bestSize) {
-      best = tag;
-      bestSize = size;
-    }
-  }
-  return best;
+vision::FollowerSettings followerSettings(const Settings& s) {
+  return {.targetId = s.targetId,
+          .lostTimeout = std::chrono::milliseconds(s.lostTimeoutMs),
+          .enabled = s.enabled != FALSE};
 }
 
 double meanEdge(const WircTag& tag) {
@@ -159,6 +173,16 @@ double meanEdge(const WircTag& tag) {
                         tag.corners[2 * j + 1] - tag.corners[2 * i + 1]);
   }
   return total / 4;
+}
+
+void readSightings(WircTagMeta* meta, std::vector<vision::TagSighting>& out) {
+  out.clear();
+  if (!meta) return;
+  for (guint i = 0; i < meta->tags->len; ++i) {
+    const auto& tag = g_array_index(meta->tags, WircTag, i);
+    out.push_back({tag.id, tag.cx, meanEdge(tag),
+                   tag.has_pose ? std::optional<double>(tag.z) : std::nullopt});
+  }
 }
 
 }  // namespace
@@ -174,6 +198,51 @@ static GstStaticPadTemplate sink_template =
     GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS_ANY);
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS_ANY);
+
+static void post_control_right(GstWircControl* self, GstStructure* s) {
+  gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), s));
+}
+
+// On the event loop: the control right and the answers to AREQ.
+static void on_link_event(GstWircControl* self, const link::LinkEvent& event) {
+  auto* state = self->state;
+  if (const auto* right = std::get_if<link::ControlRightChanged>(&event)) {
+    bool had = state->hasControl.exchange(right->hasControl);
+    GST_INFO_OBJECT(self, "%s", link::describe(event).c_str());
+    post_control_right(self, gst_structure_new("wirc-control-right", "has-control", G_TYPE_BOOLEAN,
+                                               right->hasControl, "holder", G_TYPE_STRING,
+                                               right->holder.c_str(), nullptr));
+    if (had != right->hasControl) g_object_notify_by_pspec(G_OBJECT(self), hasControlSpec);
+  } else if (const auto* answer = std::get_if<link::ControlRequestAnswered>(&event)) {
+    GST_INFO_OBJECT(self, "%s", link::describe(event).c_str());
+    post_control_right(
+        self, gst_structure_new("wirc-control-right", "has-control", G_TYPE_BOOLEAN,
+                                state->hasControl.load(), "request", G_TYPE_STRING,
+                                answer->granted ? "granted" : "denied", "reason", G_TYPE_STRING,
+                                answer->reason.c_str(), nullptr));
+  } else if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
+    std::shared_ptr<wirc::TransmitterSession> session;
+    {
+      gst::GLibLocker lock(self);
+      if (state->settings.takeControl) session = state->session;
+    }
+    if (session && changed->state == link::LinkState::Live && !state->hasControl)
+      session->requestControl();
+  }
+}
+
+static void gst_wirc_control_request_control(GstWircControl* self) {
+  std::shared_ptr<wirc::TransmitterSession> session;
+  {
+    gst::GLibLocker lock(self);
+    session = self->state->session;
+  }
+  if (!session) {
+    GST_WARNING_OBJECT(self, "request-control before the element started: nothing to ask");
+    return;
+  }
+  session->requestControl();
+}
 
 static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
   auto* self = GST_WIRC_CONTROL(transform);
@@ -202,67 +271,92 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
                        settings.neutral, settings.max));
     return FALSE;
   }
-  // The first element to name the device sets the session's PCD pacing;
-  // commands older than lost-timeout give way to neutral there too.
-  state->session = wirc::TransmitterSession::acquire(
+  // The commander's pacing settings are the link's; another element that
+  // gave different ones is named in the error.
+  auto session = wirc::TransmitterSession::acquire(
       {.host = settings.host,
        .port = static_cast<uint16_t>(settings.port),
        .pcdRate = settings.pcdRate,
-       .commandTtl = std::chrono::milliseconds(settings.lostTimeoutMs)});
-  state->lastBuffer.reset();
-  state->lastSeen.reset();
+       .keepalive = std::chrono::milliseconds(settings.keepaliveMs),
+       .commandTtl = std::chrono::milliseconds(settings.lostTimeoutMs),
+       .given = {"pcd-rate", "keepalive", "command-ttl"}},
+      GST_OBJECT_NAME(self));
+  if (!session) {
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Cannot use the WiRC device's link"), ("%s",
+                      session.error().c_str()));
+    return FALSE;
+  }
+  state->hasControl = (*session)->status().hasControl;
+  state->warnedWithoutControl = false;
+  state->follower.reset();
+  state->sessionListener = (*session)->addListener(
+      [self](const link::LinkEvent& event) { on_link_event(self, event); });
+  {
+    gst::GLibLocker lock(self);
+    state->session = std::move(*session);
+  }
+  if (settings.takeControl && state->session->status().state == link::LinkState::Live &&
+      !state->hasControl)
+    state->session->requestControl();
   return TRUE;
 }
 
 static gboolean gst_wirc_control_stop(GstBaseTransform* transform) {
-  auto* state = GST_WIRC_CONTROL(transform)->state;
-  if (state->session) state->session->setCommand(wirc::neutralChannels());
-  state->session.reset();
-  state->controller.reset();
+  auto* self = GST_WIRC_CONTROL(transform);
+  auto* state = self->state;
+  std::shared_ptr<wirc::TransmitterSession> session;
+  {
+    gst::GLibLocker lock(self);
+    session = std::move(state->session);
+  }
+  if (session) {
+    session->removeListener(state->sessionListener);
+    session->setCommand(wirc::neutralChannels());
+  }
+  state->follower.reset();
   return TRUE;
 }
 
 static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, GstBuffer* buffer) {
   auto* self = GST_WIRC_CONTROL(transform);
   auto* state = self->state;
-  bool changed = !state->controller;
+  bool changed = false;
   {
     // Copied only when a property changed, not per frame.
     gst::GLibLocker lock(self);
-    if (state->settingsChanged || changed) {
+    if (state->settingsChanged || !state->follower) {
       state->active = state->settings;
       state->settingsChanged = false;
       changed = true;
     }
   }
   const Settings& settings = state->active;
-  if (changed) state->controller.emplace(followConfig(settings));
-
-  auto now = Clock::now();
-  double dt =
-      state->lastBuffer ? std::chrono::duration<double>(now - *state->lastBuffer).count() : 0;
-  dt = std::clamp(dt, 0.0, 0.5);
-  state->lastBuffer = now;
+  if (!state->follower)
+    state->follower.emplace(followConfig(settings), followerSettings(settings));
+  else if (changed)
+    state->follower->reconfigure(followConfig(settings), followerSettings(settings));
 
   WircTagMeta* meta = gst_buffer_get_wirc_tag_meta(buffer);
-  const WircTag* target = pickTarget(meta, settings.targetId);
-  auto lostTimeout = std::chrono::milliseconds(settings.lostTimeoutMs);
-  if (!settings.enabled) {
-    state->command = state->controller->neutral();
-  } else if (target) {
-    vision::TargetObservation seen{
-        target->cx, meanEdge(*target), static_cast<int>(meta->width),
-        target->has_pose ? std::optional<double>(target->z) : std::nullopt};
-    state->command = state->controller->update(seen, dt);
-    state->lastSeen = now;
-  } else if (!state->lastSeen || now - *state->lastSeen > lostTimeout) {
-    state->command = state->controller->neutral();
-  }  // else: briefly out of view, keep the last command
+  readSightings(meta, state->sightings);
+  auto step = state->follower->step(state->sightings, meta ? static_cast<int>(meta->width) : 0,
+                                    std::chrono::steady_clock::now());
+  const auto& command = step.command;
 
   wirc::ChannelValues pulses = wirc::neutralChannels();
-  pulses[settings.steeringChannel - 1] = state->command.steeringPulse;
-  pulses[settings.throttleChannel - 1] = state->command.throttlePulse;
+  pulses[settings.steeringChannel - 1] = command.steeringPulse;
+  pulses[settings.throttleChannel - 1] = command.throttlePulse;
   state->session->setCommand(pulses);
+
+  bool steering = command.steeringPulse != settings.neutral ||
+                  command.throttlePulse != settings.neutral;
+  if (state->hasControl) {
+    state->warnedWithoutControl = false;
+  } else if (steering && !state->warnedWithoutControl) {
+    state->warnedWithoutControl = true;
+    GST_ELEMENT_WARNING(self, RESOURCE, WRITE, ("Steering without the control right"),
+                        ("Another transmitter controls the vehicle: the commands are not sent. "
+                         "Emit request-control (or set take-control=true) to ask for it."));
+  }
 
   gst_element_post_message(
       GST_ELEMENT(self),
@@ -270,12 +364,12 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
           GST_OBJECT(self),
           gst_structure_new(
               "wirc-control", "timestamp", G_TYPE_UINT64, GST_BUFFER_PTS(buffer), "target-visible",
-              G_TYPE_BOOLEAN, target != nullptr, "enabled", G_TYPE_BOOLEAN, settings.enabled,
-              "bearing", G_TYPE_DOUBLE, state->command.bearingRad, "distance", G_TYPE_DOUBLE,
-              state->command.distance, "steering", G_TYPE_DOUBLE, state->command.steering,
-              "throttle", G_TYPE_DOUBLE, state->command.throttle, "steering-pulse", G_TYPE_UINT,
-              static_cast<guint>(state->command.steeringPulse), "throttle-pulse", G_TYPE_UINT,
-              static_cast<guint>(state->command.throttlePulse), nullptr)));
+              G_TYPE_BOOLEAN, step.targetVisible, "enabled", G_TYPE_BOOLEAN, settings.enabled,
+              "has-control", G_TYPE_BOOLEAN, state->hasControl.load(), "bearing", G_TYPE_DOUBLE,
+              command.bearingRad, "distance", G_TYPE_DOUBLE, command.distance, "steering",
+              G_TYPE_DOUBLE, command.steering, "throttle", G_TYPE_DOUBLE, command.throttle,
+              "steering-pulse", G_TYPE_UINT, static_cast<guint>(command.steeringPulse),
+              "throttle-pulse", G_TYPE_UINT, static_cast<guint>(command.throttlePulse), nullptr)));
   return GST_FLOW_OK;
 }
 
@@ -361,8 +455,14 @@ static void gst_wirc_control_set_property(GObject* object, guint id, const GValu
     case PROP_PCD_RATE:
       s.pcdRate = g_value_get_double(value);
       break;
+    case PROP_KEEPALIVE:
+      s.keepaliveMs = g_value_get_uint(value);
+      break;
     case PROP_ENABLED:
       s.enabled = g_value_get_boolean(value);
+      break;
+    case PROP_TAKE_CONTROL:
+      s.takeControl = g_value_get_boolean(value);
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
@@ -453,8 +553,17 @@ static void gst_wirc_control_get_property(GObject* object, guint id, GValue* val
     case PROP_PCD_RATE:
       g_value_set_double(value, s.pcdRate);
       break;
+    case PROP_KEEPALIVE:
+      g_value_set_uint(value, s.keepaliveMs);
+      break;
     case PROP_ENABLED:
       g_value_set_boolean(value, s.enabled);
+      break;
+    case PROP_TAKE_CONTROL:
+      g_value_set_boolean(value, s.takeControl);
+      break;
+    case PROP_HAS_CONTROL:
+      g_value_set_boolean(value, self->state->hasControl.load());
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
@@ -568,13 +677,40 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
                "buffer) before both channels go to neutral",
                50, 10000, DEFAULT_LOST_TIMEOUT, ready);
   install_double(gobject, PROP_PCD_RATE, "pcd-rate",
-                 "PCD messages per second while holding the control right", 20, 200,
-                 DEFAULT_PCD_RATE, ready);
+                 "Rate limit: at most this many PCD per second; a changed command leaves at "
+                 "once unless one left less than 1/pcd-rate s ago",
+                 1, 1000, DEFAULT_PCD_RATE, ready);
+  install_uint(gobject, PROP_KEEPALIVE, "keepalive",
+               "Milliseconds between repeats of an unchanged command; keep it well below the "
+               "device's PCD timeout (200..2000 ms, 800 by default)",
+               10, static_cast<guint>(wirc::kMaxKeepalive.count()), DEFAULT_KEEPALIVE, ready);
   g_object_class_install_property(
       gobject, PROP_ENABLED,
       g_param_spec_boolean("enabled", "Enabled",
                            "Follow the tag; false = hold both channels at neutral", DEFAULT_ENABLED,
                            live));
+  g_object_class_install_property(
+      gobject, PROP_TAKE_CONTROL,
+      g_param_spec_boolean("take-control", "Take control",
+                           "Ask the device for the control right (AREQ) at each login that "
+                           "does not bring it; the answer comes as a wirc-control-right message",
+                           DEFAULT_TAKE_CONTROL, ready));
+  hasControlSpec = g_param_spec_boolean(
+      "has-control", "Has control",
+      "Whether this transmitter holds the control right (only then do commands reach the "
+      "vehicle)",
+      FALSE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS));
+  g_object_class_install_property(gobject, PROP_HAS_CONTROL, hasControlSpec);
+  /**
+   * GstWircControl::request-control:
+   *
+   * Asks the device for the control right (AREQ). The answer is posted as a
+   * `wirc-control-right` element message with `request` granted or denied.
+   */
+  signals[SIGNAL_REQUEST_CONTROL] = g_signal_new_class_handler(
+      "request-control", G_TYPE_FROM_CLASS(klass),
+      static_cast<GSignalFlags>(G_SIGNAL_RUN_LAST | G_SIGNAL_ACTION),
+      G_CALLBACK(gst_wirc_control_request_control), nullptr, nullptr, nullptr, G_TYPE_NONE, 0);
 
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);

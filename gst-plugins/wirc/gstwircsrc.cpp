@@ -6,9 +6,18 @@
  * for camera `camera` with STST, reassembles the MJPEG-over-UDP packets and
  * pushes whole JPEG frames. Never pushes a corrupt or partial frame; every
  * dropped packet or frame is counted in `stats` and in a periodic
- * `wirc-stats` element message (which also carries the session state and
+ * `wirc-stats` element message (which also carries the link state and
  * the device's last status report: battery-mv, analog-mv, inputs as bits).
- * Stopping sends EST and logs out.
+ * Link events (state changes, the control right, refusals) come as
+ * `wirc-session` element messages with `event` (text) and `state`.
+ *
+ * Going to PAUSED does not wait for the device: the login runs on the
+ * process's event loop, and a device that is not logged in to within
+ * `login-timeout` (or is lost with `reconnect=false`) ends the stream with
+ * an error naming the cause. Stopping sends EST and logs out, and never
+ * waits on the network. Elements naming the same device share its login
+ * only when the settings they were given agree (transmitter-name, priority,
+ * reconnect, login-timeout); a conflict is an error naming both elements.
  *
  * ## Example launch line
  * |[
@@ -23,14 +32,16 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
+#include <deque>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
-#include <vector>
 
 #include "frame_buffers.h"
 #include "glib_locker.h"
-#include "wirc/frame_assembler.h"
+#include "wirc/stream_receiver.h"
 #include "wirc/transmitter_session.h"
 
 GST_DEBUG_CATEGORY_STATIC(wirc_src_debug);
@@ -87,6 +98,7 @@ struct Settings {
   std::string discoveryAddress = DEFAULT_DISCOVERY_ADDRESS;
   guint loginTimeoutMs = DEFAULT_LOGIN_TIMEOUT;
   guint statsIntervalMs = DEFAULT_STATS_INTERVAL;
+  std::set<std::string> given;  // the shared link's settings the user set
 };
 
 // The C++ side of the element; GObject memory runs no constructors.
@@ -94,23 +106,26 @@ struct WircSrcState {
   Settings settings;  // guarded by the object lock
 
   // Streaming-thread state, set up in start() and torn down in stop().
+  Settings active;  // what start() used: properties may change meanwhile
   std::shared_ptr<wirc::TransmitterSession> session;
   int sessionListener = 0;
-  std::unique_ptr<wirc::FrameAssembler> assembler;
+  std::optional<wirc::StreamReceiver> receiver;
   UniqueFd socket;
-  UniqueFd wake;  // unlock() writes here to end a blocking receive
-  SocketAddress device;
-  std::optional<uint16_t> senderPort;  // the device's video port, once seen
-  uint64_t sessionLogins = 0;          // a new login means a new sender port
-  std::vector<wirc::AssembledFrame> ready;
+  UniqueFd wake;         // unlock() writes here to end a blocking receive
+  UniqueFd linkChanged;  // the session's listener writes here
+  Clock::time_point loginDeadline;
+  bool streaming = false;  // the link was live and the camera exists
+  std::deque<wirc::AssembledFrame> ready;
   std::array<std::vector<uint8_t>, kBatch> buffers;
   int width = 0;
   int height = 0;
   Clock::time_point nextStats;
 
-  std::mutex statsMutex;  // guards the copies read by the stats property
-  wirc::AssemblerStats stats;
-  uint64_t foreignPackets = 0;
+  std::mutex refusalMutex;  // guards refusal, written on the event loop
+  std::string refusal;      // the device refused this camera's STST
+
+  std::mutex statsMutex;  // guards the copy read by the stats property
+  wirc::StreamReceiverStats stats;
 };
 
 }  // namespace
@@ -127,15 +142,10 @@ static GstStaticPadTemplate src_template =
 
 namespace {
 
-Settings settingsOf(GstWircSrc* self) {
-  gst::GLibLocker lock(self);
-  return self->state->settings;
-}
-
 void publishStats(GstWircSrc* self) {
   auto* state = self->state;
   std::lock_guard lock(state->statsMutex);
-  state->stats = state->assembler->stats();
+  state->stats = state->receiver->stats();
 }
 
 void postStats(GstWircSrc* self) {
@@ -143,65 +153,76 @@ void postStats(GstWircSrc* self) {
   GstStructure* stats;
   {
     std::lock_guard lock(state->statsMutex);
-    stats = gst::statsStructure(state->stats, state->foreignPackets);
+    stats = gst::statsStructure(state->stats.assembler, state->stats.packetsForeign);
   }
   // The device's latest status report rides along, for recorders and UIs.
-  auto session = state->session->status();
-  gst_structure_set(stats, "session", G_TYPE_STRING, wirc::sessionStateName(session.state),
-                    nullptr);
+  auto session = state->session->sessionStatus();
+  gst_structure_set(stats, "session", G_TYPE_STRING, link::linkStateName(session.state), nullptr);
   if (const auto& psd = session.lastStatus) {
     gst_structure_set(stats, "battery-mv", G_TYPE_UINT, static_cast<guint>(psd->batteryMillivolts),
                       "analog-mv", G_TYPE_UINT, static_cast<guint>(psd->analogMillivolts), "inputs",
-                      G_TYPE_UINT,
-                      static_cast<guint>(psd->inputs[0] | psd->inputs[1] << 1 |
-                                         psd->inputs[2] << 2 | psd->inputs[3] << 3),
-                      nullptr);
+                      G_TYPE_UINT, static_cast<guint>(*session.telemetry->inputs), nullptr);
   }
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), stats));
 }
 
-}  // namespace
+void signal(const UniqueFd& fd) {
+  uint64_t one = 1;
+  if (fd.valid() && write(fd.get(), &one, sizeof one) < 0) {
+    // Only fails when the counter is saturated: the reader wakes anyway.
+  }
+}
 
-static gboolean gst_wirc_src_start(GstBaseSrc* base) {
-  auto* self = GST_WIRC_SRC(base);
+void drain(const UniqueFd& fd) {
+  uint64_t value;
+  if (fd.valid() && read(fd.get(), &value, sizeof value) < 0) {
+    // Nothing was pending: fine.
+  }
+}
+
+// Link events reach the application as "wirc-session" element messages
+// and wake the streaming thread when they change what it must do.
+void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
   auto* state = self->state;
-  Settings settings = settingsOf(self);
-
-  wirc::SessionConfig config{.host = settings.host,
-                             .port = static_cast<uint16_t>(settings.port),
-                             .device = settings.device,
-                             .discoveryAddress = settings.discoveryAddress,
-                             .transmitterName = settings.transmitterName,
-                             .priority = static_cast<uint8_t>(settings.priority),
-                             .loginTimeout = std::chrono::milliseconds(settings.loginTimeoutMs),
-                             .reconnect = settings.reconnect != FALSE};
-  state->session = wirc::TransmitterSession::acquire(config);
-  if (auto error =
-          state->session->waitLoggedIn(std::chrono::milliseconds(settings.loginTimeoutMs + 500))) {
-    state->session.reset();
-    GST_ELEMENT_ERROR(
-        self, RESOURCE, OPEN_READ,
-        ("Could not log in to the WiRC device %s",
-         settings.host.empty() ? "(discovery)" : settings.host.c_str()),
-        ("%s. Check host/port, or leave host empty to discover the device.", error->c_str()));
-    return FALSE;
+  if (std::holds_alternative<link::TelemetryReceived>(event)) return;  // in wirc-stats
+  std::string text = link::describe(event);
+  GST_INFO_OBJECT(self, "link: %s", text.c_str());
+  GstStructure* s = gst_structure_new("wirc-session", "event", G_TYPE_STRING, text.c_str(), nullptr);
+  if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
+    gst_structure_set(s, "state", G_TYPE_STRING, link::linkStateName(changed->state), "reason",
+                      G_TYPE_STRING, changed->reason.c_str(), nullptr);
+    signal(state->linkChanged);
   }
-  auto status = state->session->status();
-  if (settings.camera >= status.cameraCount) {
-    state->session.reset();
-    GST_ELEMENT_ERROR(
-        self, RESOURCE, SETTINGS, ("The device has no camera %u", settings.camera),
-        ("It reports %u camera(s): set camera=0..%d", status.cameraCount, status.cameraCount - 1));
-    return FALSE;
+  if (const auto* refused = std::get_if<link::DeviceRefused>(&event);
+      refused && refused->request == "STST") {
+    {
+      std::lock_guard lock(state->refusalMutex);
+      state->refusal = text;
+    }
+    signal(state->linkChanged);
   }
+  gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), s));
+}
 
-  auto bindAddress = SocketAddress::resolve("", static_cast<uint16_t>(settings.streamPort));
-  auto socket = bindUdp(*bindAddress);
+wirc::SessionConfig sessionConfig(const Settings& s) {
+  return {.host = s.host,
+          .port = static_cast<uint16_t>(s.port),
+          .device = s.device,
+          .discoveryAddress = s.discoveryAddress,
+          .transmitterName = s.transmitterName,
+          .priority = static_cast<uint8_t>(s.priority),
+          .loginTimeout = std::chrono::milliseconds(s.loginTimeoutMs),
+          .reconnect = s.reconnect != FALSE,
+          .given = s.given};
+}
+
+bool openStreamSocket(GstWircSrc* self, guint streamPort) {
+  auto* state = self->state;
+  auto socket = bindUdp(*SocketAddress::resolve("", static_cast<uint16_t>(streamPort)));
   if (!socket) {
-    state->session.reset();
     GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Could not open the stream port"),
                       ("%s. Set stream-port=0 to pick a free port.", socket.error().c_str()));
-    return FALSE;
+    return false;
   }
   state->socket = std::move(*socket);
   // The device sends whole frames in bursts of up to 64 KB datagrams.
@@ -216,33 +237,44 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
                         ("The kernel capped it at %d bytes (wanted %d): frames may be lost in "
                          "bursts. Raise it with: sysctl -w net.core.rmem_max=%d",
                          granted, kReceiveBufferBytes, kReceiveBufferBytes));
-  state->wake = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
-  state->assembler = std::make_unique<wirc::FrameAssembler>(wirc::FrameAssemblerConfig{
-      .frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)});
-  state->device = *state->session->deviceAddress();
-  state->senderPort.reset();
-  state->sessionLogins = status.logins;
-  state->width = state->height = 0;
-  state->nextStats = Clock::now() + std::chrono::milliseconds(settings.statsIntervalMs);
+  return true;
+}
+
+}  // namespace
+
+static gboolean gst_wirc_src_start(GstBaseSrc* base) {
+  auto* self = GST_WIRC_SRC(base);
+  auto* state = self->state;
   {
-    std::lock_guard lock(state->statsMutex);
-    state->stats = {};
-    state->foreignPackets = 0;
+    gst::GLibLocker lock(self);
+    state->active = state->settings;
   }
-  // Session events (losses, reconnects, control changes, ERR) reach the
-  // application as "wirc-session" element messages.
-  state->sessionListener = state->session->addListener([self](const std::string& event) {
-    GST_INFO_OBJECT(self, "session: %s", event.c_str());
-    gst_element_post_message(
-        GST_ELEMENT(self),
-        gst_message_new_element(
-            GST_OBJECT(self),
-            gst_structure_new("wirc-session", "event", G_TYPE_STRING, event.c_str(), nullptr)));
-  });
+  const Settings& settings = state->active;
+
+  auto session = wirc::TransmitterSession::acquire(sessionConfig(settings), GST_OBJECT_NAME(self));
+  if (!session) {
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Cannot use the WiRC device's link"), ("%s",
+                      session.error().c_str()));
+    return FALSE;
+  }
+  if (!openStreamSocket(self, settings.streamPort)) return FALSE;
+  state->session = std::move(*session);
+  state->wake = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
+  state->linkChanged = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
+  state->receiver.emplace(wirc::FrameAssemblerConfig{
+      .frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)});
+  state->streaming = false;
+  state->refusal.clear();
+  state->width = state->height = 0;
+  state->loginDeadline = Clock::now() + std::chrono::milliseconds(settings.loginTimeoutMs + 500);
+  state->nextStats = Clock::now() + std::chrono::milliseconds(settings.statsIntervalMs);
+  publishStats(self);
+  state->sessionListener = state->session->addListener(
+      [self](const link::LinkEvent& event) { onLinkEvent(self, event); });
+  // The session sends STST once logged in, and again after each reconnect.
   uint16_t port = localAddress(state->socket.get()).port();
   state->session->startStream(static_cast<uint8_t>(settings.camera), port);
-  GST_INFO_OBJECT(self, "logged in to %s, camera %u streaming to port %u",
-                  state->device.toString().c_str(), settings.camera, port);
+  GST_INFO_OBJECT(self, "camera %u will stream to port %u", settings.camera, port);
   return TRUE;
 }
 
@@ -251,31 +283,25 @@ static gboolean gst_wirc_src_stop(GstBaseSrc* base) {
   auto* state = self->state;
   if (state->session) {
     state->session->removeListener(state->sessionListener);
-    state->session->stopStream(static_cast<uint8_t>(settingsOf(self).camera));
-    state->session.reset();  // the last user's release logs out
+    state->session->stopStream(static_cast<uint8_t>(state->active.camera));
+    state->session.reset();  // the last user's release logs out, without waiting
   }
-  if (state->assembler) publishStats(self);
+  if (state->receiver) publishStats(self);
   state->ready.clear();
-  state->assembler.reset();
+  state->receiver.reset();
   state->socket.reset();
   state->wake.reset();
+  state->linkChanged.reset();
   return TRUE;
 }
 
 static gboolean gst_wirc_src_unlock(GstBaseSrc* base) {
-  auto* state = GST_WIRC_SRC(base)->state;
-  uint64_t one = 1;
-  if (state->wake.valid() && write(state->wake.get(), &one, sizeof one) < 0)
-    GST_WARNING_OBJECT(base, "could not wake the streaming thread");
+  signal(GST_WIRC_SRC(base)->state->wake);
   return TRUE;
 }
 
 static gboolean gst_wirc_src_unlock_stop(GstBaseSrc* base) {
-  auto* state = GST_WIRC_SRC(base)->state;
-  uint64_t value;
-  if (state->wake.valid() && read(state->wake.get(), &value, sizeof value) < 0) {
-    // Nothing was pending: fine.
-  }
+  drain(GST_WIRC_SRC(base)->state->wake);
   return TRUE;
 }
 
@@ -283,14 +309,18 @@ static gboolean gst_wirc_src_query(GstBaseSrc* base, GstQuery* query) {
   if (GST_QUERY_TYPE(query) == GST_QUERY_LATENCY) {
     // Frames are stamped when their first packet arrives and pushed when the
     // last one does; an incomplete frame waits at most frame-timeout.
-    guint timeout = settingsOf(GST_WIRC_SRC(base)).frameTimeoutMs;
+    guint timeout;
+    {
+      gst::GLibLocker lock(base);
+      timeout = GST_WIRC_SRC(base)->state->settings.frameTimeoutMs;
+    }
     gst_query_set_latency(query, TRUE, 0, timeout * GST_MSECOND);
     return TRUE;
   }
   return GST_BASE_SRC_CLASS(gst_wirc_src_parent_class)->query(base, query);
 }
 
-// Reads whatever datagrams are queued (up to a batch) into the assembler.
+// Reads whatever datagrams are queued (up to a batch) into the receiver.
 static void receive_batch(GstWircSrc* self) {
   auto* state = self->state;
   std::array<mmsghdr, kBatch> headers{};
@@ -306,62 +336,101 @@ static void receive_batch(GstWircSrc* self) {
   int count = recvmmsg(state->socket.get(), headers.data(), kBatch, MSG_DONTWAIT, nullptr);
   auto now = Clock::now();
   for (int i = 0; i < count; ++i) {
-    SocketAddress from(sources[i]);
-    // Only the device may feed the stream, and only from the port it first
-    // used in this login: stray or hostile senders are counted and ignored.
-    if (!from.sameHost(state->device) || (state->senderPort && *state->senderPort != from.port())) {
-      std::lock_guard lock(state->statsMutex);
-      ++state->foreignPackets;
-      GST_LOG_OBJECT(self, "ignored a packet from %s", from.toString().c_str());
-      continue;
-    }
-    if (!state->senderPort) state->senderPort = from.port();
-    state->assembler->pushDatagram(
-        {state->buffers[i].data(), headers[i].msg_len}, now,
+    state->receiver->push(
+        SocketAddress(sources[i]), {state->buffers[i].data(), headers[i].msg_len}, now,
         [&](wirc::AssembledFrame&& frame) { state->ready.push_back(std::move(frame)); });
   }
+}
+
+// What the link says: FLOW_OK to go on (streaming says whether frames can
+// come), or an error already posted.
+static GstFlowReturn follow_link(GstWircSrc* self) {
+  auto* state = self->state;
+  const Settings& settings = state->active;
+  drain(state->linkChanged);
+  {
+    std::lock_guard lock(state->refusalMutex);
+    if (!state->refusal.empty()) {
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("The device refused camera %u",
+                        settings.camera), ("%s", state->refusal.c_str()));
+      return GST_FLOW_ERROR;
+    }
+  }
+  auto status = state->session->sessionStatus();
+  const char* where = settings.host.empty() ? "(discovery)" : settings.host.c_str();
+  if (status.state == link::LinkState::Failed) {
+    if (status.logins == 0)
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Could not log in to the WiRC device %s", where),
+                        ("%s. Check host/port, or leave host empty to discover the device.",
+                         status.reason.c_str()));
+    else
+      GST_ELEMENT_ERROR(self, RESOURCE, READ, ("Lost the WiRC device %s", where),
+                        ("%s (reconnect=false)", status.reason.c_str()));
+    return GST_FLOW_ERROR;
+  }
+  if (status.state != link::LinkState::Live) {
+    if (status.logins == 0 && Clock::now() >= state->loginDeadline) {
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Could not log in to the WiRC device %s", where),
+                        ("no login within %u ms%s%s. Check host/port, or leave host empty to "
+                         "discover the device.",
+                         settings.loginTimeoutMs + 500, status.reason.empty() ? "" : ": ",
+                         status.reason.c_str()));
+      return GST_FLOW_ERROR;
+    }
+    return GST_FLOW_OK;
+  }
+  if (settings.camera >= status.cameraCount) {
+    GST_ELEMENT_ERROR(
+        self, RESOURCE, SETTINGS, ("The device has no camera %u", settings.camera),
+        ("It reports %u camera(s): set camera=0..%d", status.cameraCount, status.cameraCount - 1));
+    return GST_FLOW_ERROR;
+  }
+  // After a reconnect the device streams from a new port.
+  state->receiver->follow(*state->session->deviceAddress(), status.logins);
+  state->streaming = true;
+  return GST_FLOW_OK;
 }
 
 static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
   auto* self = GST_WIRC_SRC(pushsrc);
   auto* state = self->state;
-  auto intervalMs = settingsOf(self).statsIntervalMs;
+  auto intervalMs = state->active.statsIntervalMs;
+  bool checkLink = !state->streaming;
 
   while (state->ready.empty()) {
-    // After a reconnect the device streams from a new port.
-    auto logins = state->session->logins();
-    if (logins != state->sessionLogins) {
-      state->sessionLogins = logins;
-      state->senderPort.reset();
-      state->assembler->reset();
-      GST_INFO_OBJECT(self, "the session logged in again: following the new stream");
+    if (checkLink) {
+      if (GstFlowReturn flow = follow_link(self); flow != GST_FLOW_OK) return flow;
+      checkLink = false;
     }
-    auto deadline = state->assembler->nextDeadline();
     int timeoutMs = 100;
-    if (deadline)
+    if (auto deadline = state->receiver->nextDeadline())
       timeoutMs = std::clamp<int>(
           static_cast<int>(
               std::chrono::duration_cast<std::chrono::milliseconds>(*deadline - Clock::now())
                   .count()) +
               1,
           0, 100);
-    std::array<pollfd, 2> fds = {pollfd{state->socket.get(), POLLIN, 0},
-                                 pollfd{state->wake.get(), POLLIN, 0}};
+    std::array<pollfd, 3> fds = {pollfd{state->socket.get(), POLLIN, 0},
+                                 pollfd{state->wake.get(), POLLIN, 0},
+                                 pollfd{state->linkChanged.get(), POLLIN, 0}};
     ::poll(fds.data(), fds.size(), timeoutMs);
     if (fds[1].revents & POLLIN) return GST_FLOW_FLUSHING;
+    // Until the first login, poll's timeout is what checks the deadline.
+    checkLink = (fds[2].revents & POLLIN) || !state->streaming;
     if (fds[0].revents & POLLIN) receive_batch(self);
-    state->assembler->expire(Clock::now(), [&](wirc::AssembledFrame&& frame) {
+    state->receiver->expire(Clock::now(), [&](wirc::AssembledFrame&& frame) {
       state->ready.push_back(std::move(frame));
     });
-    publishStats(self);
     if (intervalMs > 0 && Clock::now() >= state->nextStats) {
       state->nextStats = Clock::now() + std::chrono::milliseconds(intervalMs);
+      publishStats(self);
       postStats(self);
     }
   }
+  publishStats(self);
 
   wirc::AssembledFrame frame = std::move(state->ready.front());
-  state->ready.erase(state->ready.begin());
+  state->ready.pop_front();
   auto age = Clock::now() - frame.firstPacketTime;
   bool discont = frame.discont;
   GstBuffer* buffer = gst::wrapFrame(std::move(frame));
@@ -411,17 +480,28 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
       s.streamPort = g_value_get_uint(value);
       break;
     case PROP_TRANSMITTER_NAME:
-      s.transmitterName = g_value_get_string(value) ? g_value_get_string(value) : "";
-      if (s.transmitterName.size() > 64) s.transmitterName.resize(64);
+    {
+      std::string name = g_value_get_string(value) ? g_value_get_string(value) : "";
+      if (auto tl = wirc::encode(wirc::Tl{.name = name}); !tl) {
+        g_warning("wircsrc %s: transmitter-name '%s' refused, kept '%s': %s",
+                  GST_OBJECT_NAME(self), name.c_str(), s.transmitterName.c_str(),
+                  tl.error().message().c_str());
+        break;
+      }
+      s.transmitterName = name;
+      s.given.insert("transmitter-name");  // shared-link settings the user gave
       break;
+    }
     case PROP_PRIORITY:
       s.priority = g_value_get_uint(value);
+      s.given.insert("priority");
       break;
     case PROP_FRAME_TIMEOUT:
       s.frameTimeoutMs = g_value_get_uint(value);
       break;
     case PROP_RECONNECT:
       s.reconnect = g_value_get_boolean(value);
+      s.given.insert("reconnect");
       break;
     case PROP_DISCOVERY_ADDRESS:
       s.discoveryAddress =
@@ -429,6 +509,7 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
       break;
     case PROP_LOGIN_TIMEOUT:
       s.loginTimeoutMs = g_value_get_uint(value);
+      s.given.insert("login-timeout");
       break;
     case PROP_STATS_INTERVAL:
       s.statsIntervalMs = g_value_get_uint(value);
@@ -443,7 +524,8 @@ static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, 
   auto* self = GST_WIRC_SRC(object);
   if (id == PROP_STATS) {
     std::lock_guard lock(self->state->statsMutex);
-    g_value_take_boxed(value, gst::statsStructure(self->state->stats, self->state->foreignPackets));
+    const auto& stats = self->state->stats;
+    g_value_take_boxed(value, gst::statsStructure(stats.assembler, stats.packetsForeign));
     return;
   }
   gst::GLibLocker lock(self);
@@ -545,7 +627,8 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
       gobject, PROP_TRANSMITTER_NAME,
       g_param_spec_string("transmitter-name", "Transmitter name",
                           "Name this transmitter logs in "
-                          "with (up to 64 ASCII characters; shown in TLST)",
+                          "with (up to 64 printable ASCII characters; shown in TLST; others are "
+                          "refused when set)",
                           DEFAULT_TRANSMITTER_NAME, kReady));
   g_object_class_install_property(gobject, PROP_PRIORITY,
                                   g_param_spec_uint("priority", "Priority",

@@ -1,10 +1,14 @@
-// TransmitterSession against the simulated device over loopback.
+// The WiRC vehicle link against the simulated device and misbehaving peers
+// over loopback.
 #include "wirc/transmitter_session.h"
 
 #include <gtest/gtest.h>
 
-#include <thread>
+#include <mutex>
 
+#include "misbehaving_peers.h"
+#include "raw_transmitter.h"
+#include "wait_for.h"
 #include "wirc/device.h"
 #include "wirc/discovery.h"
 
@@ -12,6 +16,7 @@ namespace wircam::wirc {
 namespace {
 
 using std::chrono::milliseconds;
+using testing::waitFor;
 
 std::unique_ptr<Device> startDevice(DeviceConfig config = {}) {
   auto device = Device::start(config, nullptr);
@@ -23,69 +28,173 @@ SessionConfig sessionFor(const Device& device, std::string name = "test") {
   return {.host = "127.0.0.1", .port = device.port(), .transmitterName = std::move(name)};
 }
 
+std::shared_ptr<TransmitterSession> acquire(const SessionConfig& config,
+                                            const std::string& user = "test") {
+  auto session = TransmitterSession::acquire(config, user);
+  EXPECT_TRUE(session.has_value()) << session.error();
+  return session ? *session : nullptr;
+}
+
+// Every event a link emits, for assertions.
+class EventLog {
+ public:
+  explicit EventLog(TransmitterSession& session) : session_(session) {
+    id_ = session.addListener([this](const link::LinkEvent& event) {
+      std::lock_guard lock(mutex_);
+      events_.push_back(event);
+    });
+  }
+  ~EventLog() { session_.removeListener(id_); }
+
+  template <typename T>
+  std::optional<T> first() {
+    std::lock_guard lock(mutex_);
+    for (const auto& event : events_)
+      if (const auto* found = std::get_if<T>(&event)) return *found;
+    return std::nullopt;
+  }
+
+ private:
+  TransmitterSession& session_;
+  int id_;
+  std::mutex mutex_;
+  std::vector<link::LinkEvent> events_;
+};
+
 TEST(TransmitterSession, LogsInAndTakesTheControlRight) {
   auto device = startDevice({.port = 0, .cameras = 2});
-  auto session = TransmitterSession::acquire(sessionFor(*device));
+  auto session = acquire(sessionFor(*device));
   ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
-  auto status = session->status();
-  EXPECT_EQ(status.cameraCount, 2);
-  for (int i = 0; i < 50 && !session->status().hasControl; ++i)
-    std::this_thread::sleep_for(milliseconds(10));
-  EXPECT_TRUE(session->status().hasControl);
+  EXPECT_EQ(session->sessionStatus().cameraCount, 2);
+  EXPECT_TRUE(waitFor([&] { return session->status().hasControl; }));
 }
 
 TEST(TransmitterSession, IsSharedByEveryUserOfTheSameDevice) {
   auto device = startDevice({.port = 0});
-  auto a = TransmitterSession::acquire(sessionFor(*device));
-  auto b = TransmitterSession::acquire(sessionFor(*device));
+  auto a = acquire(sessionFor(*device), "a");
+  auto b = acquire(sessionFor(*device), "b");
   EXPECT_EQ(a.get(), b.get());
   ASSERT_EQ(a->waitLoggedIn(milliseconds(3000)), std::nullopt);
   // The device publishes its counters just after it answers.
-  for (int i = 0; i < 100 && device->stats().logins == 0; ++i)
-    std::this_thread::sleep_for(milliseconds(5));
+  EXPECT_TRUE(waitFor([&] { return device->stats().logins > 0; }));
   EXPECT_EQ(device->stats().logins, 1u);
 }
 
-TEST(TransmitterSession, ReportsARefusedConnection) {
+TEST(TransmitterSession, RefusesASettingAnotherUserGaveDifferentlyNamingBoth) {
   auto device = startDevice({.port = 0});
-  uint16_t port = device->port();
-  device.reset();  // nothing listens there now
-  auto session =
-      TransmitterSession::acquire({.host = "127.0.0.1", .port = port, .reconnect = false});
+  auto config = sessionFor(*device, "alice");
+  config.given = {"transmitter-name"};
+  auto first = acquire(config, "wircsrc0");
+  config.transmitterName = "bob";
+  auto second = TransmitterSession::acquire(config, "wirccontrol0");
+  ASSERT_FALSE(second.has_value());
+  for (const char* part : {"transmitter-name", "'alice'", "'bob'", "wircsrc0", "wirccontrol0"})
+    EXPECT_NE(second.error().find(part), std::string::npos) << second.error();
+}
+
+TEST(TransmitterSession, AdoptsASettingNobodyGaveAndLogsInAgainWithIt) {
+  auto device = startDevice({.port = 0});
+  // The first user (like wirccontrol, a sink, starting first) names no login
+  // settings; the second (like wircsrc) does.
+  auto first = acquire(sessionFor(*device, "wircam"), "wirccontrol0");
+  ASSERT_EQ(first->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  auto config = sessionFor(*device, "alice");
+  config.priority = 7;
+  config.given = {"transmitter-name", "priority"};
+  auto second = acquire(config, "wircsrc0");
+  ASSERT_EQ(first.get(), second.get());
+  EXPECT_TRUE(waitFor([&] { return second->status().logins == 2; }));
+  auto list = second->listTransmitters(milliseconds(2000));
+  ASSERT_TRUE(list.has_value());
+  ASSERT_EQ(list->size(), 1u);  // the first login was replaced, not doubled
+  EXPECT_EQ((*list)[0].name, "alice");
+  EXPECT_EQ((*list)[0].priority, 7);
+}
+
+TEST(TransmitterSession, RefusesANameTheProtocolCannotCarry) {
+  auto result = TransmitterSession::acquire({.host = "127.0.0.1", .transmitterName = "Pál"});
+  ASSERT_FALSE(result.has_value());
+  EXPECT_NE(result.error().find("transmitter-name"), std::string::npos) << result.error();
+}
+
+TEST(TransmitterSession, RefusesAKeepaliveTheDeviceWatchdogWouldMiss) {
+  auto result = TransmitterSession::acquire({.host = "127.0.0.1", .keepalive = milliseconds(900)});
+  ASSERT_FALSE(result.has_value());
+  EXPECT_NE(result.error().find("keepalive"), std::string::npos) << result.error();
+}
+
+TEST(TransmitterSession, ReportsARefusedConnection) {
+  auto session = acquire({.host = "127.0.0.1", .port = testing::deadPort(), .reconnect = false});
   auto error = session->waitLoggedIn(milliseconds(3000));
   ASSERT_TRUE(error.has_value());
   EXPECT_NE(error->find("cannot connect"), std::string::npos) << *error;
+  EXPECT_EQ(session->status().state, link::LinkState::Failed);
 }
 
-TEST(TransmitterSession, KeepsPcdFlowingWhileNoCommandsCome) {
-  auto device = startDevice({.port = 0});
-  auto session = TransmitterSession::acquire(sessionFor(*device));
+TEST(TransmitterSession, GivesUpOnAPeerThatAcceptsButNeverAnswers) {
+  testing::SilentPeer peer;
+  auto session = acquire({.host = "127.0.0.1",
+                          .port = peer.port(),
+                          .loginTimeout = milliseconds(300),
+                          .reconnect = false});
+  auto error = session->waitLoggedIn(milliseconds(3000));
+  ASSERT_TRUE(error.has_value());
+  EXPECT_NE(error->find("no WST"), std::string::npos) << *error;
+}
+
+TEST(TransmitterSession, GivesUpOnAConnectThatNeverCompletes) {
+  testing::FullAcceptQueuePeer peer;
+  auto session = acquire({.host = "127.0.0.1",
+                          .port = peer.port(),
+                          .loginTimeout = milliseconds(300),
+                          .reconnect = false});
+  auto error = session->waitLoggedIn(milliseconds(3000));
+  ASSERT_TRUE(error.has_value());
+  EXPECT_TRUE(error->find("cannot connect") != std::string::npos ||
+              error->find("no WST") != std::string::npos)
+      << *error;
+}
+
+TEST(TransmitterSession, ReleasingTheLastUserNeverWaitsOnTheNetwork) {
+  testing::FullAcceptQueuePeer peer;
+  auto session = acquire({.host = "127.0.0.1", .port = peer.port()});
+  // Mid-connect: the release must cut it short rather than wait it out.
+  auto before = std::chrono::steady_clock::now();
+  session.reset();
+  EXPECT_LT(std::chrono::steady_clock::now() - before, milliseconds(500));
+}
+
+TEST(TransmitterSession, SendsAChangedCommandAtOnceAndKeepsTheWatchdogFedWhileNoneCome) {
+  auto device = startDevice({.port = 0, .pcdTimeout = milliseconds(300)});
+  auto config = sessionFor(*device);
+  config.commandTtl = milliseconds(200);
+  auto session = acquire(config);
   ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  ASSERT_TRUE(waitFor([&] { return session->status().hasControl; }));
   ChannelValues drive = neutralChannels();
   drive[1] = 1700;
   session->setCommand(drive);
-  std::this_thread::sleep_for(milliseconds(100));
-  EXPECT_EQ(device->outputs().pulses[1], 1700);
-  // The "pipeline" stalls: no command for 2 s. PCD must go on, now neutral.
-  std::this_thread::sleep_for(milliseconds(2000));
-  auto stats = device->stats();
-  EXPECT_EQ(device->outputs().pulses[1], kPulseNeutral);
+  EXPECT_TRUE(waitFor([&] { return device->outputs().pulses[1] == 1700; }));
+  // The "pipeline" stalls: no command for three device timeouts. Keepalives
+  // keep the link, and the stale command gives way to neutral.
+  EXPECT_TRUE(waitFor([&] { return device->outputs().pulses[1] == kPulseNeutral; }));
+  auto received = device->stats().pcdReceived;
+  EXPECT_TRUE(waitFor([&] { return device->stats().pcdReceived >= received + 9; }));
+  EXPECT_EQ(device->stats().failsafeEntries, 0u);
   EXPECT_FALSE(device->outputs().failsafe);
-  EXPECT_GT(stats.pcdReceived, 90u);  // 50 Hz for 2.1 s
-  EXPECT_LE(stats.maxPcdGap.count(), 60);
-  EXPECT_EQ(stats.failsafeEntries, 0u);
+  EXPECT_EQ(session->status().state, link::LinkState::Live);
 }
 
 TEST(TransmitterSession, ClampsCommandsIntoThePulseRange) {
   auto device = startDevice({.port = 0});
-  auto session = TransmitterSession::acquire(sessionFor(*device));
+  auto session = acquire(sessionFor(*device));
   ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  ASSERT_TRUE(waitFor([&] { return session->status().hasControl; }));
   ChannelValues wild = neutralChannels();
   wild[0] = 5000;
   wild[1] = 10;
   session->setCommand(wild);
-  std::this_thread::sleep_for(milliseconds(100));
-  EXPECT_EQ(device->outputs().pulses[0], kPulseMax);
+  EXPECT_TRUE(waitFor([&] { return device->outputs().pulses[0] == kPulseMax; }));
   EXPECT_EQ(device->outputs().pulses[1], kPulseMin);
   EXPECT_EQ(device->stats().pcdRejected, 0u);
 }
@@ -93,23 +202,55 @@ TEST(TransmitterSession, ClampsCommandsIntoThePulseRange) {
 TEST(TransmitterSession, ReconnectsAfterTheDeviceRestarts) {
   auto device = startDevice({.port = 0});
   uint16_t port = device->port();
-  auto session = TransmitterSession::acquire(sessionFor(*device));
+  auto session = acquire(sessionFor(*device));
   ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
   device.reset();
-  for (int i = 0; i < 100 && session->status().state == SessionState::LoggedIn; ++i)
-    std::this_thread::sleep_for(milliseconds(10));
-  EXPECT_NE(session->status().state, SessionState::LoggedIn);
-
+  EXPECT_TRUE(waitFor([&] { return session->status().state == link::LinkState::Lost; }));
   device = startDevice({.port = port});
-  for (int i = 0; i < 600 && session->status().state != SessionState::LoggedIn; ++i)
-    std::this_thread::sleep_for(milliseconds(10));
-  EXPECT_EQ(session->status().state, SessionState::LoggedIn);
+  EXPECT_TRUE(waitFor([&] { return session->status().state == link::LinkState::Live; }));
   EXPECT_EQ(session->status().logins, 2u);
+}
+
+TEST(TransmitterSession, EndsInFailedWithTheCauseWhenReconnectIsOff) {
+  auto device = startDevice({.port = 0});
+  auto config = sessionFor(*device);
+  config.reconnect = false;
+  auto session = acquire(config);
+  ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  device.reset();
+  EXPECT_TRUE(waitFor([&] { return session->status().state == link::LinkState::Failed; }));
+  EXPECT_NE(session->status().reason.find("closed the connection"), std::string::npos)
+      << session->status().reason;
+}
+
+TEST(TransmitterSession, ReportsTheAnswerToAControlRequest) {
+  auto device = startDevice({.port = 0});
+  auto boss = acquire({.host = "127.0.0.1", .port = device->port(), .transmitterName = "boss",
+                       .priority = 9});
+  ASSERT_EQ(boss->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  // Same device under another name: a second transmitter of lower priority.
+  auto minion = acquire({.host = "localhost", .port = device->port(), .transmitterName = "minion",
+                         .priority = 1});
+  ASSERT_EQ(minion->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  EventLog minionEvents(*minion);
+  minion->requestControl();
+  ASSERT_TRUE(waitFor([&] { return minionEvents.first<link::ControlRequestAnswered>(); }));
+  auto answer = *minionEvents.first<link::ControlRequestAnswered>();
+  EXPECT_FALSE(answer.granted);
+  EXPECT_NE(answer.reason.find("boss"), std::string::npos) << answer.reason;
+
+  // The boss hands it over: the minion hears it, and so does its status.
+  boss->requestControlFor(minion->sessionStatus().connectionId);
+  EXPECT_TRUE(waitFor([&] { return minion->status().hasControl; }));
+  EXPECT_TRUE(waitFor([&] { return !boss->status().hasControl; }));
+  auto change = minionEvents.first<link::ControlRightChanged>();
+  ASSERT_TRUE(change.has_value());
+  EXPECT_TRUE(change->hasControl);
 }
 
 TEST(TransmitterSession, ListsTheLoggedInTransmitters) {
   auto device = startDevice({.port = 0});
-  auto session = TransmitterSession::acquire(sessionFor(*device, "lister"));
+  auto session = acquire(sessionFor(*device, "lister"));
   ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
   auto list = session->listTransmitters(milliseconds(2000));
   ASSERT_TRUE(list.has_value());
@@ -119,16 +260,26 @@ TEST(TransmitterSession, ListsTheLoggedInTransmitters) {
 
 TEST(TransmitterSession, ConfigurationErrorsComeBackAsErr) {
   auto device = startDevice({.port = 0});
-  auto first = TransmitterSession::acquire(sessionFor(*device));
+  auto first = acquire(sessionFor(*device));
   ASSERT_EQ(first->waitLoggedIn(milliseconds(3000)), std::nullopt);
   EXPECT_EQ(first->sendConfiguration(Dcfg{.name = "new-name"}, milliseconds(300)), std::nullopt);
   // Another name for the same device: a second session, a second transmitter.
-  auto second = TransmitterSession::acquire(
-      {.host = "localhost", .port = device->port(), .transmitterName = "second"});
+  auto second = acquire({.host = "localhost", .port = device->port(), .transmitterName = "second"});
+  EventLog events(*second);
   ASSERT_EQ(second->waitLoggedIn(milliseconds(3000)), std::nullopt);
   auto err = second->sendConfiguration(Dcfg{.name = "stolen"}, milliseconds(1000));
   ASSERT_TRUE(err.has_value());
   EXPECT_EQ(err->code, static_cast<uint16_t>(ErrorCode::Denied));
+  ASSERT_TRUE(waitFor([&] { return events.first<link::DeviceRefused>(); }));
+  EXPECT_EQ(events.first<link::DeviceRefused>()->meaning, "denied");
+}
+
+TEST(TransmitterSession, FindsTheDeviceByDiscovery) {
+  auto device = startDevice({.port = 0, .name = "finder"});
+  auto session = acquire({.port = device->port(), .device = "finder",
+                          .discoveryAddress = "127.0.0.1"});
+  ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  EXPECT_EQ(session->sessionStatus().deviceName, "finder");
 }
 
 TEST(Discovery, FindsTheSimulatedDeviceByName) {

@@ -6,9 +6,11 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -16,7 +18,7 @@
 
 #include "message_json.h"
 #include "wirc/discovery.h"
-#include "wirc/frame_assembler.h"
+#include "wirc/stream_receiver.h"
 #include "wirc/message_stream_parser.h"
 #include "wirc/transmitter_session.h"
 
@@ -245,9 +247,31 @@ std::shared_ptr<wirc::TransmitterSession> login(const Options& o) {
                                                     .priority = o.priority,
                                                     .loginTimeout = o.timeout,
                                                     .reconnect = false});
-  if (auto error = session->waitLoggedIn(o.timeout + milliseconds(500)))
+  if (!session) fail(session.error());
+  if (auto error = (*session)->waitLoggedIn(o.timeout + milliseconds(500)))
     fail("cannot log in: " + *error);
-  return session;
+  return std::move(*session);
+}
+
+// AREQ for connection `id`; the device's answer, or a timeout, decides.
+int requestControl(const Options& o, uint8_t id) {
+  auto session = login(o);
+  std::promise<link::ControlRequestAnswered> answered;
+  std::once_flag once;
+  int listener = session->addListener([&](const link::LinkEvent& event) {
+    if (const auto* answer = std::get_if<link::ControlRequestAnswered>(&event))
+      std::call_once(once, [&] { answered.set_value(*answer); });
+  });
+  session->requestControlFor(id);
+  auto future = answered.get_future();
+  bool came = future.wait_for(o.timeout) == std::future_status::ready;
+  session->removeListener(listener);
+  if (!came) fail("no answer to the control request within " + std::to_string(o.timeout.count()) +
+                  " ms");
+  auto answer = future.get();
+  if (!answer.granted) fail("control request denied: " + answer.reason);
+  std::printf("control right given to connection %u\n", id);
+  return 0;
 }
 
 wirc::ChannelValues channelList(const std::string& text, const char* what) {
@@ -289,8 +313,8 @@ int discover(const Options& o) {
 int info(const Options& o) {
   auto session = login(o);
   std::this_thread::sleep_for(milliseconds(wirc::kPsdPeriodMs + 100));  // one PSD
-  auto s = session->status();
-  std::printf("device        %s %s\n", s.deviceAddress.c_str(), s.deviceName.c_str());
+  auto s = session->sessionStatus();
+  std::printf("device        %s %s\n", s.vehicleAddress.c_str(), s.deviceName.c_str());
   std::printf("cameras       %u\n", s.cameraCount);
   std::printf("connection    %u%s\n", s.connectionId,
               s.hasControl ? " (has the control right)" : "");
@@ -338,9 +362,9 @@ int stream(const Options& o) {
     if (!file) fail("cannot write '" + *o.out + "'");
   }
   auto session = login(o);
-  if (o.camera >= session->status().cameraCount)
-    fail("the device has " + std::to_string(session->status().cameraCount) +
-         " camera(s); use --camera 0..");
+  auto cameras = session->sessionStatus().cameraCount;
+  if (o.camera >= cameras)
+    fail("the device has " + std::to_string(cameras) + " camera(s); use --camera 0..");
   auto socket = bindUdp(*SocketAddress::resolve("", 0));
   if (!socket) fail(socket.error());
   int size = 8 << 20;
@@ -348,7 +372,8 @@ int stream(const Options& o) {
   auto device = *session->deviceAddress();
   session->startStream(static_cast<uint8_t>(o.camera), localAddress(socket->get()).port());
 
-  wirc::FrameAssembler assembler;
+  wirc::StreamReceiver receiver;
+  receiver.follow(device, session->status().logins);
   int saved = 0;
   auto end = std::chrono::steady_clock::now() +
              std::chrono::duration<double>(o.duration > 0 ? o.duration : 1e9);
@@ -367,7 +392,7 @@ int stream(const Options& o) {
                  static_cast<std::streamsize>(bytes.size()));
     }
     ++saved;
-    assembler.recycle(std::move(frame.data));
+    receiver.recycle(std::move(frame.data));
   };
   while ((!o.frames || saved < *o.frames) && std::chrono::steady_clock::now() < end) {
     pollfd p{socket->get(), POLLIN, 0};
@@ -376,15 +401,16 @@ int stream(const Options& o) {
       socklen_t length = sizeof from;
       ssize_t n = ::recvfrom(socket->get(), buffer.data(), buffer.size(), 0,
                              reinterpret_cast<sockaddr*>(&from), &length);
-      if (n > 0 && SocketAddress(from).sameHost(device))
-        assembler.pushDatagram({buffer.data(), static_cast<size_t>(n)},
-                               std::chrono::steady_clock::now(), save);
+      if (n > 0)
+        receiver.push(SocketAddress(from), {buffer.data(), static_cast<size_t>(n)},
+                      std::chrono::steady_clock::now(), save);
     }
-    assembler.expire(std::chrono::steady_clock::now(), save);
-    if (session->status().state == wirc::SessionState::Failed) fail("lost the device");
+    receiver.expire(std::chrono::steady_clock::now(), save);
+    auto link = session->status();
+    if (link.state == link::LinkState::Failed) fail("lost the device: " + link.reason);
   }
   session->stopStream(static_cast<uint8_t>(o.camera));
-  auto stats = assembler.stats();
+  auto stats = receiver.stats().assembler;
   std::fprintf(stderr, "wirc-cli: saved %d frames to %s (%llu incomplete dropped, %llu packets)\n",
                saved, o.out->c_str(), static_cast<unsigned long long>(stats.framesDropped()),
                static_cast<unsigned long long>(stats.packets));
@@ -409,9 +435,8 @@ int drive(const Options& o) {
     std::this_thread::sleep_for(milliseconds(50));
   }
   session->setCommand(wirc::neutralChannels());
-  std::this_thread::sleep_for(milliseconds(100));  // let neutral go out before logging out
   std::fprintf(stderr, "wirc-cli: drove %.1f s, %llu PCD sent\n", seconds,
-               static_cast<unsigned long long>(session->status().pcdSent));
+               static_cast<unsigned long long>(session->status().commandsSent));
   return 0;
 }
 
@@ -492,10 +517,7 @@ int main(int argc, char** argv) {
   if (command == "request-control") {
     wantArguments(1);
     auto id = static_cast<uint8_t>(integer(o.positional[0].c_str(), "ID", 1, 255));
-    auto session = login(o);
-    session->requestControl(id);
-    std::this_thread::sleep_for(milliseconds(300));
-    return 0;
+    return requestControl(o, id);
   }
   if (command == "configure") {
     if (!o.periods && !o.failsafe) usageError("configure needs --periods and/or --failsafe");

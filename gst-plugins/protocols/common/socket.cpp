@@ -88,6 +88,21 @@ Expected<UniqueFd, std::string> connectTcp(const SocketAddress& address) {
   return fd;
 }
 
+Expected<UniqueFd, std::string> startConnectTcp(const SocketAddress& address) {
+  UniqueFd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+  if (!fd.valid()) return unexpected("socket: " + errnoText(errno));
+  if (::connect(fd.get(), address.raw(), address.size()) != 0 && errno != EINPROGRESS)
+    return unexpected("cannot connect to " + address.toString() + ": " + errnoText(errno));
+  return fd;
+}
+
+int pendingError(int fd) {
+  int error = 0;
+  socklen_t size = sizeof error;
+  if (getsockopt(fd, SOL_SOCKET, SO_ERROR, &error, &size) != 0) return errno;
+  return error;
+}
+
 SocketAddress localAddress(int fd) {
   sockaddr_in address{};
   socklen_t size = sizeof address;

@@ -69,6 +69,11 @@ class SocketAddress {
 Expected<UniqueFd, std::string> bindUdp(const SocketAddress& address);
 Expected<UniqueFd, std::string> listenTcp(const SocketAddress& address);
 Expected<UniqueFd, std::string> connectTcp(const SocketAddress& address);
+// Non-blocking: the connection is under way (wait for writability, then
+// read pendingError()) or already made.
+Expected<UniqueFd, std::string> startConnectTcp(const SocketAddress& address);
+// SO_ERROR: 0 once a non-blocking connect has succeeded.
+int pendingError(int fd);
 
 SocketAddress localAddress(int fd);
 SocketAddress peerAddress(int fd);

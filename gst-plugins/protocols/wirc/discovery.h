@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,12 @@ struct DiscoveredDevice {
 Expected<std::vector<DiscoveredDevice>, std::string> discoverDevices(
     std::chrono::milliseconds timeout, const std::string& target = "255.255.255.255",
     uint16_t port = kDefaultPort);
+
+// The two halves of discoverDevices(), for callers that wait on their own
+// event loop: a bound socket that has sent BCSD to `destination`, and one
+// answer read from it (nothing when the datagram is not a BCSA).
+Expected<UniqueFd, std::string> sendDiscoveryRequest(const SocketAddress& destination);
+std::optional<DiscoveredDevice> readDiscoveryAnswer(int fd);
 
 // The device whose name or serial is `wanted`, or the only one when `wanted`
 // is empty; an error names what was found otherwise.

@@ -1,20 +1,18 @@
 #include "wirc/transmitter_session.h"
 
-#include <poll.h>
-#include <sys/eventfd.h>
+#include <sys/epoll.h>
 #include <sys/socket.h>
-#include <time.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <atomic>
+#include <cerrno>
 #include <condition_variable>
+#include <functional>
 #include <map>
 #include <mutex>
-#include <set>
-#include <thread>
 
+#include "link/command_pacer.h"
+#include "link/event_loop.h"
 #include "wirc/discovery.h"
 #include "wirc/message_stream_parser.h"
 
@@ -22,321 +20,442 @@ namespace wircam::wirc {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using link::Clock;
+using link::EventLoop;
 using std::chrono::milliseconds;
 
 constexpr milliseconds kFirstBackoff{200};
 constexpr milliseconds kMaxBackoff{5000};
+// Discovery listens this long (at most) for the devices to answer.
+constexpr milliseconds kDiscoveryWindow{1000};
 
-// FCFG's special values are not pulses; a PCD sends neutral for them.
-ChannelValues pcdFallback(const ChannelValues& failsafe) {
-  ChannelValues values = failsafe;
-  for (auto& v : values)
-    if (v < kPulseMin || v > kPulseMax) v = kPulseNeutral;
-  return values;
+// FCFG's special values are not pulses; PCD sends neutral for them.
+link::Pulses pcdFailsafe(const ChannelValues& failsafe) {
+  link::Pulses pulses = failsafe;
+  for (auto& pulse : pulses)
+    if (pulse < kPulseMin || pulse > kPulseMax) pulse = kPulseNeutral;
+  return pulses;
 }
 
+link::PacerConfig pacerConfig(const SessionConfig& config) {
+  auto interval = std::chrono::duration<double>(1.0 / std::clamp(config.pcdRate, 1.0, 1000.0));
+  return {.keepalive = config.keepalive,
+          .minInterval = std::chrono::duration_cast<std::chrono::microseconds>(interval),
+          .ttl = config.commandTtl,
+          .failsafe = pcdFailsafe(config.failsafe)};
+}
+
+std::string joined(const ChannelValues& values) {
+  std::string text;
+  for (auto v : values) text += (text.empty() ? "" : ",") + std::to_string(v);
+  return text;
+}
+
+// A setting several users of one link may give: how it reads in a message,
+// how it is taken over, and whether the device must hear it in a new login.
+struct SharedSetting {
+  const char* name;
+  std::function<std::string(const SessionConfig&)> text;
+  std::function<void(SessionConfig&, const SessionConfig&)> adopt;
+  bool needsLogin;
+};
+
+#define WIRCAM_SETTING(NAME, FIELD, TEXT, LOGIN)                                     \
+  SharedSetting {                                                                    \
+    NAME, [](const SessionConfig& c) { return TEXT(c.FIELD); },                      \
+        [](SessionConfig& to, const SessionConfig& from) { to.FIELD = from.FIELD; }, \
+        LOGIN                                                                        \
+  }
+
+std::string quoted(const std::string& text) { return "'" + text + "'"; }
+std::string number(double value) {
+  std::string text = std::to_string(value);
+  text.erase(text.find_last_not_of('0') + 1);
+  if (text.back() == '.') text.pop_back();
+  return text;
+}
+std::string ms(milliseconds value) { return std::to_string(value.count()) + " ms"; }
+std::string flag(bool value) { return value ? "true" : "false"; }
+
+const std::vector<SharedSetting>& sharedSettings() {
+  static const std::vector<SharedSetting> settings = {
+      WIRCAM_SETTING("transmitter-name", transmitterName, quoted, true),
+      WIRCAM_SETTING("priority", priority, std::to_string, true),
+      WIRCAM_SETTING("periods", periods, joined, true),
+      WIRCAM_SETTING("failsafe", failsafe, joined, true),
+      WIRCAM_SETTING("pcd-rate", pcdRate, number, false),
+      WIRCAM_SETTING("keepalive", keepalive, ms, false),
+      WIRCAM_SETTING("command-ttl", commandTtl, ms, false),
+      WIRCAM_SETTING("login-timeout", loginTimeout, ms, false),
+      WIRCAM_SETTING("reconnect", reconnect, flag, false),
+  };
+  return settings;
+}
+
+#undef WIRCAM_SETTING
+
 }  // namespace
+
+std::vector<std::string> sharedSettingNames() {
+  std::vector<std::string> names;
+  for (const auto& setting : sharedSettings()) names.emplace_back(setting.name);
+  return names;
+}
 
 std::string SessionConfig::key() const {
   if (!host.empty()) return host + ":" + std::to_string(port);
   return "discover:" + device + "@" + discoveryAddress + ":" + std::to_string(port);
 }
 
-const char* sessionStateName(SessionState state) {
-  switch (state) {
-    case SessionState::Connecting:
-      return "connecting";
-    case SessionState::LoggedIn:
-      return "logged-in";
-    case SessionState::Reconnecting:
-      return "reconnecting";
-    case SessionState::Failed:
-      return "failed";
-    case SessionState::Closed:
-      return "closed";
+const char* errorCodeMeaning(uint16_t code) {
+  switch (static_cast<ErrorCode>(code)) {
+    case ErrorCode::None:
+      return "no error";
+    case ErrorCode::Format:
+      return "format error";
+    case ErrorCode::Denied:
+      return "denied";
+    case ErrorCode::System:
+      return "system error";
+    case ErrorCode::Save:
+      return "could not save";
+    case ErrorCode::Unauthorised:
+      return "unauthorised: not logged in";
+    case ErrorCode::Busy:
+      return "busy: the device already has a connection from this address";
   }
-  return "unknown";
+  return "unknown error code";
 }
 
 class TransmitterSession::Impl {
  public:
-  explicit Impl(SessionConfig config);
+  Impl(SessionConfig config, link::LinkListeners& listeners);
   ~Impl();
 
-  void run();
-  void runPcd();
-  void emit(const std::string& event);
-  bool sendControl(const Message& message);
+  enum class Phase { Waiting, Discovering, Connecting, LoggingIn, LoggedIn, Closed };
 
-  SessionConfig config_;
-  std::atomic<bool> stopping_{false};
-  UniqueFd wake_;
+  // Loop thread: one login attempt, step by step.
+  void onAttemptTimer();
+  void beginAttempt();
+  void onDiscoveryAnswer();
+  void finishDiscovery();
+  void startConnect(const SocketAddress& device, const std::string& name);
+  void onTcp(uint32_t events);
+  void onConnected();
+  void onLoggedIn(const Wst& wst);
+  void handle(const Message& message);
+  void fail(const std::string& why, bool retryAtOnce = false);
+  void closeConnection();
+  void onPsd();
+  void onPacerTimer();
+
+  bool sendControl(const Message& message);
+  void sendPcd(const link::Pulses& pulses, const SocketAddress& to);
+  void publish(std::vector<link::LinkEvent> events);
+
+  EventLoop& loop_ = EventLoop::shared();
+  link::LinkListeners& listeners_;
   UniqueFd psdSocket_;  // PSD arrive here
   UniqueFd pcdSocket_;  // PCD leave from here
+  EventLoop::Id psdWatch_ = 0;
+  EventLoop::Id attemptTimer_ = 0;
+  EventLoop::Id pacerTimer_ = 0;
 
-  // Guards everything below; never held while blocking on the network.
+  // Loop thread only.
+  Phase phase_ = Phase::Waiting;
+  Clock::time_point attemptDeadline_;
+  milliseconds backoff_ = kFirstBackoff;
+  UniqueFd discovery_;
+  EventLoop::Id discoveryWatch_ = 0;
+  std::vector<DiscoveredDevice> found_;
+  EventLoop::Id tcpWatch_ = 0;
+  MessageStreamParser parser_;  // one per connection, for its whole life
+
+  // Guards everything below; never held while sending, waiting or emitting.
   mutable std::mutex mutex_;
   std::condition_variable changed_;
+  SessionConfig config_;
+  std::map<std::string, std::string> owners_;  // setting name → the user who gave it
   SessionStatus status_;
   std::optional<SocketAddress> device_;
   std::optional<SocketAddress> controlAddress_;
   std::map<uint8_t, uint16_t> streamPorts_;
-  ChannelValues command_ = neutralChannels();
-  Clock::time_point commandTime_{};
+  link::CommandPacer pacer_;
   std::vector<TransmitterInfo> transmitters_;
   bool listComplete_ = false;
   std::vector<Err> errors_;
   uint64_t failedAttempts_ = 0;
-  std::map<int, Listener> listeners_;
-  std::mutex emitMutex_;
-  int nextListener_ = 1;
+  int controlRequests_ = 0;  // AREQ sent and not answered yet
 
   // The TCP connection; sendMutex_ serialises writers from any thread.
   std::mutex sendMutex_;
   UniqueFd tcp_;
-
-  std::thread io_;
-  std::thread pacer_;
-
- private:
-  std::optional<std::string> connectAndLogin();
-  void serve();
-  void handle(const Message& message);
-  bool sleepInterruptibly(milliseconds duration);
 };
 
-TransmitterSession::Impl::Impl(SessionConfig config) : config_(std::move(config)) {
-  wake_ = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
+TransmitterSession::Impl::Impl(SessionConfig config, link::LinkListeners& listeners)
+    : listeners_(listeners), config_(std::move(config)), pacer_(pacerConfig(config_)) {
   if (auto fd = bindUdp(*SocketAddress::resolve("", 0))) psdSocket_ = std::move(*fd);
   if (auto fd = bindUdp(*SocketAddress::resolve("", 0))) pcdSocket_ = std::move(*fd);
-  io_ = std::thread([this] { run(); });
-  pacer_ = std::thread([this] { runPcd(); });
+  setNonBlocking(psdSocket_.get());
+  setNonBlocking(pcdSocket_.get());
+  psdWatch_ = loop_.watch(psdSocket_.get(), EPOLLIN, [this](uint32_t) { onPsd(); });
+  pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
+  attemptTimer_ = loop_.addTimer([this] { onAttemptTimer(); });
+  loop_.arm(attemptTimer_, Clock::now());
 }
 
 TransmitterSession::Impl::~Impl() {
-  stopping_ = true;
-  uint64_t one = 1;
-  if (write(wake_.get(), &one, sizeof one) < 0) {
-    // Cannot fail for an eventfd below its maximum; the flag is set anyway.
-  }
-  changed_.notify_all();
-  io_.join();
-  pacer_.join();
+  // On the loop thread, so no callback of this session runs during or after.
+  loop_.invoke([this] {
+    phase_ = Phase::Closed;
+    std::map<uint8_t, uint16_t> streams;
+    {
+      std::lock_guard lock(mutex_);
+      streams = streamPorts_;
+    }
+    // Log out: stop the streams this session started (best effort, no wait).
+    for (const auto& [camera, port] : streams) sendControl(Est{camera});
+    closeConnection();
+    for (auto id : {psdWatch_, attemptTimer_, pacerTimer_}) loop_.remove(id);
+  });
 }
 
-void TransmitterSession::Impl::emit(const std::string& event) {
-  // Held while listeners run, so that once removeListener() returns its
-  // listener is never called again.
-  std::lock_guard emitting(emitMutex_);
-  std::vector<Listener> listeners;
-  {
-    std::lock_guard lock(mutex_);
-    for (auto& [id, listener] : listeners_) listeners.push_back(listener);
-  }
-  for (auto& listener : listeners) listener(event);
+void TransmitterSession::Impl::publish(std::vector<link::LinkEvent> events) {
+  for (const auto& event : events) listeners_.emit(event);
 }
 
 bool TransmitterSession::Impl::sendControl(const Message& message) {
   auto frame = encode(message);
-  if (!frame) {
-    emit("not sent: " + frame.error().message());
-    return false;
-  }
+  if (!frame) return false;
   std::lock_guard lock(sendMutex_);
   if (!tcp_.valid()) return false;
-  return ::send(tcp_.get(), frame->data(), frame->size(), MSG_NOSIGNAL) ==
-         static_cast<ssize_t>(frame->size());
+  // Non-blocking: a device that stops reading its connection is not waited
+  // for; the short write shows up as a lost connection on the next read.
+  ssize_t sent = ::send(tcp_.get(), frame->data(), frame->size(), MSG_NOSIGNAL);
+  if (sent != static_cast<ssize_t>(frame->size())) ::shutdown(tcp_.get(), SHUT_RDWR);
+  return sent == static_cast<ssize_t>(frame->size());
 }
 
-bool TransmitterSession::Impl::sleepInterruptibly(milliseconds duration) {
-  std::unique_lock lock(mutex_);
-  return !changed_.wait_for(lock, duration, [this] { return stopping_.load(); });
-}
-
-void TransmitterSession::Impl::run() {
-  milliseconds backoff = kFirstBackoff;
-  while (!stopping_) {
-    auto error = connectAndLogin();
-    if (!error) {
-      backoff = kFirstBackoff;
-      serve();
-      if (stopping_) break;
-      error = "connection to the device lost";
-    }
-    bool retry;
-    {
-      std::lock_guard lock(mutex_);
-      ++failedAttempts_;
-      status_.hasControl = false;
-      status_.error = *error;
-      retry = config_.reconnect;
-      status_.state = retry ? SessionState::Reconnecting : SessionState::Failed;
-    }
-    changed_.notify_all();
-    emit(*error + (retry ? "; retrying in " + std::to_string(backoff.count()) + " ms" : ""));
-    if (!retry || !sleepInterruptibly(backoff)) break;
-    backoff = std::min(backoff * 2, kMaxBackoff);
+void TransmitterSession::Impl::sendPcd(const link::Pulses& pulses, const SocketAddress& to) {
+  auto frame = encode(Pcd{pulses});  // the pacer clamps: always valid
+  if (frame && sendDatagram(pcdSocket_.get(), to, *frame)) {
+    std::lock_guard lock(mutex_);
+    ++status_.commandsSent;
   }
-  // Log out: stop the streams this session started, then close.
-  std::set<uint8_t> cameras;
+}
+
+void TransmitterSession::Impl::onAttemptTimer() {
+  switch (phase_) {
+    case Phase::Waiting:
+      return beginAttempt();
+    case Phase::Discovering:
+      return finishDiscovery();
+    case Phase::Connecting:
+      return fail("cannot connect to " + (device_ ? device_->toString() : config_.host) +
+                  " within the login timeout (is the device on and is that its address?)");
+    case Phase::LoggingIn:
+      return fail("no WST from " + (device_ ? device_->toString() : config_.host) +
+                  " within the login timeout (the device accepted the connection but did not "
+                  "answer the login)");
+    case Phase::LoggedIn:
+    case Phase::Closed:
+      return;
+  }
+}
+
+void TransmitterSession::Impl::beginAttempt() {
+  SessionConfig config;
   {
     std::lock_guard lock(mutex_);
-    for (const auto& [camera, port] : streamPorts_) cameras.insert(camera);
+    config = config_;
   }
-  for (uint8_t camera : cameras) sendControl(Est{camera});
-  {
-    std::lock_guard lock(sendMutex_);
-    if (tcp_.valid()) ::shutdown(tcp_.get(), SHUT_RDWR);
-    tcp_.reset();
+  attemptDeadline_ = Clock::now() + config.loginTimeout;
+  if (!config.host.empty()) {
+    auto resolved = SocketAddress::resolve(config.host, config.port);
+    if (!resolved) return fail(resolved.error());
+    return startConnect(*resolved, "");
   }
-  {
-    std::lock_guard lock(mutex_);
-    if (status_.state != SessionState::Failed) status_.state = SessionState::Closed;
-    status_.hasControl = false;
-  }
-  changed_.notify_all();
+  auto destination = SocketAddress::resolve(config.discoveryAddress, config.port);
+  if (!destination) return fail(destination.error());
+  auto socket = sendDiscoveryRequest(*destination);
+  if (!socket) return fail(socket.error());
+  discovery_ = std::move(*socket);
+  found_.clear();
+  phase_ = Phase::Discovering;
+  discoveryWatch_ =
+      loop_.watch(discovery_.get(), EPOLLIN, [this](uint32_t) { onDiscoveryAnswer(); });
+  loop_.arm(attemptTimer_,
+            std::min(attemptDeadline_, Clock::now() + std::min(config.loginTimeout / 2,
+                                                               kDiscoveryWindow)));
 }
 
-std::optional<std::string> TransmitterSession::Impl::connectAndLogin() {
-  SocketAddress device;
-  std::string deviceName;
-  if (config_.host.empty()) {
-    auto found = discoverDevices(config_.loginTimeout, config_.discoveryAddress, config_.port);
-    if (!found) return found.error();
-    auto picked = pickDevice(*found, config_.device);
-    if (!picked) return picked.error();
-    device = picked->address;
-    deviceName = picked->advertisement.name;
-  } else {
-    auto resolved = SocketAddress::resolve(config_.host, config_.port);
-    if (!resolved) return resolved.error();
-    device = *resolved;
+void TransmitterSession::Impl::onDiscoveryAnswer() {
+  while (auto answer = readDiscoveryAnswer(discovery_.get())) {
+    bool known = false;
+    for (const auto& device : found_) known = known || device.address == answer->address;
+    if (!known) found_.push_back(std::move(*answer));
   }
-  auto fd = connectTcp(device);
-  if (!fd) return fd.error() + " (is the device on and is " + device.toString() + " its address?)";
+  std::string wanted;
+  {
+    std::lock_guard lock(mutex_);
+    wanted = config_.device;
+  }
+  // The named device answered: no need to wait for the others.
+  if (!wanted.empty() && pickDevice(found_, wanted)) finishDiscovery();
+}
+
+void TransmitterSession::Impl::finishDiscovery() {
+  loop_.remove(discoveryWatch_);
+  discoveryWatch_ = 0;
+  discovery_.reset();
+  std::string wanted;
+  {
+    std::lock_guard lock(mutex_);
+    wanted = config_.device;
+  }
+  auto picked = pickDevice(found_, wanted);
+  if (!picked) return fail(picked.error());
+  startConnect(picked->address, picked->advertisement.name);
+}
+
+void TransmitterSession::Impl::startConnect(const SocketAddress& device, const std::string& name) {
+  {
+    std::lock_guard lock(mutex_);
+    device_ = device;
+    status_.vehicleAddress = device.toString();
+    if (!name.empty()) status_.deviceName = name;
+  }
+  auto fd = startConnectTcp(device);
+  if (!fd) return fail(fd.error());
+  int fdNumber = fd->get();
   {
     std::lock_guard lock(sendMutex_);
     tcp_ = std::move(*fd);
   }
-  {
-    std::lock_guard lock(mutex_);
-    device_ = device;
-    status_.deviceAddress = device.toString();
-    status_.deviceName = deviceName;
-  }
-
-  sendControl(Tl{.system = static_cast<uint8_t>(SystemType::PcClient),
-                 .version = {1, 0},
-                 .priority = config_.priority,
-                 .name = config_.transmitterName,
-                 .statusPort = localAddress(psdSocket_.get()).port()});
-  sendControl(Ccfg{config_.periods});
-  sendControl(Fcfg{config_.failsafe});
-
-  // Wait for WST; ERR on CCFG/FCFG only means another transmitter was first.
-  MessageStreamParser parser;
-  std::optional<Wst> wst;
-  std::vector<Message> early;
-  auto deadline = Clock::now() + config_.loginTimeout;
-  std::array<uint8_t, 1024> buffer;
-  while (!wst && !stopping_) {
-    auto left = std::chrono::duration_cast<milliseconds>(deadline - Clock::now());
-    if (left.count() <= 0) return "no WST from " + device.toString() + " within the login timeout";
-    pollfd p{tcp_.get(), POLLIN, 0};
-    if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
-    ssize_t n = ::recv(tcp_.get(), buffer.data(), buffer.size(), 0);
-    if (n <= 0) return "the device closed the connection during login";
-    parser.feed(std::span(buffer.data(), static_cast<size_t>(n)),
-                [&](const Expected<Message, ProtocolError>& result) {
-                  if (!result) return;
-                  if (auto* w = std::get_if<Wst>(&*result); w && !wst)
-                    wst = *w;
-                  else
-                    early.push_back(*result);
-                });
-  }
-  if (stopping_) return "stopped";
-
-  std::map<uint8_t, uint16_t> streams;
-  {
-    std::lock_guard lock(mutex_);
-    status_.state = SessionState::LoggedIn;
-    status_.error.clear();
-    status_.connectionId = wst->connectionId;
-    status_.cameraCount = wst->cameraCount;
-    ++status_.logins;
-    controlAddress_ = device.withPort(wst->controlPort);
-    streams = streamPorts_;
-  }
-  changed_.notify_all();
-  emit("logged in to " + device.toString() + " as connection " + std::to_string(wst->connectionId) +
-       " (" + std::to_string(wst->cameraCount) + " cameras)");
-  for (const auto& message : early) handle(message);
-  for (auto [camera, port] : streams) sendControl(Stst{camera, port});
-  return std::nullopt;
+  phase_ = Phase::Connecting;
+  parser_ = MessageStreamParser();
+  tcpWatch_ = loop_.watch(fdNumber, EPOLLOUT, [this](uint32_t events) { onTcp(events); });
+  loop_.arm(attemptTimer_, attemptDeadline_);
 }
 
-void TransmitterSession::Impl::serve() {
-  MessageStreamParser parser;
-  std::array<uint8_t, 2048> buffer;
-  while (!stopping_) {
-    std::array<pollfd, 3> fds = {pollfd{tcp_.get(), POLLIN, 0}, pollfd{psdSocket_.get(), POLLIN, 0},
-                                 pollfd{wake_.get(), POLLIN, 0}};
-    if (::poll(fds.data(), fds.size(), 1000) <= 0) continue;
-    if (fds[1].revents & POLLIN) {
-      ssize_t n = ::recv(psdSocket_.get(), buffer.data(), buffer.size(), 0);
-      if (n > 0) {
-        auto message = decode(std::span(buffer.data(), static_cast<size_t>(n)));
-        if (message && std::holds_alternative<Psd>(*message)) {
-          std::lock_guard lock(mutex_);
-          status_.lastStatus = std::get<Psd>(*message);
-        }
-      }
-    }
-    if (fds[0].revents & (POLLIN | POLLHUP | POLLERR)) {
-      ssize_t n = ::recv(tcp_.get(), buffer.data(), buffer.size(), 0);
-      if (n <= 0) return;
-      parser.feed(std::span(buffer.data(), static_cast<size_t>(n)),
-                  [&](const Expected<Message, ProtocolError>& result) {
-                    if (result)
-                      handle(*result);
-                    else
-                      emit("from the device: " + result.error().message());
-                  });
-    }
+void TransmitterSession::Impl::onTcp(uint32_t events) {
+  if (phase_ == Phase::Connecting) {
+    int error = pendingError(tcp_.get());
+    if (error != 0 || (events & (EPOLLERR | EPOLLHUP)))
+      return fail("cannot connect to " + device_->toString() + ": " +
+                  errnoText(error ? error : ECONNREFUSED) +
+                  " (is the device on and is that its address?)");
+    return onConnected();
   }
+  std::array<uint8_t, 4096> buffer;
+  for (;;) {
+    ssize_t n = ::recv(tcp_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT);
+    if (n == 0) return fail("the device closed the connection");
+    if (n < 0) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK) return;
+      if (errno == EINTR) continue;
+      return fail("connection to the device lost: " + errnoText(errno));
+    }
+    bool closed = false;
+    parser_.feed(std::span(buffer.data(), static_cast<size_t>(n)),
+                 [&](const Expected<Message, ProtocolError>& result) {
+                   // Malformed input is counted by the parser and dropped.
+                   if (result && !closed) handle(*result);
+                   closed = !tcp_.valid();
+                 });
+    if (closed) return;
+  }
+}
+
+void TransmitterSession::Impl::onConnected() {
+  loop_.setEvents(tcpWatch_, EPOLLIN);
+  phase_ = Phase::LoggingIn;
+  SessionConfig config;
+  {
+    std::lock_guard lock(mutex_);
+    config = config_;
+  }
+  sendControl(Tl{.system = static_cast<uint8_t>(SystemType::PcClient),
+                 .version = {1, 0},
+                 .priority = config.priority,
+                 .name = config.transmitterName,
+                 .statusPort = localAddress(psdSocket_.get()).port()});
+  sendControl(Ccfg{config.periods});
+  sendControl(Fcfg{config.failsafe});
+}
+
+void TransmitterSession::Impl::onLoggedIn(const Wst& wst) {
+  phase_ = Phase::LoggedIn;
+  backoff_ = kFirstBackoff;
+  loop_.disarm(attemptTimer_);
+  std::map<uint8_t, uint16_t> streams;
+  std::string address;
+  {
+    std::lock_guard lock(mutex_);
+    status_.state = link::LinkState::Live;
+    status_.reason.clear();
+    status_.connectionId = wst.connectionId;
+    status_.cameraCount = wst.cameraCount;
+    ++status_.logins;
+    controlAddress_ = device_->withPort(wst.controlPort);
+    streams = streamPorts_;
+    address = device_->toString();
+  }
+  changed_.notify_all();
+  publish({link::StateChanged{link::LinkState::Live,
+                              "logged in to " + address + " as connection " +
+                                  std::to_string(wst.connectionId) + " (" +
+                                  std::to_string(wst.cameraCount) + " cameras)"}});
+  for (auto [camera, port] : streams) sendControl(Stst{camera, port});
 }
 
 void TransmitterSession::Impl::handle(const Message& message) {
-  std::string event;
+  if (auto* wst = std::get_if<Wst>(&message)) {
+    if (phase_ == Phase::LoggingIn) onLoggedIn(*wst);
+    return;
+  }
+  std::vector<link::LinkEvent> events;
+  bool granted = false;
   {
     std::lock_guard lock(mutex_);
     if (auto* agr = std::get_if<Agr>(&message)) {
-      bool mine = agr->connectionId == status_.connectionId;
+      bool had = status_.hasControl;
+      bool answersRequest = controlRequests_ > 0;
+      if (answersRequest) --controlRequests_;
       switch (agr->notification) {
         case AccessNotification::Granted:
           status_.hasControl = true;
-          event = "control right granted";
           break;
         case AccessNotification::Revoked:
           status_.hasControl = false;
-          event = "control right revoked: '" + agr->name + "' has it now";
           break;
         case AccessNotification::Denied:
-          event = "control right request denied";
           break;
         case AccessNotification::Notification:
-          status_.hasControl = mine;
-          event = "control right now with '" + agr->name + "'";
+          status_.hasControl = agr->connectionId == status_.connectionId;
           break;
       }
+      if (answersRequest) {
+        bool denied = agr->notification == AccessNotification::Denied;
+        events.push_back(link::ControlRequestAnswered{
+            !denied, denied ? "'" + agr->name + "' holds it and only a transmitter of the highest "
+                                  "priority may hand it over"
+                            : ""});
+      }
+      if (had != status_.hasControl || agr->notification == AccessNotification::Notification)
+        events.push_back(link::ControlRightChanged{status_.hasControl, agr->name});
+      granted = !had && status_.hasControl;
+      if (granted) pacer_.restart();
     } else if (auto* err = std::get_if<Err>(&message)) {
       ++status_.errorsReceived;
       errors_.push_back(*err);
       if (errors_.size() > 16) errors_.erase(errors_.begin());
-      event =
-          "device answered ERR " + std::to_string(err->code) + " to " + commandName(err->command);
+      if (err->command == static_cast<uint8_t>(Command::Areq) && controlRequests_ > 0) {
+        --controlRequests_;
+        events.push_back(link::ControlRequestAnswered{false, errorCodeMeaning(err->code)});
+      }
+      events.push_back(link::DeviceRefused{commandName(err->command), err->code,
+                                           errorCodeMeaning(err->code)});
     } else if (auto* tlst = std::get_if<Tlst>(&message)) {
       if (listComplete_) transmitters_.clear();
       listComplete_ = false;
@@ -346,80 +465,195 @@ void TransmitterSession::Impl::handle(const Message& message) {
     }
   }
   changed_.notify_all();
-  if (!event.empty()) emit(event);
+  if (granted) loop_.arm(pacerTimer_, Clock::now());
+  publish(std::move(events));
+  // The login itself refused (unauthorised, busy): no WST will come.
+  if (auto* err = std::get_if<Err>(&message);
+      err && phase_ == Phase::LoggingIn && err->command == static_cast<uint8_t>(Command::Tl))
+    fail(std::string("the device refused the login: ") + errorCodeMeaning(err->code) +
+         " (ERR " + std::to_string(err->code) + ")");
 }
 
-void TransmitterSession::Impl::runPcd() {
-  auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(1.0 / std::clamp(config_.pcdRate, 1.0, 200.0)));
-  auto fallback = *encode(Pcd{pcdFallback(config_.failsafe)});
-  // The frame is encoded again only when the command changes.
-  Bytes commandFrame;
-  Clock::time_point encodedAt{};
-  auto next = Clock::now();
-  while (!stopping_) {
-    next += period;
-    if (next < Clock::now()) next = Clock::now() + period;  // fell behind: do not burst
-    // A plain absolute sleep: the cheapest way to wake 50 times a second;
-    // stop() waits at most one period for it.
-    timespec wake{};
-    auto sinceEpoch = std::chrono::duration_cast<std::chrono::nanoseconds>(next.time_since_epoch());
-    wake.tv_sec = static_cast<time_t>(sinceEpoch.count() / 1000000000);
-    wake.tv_nsec = static_cast<long>(sinceEpoch.count() % 1000000000);
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &wake, nullptr);
-    if (stopping_) break;
+void TransmitterSession::Impl::closeConnection() {
+  if (tcpWatch_) loop_.remove(tcpWatch_);
+  tcpWatch_ = 0;
+  if (discoveryWatch_) loop_.remove(discoveryWatch_);
+  discoveryWatch_ = 0;
+  discovery_.reset();
+  std::lock_guard lock(sendMutex_);
+  if (tcp_.valid()) ::shutdown(tcp_.get(), SHUT_RDWR);
+  tcp_.reset();
+}
 
-    std::unique_lock lock(mutex_);
-    if (!status_.hasControl || !controlAddress_) continue;
-    if (commandTime_ != encodedAt) {
-      commandFrame = *encode(Pcd{command_});  // clamped in setCommand: always valid
-      encodedAt = commandTime_;
+void TransmitterSession::Impl::fail(const std::string& why, bool retryAtOnce) {
+  closeConnection();
+  loop_.disarm(pacerTimer_);
+  link::LinkState state;
+  bool retry;
+  std::vector<link::LinkEvent> events;
+  {
+    std::lock_guard lock(mutex_);
+    ++failedAttempts_;
+    if (status_.hasControl) events.push_back(link::ControlRightChanged{false, ""});
+    status_.hasControl = false;
+    controlAddress_.reset();
+    controlRequests_ = 0;
+    retry = config_.reconnect || retryAtOnce;
+    state = !retry                 ? link::LinkState::Failed
+            : status_.logins == 0 ? link::LinkState::Connecting
+                                  : link::LinkState::Lost;
+    status_.state = state;
+    status_.reason = why;
+  }
+  changed_.notify_all();
+  milliseconds wait = retryAtOnce ? milliseconds(0) : backoff_;
+  std::string reason = why;
+  if (retry && !retryAtOnce) reason += "; retrying in " + std::to_string(wait.count()) + " ms";
+  events.insert(events.begin(), link::StateChanged{state, reason});
+  publish(std::move(events));
+  if (!retry) {
+    phase_ = Phase::Closed;
+    return;
+  }
+  phase_ = Phase::Waiting;
+  if (!retryAtOnce) backoff_ = std::min(backoff_ * 2, kMaxBackoff);
+  loop_.arm(attemptTimer_, Clock::now() + wait);
+}
+
+void TransmitterSession::Impl::onPsd() {
+  std::array<uint8_t, 64> buffer;
+  sockaddr_in from{};
+  socklen_t size = sizeof from;
+  ssize_t n;
+  while ((n = ::recvfrom(psdSocket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
+                         reinterpret_cast<sockaddr*>(&from), &size)) >= 0) {
+    auto message = decode(std::span(buffer.data(), static_cast<size_t>(n)));
+    if (!message || !std::holds_alternative<Psd>(*message)) continue;
+    const auto& psd = std::get<Psd>(*message);
+    link::Telemetry telemetry{
+        .batteryVolts = psd.batteryMillivolts / 1000.0,
+        .analogVolts = psd.analogMillivolts / 1000.0,
+        .inputs = static_cast<uint32_t>(psd.inputs[0] | psd.inputs[1] << 1 | psd.inputs[2] << 2 |
+                                        psd.inputs[3] << 3),
+        .received = Clock::now()};
+    {
+      std::lock_guard lock(mutex_);
+      if (!device_ || !device_->sameHost(SocketAddress(from))) continue;  // not our device
+      status_.lastStatus = psd;
+      status_.telemetry = telemetry;
     }
-    bool fresh = Clock::now() - commandTime_ <= config_.commandTtl;
-    auto to = *controlAddress_;
-    lock.unlock();
-    bool sent = sendDatagram(pcdSocket_.get(), to, fresh ? commandFrame : fallback);
-    lock.lock();
-    if (sent) ++status_.pcdSent;
+    publish({link::TelemetryReceived{telemetry}});
   }
 }
 
-std::shared_ptr<TransmitterSession> TransmitterSession::acquire(const SessionConfig& config) {
-  static std::mutex registryMutex;
-  static std::map<std::string, std::weak_ptr<TransmitterSession>> registry;
-  std::lock_guard lock(registryMutex);
-  auto& entry = registry[config.key()];
-  if (auto existing = entry.lock()) return existing;
-  std::shared_ptr<TransmitterSession> session(
-      new TransmitterSession(std::make_unique<Impl>(config)));
-  entry = session;
-  return session;
+void TransmitterSession::Impl::onPacerTimer() {
+  auto now = Clock::now();
+  std::optional<link::Pulses> due;
+  SocketAddress to;
+  Clock::time_point next;
+  {
+    std::lock_guard lock(mutex_);
+    if (status_.state != link::LinkState::Live || !status_.hasControl || !controlAddress_) return;
+    due = pacer_.poll(now);
+    next = pacer_.nextDeadline(now);
+    to = *controlAddress_;
+  }
+  if (due) sendPcd(*due, to);
+  loop_.arm(pacerTimer_, next);
 }
 
-TransmitterSession::TransmitterSession(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+// ---------------------------------------------------------------------------
+
+Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::acquire(
+    const SessionConfig& config, const std::string& user) {
+  if (config.keepalive > kMaxKeepalive || config.keepalive.count() <= 0)
+    return unexpected("keepalive " + ms(config.keepalive) + " is outside 1.." + ms(kMaxKeepalive) +
+                      ": it must stay well below the device's PCD timeout (200..2000 ms)");
+  if (auto tl = encode(Tl{.name = config.transmitterName}); !tl)
+    return unexpected("transmitter-name " + quoted(config.transmitterName) +
+                      " cannot be sent: " + tl.error().message());
+
+  std::shared_ptr<TransmitterSession> session;
+  {
+    static std::mutex registryMutex;
+    static std::map<std::string, std::weak_ptr<TransmitterSession>> registry;
+    std::lock_guard lock(registryMutex);
+    auto& entry = registry[config.key()];
+    session = entry.lock();
+    if (!session) {
+      session.reset(new TransmitterSession(config));
+      entry = session;
+    }
+  }
+
+  // Take over the settings `user` gave, unless someone else gave others.
+  auto* impl = session->impl_.get();
+  bool relogin = false;
+  {
+    std::lock_guard settingsLock(impl->mutex_);
+    for (const auto& setting : sharedSettings()) {
+      if (!config.given.count(setting.name)) continue;
+      std::string wanted = setting.text(config), current = setting.text(impl->config_);
+      auto owner = impl->owners_.find(setting.name);
+      if (wanted != current && owner != impl->owners_.end() && owner->second != user)
+        return unexpected(std::string(setting.name) + "=" + wanted + " of " + user +
+                          " conflicts with " + setting.name + "=" + current + " of " +
+                          owner->second + ", which shares the link to " + config.key() +
+                          ": give both the same value, or set it on one only");
+      impl->owners_[setting.name] = user;
+      if (wanted == current) continue;
+      setting.adopt(impl->config_, config);
+      relogin = relogin || setting.needsLogin;
+    }
+    impl->pacer_ = link::CommandPacer(pacerConfig(impl->config_));
+  }
+  if (relogin) {
+    impl->loop_.invoke([impl, &user] {
+      if (impl->phase_ == Impl::Phase::LoggingIn || impl->phase_ == Impl::Phase::LoggedIn)
+        impl->fail("logging in again with the settings of " + user, true);
+    });
+  }
+
+  // Each user holds its own reference; dropping it gives its settings back.
+  auto* strong = new std::shared_ptr<TransmitterSession>(session);
+  return std::shared_ptr<TransmitterSession>(session.get(),
+                                             [strong, user](TransmitterSession* link) {
+                                               link->release(user);
+                                               delete strong;
+                                             });
+}
+
+TransmitterSession::TransmitterSession(const SessionConfig& config)
+    : impl_(std::make_unique<Impl>(config, listeners_)) {}
+
 TransmitterSession::~TransmitterSession() = default;
 
-std::optional<std::string> TransmitterSession::waitLoggedIn(std::chrono::milliseconds timeout) {
-  std::unique_lock lock(impl_->mutex_);
-  bool done = impl_->changed_.wait_for(lock, timeout, [&] {
-    return impl_->status_.state == SessionState::LoggedIn || impl_->failedAttempts_ > 0;
-  });
-  if (impl_->status_.state == SessionState::LoggedIn) return std::nullopt;
-  if (!done) return "no login within " + std::to_string(timeout.count()) + " ms";
-  return impl_->status_.error;
+void TransmitterSession::release(const std::string& user) {
+  std::lock_guard lock(impl_->mutex_);
+  std::erase_if(impl_->owners_, [&](const auto& owner) { return owner.second == user; });
 }
 
-SessionStatus TransmitterSession::status() const {
+std::optional<std::string> TransmitterSession::waitLoggedIn(milliseconds timeout) {
+  std::unique_lock lock(impl_->mutex_);
+  bool done = impl_->changed_.wait_for(lock, timeout, [&] {
+    return impl_->status_.state == link::LinkState::Live || impl_->failedAttempts_ > 0;
+  });
+  if (impl_->status_.state == link::LinkState::Live) return std::nullopt;
+  if (!done) return "no login within " + std::to_string(timeout.count()) + " ms";
+  return impl_->status_.reason;
+}
+
+link::LinkStatus TransmitterSession::status() const { return sessionStatus(); }
+
+SessionStatus TransmitterSession::sessionStatus() const {
   std::lock_guard lock(impl_->mutex_);
   return impl_->status_;
 }
 
-uint64_t TransmitterSession::logins() const {
+SessionConfig TransmitterSession::config() const {
   std::lock_guard lock(impl_->mutex_);
-  return impl_->status_.logins;
+  return impl_->config_;
 }
-
-const SessionConfig& TransmitterSession::config() const { return impl_->config_; }
 
 std::optional<SocketAddress> TransmitterSession::deviceAddress() const {
   std::lock_guard lock(impl_->mutex_);
@@ -427,11 +661,14 @@ std::optional<SocketAddress> TransmitterSession::deviceAddress() const {
 }
 
 void TransmitterSession::startStream(uint8_t camera, uint16_t port) {
+  bool live;
   {
     std::lock_guard lock(impl_->mutex_);
     impl_->streamPorts_[camera] = port;
+    live = impl_->status_.state == link::LinkState::Live;
   }
-  impl_->sendControl(Stst{camera, port});
+  // Not live yet: the login sends it.
+  if (live) impl_->sendControl(Stst{camera, port});
 }
 
 void TransmitterSession::stopStream(uint8_t camera) {
@@ -442,19 +679,51 @@ void TransmitterSession::stopStream(uint8_t camera) {
   impl_->sendControl(Est{camera});
 }
 
-void TransmitterSession::setCommand(const ChannelValues& pulses) {
-  std::lock_guard lock(impl_->mutex_);
-  for (size_t i = 0; i < kChannelCount; ++i)
-    impl_->command_[i] = std::clamp(pulses[i], kPulseMin, kPulseMax);
-  impl_->commandTime_ = Clock::now();
+void TransmitterSession::setCommand(const link::Pulses& pulses) {
+  auto now = Clock::now();
+  std::optional<link::Pulses> due;
+  SocketAddress to;
+  Clock::time_point next;
+  bool steering;
+  {
+    std::lock_guard lock(impl_->mutex_);
+    due = impl_->pacer_.offer(pulses, now);
+    steering = impl_->status_.state == link::LinkState::Live && impl_->status_.hasControl &&
+               impl_->controlAddress_;
+    if (steering) to = *impl_->controlAddress_;
+    next = impl_->pacer_.nextDeadline(now);
+  }
+  if (!steering) return;  // kept for when the control right comes
+  // A change leaves now, from this thread: no wait for a tick.
+  if (due) impl_->sendPcd(*due, to);
+  impl_->loop_.armIfEarlier(impl_->pacerTimer_, next);
 }
 
-void TransmitterSession::requestControl(uint8_t connectionId) {
-  impl_->sendControl(Areq{connectionId});
+void TransmitterSession::requestControl() {
+  uint8_t id;
+  {
+    std::lock_guard lock(impl_->mutex_);
+    id = impl_->status_.connectionId;
+  }
+  requestControlFor(id);
+}
+
+void TransmitterSession::requestControlFor(uint8_t connectionId) {
+  {
+    std::lock_guard lock(impl_->mutex_);
+    ++impl_->controlRequests_;
+  }
+  if (!impl_->sendControl(Areq{connectionId})) {
+    {
+      std::lock_guard lock(impl_->mutex_);
+      --impl_->controlRequests_;
+    }
+    impl_->publish({link::ControlRequestAnswered{false, "not logged in"}});
+  }
 }
 
 std::optional<std::vector<TransmitterInfo>> TransmitterSession::listTransmitters(
-    std::chrono::milliseconds timeout) {
+    milliseconds timeout) {
   {
     std::lock_guard lock(impl_->mutex_);
     impl_->listComplete_ = false;
@@ -468,7 +737,7 @@ std::optional<std::vector<TransmitterInfo>> TransmitterSession::listTransmitters
 }
 
 std::optional<Err> TransmitterSession::sendConfiguration(const Message& message,
-                                                         std::chrono::milliseconds timeout) {
+                                                         milliseconds timeout) {
   uint8_t command = commandCode(message);
   {
     std::lock_guard lock(impl_->mutex_);
@@ -483,19 +752,6 @@ std::optional<Err> TransmitterSession::sendConfiguration(const Message& message,
     return answer.has_value();
   });
   return answer;
-}
-
-int TransmitterSession::addListener(Listener listener) {
-  std::lock_guard lock(impl_->mutex_);
-  int id = impl_->nextListener_++;
-  impl_->listeners_[id] = std::move(listener);
-  return id;
-}
-
-void TransmitterSession::removeListener(int id) {
-  std::lock_guard emitting(impl_->emitMutex_);
-  std::lock_guard lock(impl_->mutex_);
-  impl_->listeners_.erase(id);
 }
 
 }  // namespace wircam::wirc

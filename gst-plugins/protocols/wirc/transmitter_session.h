@@ -1,22 +1,27 @@
-// One transmitter's login to one WiRC device, shared by every user in the
-// process that names the same device (two wircsrc on cameras 0 and 1 plus a
-// wirccontrol = one login, one connection ID, one PCD sender). It logs in,
-// keeps the streams it was asked for running, reconnects after a loss, and
-// while it holds the control right sends PCD at a fixed rate from its own
-// thread, so a stalled pipeline stops the vehicle but never loses the link.
+// The WiRC vehicle link: one transmitter's login to one WiRC device, shared
+// by every user in the process that names the same device (two wircsrc on
+// cameras 0 and 1 plus a wirccontrol = one login, one connection ID; the
+// real device accepts one TCP connection per IP address). It runs on the
+// process's event loop: discovery, a non-blocking connect and the login
+// have one deadline, losses reconnect with backoff, PSD become telemetry,
+// and PCD leave when the command changes or a keepalive is due.
 #pragma once
 
 #include <chrono>
-#include <functional>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "common/expected.h"
 #include "common/socket.h"
+#include "link/vehicle_link.h"
 #include "wirc/messages.h"
 
 namespace wircam::wirc {
+
+static_assert(std::is_same_v<ChannelValues, link::Pulses>);
 
 struct SessionConfig {
   std::string host;  // empty: discover
@@ -31,30 +36,30 @@ struct SessionConfig {
     return p;
   }();
   ChannelValues failsafe = neutralChannels();
-  double pcdRate = 50;                        // Hz while holding the control right
-  std::chrono::milliseconds commandTtl{250};  // older commands give way to neutral
+  double pcdRate = 50;  // Hz: the most commands per second (a rate limit)
+  std::chrono::milliseconds keepalive{100};   // PCD repeat while nothing changes
+  std::chrono::milliseconds commandTtl{250};  // older commands give way to the failsafe
   std::chrono::milliseconds loginTimeout{3000};
   bool reconnect = true;
+  // The settings this user set, by property name ("transmitter-name",
+  // "priority", "pcd-rate", ...). The others defer to another user's.
+  std::set<std::string> given;
 
   // Sessions are shared by this key: the device's address, or the discovery
   // request when no host is named.
   std::string key() const;
 };
 
-enum class SessionState { Connecting, LoggedIn, Reconnecting, Failed, Closed };
-const char* sessionStateName(SessionState state);
+// The shared link's settings that a user can set, by property name.
+std::vector<std::string> sharedSettingNames();
+// keepalive must stay well below the device's PCD timeout (200..2000 ms).
+constexpr std::chrono::milliseconds kMaxKeepalive{400};
 
-struct SessionStatus {
-  SessionState state = SessionState::Connecting;
-  std::string error;  // why the last attempt failed, if it did
-  std::string deviceAddress;
+struct SessionStatus : link::LinkStatus {
   std::string deviceName;
   uint8_t connectionId = 0;
   uint8_t cameraCount = 0;
-  bool hasControl = false;
   std::optional<Psd> lastStatus;
-  uint64_t logins = 0;  // 1 after the first login, +1 per reconnect
-  uint64_t pcdSent = 0;
   uint64_t errorsReceived = 0;
 };
 
@@ -64,22 +69,28 @@ struct TransmitterInfo {
   std::string name;
 };
 
-class TransmitterSession {
- public:
-  // The process-wide session for this device, created on first use and
-  // logged out when the last user lets go.
-  static std::shared_ptr<TransmitterSession> acquire(const SessionConfig& config);
+// The spec's meaning of an ERR code ("busy", "unauthorised", ...).
+const char* errorCodeMeaning(uint16_t code);
 
-  ~TransmitterSession();
+class TransmitterSession : public link::VehicleLink {
+ public:
+  // The process-wide link for this device, used by `user` (an element's
+  // name) until the returned pointer is dropped; the last one logs out.
+  // A setting `user` gave that another user gave differently is refused,
+  // naming both; one that nobody gave is adopted, logging in again when
+  // it changes the login.
+  static Expected<std::shared_ptr<TransmitterSession>, std::string> acquire(
+      const SessionConfig& config, const std::string& user = "");
+
+  ~TransmitterSession() override;
   TransmitterSession(const TransmitterSession&) = delete;
   TransmitterSession& operator=(const TransmitterSession&) = delete;
 
-  // Blocks until logged in; the error says why not (no device, refused...).
-  std::optional<std::string> waitLoggedIn(std::chrono::milliseconds timeout);
-  SessionStatus status() const;
-  // status().logins without copying the rest: cheap enough for every packet.
-  uint64_t logins() const;
-  const SessionConfig& config() const;
+  void setCommand(const link::Pulses& pulses) override;
+  void requestControl() override;
+  link::LinkStatus status() const override;
+  SessionStatus sessionStatus() const;
+  SessionConfig config() const;
   // The device's address once known (for filtering the stream's sender).
   std::optional<SocketAddress> deviceAddress() const;
 
@@ -87,27 +98,21 @@ class TransmitterSession {
   void startStream(uint8_t camera, uint16_t port);
   void stopStream(uint8_t camera);
 
-  // The pulses to send while holding the control right. Values outside
-  // 800..2200 are clamped here: nothing out of range ever leaves.
-  void setCommand(const ChannelValues& pulses);
-
-  // Control-connection requests; replies arrive as events and in status().
-  void requestControl(uint8_t connectionId);
+  // For command-line use: block until logged in (or failed); the error says
+  // why not.
+  std::optional<std::string> waitLoggedIn(std::chrono::milliseconds timeout);
+  // AREQ for another transmitter; the answer comes as ControlRequestAnswered.
+  void requestControlFor(uint8_t connectionId);
   std::optional<std::vector<TransmitterInfo>> listTransmitters(std::chrono::milliseconds timeout);
   // CCFG/FCFG/DCFG/WCFG/EXTOUT/FWUP; the ERR the device answers, if any
   // within `timeout`, is returned.
   std::optional<Err> sendConfiguration(const Message& message, std::chrono::milliseconds timeout);
 
-  // Human-readable events (logins, losses, ERR, control changes), from the
-  // session's thread. Returns an id for removeListener.
-  using Listener = std::function<void(const std::string& event)>;
-  int addListener(Listener listener);
-  void removeListener(int id);
-
   class Impl;
 
  private:
-  explicit TransmitterSession(std::unique_ptr<Impl> impl);
+  explicit TransmitterSession(const SessionConfig& config);
+  void release(const std::string& user);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -1,0 +1,47 @@
+#include "link/command_pacer.h"
+
+#include <algorithm>
+
+namespace wircam::link {
+
+Pulses CommandPacer::effective(Clock::time_point now) const {
+  if (!command_ || now - commandTime_ > config_.ttl) return config_.failsafe;
+  return *command_;
+}
+
+std::optional<Pulses> CommandPacer::sendIfDue(Clock::time_point now, bool keepaliveDue) {
+  Pulses wanted = effective(now);
+  bool changed = !lastSent_ || wanted != *lastSent_;
+  bool allowed = !lastSent_ || now - lastSentTime_ >= config_.minInterval;
+  if (!(changed && allowed) && !keepaliveDue) return std::nullopt;
+  lastSent_ = wanted;
+  lastSentTime_ = now;
+  return wanted;
+}
+
+std::optional<Pulses> CommandPacer::offer(const Pulses& pulses, Clock::time_point now) {
+  command_ = pulses;
+  for (auto& pulse : *command_) pulse = std::clamp(pulse, kPulseMin, kPulseMax);
+  commandTime_ = now;
+  return sendIfDue(now, false);
+}
+
+std::optional<Pulses> CommandPacer::poll(Clock::time_point now) {
+  return sendIfDue(now, !lastSent_ || now - lastSentTime_ >= config_.keepalive);
+}
+
+CommandPacer::Clock::time_point CommandPacer::nextDeadline(Clock::time_point now) const {
+  if (!lastSent_) return now;
+  auto next = lastSentTime_ + config_.keepalive;
+  // A change the rate limit holds back.
+  if (effective(now) != *lastSent_)
+    next = std::min(next, std::max(now, lastSentTime_ + config_.minInterval));
+  // The command running out.
+  auto expiry = commandTime_ + config_.ttl + std::chrono::nanoseconds(1);
+  if (command_ && expiry > now) next = std::min(next, expiry);
+  return next;
+}
+
+void CommandPacer::restart() { lastSent_.reset(); }
+
+}  // namespace wircam::link

@@ -1,0 +1,50 @@
+// When a vehicle link sends a command: at once when it changes (no faster
+// than the rate limit), otherwise a keepalive every `keepalive` so the
+// vehicle's watchdog stays fed, and the failsafe once the command is older
+// than `ttl` (a stalled pipeline stops the vehicle, the link stays up).
+// Pure policy: the caller passes the time and does the sending.
+#pragma once
+
+#include <chrono>
+#include <optional>
+
+#include "link/vehicle_link.h"
+
+namespace wircam::link {
+
+struct PacerConfig {
+  std::chrono::milliseconds keepalive{100};
+  std::chrono::microseconds minInterval{0};  // 1 / rate limit
+  std::chrono::milliseconds ttl{250};
+  Pulses failsafe = neutralPulses();
+};
+
+class CommandPacer {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  explicit CommandPacer(PacerConfig config) : config_(config) {}
+
+  // A new command: the pulses to send now, if they should leave now.
+  std::optional<Pulses> offer(const Pulses& pulses, Clock::time_point now);
+  // From the link's timer: the pulses to send now, if any are due.
+  std::optional<Pulses> poll(Clock::time_point now);
+  // When poll() has something to send next, seen from `now`.
+  Clock::time_point nextDeadline(Clock::time_point now) const;
+  // Forget what was sent (a new login): the next poll sends at once.
+  void restart();
+
+  const PacerConfig& config() const { return config_; }
+
+ private:
+  Pulses effective(Clock::time_point now) const;
+  std::optional<Pulses> sendIfDue(Clock::time_point now, bool keepaliveDue);
+
+  PacerConfig config_;
+  std::optional<Pulses> command_;
+  Clock::time_point commandTime_{};
+  std::optional<Pulses> lastSent_;
+  Clock::time_point lastSentTime_{};
+};
+
+}  // namespace wircam::link

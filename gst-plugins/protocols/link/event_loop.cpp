@@ -1,0 +1,204 @@
+#include "link/event_loop.h"
+
+#include <sys/epoll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <array>
+#include <future>
+#include <vector>
+
+namespace wircam::link {
+
+EventLoop& EventLoop::shared() {
+  static auto* loop = new EventLoop();
+  return *loop;
+}
+
+EventLoop::EventLoop()
+    : epoll_(epoll_create1(EPOLL_CLOEXEC)), wake_(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)) {
+  epoll_event event{.events = EPOLLIN, .data = {.u64 = 0}};
+  epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, wake_.get(), &event);
+  thread_ = std::thread([this] { run(); });
+}
+
+EventLoop::~EventLoop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake();
+  thread_.join();
+}
+
+void EventLoop::wake() {
+  uint64_t one = 1;
+  if (write(wake_.get(), &one, sizeof one) < 0) {
+    // Only fails when the counter is saturated: the loop is awake anyway.
+  }
+}
+
+EventLoop::Id EventLoop::watch(int fd, uint32_t events, IoCallback callback) {
+  std::lock_guard lock(mutex_);
+  Id id = nextId_++;
+  entries_[id] = Entry{.fd = fd, .onIo = std::make_shared<const IoCallback>(std::move(callback))};
+  epoll_event event{.events = events, .data = {.u64 = id}};
+  epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, fd, &event);
+  return id;
+}
+
+void EventLoop::setEvents(Id id, uint32_t events) {
+  std::lock_guard lock(mutex_);
+  auto it = entries_.find(id);
+  if (it == entries_.end()) return;
+  epoll_event event{.events = events, .data = {.u64 = id}};
+  epoll_ctl(epoll_.get(), EPOLL_CTL_MOD, it->second.fd, &event);
+}
+
+EventLoop::Id EventLoop::addTimer(Callback callback) {
+  std::lock_guard lock(mutex_);
+  Id id = nextId_++;
+  entries_[id] = Entry{.onTimer = std::make_shared<const Callback>(std::move(callback))};
+  return id;
+}
+
+void EventLoop::arm(Id id, Clock::time_point when) {
+  bool earliest;
+  {
+    std::lock_guard lock(mutex_);
+    auto it = entries_.find(id);
+    if (it == entries_.end()) return;
+    unqueue(it->second);
+    earliest = timers_.empty() || when < timers_.begin()->first;
+    it->second.queued = timers_.emplace(when, id);
+  }
+  // The loop sleeps until its earliest timer: wake it only to sleep less.
+  if (earliest && !inLoopThread()) wake();
+}
+
+void EventLoop::armIfEarlier(Id id, Clock::time_point when) {
+  {
+    std::lock_guard lock(mutex_);
+    auto it = entries_.find(id);
+    if (it == entries_.end() || (it->second.queued && (*it->second.queued)->first <= when))
+      return;
+  }
+  arm(id, when);
+}
+
+void EventLoop::disarm(Id id) {
+  std::lock_guard lock(mutex_);
+  auto it = entries_.find(id);
+  if (it != entries_.end()) unqueue(it->second);
+}
+
+void EventLoop::unqueue(Entry& entry) {
+  if (!entry.queued) return;
+  timers_.erase(*entry.queued);
+  entry.queued.reset();
+}
+
+void EventLoop::waitUntilIdle(Id id, std::unique_lock<std::mutex>& lock) {
+  if (inLoopThread()) return;
+  idle_.wait(lock, [&] { return running_ != id; });
+}
+
+void EventLoop::remove(Id id) {
+  std::unique_lock lock(mutex_);
+  auto it = entries_.find(id);
+  if (it == entries_.end()) return;
+  if (it->second.fd >= 0) epoll_ctl(epoll_.get(), EPOLL_CTL_DEL, it->second.fd, nullptr);
+  unqueue(it->second);
+  // Destroyed here, outside the lock, once the loop has let go of it.
+  Entry entry = std::move(it->second);
+  entries_.erase(it);
+  waitUntilIdle(id, lock);
+  lock.unlock();
+}
+
+void EventLoop::invoke(const Callback& task) {
+  if (inLoopThread()) {
+    task();
+    return;
+  }
+  std::promise<void> done;
+  Id timer = addTimer([&] {
+    task();
+    done.set_value();
+  });
+  arm(timer, Clock::time_point::min());
+  done.get_future().wait();
+  remove(timer);
+}
+
+int EventLoop::msUntilNextTimer(Clock::time_point now) const {
+  if (timers_.empty()) return -1;
+  auto due = timers_.begin()->first;
+  if (due <= now) return 0;
+  // Rounded up: waking a little late is fine, waking early spins.
+  auto us = std::chrono::duration_cast<std::chrono::microseconds>(due - now).count();
+  return static_cast<int>(std::min<int64_t>((us + 999) / 1000, 60000));
+}
+
+void EventLoop::run() {
+  std::array<epoll_event, 64> events;
+  std::vector<Id> due;
+  for (;;) {
+    int timeout;
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_) return;
+      timeout = msUntilNextTimer(Clock::now());
+    }
+    int count = epoll_wait(epoll_.get(), events.data(), static_cast<int>(events.size()), timeout);
+
+    // Each callback runs with running_ set, so remove() can wait for it.
+    auto runEntry = [&](Id id, uint32_t ready) {
+      std::shared_ptr<const Callback> onTimer;
+      std::shared_ptr<const IoCallback> onIo;
+      {
+        std::lock_guard lock(mutex_);
+        auto it = entries_.find(id);
+        if (it == entries_.end()) return;
+        if (ready == 0)
+          onTimer = it->second.onTimer;
+        else
+          onIo = it->second.onIo;
+        running_ = id;
+      }
+      if (onIo) (*onIo)(ready);
+      if (onTimer) (*onTimer)();
+      {
+        std::lock_guard lock(mutex_);
+        running_ = 0;
+      }
+      idle_.notify_all();
+    };
+
+    for (int i = 0; i < count; ++i) {
+      if (events[i].data.u64 == 0) {
+        uint64_t value;
+        if (read(wake_.get(), &value, sizeof value) < 0) {
+          // Spurious: nothing to drain.
+        }
+        continue;
+      }
+      runEntry(events[i].data.u64, events[i].events);
+    }
+
+    due.clear();
+    {
+      std::lock_guard lock(mutex_);
+      auto now = Clock::now();
+      while (!timers_.empty() && timers_.begin()->first <= now) {
+        Id id = timers_.begin()->second;
+        entries_[id].queued.reset();
+        timers_.erase(timers_.begin());
+        due.push_back(id);
+      }
+    }
+    for (Id id : due) runEntry(id, 0);
+  }
+}
+
+}  // namespace wircam::link

@@ -1,0 +1,93 @@
+// The one event loop (sockets + timers) on which every vehicle link of a
+// process runs: a single thread around epoll, so a recorder of 200 vehicles
+// stays a handful of threads. Callbacks run on the loop thread and must not
+// block; anything may be registered or removed from any thread.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "common/socket.h"
+
+namespace wircam::link {
+
+using Clock = std::chrono::steady_clock;
+
+class EventLoop {
+ public:
+  using Id = uint64_t;
+  using Callback = std::function<void()>;
+  using IoCallback = std::function<void(uint32_t events)>;  // EPOLLIN, EPOLLOUT, ...
+
+  // The process's loop, started on first use and never torn down (plugins
+  // may be unloaded in any order at exit).
+  static EventLoop& shared();
+
+  EventLoop();
+  ~EventLoop();
+  EventLoop(const EventLoop&) = delete;
+  EventLoop& operator=(const EventLoop&) = delete;
+
+  // Calls `callback` with the ready events of `fd` until unwatched.
+  Id watch(int fd, uint32_t events, IoCallback callback);
+  void setEvents(Id watch, uint32_t events);
+
+  // A timer fires once per arm(); arming again moves it. A disarm from
+  // another thread that races the due time may still see it fire once, so
+  // timer callbacks work out what is due from their own state.
+  Id addTimer(Callback callback);
+  void arm(Id timer, Clock::time_point when);
+  // Arms only when `when` is earlier than the pending time (or none is).
+  void armIfEarlier(Id timer, Clock::time_point when);
+  void disarm(Id timer);
+
+  // Unwatches or deletes a timer. Once it returns, the callback is not
+  // running and never runs again (unless called from that very callback).
+  void remove(Id id);
+
+  // Runs `task` on the loop thread and waits for it; inline when already
+  // there. Tasks must not block, so the wait is bounded by the loop's work.
+  void invoke(const Callback& task);
+  bool inLoopThread() const { return std::this_thread::get_id() == thread_.get_id(); }
+
+  // Threads started by this loop: always 1, for the README's thread counts.
+  static constexpr int kThreads = 1;
+
+ private:
+  using TimerQueue = std::multimap<Clock::time_point, Id>;
+  struct Entry {
+    int fd = -1;  // -1 for timers
+    // Shared so that the loop can run one while remove() drops the entry.
+    std::shared_ptr<const Callback> onTimer;
+    std::shared_ptr<const IoCallback> onIo;
+    std::optional<TimerQueue::iterator> queued;  // armed: its place in timers_
+  };
+
+  void run();
+  void wake();
+  void waitUntilIdle(Id id, std::unique_lock<std::mutex>& lock);
+  void unqueue(Entry& entry);
+  int msUntilNextTimer(Clock::time_point now) const;
+
+  UniqueFd epoll_;
+  UniqueFd wake_;
+  std::thread thread_;
+
+  // Guards everything below; never held while a callback runs.
+  mutable std::mutex mutex_;
+  std::condition_variable idle_;  // a callback finished
+  std::map<Id, Entry> entries_;
+  TimerQueue timers_;  // armed timers by due time
+  Id nextId_ = 1;
+  Id running_ = 0;  // the entry whose callback runs now
+  bool stopping_ = false;
+};
+
+}  // namespace wircam::link
