@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <set>
+#include <string_view>
 
 #include "gst_json.h"
 
@@ -136,7 +137,9 @@ void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime
   line["pts"] = pts;
   std::string text = line.dump();
   stream.sidecar.write(text);
-  if (stream.track) stream.track->write(text, pts);
+  // Before the first segment opens (the login comes before the first frame)
+  // a text buffer could open a segment of its own: the sidecar keeps those.
+  if (stream.track && !stream.segment.empty()) stream.track->write(text, pts);
 }
 
 void Recording::handleElementMessage(GstMessage* message) {
@@ -158,16 +161,18 @@ void Recording::handleElementMessage(GstMessage* message) {
 
   nlohmann::json line = toJson(s);
   if (type == "wirc-session") {
-    // Losses and logins of the device's session. A new login after a loss
-    // starts a new segment, so the gap falls between two files.
+    // Link events: losses, logins, the control right, refusals. A login
+    // after a loss starts a new segment, so the gap falls between two files.
     std::string event = gst_structure_get_string(s, "event");
     log(stream->plan.name + ": " + event);
     line["type"] = "session";
     writeTelemetry(*stream, line, runningTime());
+    const char* state = gst_structure_get_string(s, "state");
+    if (!state) return;
+    if (std::string_view(state) == "lost") stream->lost = true;
     // Only a login after a loss splits: the first login's event may or may
     // not arrive, depending on when wircsrc began listening.
-    if (event.find("lost") != std::string::npos) stream->lost = true;
-    if (event.rfind("logged in", 0) == 0 && stream->lost) {
+    if (std::string_view(state) == "live" && stream->lost) {
       stream->lost = false;
       GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline_), stream->plan.muxer.c_str());
       g_signal_emit_by_name(sink, "split-now");

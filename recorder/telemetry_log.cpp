@@ -7,6 +7,9 @@ bool TelemetryLog::open(const std::string& segment) {
   auto dot = segment.rfind('.');
   path_ = (dot == std::string::npos ? segment : segment.substr(0, dot)) + ".jsonl";
   file_ = std::fopen(path_.c_str(), "w");
+  opened_ = true;
+  for (const auto& line : early_) writeLine(line);
+  early_.clear();
   return file_ != nullptr;
 }
 
@@ -16,6 +19,14 @@ void TelemetryLog::close() {
 }
 
 void TelemetryLog::write(const std::string& json) {
+  if (!opened_) {
+    if (early_.size() < kMaxEarlyLines) early_.push_back(json);
+    return;
+  }
+  writeLine(json);
+}
+
+void TelemetryLog::writeLine(const std::string& json) {
   if (!file_) return;
   std::fputs(json.c_str(), file_);
   std::fputc('\n', file_);

@@ -206,6 +206,7 @@ static void post_control_right(GstWircControl* self, GstStructure* s) {
 // On the event loop: the control right and the answers to AREQ.
 static void on_link_event(GstWircControl* self, const link::LinkEvent& event) {
   auto* state = self->state;
+  GST_DEBUG_OBJECT(self, "link: %s", link::describe(event).c_str());
   if (const auto* right = std::get_if<link::ControlRightChanged>(&event)) {
     bool had = state->hasControl.exchange(right->hasControl);
     GST_INFO_OBJECT(self, "%s", link::describe(event).c_str());

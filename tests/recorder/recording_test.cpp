@@ -187,7 +187,7 @@ TEST(WircRecorder, StartsANewSegmentWhenTheDeviceComesBack) {
   for (const auto& video : videos) EXPECT_TRUE(GST_CLOCK_TIME_IS_VALID(durationOf(video))) << video;
   std::string text;
   for (const auto& line : linesOf(recorder.files(".jsonl")[0])) text += line;
-  EXPECT_NE(text.find("connection to the device lost"), std::string::npos);
+  EXPECT_NE(text.find("link lost: the device closed the connection"), std::string::npos);
 }
 
 TEST(WircRecorder, DeletesTheOldestSegmentsToStayUnderMaxBytes) {

@@ -1,0 +1,90 @@
+// CommandPacer with a fake clock: when a command leaves.
+#include "link/command_pacer.h"
+
+#include <gtest/gtest.h>
+
+namespace wircam::link {
+namespace {
+
+using std::chrono::milliseconds;
+using Clock = CommandPacer::Clock;
+
+Pulses steer(uint16_t pulse) {
+  Pulses pulses = neutralPulses();
+  pulses[0] = pulse;
+  return pulses;
+}
+
+class CommandPacerTest : public ::testing::Test {
+ protected:
+  CommandPacer pacer{{.keepalive = milliseconds(100),
+                      .minInterval = milliseconds(10),
+                      .ttl = milliseconds(250)}};
+  Clock::time_point t0 = Clock::now();
+  Clock::time_point at(int ms) { return t0 + milliseconds(ms); }
+};
+
+TEST_F(CommandPacerTest, SendsTheFailsafeFirstWhenNoCommandCameYet) {
+  EXPECT_EQ(pacer.nextDeadline(at(0)), at(0));
+  EXPECT_EQ(pacer.poll(at(0)), neutralPulses());
+}
+
+TEST_F(CommandPacerTest, SendsAChangedCommandAtOnce) {
+  pacer.poll(at(0));
+  EXPECT_EQ(pacer.offer(steer(1700), at(15)), steer(1700));
+}
+
+TEST_F(CommandPacerTest, DoesNotRepeatAnUnchangedCommandBeforeTheKeepalive) {
+  pacer.offer(steer(1700), at(0));
+  EXPECT_EQ(pacer.offer(steer(1700), at(30)), std::nullopt);
+  EXPECT_EQ(pacer.poll(at(99)), std::nullopt);
+  EXPECT_EQ(pacer.nextDeadline(at(99)), at(100));
+  EXPECT_EQ(pacer.poll(at(100)), steer(1700));
+}
+
+TEST_F(CommandPacerTest, HoldsBackAChangeWithinTheRateLimitAndSendsItWhenAllowed) {
+  pacer.offer(steer(1700), at(0));
+  EXPECT_EQ(pacer.offer(steer(1800), at(4)), std::nullopt);
+  EXPECT_EQ(pacer.nextDeadline(at(4)), at(10));
+  EXPECT_EQ(pacer.poll(at(10)), steer(1800));
+}
+
+TEST_F(CommandPacerTest, GivesWayToTheFailsafeWhenTheCommandIsOlderThanTheTtl) {
+  pacer.offer(steer(1700), at(0));
+  pacer.poll(at(100));
+  pacer.poll(at(200));
+  EXPECT_EQ(pacer.nextDeadline(at(200)), at(250) + std::chrono::nanoseconds(1));
+  EXPECT_EQ(pacer.poll(at(251)), neutralPulses());
+  // And keeps the vehicle's watchdog fed with it.
+  EXPECT_EQ(pacer.poll(at(351)), neutralPulses());
+}
+
+TEST_F(CommandPacerTest, NeverLeavesAGapLongerThanTheKeepaliveWhileNothingChanges) {
+  pacer.offer(steer(1700), at(0));
+  auto last = at(0);
+  for (int ms = 1; ms < 2000; ++ms) {
+    if (pacer.poll(at(ms))) {
+      EXPECT_LE(at(ms) - last, milliseconds(100));
+      last = at(ms);
+    }
+  }
+}
+
+TEST_F(CommandPacerTest, ClampsEveryPulseIntoTheProtocolRange) {
+  Pulses wild = neutralPulses();
+  wild[0] = 0;
+  wild[1] = 65535;
+  auto sent = pacer.offer(wild, at(0));
+  ASSERT_TRUE(sent.has_value());
+  EXPECT_EQ((*sent)[0], kPulseMin);
+  EXPECT_EQ((*sent)[1], kPulseMax);
+}
+
+TEST_F(CommandPacerTest, SendsAtOnceAfterARestart) {
+  pacer.offer(steer(1700), at(0));
+  pacer.restart();
+  EXPECT_EQ(pacer.poll(at(1)), steer(1700));
+}
+
+}  // namespace
+}  // namespace wircam::link

@@ -1,0 +1,87 @@
+// The event loop: timers, watches, and removal that waits for a callback.
+#include "link/event_loop.h"
+
+#include <gtest/gtest.h>
+#include <sys/epoll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <future>
+
+namespace wircam::link {
+namespace {
+
+using std::chrono::milliseconds;
+
+TEST(EventLoop, FiresATimerOnceWhenDue) {
+  EventLoop loop;
+  std::atomic<int> fired{0};
+  std::promise<void> done;
+  auto id = loop.addTimer([&] {
+    if (++fired == 1) done.set_value();
+  });
+  loop.arm(id, Clock::now() + milliseconds(5));
+  ASSERT_EQ(done.get_future().wait_for(milliseconds(2000)), std::future_status::ready);
+  loop.invoke([] {});  // the loop has gone round once more
+  EXPECT_EQ(fired, 1);
+  loop.remove(id);
+}
+
+TEST(EventLoop, ADisarmedTimerDoesNotFire) {
+  EventLoop loop;
+  std::atomic<bool> fired{false};
+  auto id = loop.addTimer([&] { fired = true; });
+  loop.arm(id, Clock::now() + milliseconds(20));
+  loop.disarm(id);
+  // A later timer firing shows the loop went past the first one's time.
+  std::promise<void> later;
+  loop.arm(loop.addTimer([&] { later.set_value(); }), Clock::now() + milliseconds(40));
+  later.get_future().wait();
+  EXPECT_FALSE(fired);
+}
+
+TEST(EventLoop, CallsAWatchWhenItsDescriptorIsReady) {
+  EventLoop loop;
+  UniqueFd fd(eventfd(0, EFD_NONBLOCK));
+  std::promise<uint32_t> ready;
+  auto id = loop.watch(fd.get(), EPOLLIN, [&](uint32_t events) {
+    uint64_t value;
+    if (read(fd.get(), &value, sizeof value) > 0) ready.set_value(events);
+  });
+  uint64_t one = 1;
+  ASSERT_EQ(write(fd.get(), &one, sizeof one), 8);
+  auto future = ready.get_future();
+  ASSERT_EQ(future.wait_for(milliseconds(2000)), std::future_status::ready);
+  EXPECT_TRUE(future.get() & EPOLLIN);
+  loop.remove(id);
+}
+
+TEST(EventLoop, RemoveWaitsForARunningCallbackToFinish) {
+  EventLoop loop;
+  std::promise<void> entered;
+  std::atomic<bool> finished{false};
+  auto id = loop.addTimer([&] {
+    entered.set_value();
+    std::this_thread::sleep_for(milliseconds(50));
+    finished = true;
+  });
+  loop.arm(id, Clock::now());
+  entered.get_future().wait();
+  loop.remove(id);
+  EXPECT_TRUE(finished);
+}
+
+TEST(EventLoop, InvokeRunsOnTheLoopThreadAndInlineFromIt) {
+  EventLoop loop;
+  bool onLoop = false, nested = false;
+  loop.invoke([&] {
+    onLoop = loop.inLoopThread();
+    loop.invoke([&] { nested = true; });
+  });
+  EXPECT_TRUE(onLoop);
+  EXPECT_TRUE(nested);
+}
+
+}  // namespace
+}  // namespace wircam::link
