@@ -116,7 +116,10 @@ struct WircSrcState {
   Clock::time_point loginDeadline;
   bool streaming = false;  // the link was live and the camera exists
   std::deque<wirc::AssembledFrame> ready;
-  std::array<std::vector<uint8_t>, kBatch> buffers;
+  // kBatch datagrams of up to 64 KB. Left uninitialised: the allocation is
+  // large enough to be mapped lazily, so only the bytes datagrams actually
+  // fill become resident (a zeroed vector made 1 MB resident per source).
+  std::unique_ptr<uint8_t[]> buffers{new uint8_t[kBatch * wirc::kMaxDatagramSize]};
   int width = 0;
   int height = 0;
   Clock::time_point nextStats;
@@ -327,7 +330,7 @@ static void receive_batch(GstWircSrc* self) {
   std::array<iovec, kBatch> vectors{};
   std::array<sockaddr_in, kBatch> sources{};
   for (size_t i = 0; i < kBatch; ++i) {
-    vectors[i] = {state->buffers[i].data(), state->buffers[i].size()};
+    vectors[i] = {state->buffers.get() + i * wirc::kMaxDatagramSize, wirc::kMaxDatagramSize};
     headers[i].msg_hdr.msg_iov = &vectors[i];
     headers[i].msg_hdr.msg_iovlen = 1;
     headers[i].msg_hdr.msg_name = &sources[i];
@@ -337,7 +340,8 @@ static void receive_batch(GstWircSrc* self) {
   auto now = Clock::now();
   for (int i = 0; i < count; ++i) {
     state->receiver->push(
-        SocketAddress(sources[i]), {state->buffers[i].data(), headers[i].msg_len}, now,
+        SocketAddress(sources[i]),
+        {static_cast<const uint8_t*>(vectors[i].iov_base), headers[i].msg_len}, now,
         [&](wirc::AssembledFrame&& frame) { state->ready.push_back(std::move(frame)); });
   }
 }
@@ -580,7 +584,6 @@ static void gst_wirc_src_finalize(GObject* object) {
 
 static void gst_wirc_src_init(GstWircSrc* self) {
   self->state = new WircSrcState();
-  for (auto& buffer : self->state->buffers) buffer.resize(wirc::kMaxDatagramSize);
   gst_base_src_set_live(GST_BASE_SRC(self), TRUE);
   gst_base_src_set_format(GST_BASE_SRC(self), GST_FORMAT_TIME);
 }

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <tuple>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -27,9 +28,26 @@ using Clock = std::chrono::steady_clock;
 
 struct Probes {
   std::mutex mutex;
-  std::map<GstClockTime, Clock::time_point> pushed;                        // by PTS
-  std::vector<std::pair<Clock::time_point, Clock::time_point>> commanded;  // (pushed, commanded)
+  std::map<GstClockTime, Clock::time_point> pushed;  // by PTS
+  // (PTS, pushed, commanded) per frame that reached wirccontrol
+  std::vector<std::tuple<GstClockTime, Clock::time_point, Clock::time_point>> commanded;
+  std::map<GstClockTime, std::pair<guint, guint>> pulses;  // by PTS, from wirc-control
 };
+
+// wirc-control messages, as they are posted: which frames changed the command.
+GstBusSyncReply onMessage(GstBus*, GstMessage* message, gpointer data) {
+  const GstStructure* s = gst_message_get_structure(message);
+  if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ELEMENT && gst_structure_has_name(s, "wirc-control")) {
+    auto* probes = static_cast<Probes*>(data);
+    guint64 pts = 0;
+    guint steering = 0, throttle = 0;
+    gst_structure_get(s, "timestamp", G_TYPE_UINT64, &pts, "steering-pulse", G_TYPE_UINT,
+                      &steering, "throttle-pulse", G_TYPE_UINT, &throttle, nullptr);
+    std::lock_guard lock(probes->mutex);
+    probes->pulses[pts] = {steering, throttle};
+  }
+  return GST_BUS_PASS;
+}
 
 GstPadProbeReturn onPushed(GstPad*, GstPadProbeInfo* info, gpointer data) {
   auto* probes = static_cast<Probes*>(data);
@@ -44,7 +62,7 @@ GstPadProbeReturn onCommanded(GstPad*, GstPadProbeInfo* info, gpointer data) {
   std::lock_guard lock(probes->mutex);
   auto found = probes->pushed.find(GST_BUFFER_PTS(GST_PAD_PROBE_INFO_BUFFER(info)));
   if (found != probes->pushed.end()) {
-    probes->commanded.emplace_back(found->second, now);
+    probes->commanded.emplace_back(found->first, found->second, now);
     probes->pushed.erase(found);
   }
   return GST_PAD_PROBE_OK;
@@ -75,6 +93,9 @@ void run(const char* decoder, double seconds) {
     gst_object_unref(pad);
     gst_object_unref(element);
   };
+  GstBus* bus = gst_element_get_bus(pipeline);
+  gst_bus_set_sync_handler(bus, onMessage, &probes, nullptr);
+  gst_object_unref(bus);
   attach("src", "src", onPushed);
   attach("control", "sink", onCommanded);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
@@ -83,15 +104,23 @@ void run(const char* decoder, double seconds) {
   gst_object_unref(pipeline);
 
   auto arrivals = device->pcdArrivals();
+  // Only a frame whose command differs from the one before sends a PCD;
+  // the others change nothing on the vehicle (keepalives repeat them).
   std::vector<double> processing, total;
-  for (auto [pushed, commanded] : probes.commanded) {
+  std::pair<guint, guint> previous{};
+  for (auto [pts, pushed, commanded] : probes.commanded) {
+    auto sent = probes.pulses.find(pts);
+    if (sent == probes.pulses.end()) continue;
+    bool changed = sent->second != previous;
+    previous = sent->second;
+    if (!changed) continue;
     auto pcd = std::upper_bound(arrivals.begin(), arrivals.end(), commanded);
     if (pcd == arrivals.end()) continue;
     processing.push_back(std::chrono::duration<double, std::milli>(commanded - pushed).count());
     total.push_back(std::chrono::duration<double, std::milli>(*pcd - pushed).count());
   }
   std::printf(
-      "%-9s %6zu frames   frame → command median %5.2f ms p99 %5.2f ms   frame → PCD median "
+      "%-9s %6zu changes  frame → command median %5.2f ms p99 %5.2f ms   frame → PCD median "
       "%5.2f ms p99 %5.2f ms   longest PCD gap %lld ms\n",
       decoder, total.size(), percentile(processing, 0.5), percentile(processing, 0.99),
       percentile(total, 0.5), percentile(total, 0.99),

@@ -17,6 +17,9 @@ struct PacerConfig {
   std::chrono::microseconds minInterval{0};  // 1 / rate limit
   std::chrono::milliseconds ttl{250};
   Pulses failsafe = neutralPulses();
+  // A keepalive may leave this much early, so that timers of many links
+  // can share one wake-up (EventLoop::kCoalesce); never late.
+  std::chrono::milliseconds keepaliveEarly{10};
 };
 
 class CommandPacer {

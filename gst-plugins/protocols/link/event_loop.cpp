@@ -189,8 +189,8 @@ void EventLoop::run() {
     due.clear();
     {
       std::lock_guard lock(mutex_);
-      auto now = Clock::now();
-      while (!timers_.empty() && timers_.begin()->first <= now) {
+      auto horizon = Clock::now() + kCoalesce;
+      while (!timers_.empty() && timers_.begin()->first <= horizon) {
         Id id = timers_.begin()->second;
         entries_[id].queued.reset();
         timers_.erase(timers_.begin());

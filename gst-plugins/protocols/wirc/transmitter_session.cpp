@@ -42,7 +42,8 @@ link::PacerConfig pacerConfig(const SessionConfig& config) {
   return {.keepalive = config.keepalive,
           .minInterval = std::chrono::duration_cast<std::chrono::microseconds>(interval),
           .ttl = config.commandTtl,
-          .failsafe = pcdFailsafe(config.failsafe)};
+          .failsafe = pcdFailsafe(config.failsafe),
+          .keepaliveEarly = EventLoop::kCoalesce};
 }
 
 std::string joined(const ChannelValues& values) {
@@ -150,7 +151,7 @@ class TransmitterSession::Impl {
   void onPacerTimer();
 
   bool sendControl(const Message& message);
-  void sendPcd(const link::Pulses& pulses, const SocketAddress& to);
+  void sendPcd(const link::Pulses& pulses);
   void publish(std::vector<link::LinkEvent> events);
 
   EventLoop& loop_ = EventLoop::shared();
@@ -236,9 +237,12 @@ bool TransmitterSession::Impl::sendControl(const Message& message) {
   return sent == static_cast<ssize_t>(frame->size());
 }
 
-void TransmitterSession::Impl::sendPcd(const link::Pulses& pulses, const SocketAddress& to) {
+void TransmitterSession::Impl::sendPcd(const link::Pulses& pulses) {
   auto frame = encode(Pcd{pulses});  // the pacer clamps: always valid
-  if (frame && sendDatagram(pcdSocket_.get(), to, *frame)) {
+  // The socket is connected to the device's control port at login: a send
+  // skips the route lookup a sendto pays, many times a second.
+  if (frame && ::send(pcdSocket_.get(), frame->data(), frame->size(), MSG_NOSIGNAL) ==
+                   static_cast<ssize_t>(frame->size())) {
     std::lock_guard lock(mutex_);
     ++status_.commandsSent;
   }
@@ -398,6 +402,7 @@ void TransmitterSession::Impl::onLoggedIn(const Wst& wst) {
     status_.cameraCount = wst.cameraCount;
     ++status_.logins;
     controlAddress_ = device_->withPort(wst.controlPort);
+    ::connect(pcdSocket_.get(), controlAddress_->raw(), controlAddress_->size());
     streams = streamPorts_;
     address = device_->toString();
   }
@@ -549,16 +554,14 @@ void TransmitterSession::Impl::onPsd() {
 void TransmitterSession::Impl::onPacerTimer() {
   auto now = Clock::now();
   std::optional<link::Pulses> due;
-  SocketAddress to;
   Clock::time_point next;
   {
     std::lock_guard lock(mutex_);
     if (status_.state != link::LinkState::Live || !status_.hasControl || !controlAddress_) return;
     due = pacer_.poll(now);
     next = pacer_.nextDeadline(now);
-    to = *controlAddress_;
   }
-  if (due) sendPcd(*due, to);
+  if (due) sendPcd(*due);
   loop_.arm(pacerTimer_, next);
 }
 
@@ -682,7 +685,6 @@ void TransmitterSession::stopStream(uint8_t camera) {
 void TransmitterSession::setCommand(const link::Pulses& pulses) {
   auto now = Clock::now();
   std::optional<link::Pulses> due;
-  SocketAddress to;
   Clock::time_point next;
   bool steering;
   {
@@ -690,12 +692,11 @@ void TransmitterSession::setCommand(const link::Pulses& pulses) {
     due = impl_->pacer_.offer(pulses, now);
     steering = impl_->status_.state == link::LinkState::Live && impl_->status_.hasControl &&
                impl_->controlAddress_;
-    if (steering) to = *impl_->controlAddress_;
     next = impl_->pacer_.nextDeadline(now);
   }
   if (!steering) return;  // kept for when the control right comes
   // A change leaves now, from this thread: no wait for a tick.
-  if (due) impl_->sendPcd(*due, to);
+  if (due) impl_->sendPcd(*due);
   impl_->loop_.armIfEarlier(impl_->pacerTimer_, next);
 }
 

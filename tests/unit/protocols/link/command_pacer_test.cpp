@@ -19,7 +19,8 @@ class CommandPacerTest : public ::testing::Test {
  protected:
   CommandPacer pacer{{.keepalive = milliseconds(100),
                       .minInterval = milliseconds(10),
-                      .ttl = milliseconds(250)}};
+                      .ttl = milliseconds(250),
+                      .keepaliveEarly = milliseconds(10)}};
   Clock::time_point t0 = Clock::now();
   Clock::time_point at(int ms) { return t0 + milliseconds(ms); }
 };
@@ -37,9 +38,15 @@ TEST_F(CommandPacerTest, SendsAChangedCommandAtOnce) {
 TEST_F(CommandPacerTest, DoesNotRepeatAnUnchangedCommandBeforeTheKeepalive) {
   pacer.offer(steer(1700), at(0));
   EXPECT_EQ(pacer.offer(steer(1700), at(30)), std::nullopt);
-  EXPECT_EQ(pacer.poll(at(99)), std::nullopt);
-  EXPECT_EQ(pacer.nextDeadline(at(99)), at(100));
+  EXPECT_EQ(pacer.poll(at(89)), std::nullopt);
+  EXPECT_EQ(pacer.nextDeadline(at(89)), at(100));
   EXPECT_EQ(pacer.poll(at(100)), steer(1700));
+}
+
+TEST_F(CommandPacerTest, AKeepaliveMayLeaveEarlyToShareAWakeUpButNeverLate) {
+  pacer.offer(steer(1700), at(0));
+  EXPECT_EQ(pacer.poll(at(90)), steer(1700));
+  EXPECT_EQ(pacer.nextDeadline(at(90)), at(190));
 }
 
 TEST_F(CommandPacerTest, HoldsBackAChangeWithinTheRateLimitAndSendsItWhenAllowed) {
