@@ -72,6 +72,16 @@ int framesInFolder(const fs::path& folder) {
   return total;
 }
 
+// Threads of a running process, counted halfway through its run.
+int threadsOf(pid_t pid) {
+  int count = 0;
+  std::error_code error;
+  for (auto it = fs::directory_iterator("/proc/" + std::to_string(pid) + "/task", error);
+       !error && it != fs::directory_iterator(); ++it)
+    ++count;
+  return count;
+}
+
 // "frames sent        N" from a wirc-sim summary.
 int framesSent(const fs::path& summary) {
   std::ifstream in(summary);
@@ -104,7 +114,8 @@ int main(int argc, char** argv) {
   }
   int basePort = 21000 + getpid() % 20000;
 
-  std::printf("%-8s | %-44s | %-44s\n", "streams", "wirc-recorder: lost, CPU %/stream, MB/stream",
+  std::printf("%-8s | %-54s | %-54s\n", "streams",
+              "wirc-recorder: lost, CPU %/stream, MB/stream, threads",
               "udpsrc ! rtpjpegdepay ! matroskamux: same");
   for (int n : counts) {
     // wircam
@@ -122,6 +133,8 @@ int main(int argc, char** argv) {
     pid_t recorder =
         spawn((bin / "wirc-recorder").string() + devices + " --out " + (work / "rec").string() +
               " --segment 600 --duration " + std::to_string(seconds));
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+    int ourThreads = threadsOf(recorder);
     Usage ours = waitFor(recorder);
     for (pid_t sim : sims) wircam::bench::stopGroup(sim, SIGINT);
     int sent = 0;
@@ -153,16 +166,19 @@ int main(int argc, char** argv) {
                 " caps=image/jpeg,width=352,height=288,framerate=15/1 ! identity sleep-time=66666"
                 " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" +
                 std::to_string(basePort + 2 * i + 1)));
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+    int theirThreads = threadsOf(receiver);
     for (pid_t s : senders) waitpid(s, nullptr, 0);
     Usage theirs = waitFor(receiver);
     int rtpRecorded = framesInFolder(work / "rtp");
     int rtpSent = rtpFrames * n;
 
     std::printf(
-        "%-8d | lost %4d of %5d, %5.2f %%, %5.1f MB     | lost %4d of %5d, %5.2f %%, %5.1f MB\n", n,
-        sent - recorded, sent, 100 * ours.cpuSeconds / seconds / n, ours.maxRssKb / 1024.0 / n,
-        rtpSent - rtpRecorded, rtpSent, 100 * theirs.cpuSeconds / (seconds + 1) / n,
-        theirs.maxRssKb / 1024.0 / n);
+        "%-8d | lost %4d of %5d, %5.2f %%, %5.1f MB, %4d threads | lost %4d of %5d, %5.2f %%, %5.1f "
+        "MB, %4d threads\n",
+        n, sent - recorded, sent, 100 * ours.cpuSeconds / seconds / n, ours.maxRssKb / 1024.0 / n,
+        ourThreads, rtpSent - rtpRecorded, rtpSent, 100 * theirs.cpuSeconds / (seconds + 1) / n,
+        theirs.maxRssKb / 1024.0 / n, theirThreads);
     std::fflush(stdout);
   }
   fs::remove_all(work);

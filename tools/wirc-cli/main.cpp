@@ -35,7 +35,8 @@ Commands:
   discover                     list the devices that answer discovery
   info                         log in and show the device's cameras, connection and status
   transmitters                 list the logged-in transmitters (TLR)
-  request-control ID           ask for the control right to go to connection ID (AREQ)
+  request-control ID           ask for the control right to go to connection ID (AREQ);
+                               exits 1 with the reason when the device denies it
   configure [--periods US,..] [--failsafe US,..]
                                set channel periods (CCFG) and failsafe values (FCFG);
                                12 comma-separated values, or one for all channels
