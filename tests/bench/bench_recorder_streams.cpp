@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -72,13 +74,34 @@ int framesInFolder(const fs::path& folder) {
   return total;
 }
 
-// Threads of a running process, counted halfway through its run.
-int threadsOf(pid_t pid) {
+// Threads of a process and all its descendants (the stock receiver runs
+// under `timeout`), counted halfway through its run.
+int threadsOf(pid_t root) {
+  std::map<pid_t, pid_t> parents;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    pid_t pid = std::atoi(entry.path().filename().c_str());
+    if (pid <= 0) continue;
+    std::ifstream stat(entry.path() / "stat");
+    std::string line;
+    std::getline(stat, line);
+    auto close = line.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream rest(line.substr(close + 2));
+    std::string state;
+    pid_t parent = 0;
+    rest >> state >> parent;
+    parents[pid] = parent;
+  }
   int count = 0;
-  std::error_code error;
-  for (auto it = fs::directory_iterator("/proc/" + std::to_string(pid) + "/task", error);
-       !error && it != fs::directory_iterator(); ++it)
-    ++count;
+  for (const auto& [pid, parent] : parents) {
+    pid_t p = pid;
+    while (p > 1 && p != root) p = parents.count(p) ? parents[p] : 0;
+    if (p != root) continue;
+    std::error_code error;
+    for (auto it = fs::directory_iterator("/proc/" + std::to_string(pid) + "/task", error);
+         !error && it != fs::directory_iterator(); ++it)
+      ++count;
+  }
   return count;
 }
 

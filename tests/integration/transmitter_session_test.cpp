@@ -142,6 +142,15 @@ TEST(TransmitterSession, GivesUpOnAPeerThatAcceptsButNeverAnswers) {
   EXPECT_NE(error->find("no WST"), std::string::npos) << *error;
 }
 
+TEST(TransmitterSession, ReportsABusyDeviceAsBusyAtOnce) {
+  testing::RefusingPeer peer(static_cast<uint16_t>(ErrorCode::Busy));
+  auto session = acquire({.host = "127.0.0.1", .port = peer.port(), .reconnect = false});
+  auto error = session->waitLoggedIn(milliseconds(3000));
+  ASSERT_TRUE(error.has_value());
+  EXPECT_NE(error->find("busy"), std::string::npos) << *error;
+  EXPECT_NE(error->find("ERR 6"), std::string::npos) << *error;
+}
+
 TEST(TransmitterSession, GivesUpOnAConnectThatNeverCompletes) {
   testing::FullAcceptQueuePeer peer;
   auto session = acquire({.host = "127.0.0.1",

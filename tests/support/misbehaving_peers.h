@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <thread>
 #include <vector>
 
 #include "common/socket.h"
@@ -33,6 +34,21 @@ class FullAcceptQueuePeer {
   UniqueFd listener_;
   std::vector<UniqueFd> fillers_;
   uint16_t port_ = 0;
+};
+
+// Answers every connection's first bytes with ERR (command TL, `code`), as
+// a real WiRC answers a second connection from one address (6, busy).
+class RefusingPeer {
+ public:
+  explicit RefusingPeer(uint16_t code);
+  ~RefusingPeer();
+  uint16_t port() const { return port_; }
+
+ private:
+  UniqueFd listener_;
+  UniqueFd wake_;
+  uint16_t port_ = 0;
+  std::thread thread_;
 };
 
 // A loopback port nothing listens on (bound, then closed).

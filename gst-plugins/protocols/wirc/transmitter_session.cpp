@@ -61,14 +61,15 @@ struct SharedSetting {
   bool needsLogin;
 };
 
-#define WIRCAM_SETTING(NAME, FIELD, TEXT, LOGIN)                                     \
-  SharedSetting {                                                                    \
-    NAME, [](const SessionConfig& c) { return TEXT(c.FIELD); },                      \
-        [](SessionConfig& to, const SessionConfig& from) { to.FIELD = from.FIELD; }, \
-        LOGIN                                                                        \
-  }
+template <typename T, typename Text>
+SharedSetting shared(const char* name, T SessionConfig::*field, Text text, bool needsLogin) {
+  return {name, [field, text](const SessionConfig& c) { return text(c.*field); },
+          [field](SessionConfig& to, const SessionConfig& from) { to.*field = from.*field; },
+          needsLogin};
+}
 
 std::string quoted(const std::string& text) { return "'" + text + "'"; }
+std::string integer(uint8_t value) { return std::to_string(value); }
 std::string number(double value) {
   std::string text = std::to_string(value);
   text.erase(text.find_last_not_of('0') + 1);
@@ -80,20 +81,18 @@ std::string flag(bool value) { return value ? "true" : "false"; }
 
 const std::vector<SharedSetting>& sharedSettings() {
   static const std::vector<SharedSetting> settings = {
-      WIRCAM_SETTING("transmitter-name", transmitterName, quoted, true),
-      WIRCAM_SETTING("priority", priority, std::to_string, true),
-      WIRCAM_SETTING("periods", periods, joined, true),
-      WIRCAM_SETTING("failsafe", failsafe, joined, true),
-      WIRCAM_SETTING("pcd-rate", pcdRate, number, false),
-      WIRCAM_SETTING("keepalive", keepalive, ms, false),
-      WIRCAM_SETTING("command-ttl", commandTtl, ms, false),
-      WIRCAM_SETTING("login-timeout", loginTimeout, ms, false),
-      WIRCAM_SETTING("reconnect", reconnect, flag, false),
+      shared("transmitter-name", &SessionConfig::transmitterName, quoted, true),
+      shared("priority", &SessionConfig::priority, integer, true),
+      shared("periods", &SessionConfig::periods, joined, true),
+      shared("failsafe", &SessionConfig::failsafe, joined, true),
+      shared("pcd-rate", &SessionConfig::pcdRate, number, false),
+      shared("keepalive", &SessionConfig::keepalive, ms, false),
+      shared("command-ttl", &SessionConfig::commandTtl, ms, false),
+      shared("login-timeout", &SessionConfig::loginTimeout, ms, false),
+      shared("reconnect", &SessionConfig::reconnect, flag, false),
   };
   return settings;
 }
-
-#undef WIRCAM_SETTING
 
 }  // namespace
 
@@ -145,7 +144,11 @@ class TransmitterSession::Impl {
   void onConnected();
   void onLoggedIn(const Wst& wst);
   void handle(const Message& message);
-  void fail(const std::string& why, bool retryAtOnce = false);
+  // Closes the connection and reports why; tries again after the backoff
+  // (or not at all with reconnect off). A new login for new settings tries
+  // again at once and is no loss.
+  enum class Retry { AfterBackoff, AtOnceForNewSettings };
+  void fail(const std::string& why, Retry retry = Retry::AfterBackoff);
   void closeConnection();
   void onPsd();
   void onPacerTimer();
@@ -490,7 +493,8 @@ void TransmitterSession::Impl::closeConnection() {
   tcp_.reset();
 }
 
-void TransmitterSession::Impl::fail(const std::string& why, bool retryAtOnce) {
+void TransmitterSession::Impl::fail(const std::string& why, Retry retryWhen) {
+  bool retryAtOnce = retryWhen == Retry::AtOnceForNewSettings;
   closeConnection();
   loop_.disarm(pacerTimer_);
   link::LinkState state;
@@ -504,9 +508,9 @@ void TransmitterSession::Impl::fail(const std::string& why, bool retryAtOnce) {
     controlAddress_.reset();
     controlRequests_ = 0;
     retry = config_.reconnect || retryAtOnce;
-    state = !retry                 ? link::LinkState::Failed
-            : status_.logins == 0 ? link::LinkState::Connecting
-                                  : link::LinkState::Lost;
+    state = !retry                                ? link::LinkState::Failed
+            : status_.logins == 0 || retryAtOnce ? link::LinkState::Connecting
+                                                 : link::LinkState::Lost;
     status_.state = state;
     status_.reason = why;
   }
@@ -613,7 +617,8 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
   if (relogin) {
     impl->loop_.invoke([impl, &user] {
       if (impl->phase_ == Impl::Phase::LoggingIn || impl->phase_ == Impl::Phase::LoggedIn)
-        impl->fail("logging in again with the settings of " + user, true);
+        impl->fail("logging in again with the settings of " + user,
+                   Impl::Retry::AtOnceForNewSettings);
     });
   }
 
