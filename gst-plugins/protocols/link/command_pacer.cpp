@@ -12,8 +12,11 @@ Pulses CommandPacer::effective(Clock::time_point now) const {
 std::optional<Pulses> CommandPacer::sendIfDue(Clock::time_point now, bool keepaliveDue) {
   Pulses wanted = effective(now);
   bool changed = !lastSent_ || wanted != *lastSent_;
-  bool allowed = !lastSent_ || now - lastSentTime_ >= config_.minInterval;
+  // The rate limit spaces changes, not a change and a keepalive: a change
+  // right after a keepalive still leaves at once.
+  bool allowed = !lastChangeTime_ || now - *lastChangeTime_ >= config_.minInterval;
   if (!(changed && allowed) && !keepaliveDue) return std::nullopt;
+  if (changed) lastChangeTime_ = now;
   lastSent_ = wanted;
   lastSentTime_ = now;
   return wanted;
@@ -36,13 +39,16 @@ CommandPacer::Clock::time_point CommandPacer::nextDeadline(Clock::time_point now
   auto next = lastSentTime_ + config_.keepalive;
   // A change the rate limit holds back.
   if (effective(now) != *lastSent_)
-    next = std::min(next, std::max(now, lastSentTime_ + config_.minInterval));
+    next = std::min(next, std::max(now, *lastChangeTime_ + config_.minInterval));
   // The command running out.
   auto expiry = commandTime_ + config_.ttl + std::chrono::nanoseconds(1);
   if (command_ && expiry > now) next = std::min(next, expiry);
   return next;
 }
 
-void CommandPacer::restart() { lastSent_.reset(); }
+void CommandPacer::restart() {
+  lastSent_.reset();
+  lastChangeTime_.reset();
+}
 
 }  // namespace wircam::link

@@ -1,5 +1,5 @@
-// When a vehicle link sends a command: at once when it changes (no faster
-// than the rate limit), otherwise a keepalive every `keepalive` so the
+// When a vehicle link sends a command: at once when it changes (changes no
+// closer together than the rate limit allows), otherwise a keepalive every `keepalive` so the
 // vehicle's watchdog stays fed, and the failsafe once the command is older
 // than `ttl` (a stalled pipeline stops the vehicle, the link stays up).
 // Pure policy: the caller passes the time and does the sending.
@@ -14,7 +14,7 @@ namespace wircam::link {
 
 struct PacerConfig {
   std::chrono::milliseconds keepalive{100};
-  std::chrono::microseconds minInterval{0};  // 1 / rate limit
+  std::chrono::microseconds minInterval{0};  // 1 / rate limit, between changes
   std::chrono::milliseconds ttl{250};
   Pulses failsafe = neutralPulses();
   // A keepalive may leave this much early, so that timers of many links
@@ -48,6 +48,7 @@ class CommandPacer {
   Clock::time_point commandTime_{};
   std::optional<Pulses> lastSent_;
   Clock::time_point lastSentTime_{};
+  std::optional<Clock::time_point> lastChangeTime_;  // the last send of a new value
 };
 
 }  // namespace wircam::link

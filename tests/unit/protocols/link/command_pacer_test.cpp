@@ -56,6 +56,12 @@ TEST_F(CommandPacerTest, HoldsBackAChangeWithinTheRateLimitAndSendsItWhenAllowed
   EXPECT_EQ(pacer.poll(at(10)), steer(1800));
 }
 
+TEST_F(CommandPacerTest, AChangeRightAfterAKeepaliveStillLeavesAtOnce) {
+  pacer.offer(steer(1700), at(0));
+  ASSERT_EQ(pacer.poll(at(100)), steer(1700));  // keepalive
+  EXPECT_EQ(pacer.offer(steer(1800), at(102)), steer(1800));
+}
+
 TEST_F(CommandPacerTest, GivesWayToTheFailsafeWhenTheCommandIsOlderThanTheTtl) {
   pacer.offer(steer(1700), at(0));
   pacer.poll(at(100));
