@@ -38,8 +38,8 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
   if (error) return unexpected("cannot create '" + options.outDir + "': " + error.message());
   if (access(options.outDir.c_str(), W_OK) != 0)
     return unexpected("cannot write into '" + options.outDir + "'");
-  if (options.codec == Codec::kH264 && !gst_registry_check_feature_version(
-                                           gst_registry_get(), "x264enc", 1, 0, 0))
+  if (options.codec == Codec::kH264 &&
+      !gst_registry_check_feature_version(gst_registry_get(), "x264enc", 1, 0, 0))
     return unexpected(
         "--codec h264 needs x264enc, from Debian's gstreamer1.0-plugins-ugly "
         "(tools/install-deps installs it)");
@@ -58,8 +58,8 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     auto stream = std::make_unique<Stream>();
     stream->plan = streamPlan;
     if (!streamPlan.telemetrySource.empty()) {
-      GstElement* source = gst_bin_get_by_name(GST_BIN(recording->pipeline_),
-                                               streamPlan.telemetrySource.c_str());
+      GstElement* source =
+          gst_bin_get_by_name(GST_BIN(recording->pipeline_), streamPlan.telemetrySource.c_str());
       stream->track.emplace(source);
       gst_object_unref(source);  // the pipeline keeps it
     }
@@ -69,8 +69,8 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
       stream->frames = std::make_unique<FrameTap>(sink);
       gst_object_unref(sink);
     }
-    for (const auto* element : {&streamPlan.source, &streamPlan.muxer, &streamPlan.detector,
-                                &streamPlan.controller})
+    for (const auto* element :
+         {&streamPlan.source, &streamPlan.muxer, &streamPlan.detector, &streamPlan.controller})
       if (!element->empty()) recording->streamByElement_[*element] = stream.get();
     recording->streams_.push_back(std::move(stream));
   }
@@ -149,8 +149,7 @@ void Recording::handleElementMessage(GstMessage* message) {
   std::string type = gst_structure_get_name(s);
   if (type == "splitmuxsink-fragment-opened") {
     stream->segment = gst_structure_get_string(s, "location");
-    if (!stream->sidecar.open(stream->segment))
-      log("cannot write " + stream->sidecar.path());
+    if (!stream->sidecar.open(stream->segment)) log("cannot write " + stream->sidecar.path());
     return;
   }
   if (type == "splitmuxsink-fragment-closed") {
@@ -335,7 +334,8 @@ nlohmann::json Recording::status() const {
         {"segment", std::filesystem::path(s->segment).filename().string()},
         {"live", "/live/" + s->plan.name + ".mjpg"}};
     if (rtsp_)
-      stream["rtsp"] = rtsp_->url() + "/" + s->plan.device + "/cam" + std::to_string(s->plan.camera);
+      stream["rtsp"] =
+          rtsp_->url() + "/" + s->plan.device + "/cam" + std::to_string(s->plan.camera);
     streams.push_back(stream);
   }
   return {{"out", options_.outDir},

@@ -16,7 +16,7 @@ namespace wircam::vision {
 struct TagSighting {
   int id = 0;
   double centerX = 0;
-  double sizePx = 0;  // mean edge length
+  double sizePx = 0;               // mean edge length
   std::optional<double> distance;  // m, from pose when known
 };
 

@@ -1,3 +1,4 @@
+// clang-format off
 /**
  * SECTION:element-wirccontrol
  *
@@ -24,19 +25,19 @@
  *
  * ## Example launch line
  * |[
- * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! apriltagdetect quad-decimate=1 ! wirccontrol
- * host=127.0.0.1 target-id=0 target-distance=1.0 ! fakesink
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! apriltagdetect quad-decimate=1 ! wirccontrol host=127.0.0.1 target-id=0 target-distance=1.0 ! fakesink
  * ]|
  */
+// clang-format on
 #include "gstwirccontrol.h"
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <vector>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "glib_locker.h"
 #include "target_follower.h"
@@ -216,11 +217,10 @@ static void on_link_event(GstWircControl* self, const link::LinkEvent& event) {
     if (had != right->hasControl) g_object_notify_by_pspec(G_OBJECT(self), hasControlSpec);
   } else if (const auto* answer = std::get_if<link::ControlRequestAnswered>(&event)) {
     GST_INFO_OBJECT(self, "%s", link::describe(event).c_str());
-    post_control_right(
-        self, gst_structure_new("wirc-control-right", "has-control", G_TYPE_BOOLEAN,
-                                state->hasControl.load(), "request", G_TYPE_STRING,
-                                answer->granted ? "granted" : "denied", "reason", G_TYPE_STRING,
-                                answer->reason.c_str(), nullptr));
+    post_control_right(self, gst_structure_new("wirc-control-right", "has-control", G_TYPE_BOOLEAN,
+                                               state->hasControl.load(), "request", G_TYPE_STRING,
+                                               answer->granted ? "granted" : "denied", "reason",
+                                               G_TYPE_STRING, answer->reason.c_str(), nullptr));
   } else if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
     std::shared_ptr<wirc::TransmitterSession> session;
     {
@@ -283,15 +283,15 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
        .given = {"pcd-rate", "keepalive", "command-ttl"}},
       GST_OBJECT_NAME(self));
   if (!session) {
-    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Cannot use the WiRC device's link"), ("%s",
-                      session.error().c_str()));
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Cannot use the WiRC device's link"),
+                      ("%s", session.error().c_str()));
     return FALSE;
   }
   state->hasControl = (*session)->status().hasControl;
   state->warnedWithoutControl = false;
   state->follower.reset();
-  state->sessionListener = (*session)->addListener(
-      [self](const link::LinkEvent& event) { on_link_event(self, event); });
+  state->sessionListener =
+      (*session)->addListener([self](const link::LinkEvent& event) { on_link_event(self, event); });
   {
     gst::GLibLocker lock(self);
     state->session = std::move(*session);
@@ -348,8 +348,8 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
   pulses[settings.throttleChannel - 1] = command.throttlePulse;
   state->session->setCommand(pulses);
 
-  bool steering = command.steeringPulse != settings.neutral ||
-                  command.throttlePulse != settings.neutral;
+  bool steering =
+      command.steeringPulse != settings.neutral || command.throttlePulse != settings.neutral;
   if (state->hasControl) {
     state->warnedWithoutControl = false;
   } else if (steering && !state->warnedWithoutControl) {

@@ -190,7 +190,8 @@ void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
   if (std::holds_alternative<link::TelemetryReceived>(event)) return;  // in wirc-stats
   std::string text = link::describe(event);
   GST_INFO_OBJECT(self, "link: %s", text.c_str());
-  GstStructure* s = gst_structure_new("wirc-session", "event", G_TYPE_STRING, text.c_str(), nullptr);
+  GstStructure* s =
+      gst_structure_new("wirc-session", "event", G_TYPE_STRING, text.c_str(), nullptr);
   if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
     gst_structure_set(s, "state", G_TYPE_STRING, link::linkStateName(changed->state), "reason",
                       G_TYPE_STRING, changed->reason.c_str(), nullptr);
@@ -256,8 +257,8 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
 
   auto session = wirc::TransmitterSession::acquire(sessionConfig(settings), GST_OBJECT_NAME(self));
   if (!session) {
-    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Cannot use the WiRC device's link"), ("%s",
-                      session.error().c_str()));
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Cannot use the WiRC device's link"),
+                      ("%s", session.error().c_str()));
     return FALSE;
   }
   if (!openStreamSocket(self, settings.streamPort)) return FALSE;
@@ -355,8 +356,9 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
   {
     std::lock_guard lock(state->refusalMutex);
     if (!state->refusal.empty()) {
-      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("The device refused camera %u",
-                        settings.camera), ("%s", state->refusal.c_str()));
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
+                        ("The device refused camera %u", settings.camera),
+                        ("%s", state->refusal.c_str()));
       return GST_FLOW_ERROR;
     }
   }
@@ -364,7 +366,8 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
   const char* where = settings.host.empty() ? "(discovery)" : settings.host.c_str();
   if (status.state == link::LinkState::Failed) {
     if (status.logins == 0)
-      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Could not log in to the WiRC device %s", where),
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
+                        ("Could not log in to the WiRC device %s", where),
                         ("%s. Check host/port, or leave host empty to discover the device.",
                          status.reason.c_str()));
     else
@@ -374,7 +377,8 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
   }
   if (status.state != link::LinkState::Live) {
     if (status.logins == 0 && Clock::now() >= state->loginDeadline) {
-      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Could not log in to the WiRC device %s", where),
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
+                        ("Could not log in to the WiRC device %s", where),
                         ("no login within %u ms%s%s. Check host/port, or leave host empty to "
                          "discover the device.",
                          settings.loginTimeoutMs + 500, status.reason.empty() ? "" : ": ",
@@ -483,13 +487,11 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
     case PROP_STREAM_PORT:
       s.streamPort = g_value_get_uint(value);
       break;
-    case PROP_TRANSMITTER_NAME:
-    {
+    case PROP_TRANSMITTER_NAME: {
       std::string name = g_value_get_string(value) ? g_value_get_string(value) : "";
       if (auto tl = wirc::encode(wirc::Tl{.name = name}); !tl) {
-        g_warning("wircsrc %s: transmitter-name '%s' refused, kept '%s': %s",
-                  GST_OBJECT_NAME(self), name.c_str(), s.transmitterName.c_str(),
-                  tl.error().message().c_str());
+        g_warning("wircsrc %s: transmitter-name '%s' refused, kept '%s': %s", GST_OBJECT_NAME(self),
+                  name.c_str(), s.transmitterName.c_str(), tl.error().message().c_str());
         break;
       }
       s.transmitterName = name;

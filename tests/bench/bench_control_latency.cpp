@@ -13,9 +13,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
-#include <tuple>
 #include <mutex>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "follow_scene.h"
@@ -37,12 +37,13 @@ struct Probes {
 // wirc-control messages, as they are posted: which frames changed the command.
 GstBusSyncReply onMessage(GstBus*, GstMessage* message, gpointer data) {
   const GstStructure* s = gst_message_get_structure(message);
-  if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ELEMENT && gst_structure_has_name(s, "wirc-control")) {
+  if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ELEMENT &&
+      gst_structure_has_name(s, "wirc-control")) {
     auto* probes = static_cast<Probes*>(data);
     guint64 pts = 0;
     guint steering = 0, throttle = 0;
-    gst_structure_get(s, "timestamp", G_TYPE_UINT64, &pts, "steering-pulse", G_TYPE_UINT,
-                      &steering, "throttle-pulse", G_TYPE_UINT, &throttle, nullptr);
+    gst_structure_get(s, "timestamp", G_TYPE_UINT64, &pts, "steering-pulse", G_TYPE_UINT, &steering,
+                      "throttle-pulse", G_TYPE_UINT, &throttle, nullptr);
     std::lock_guard lock(probes->mutex);
     probes->pulses[pts] = {steering, throttle};
   }
@@ -130,12 +131,15 @@ void run(const char* decoder, double seconds) {
 // The streaming thread blocks 2 s on every buffer; the link's keepalives
 // come from the event loop and must keep the device's watchdog fed.
 void runStalled(double seconds) {
-  auto device = std::move(*wirc::Device::start({.port = 0}, std::move(*sim::FollowScene::create({}))));
+  auto device =
+      std::move(*wirc::Device::start({.port = 0}, std::move(*sim::FollowScene::create({}))));
   auto port = std::to_string(device->port());
-  GstElement* pipeline = gst_parse_launch(
-      ("wircsrc host=127.0.0.1 port=" + port + " ! tjpegdec ! apriltagdetect ! wirccontrol "
-       "name=control host=127.0.0.1 port=" + port + " ! fakesink").c_str(),
-      nullptr);
+  GstElement* pipeline = gst_parse_launch(("wircsrc host=127.0.0.1 port=" + port +
+                                           " ! tjpegdec ! apriltagdetect ! wirccontrol "
+                                           "name=control host=127.0.0.1 port=" +
+                                           port + " ! fakesink")
+                                              .c_str(),
+                                          nullptr);
   GstElement* control = gst_bin_get_by_name(GST_BIN(pipeline), "control");
   GstPad* pad = gst_element_get_static_pad(control, "src");
   gst_pad_add_probe(
@@ -148,11 +152,12 @@ void runStalled(double seconds) {
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
   auto stats = device->stats();
-  std::printf("stalled   %6llu PCD received   longest PCD gap %lld ms (keepalive 100 ms, device "
-              "timeout 800 ms)   watchdog fired %llu times\n",
-              static_cast<unsigned long long>(stats.pcdReceived),
-              static_cast<long long>(stats.maxPcdGap.count()),
-              static_cast<unsigned long long>(stats.failsafeEntries));
+  std::printf(
+      "stalled   %6llu PCD received   longest PCD gap %lld ms (keepalive 100 ms, device "
+      "timeout 800 ms)   watchdog fired %llu times\n",
+      static_cast<unsigned long long>(stats.pcdReceived),
+      static_cast<long long>(stats.maxPcdGap.count()),
+      static_cast<unsigned long long>(stats.failsafeEntries));
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(pad);
   gst_object_unref(control);

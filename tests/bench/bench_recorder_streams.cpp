@@ -197,7 +197,8 @@ int main(int argc, char** argv) {
     int rtpSent = rtpFrames * n;
 
     std::printf(
-        "%-8d | lost %4d of %5d, %5.2f %%, %5.1f MB, %4d threads | lost %4d of %5d, %5.2f %%, %5.1f "
+        "%-8d | lost %4d of %5d, %5.2f %%, %5.1f MB, %4d threads | lost %4d of %5d, %5.2f %%, "
+        "%5.1f "
         "MB, %4d threads\n",
         n, sent - recorded, sent, 100 * ours.cpuSeconds / seconds / n, ours.maxRssKb / 1024.0 / n,
         ourThreads, rtpSent - rtpRecorded, rtpSent, 100 * theirs.cpuSeconds / (seconds + 1) / n,

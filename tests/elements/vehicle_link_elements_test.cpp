@@ -80,7 +80,9 @@ TEST(VehicleLinkElements, StopsAtOnceWhileAConnectIsStuckInAFullAcceptQueue) {
   expectQuickTeardown(peer.port());
 }
 
-TEST(VehicleLinkElements, StopsAtOnceAgainstADeadPort) { expectQuickTeardown(wircam::testing::deadPort()); }
+TEST(VehicleLinkElements, StopsAtOnceAgainstADeadPort) {
+  expectQuickTeardown(wircam::testing::deadPort());
+}
 
 TEST(VehicleLinkElements, ASinkStartingFirstDoesNotOverrideTheSourcesLoginSettings) {
   auto device = startDevice();
@@ -125,8 +127,9 @@ TEST(VehicleLinkElements, TwoElementsGivingTheSameDeviceDifferentNamesIsAnErrorN
 
 TEST(VehicleLinkElements, LosingTheDeviceWithReconnectOffEndsTheStreamWithTheCause) {
   auto device = startDevice();
-  GstElement* pipeline = launch("wircsrc host=127.0.0.1 reconnect=false port=" +
-                                std::to_string(device->port()) + " ! fakesink");
+  GstElement* pipeline =
+      launch("wircsrc host=127.0.0.1 reconnect=false port=" + std::to_string(device->port()) +
+             " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   ASSERT_TRUE(waitFor([&] { return device->stats().activeStreams == 1; }));
   device.reset();

@@ -234,12 +234,12 @@ TEST(TransmitterSession, EndsInFailedWithTheCauseWhenReconnectIsOff) {
 
 TEST(TransmitterSession, ReportsTheAnswerToAControlRequest) {
   auto device = startDevice({.port = 0});
-  auto boss = acquire({.host = "127.0.0.1", .port = device->port(), .transmitterName = "boss",
-                       .priority = 9});
+  auto boss = acquire(
+      {.host = "127.0.0.1", .port = device->port(), .transmitterName = "boss", .priority = 9});
   ASSERT_EQ(boss->waitLoggedIn(milliseconds(3000)), std::nullopt);
   // Same device under another name: a second transmitter of lower priority.
-  auto minion = acquire({.host = "localhost", .port = device->port(), .transmitterName = "minion",
-                         .priority = 1});
+  auto minion = acquire(
+      {.host = "localhost", .port = device->port(), .transmitterName = "minion", .priority = 1});
   ASSERT_EQ(minion->waitLoggedIn(milliseconds(3000)), std::nullopt);
   EventLog minionEvents(*minion);
   minion->requestControl();
@@ -285,8 +285,8 @@ TEST(TransmitterSession, ConfigurationErrorsComeBackAsErr) {
 
 TEST(TransmitterSession, FindsTheDeviceByDiscovery) {
   auto device = startDevice({.port = 0, .name = "finder"});
-  auto session = acquire({.port = device->port(), .device = "finder",
-                          .discoveryAddress = "127.0.0.1"});
+  auto session =
+      acquire({.port = device->port(), .device = "finder", .discoveryAddress = "127.0.0.1"});
   ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
   EXPECT_EQ(session->sessionStatus().deviceName, "finder");
 }

@@ -36,8 +36,7 @@ TEST(WircCli, RequestControlExitsOneWithTheReasonWhenTheDeviceDenies) {
       {.host = "127.0.0.1", .port = device->port(), .transmitterName = "boss", .priority = 9});
   ASSERT_TRUE(boss.has_value());
   ASSERT_EQ((*boss)->waitLoggedIn(milliseconds(3000)), std::nullopt);
-  auto run = wircCli("request-control 2 --host 127.0.0.1 --port " +
-                     std::to_string(device->port()));
+  auto run = wircCli("request-control 2 --host 127.0.0.1 --port " + std::to_string(device->port()));
   EXPECT_EQ(run.exitCode, 1) << run.output;
   EXPECT_NE(run.output.find("denied"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("boss"), std::string::npos) << run.output;
@@ -45,8 +44,8 @@ TEST(WircCli, RequestControlExitsOneWithTheReasonWhenTheDeviceDenies) {
 
 TEST(WircCli, RequestControlExitsZeroWhenGranted) {
   auto device = std::move(*Device::start({.port = 0}, nullptr));
-  auto run = wircCli("request-control 1 --host 127.0.0.1 --port " +
-                     std::to_string(device->port()) + " --priority 5");
+  auto run = wircCli("request-control 1 --host 127.0.0.1 --port " + std::to_string(device->port()) +
+                     " --priority 5");
   EXPECT_EQ(run.exitCode, 0) << run.output;
 }
 

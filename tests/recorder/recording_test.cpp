@@ -109,8 +109,8 @@ TEST(WircRecorder, TheFileCarriesTheTelemetryAsATextTrack) {
 
 TEST(WircRecorder, TranscodesToH264InFragmentedMp4) {
   auto device = startSequenceDevice();
-  RecorderProcess recorder(device->port(), {"--segment", "2", "--duration", "5", "--codec",
-                                            "h264", "--format", "mp4"});
+  RecorderProcess recorder(
+      device->port(), {"--segment", "2", "--duration", "5", "--codec", "h264", "--format", "mp4"});
   ASSERT_EQ(recorder.wait(), 0) << recorder.log();
   auto videos = recorder.files(".mp4");
   ASSERT_GE(videos.size(), 2u);

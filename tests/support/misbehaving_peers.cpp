@@ -47,7 +47,8 @@ RefusingPeer::RefusingPeer(uint16_t code) {
       if (!connection.valid()) continue;
       std::array<uint8_t, 512> request;
       pollfd p{connection.get(), POLLIN, 0};
-      if (::poll(&p, 1, 2000) > 0 && ::recv(connection.get(), request.data(), request.size(), 0) > 0)
+      if (::poll(&p, 1, 2000) > 0 &&
+          ::recv(connection.get(), request.data(), request.size(), 0) > 0)
         ::send(connection.get(), answer.data(), answer.size(), MSG_NOSIGNAL);
       connections.push_back(std::move(connection));  // kept open: the client must act on ERR
     }

@@ -6,8 +6,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <future>
 #include <fstream>
+#include <future>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -18,8 +18,8 @@
 
 #include "message_json.h"
 #include "wirc/discovery.h"
-#include "wirc/stream_receiver.h"
 #include "wirc/message_stream_parser.h"
+#include "wirc/stream_receiver.h"
 #include "wirc/transmitter_session.h"
 
 using namespace wircam;
@@ -267,8 +267,8 @@ int requestControl(const Options& o, uint8_t id) {
   auto future = answered.get_future();
   bool came = future.wait_for(o.timeout) == std::future_status::ready;
   session->removeListener(listener);
-  if (!came) fail("no answer to the control request within " + std::to_string(o.timeout.count()) +
-                  " ms");
+  if (!came)
+    fail("no answer to the control request within " + std::to_string(o.timeout.count()) + " ms");
   auto answer = future.get();
   if (!answer.granted) fail("control request denied: " + answer.reason);
   std::printf("control right given to connection %u\n", id);

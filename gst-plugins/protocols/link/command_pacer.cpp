@@ -30,8 +30,8 @@ std::optional<Pulses> CommandPacer::offer(const Pulses& pulses, Clock::time_poin
 }
 
 std::optional<Pulses> CommandPacer::poll(Clock::time_point now) {
-  return sendIfDue(now, !lastSent_ ||
-                            now - lastSentTime_ >= config_.keepalive - config_.keepaliveEarly);
+  return sendIfDue(now,
+                   !lastSent_ || now - lastSentTime_ >= config_.keepalive - config_.keepaliveEarly);
 }
 
 CommandPacer::Clock::time_point CommandPacer::nextDeadline(Clock::time_point now) const {

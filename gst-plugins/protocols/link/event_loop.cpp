@@ -80,8 +80,7 @@ void EventLoop::armIfEarlier(Id id, Clock::time_point when) {
   {
     std::lock_guard lock(mutex_);
     auto it = entries_.find(id);
-    if (it == entries_.end() || (it->second.queued && (*it->second.queued)->first <= when))
-      return;
+    if (it == entries_.end() || (it->second.queued && (*it->second.queued)->first <= when)) return;
   }
   arm(id, when);
 }

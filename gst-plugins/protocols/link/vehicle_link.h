@@ -73,9 +73,8 @@ struct DeviceRefused {
   int code;
   std::string meaning;
 };
-using LinkEvent =
-    std::variant<StateChanged, ControlRightChanged, ControlRequestAnswered, TelemetryReceived,
-                 DeviceRefused>;
+using LinkEvent = std::variant<StateChanged, ControlRightChanged, ControlRequestAnswered,
+                               TelemetryReceived, DeviceRefused>;
 std::string describe(const LinkEvent& event);
 
 struct LinkStatus {

@@ -24,8 +24,10 @@ void StreamReceiver::push(const SocketAddress& from, std::span<const uint8_t> da
   auto packet = parseMjpegPacket(datagram);
   if (!packet) {
     // Counted by the assembler (keepalive or invalid); pins nothing.
-    if (pinnedElsewhere) ++foreign_;
-    else assembler_.pushDatagram(datagram, now, onFrame);
+    if (pinnedElsewhere)
+      ++foreign_;
+    else
+      assembler_.pushDatagram(datagram, now, onFrame);
     return;
   }
   if (pinnedElsewhere) assembler_.reset();  // the old sender went quiet: follow the new one

@@ -292,8 +292,8 @@ void TransmitterSession::Impl::beginAttempt() {
   discoveryWatch_ =
       loop_.watch(discovery_.get(), EPOLLIN, [this](uint32_t) { onDiscoveryAnswer(); });
   loop_.arm(attemptTimer_,
-            std::min(attemptDeadline_, Clock::now() + std::min(config.loginTimeout / 2,
-                                                               kDiscoveryWindow)));
+            std::min(attemptDeadline_,
+                     Clock::now() + std::min(config.loginTimeout / 2, kDiscoveryWindow)));
 }
 
 void TransmitterSession::Impl::onDiscoveryAnswer() {
@@ -410,10 +410,10 @@ void TransmitterSession::Impl::onLoggedIn(const Wst& wst) {
     address = device_->toString();
   }
   changed_.notify_all();
-  publish({link::StateChanged{link::LinkState::Live,
-                              "logged in to " + address + " as connection " +
-                                  std::to_string(wst.connectionId) + " (" +
-                                  std::to_string(wst.cameraCount) + " cameras)"}});
+  publish({link::StateChanged{link::LinkState::Live, "logged in to " + address + " as connection " +
+                                                         std::to_string(wst.connectionId) + " (" +
+                                                         std::to_string(wst.cameraCount) +
+                                                         " cameras)"}});
   for (auto [camera, port] : streams) sendControl(Stst{camera, port});
 }
 
@@ -446,7 +446,8 @@ void TransmitterSession::Impl::handle(const Message& message) {
       if (answersRequest) {
         bool denied = agr->notification == AccessNotification::Denied;
         events.push_back(link::ControlRequestAnswered{
-            !denied, denied ? "'" + agr->name + "' holds it and only a transmitter of the highest "
+            !denied, denied ? "'" + agr->name +
+                                  "' holds it and only a transmitter of the highest "
                                   "priority may hand it over"
                             : ""});
       }
@@ -462,8 +463,8 @@ void TransmitterSession::Impl::handle(const Message& message) {
         --controlRequests_;
         events.push_back(link::ControlRequestAnswered{false, errorCodeMeaning(err->code)});
       }
-      events.push_back(link::DeviceRefused{commandName(err->command), err->code,
-                                           errorCodeMeaning(err->code)});
+      events.push_back(
+          link::DeviceRefused{commandName(err->command), err->code, errorCodeMeaning(err->code)});
     } else if (auto* tlst = std::get_if<Tlst>(&message)) {
       if (listComplete_) transmitters_.clear();
       listComplete_ = false;
@@ -478,8 +479,8 @@ void TransmitterSession::Impl::handle(const Message& message) {
   // The login itself refused (unauthorised, busy): no WST will come.
   if (auto* err = std::get_if<Err>(&message);
       err && phase_ == Phase::LoggingIn && err->command == static_cast<uint8_t>(Command::Tl))
-    fail(std::string("the device refused the login: ") + errorCodeMeaning(err->code) +
-         " (ERR " + std::to_string(err->code) + ")");
+    fail(std::string("the device refused the login: ") + errorCodeMeaning(err->code) + " (ERR " +
+         std::to_string(err->code) + ")");
 }
 
 void TransmitterSession::Impl::closeConnection() {
@@ -508,7 +509,7 @@ void TransmitterSession::Impl::fail(const std::string& why, Retry retryWhen) {
     controlAddress_.reset();
     controlRequests_ = 0;
     retry = config_.reconnect || retryAtOnce;
-    state = !retry                                ? link::LinkState::Failed
+    state = !retry                               ? link::LinkState::Failed
             : status_.logins == 0 || retryAtOnce ? link::LinkState::Connecting
                                                  : link::LinkState::Lost;
     status_.state = state;

@@ -36,7 +36,7 @@ struct SessionConfig {
     return p;
   }();
   ChannelValues failsafe = neutralChannels();
-  double pcdRate = 50;  // Hz: the most commands per second (a rate limit)
+  double pcdRate = 50;                        // Hz: the most commands per second (a rate limit)
   std::chrono::milliseconds keepalive{100};   // PCD repeat while nothing changes
   std::chrono::milliseconds commandTtl{250};  // older commands give way to the failsafe
   std::chrono::milliseconds loginTimeout{3000};
