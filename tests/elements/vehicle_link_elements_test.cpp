@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "misbehaving_peers.h"
+#include "pipelines.h"
 #include "wait_for.h"
 #include "wirc/device.h"
 #include "wirc/transmitter_session.h"
@@ -15,6 +16,8 @@ namespace {
 
 using namespace wircam;
 using std::chrono::milliseconds;
+using wircam::testing::busMessage;
+using wircam::testing::launch;
 using wircam::testing::waitFor;
 
 std::unique_ptr<wirc::Device> startDevice(wirc::DeviceConfig config = {}) {
@@ -22,32 +25,6 @@ std::unique_ptr<wirc::Device> startDevice(wirc::DeviceConfig config = {}) {
   auto device = wirc::Device::start(config, nullptr);
   EXPECT_TRUE(device.has_value()) << device.error();
   return std::move(*device);
-}
-
-GstElement* launch(const std::string& description) {
-  GError* error = nullptr;
-  GstElement* pipeline = gst_parse_launch(description.c_str(), &error);
-  EXPECT_EQ(error, nullptr) << (error ? error->message : "");
-  return pipeline;
-}
-
-// The first message of `type` on the bus within `timeout`, as text.
-std::string busMessage(GstElement* pipeline, GstMessageType type, milliseconds timeout) {
-  GstBus* bus = gst_element_get_bus(pipeline);
-  GstMessage* message = gst_bus_timed_pop_filtered(bus, timeout.count() * GST_MSECOND, type);
-  std::string text;
-  if (message) {
-    GError* error = nullptr;
-    gchar* debug = nullptr;
-    if (type == GST_MESSAGE_ERROR) gst_message_parse_error(message, &error, &debug);
-    if (type == GST_MESSAGE_WARNING) gst_message_parse_warning(message, &error, &debug);
-    text = std::string(error->message) + " | " + (debug ? debug : "");
-    g_error_free(error);
-    g_free(debug);
-    gst_message_unref(message);
-  }
-  gst_object_unref(bus);
-  return text;
 }
 
 milliseconds timeToNull(GstElement* pipeline) {
@@ -118,7 +95,7 @@ TEST(VehicleLinkElements, TwoElementsGivingTheSameDeviceDifferentNamesIsAnErrorN
       " ! fakesink wircsrc name=second transmitter-name=bob camera=1 host=127.0.0.1 port=" + port +
       " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  auto error = busMessage(pipeline, GST_MESSAGE_ERROR, milliseconds(3000));
+  auto error = busMessage(pipeline, milliseconds(3000));
   for (const char* part : {"transmitter-name", "'alice'", "'bob'", "first", "second"})
     EXPECT_NE(error.find(part), std::string::npos) << error;
   gst_element_set_state(pipeline, GST_STATE_NULL);
@@ -133,7 +110,7 @@ TEST(VehicleLinkElements, LosingTheDeviceWithReconnectOffEndsTheStreamWithTheCau
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   ASSERT_TRUE(waitFor([&] { return device->stats().activeStreams == 1; }));
   device.reset();
-  auto error = busMessage(pipeline, GST_MESSAGE_ERROR, milliseconds(3000));
+  auto error = busMessage(pipeline, milliseconds(3000));
   EXPECT_NE(error.find("Lost the WiRC device"), std::string::npos) << error;
   EXPECT_NE(error.find("closed the connection"), std::string::npos) << error;
   gst_element_set_state(pipeline, GST_STATE_NULL);

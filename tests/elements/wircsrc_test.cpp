@@ -7,6 +7,7 @@
 
 #include "buffer_bytes.h"
 #include "jpeg_sequence_scene.h"
+#include "pipelines.h"
 #include "scene_frames.h"
 #include "wait_for.h"
 #include "wirc/device.h"
@@ -17,6 +18,8 @@ using namespace wircam;
 using std::chrono::milliseconds;
 using wircam::testing::isSceneFrame;
 using wircam::testing::sceneFrames;
+using wircam::testing::busMessage;
+using wircam::testing::launch;
 using wircam::testing::waitFor;
 
 std::unique_ptr<wirc::Device> startDevice(wirc::DeviceConfig config = {}) {
@@ -30,32 +33,6 @@ std::unique_ptr<wirc::Device> startDevice(wirc::DeviceConfig config = {}) {
 wirc::DeviceConfig ephemeral(wirc::DeviceConfig config = {}) {
   config.port = 0;
   return config;
-}
-
-GstElement* launch(const std::string& description) {
-  GError* error = nullptr;
-  GstElement* pipeline = gst_parse_launch(description.c_str(), &error);
-  EXPECT_EQ(error, nullptr) << (error ? error->message : "");
-  return pipeline;
-}
-
-// The first error on the bus within `timeout`, or "".
-std::string busError(GstElement* pipeline, milliseconds timeout) {
-  GstBus* bus = gst_element_get_bus(pipeline);
-  GstMessage* message =
-      gst_bus_timed_pop_filtered(bus, timeout.count() * GST_MSECOND, GST_MESSAGE_ERROR);
-  std::string text;
-  if (message) {
-    GError* error = nullptr;
-    gchar* debug = nullptr;
-    gst_message_parse_error(message, &error, &debug);
-    text = std::string(error->message) + " | " + (debug ? debug : "");
-    g_error_free(error);
-    g_free(debug);
-    gst_message_unref(message);
-  }
-  gst_object_unref(bus);
-  return text;
 }
 
 guint64 stat(GstElement* element, const char* name) {
@@ -141,20 +118,18 @@ TEST(WircSrc, TwoCamerasShareOneLoginAndStopSendsEst) {
       launch("wircsrc name=a host=127.0.0.1 camera=0 port=" + port +
              " ! fakesink wircsrc name=b host=127.0.0.1 camera=1 port=" + port + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  std::this_thread::sleep_for(milliseconds(1000));
-  EXPECT_EQ(busError(pipeline, milliseconds(0)), "");
   GstElement* a = gst_bin_get_by_name(GST_BIN(pipeline), "a");
   GstElement* b = gst_bin_get_by_name(GST_BIN(pipeline), "b");
-  EXPECT_GT(stat(a, "frames-complete"), 5u);
-  EXPECT_GT(stat(b, "frames-complete"), 5u);
+  EXPECT_TRUE(waitFor(
+      [&] { return stat(a, "frames-complete") > 5 && stat(b, "frames-complete") > 5; }));
+  EXPECT_EQ(busMessage(pipeline, milliseconds(0)), "");
   EXPECT_EQ(device->stats().logins, 1u);
   EXPECT_EQ(device->stats().activeStreams, 2u);
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(a);
   gst_object_unref(b);
   gst_object_unref(pipeline);
-  std::this_thread::sleep_for(milliseconds(200));
-  EXPECT_EQ(device->stats().activeStreams, 0u);
+  EXPECT_TRUE(waitFor([&] { return device->stats().activeStreams == 0; }));
 }
 
 TEST(WircSrc, ReportsAnUnreachableDevice) {
@@ -164,7 +139,7 @@ TEST(WircSrc, ReportsAnUnreachableDevice) {
   GstElement* pipeline =
       launch("wircsrc host=127.0.0.1 reconnect=false port=" + port + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  auto error = busError(pipeline, milliseconds(5000));
+  auto error = busMessage(pipeline, milliseconds(5000));
   EXPECT_NE(error.find("Could not log in"), std::string::npos) << error;
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(pipeline);
@@ -175,7 +150,7 @@ TEST(WircSrc, ReportsACameraTheDeviceDoesNotHave) {
   GstElement* pipeline = launch(
       "wircsrc host=127.0.0.1 camera=3 port=" + std::to_string(device->port()) + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  auto error = busError(pipeline, milliseconds(5000));
+  auto error = busMessage(pipeline, milliseconds(5000));
   EXPECT_NE(error.find("no camera 3"), std::string::npos) << error;
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(pipeline);

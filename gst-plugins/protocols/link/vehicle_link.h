@@ -89,7 +89,10 @@ struct LinkStatus {
 
 // Listeners: added and removed from any thread. Once remove() returns, the
 // listener is not running and never runs again, so it may be called from a
-// listener or a GStreamer bus sync handler alike.
+// listener or a GStreamer bus sync handler alike. Listeners run on the event
+// loop thread: they must not block, and must not drop the last reference to
+// their link (as a GStreamer application must not set a pipeline to NULL
+// from a streaming thread).
 class LinkListeners {
  public:
   using Listener = std::function<void(const LinkEvent&)>;

@@ -1,0 +1,43 @@
+// What the element tests do with whole pipelines: build one from a launch
+// line, and read the first error or warning its bus carries.
+#pragma once
+
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+
+namespace wircam::testing {
+
+inline GstElement* launch(const std::string& description) {
+  GError* error = nullptr;
+  GstElement* pipeline = gst_parse_launch(description.c_str(), &error);
+  EXPECT_EQ(error, nullptr) << (error ? error->message : "");
+  return pipeline;
+}
+
+// The first error (or warning) on the bus within `timeout` as "message |
+// debug", or "" when none came.
+inline std::string busMessage(GstElement* pipeline, std::chrono::milliseconds timeout,
+                              GstMessageType type = GST_MESSAGE_ERROR) {
+  GstBus* bus = gst_element_get_bus(pipeline);
+  GstMessage* message = gst_bus_timed_pop_filtered(bus, timeout.count() * GST_MSECOND, type);
+  std::string text;
+  if (message) {
+    GError* error = nullptr;
+    gchar* debug = nullptr;
+    if (type == GST_MESSAGE_WARNING)
+      gst_message_parse_warning(message, &error, &debug);
+    else
+      gst_message_parse_error(message, &error, &debug);
+    text = std::string(error->message) + " | " + (debug ? debug : "");
+    g_error_free(error);
+    g_free(debug);
+    gst_message_unref(message);
+  }
+  gst_object_unref(bus);
+  return text;
+}
+
+}  // namespace wircam::testing
