@@ -75,7 +75,8 @@ function showStatus(status) {
     if (!view) continue;
     view.stats.textContent = `${stream.frames} frames  ${stream.fps.toFixed(1)} fps  ` +
         `loss ${stream.loss_percent.toFixed(1)} %  ${Math.round(stream.kbps)} kbit/s  ` +
-        `battery ${stream.battery_v.toFixed(2)} V`;
+        `battery ${stream.battery_v.toFixed(2)} V` +
+        (stream.status_stale ? ` (stale, ${Math.round(stream.status_age_ms / 1000)} s old)` : "");
   }
 }
 

@@ -47,6 +47,9 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
     bool controlled = false;
     std::string host = device.host.empty() ? "" : " host=" + device.host;
     std::string port = " port=" + std::to_string(device.port);
+    std::string login;  // what the login configures, when the user said
+    if (options.periods) login += " periods=" + *options.periods;
+    if (options.failsafe) login += " failsafe=" + *options.failsafe;
     for (int camera : device.cameras) {
       auto i = std::to_string(index++);
       StreamPlan stream;
@@ -68,7 +71,7 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
       // The telemetry track is sparse: splitmuxsink lets it run up to 2 s
       // ahead of the video rather than hold the video for it (at 0, the
       // default, the two wait on each other).
-      d += "wircsrc name=" + stream.source + host + port + " camera=" + std::to_string(camera) +
+      d += "wircsrc name=" + stream.source + host + port + login + " camera=" + std::to_string(camera) +
            " ! tee name=t" + i + " t" + i + ". ! queue max-size-time=3000000000 ! " +
            encoder(options) + "splitmuxsink name=" + stream.muxer +
            " async-finalize=true alignment-threshold=2000000000 " +

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <memory>
 
+#include "wirc/channel_list.h"
+
 namespace wircam::recorder {
 
 const char* usage() {
@@ -29,6 +31,12 @@ text track in the file. SIGINT or SIGTERM finishes every file and exits 0.
   --bitrate KBPS         H.264 bit rate (default 2000)
   --detect FAMILY        find AprilTags (e.g. tag36h11); detections go to telemetry
   --follow               steer the vehicle after the largest tag (needs --detect)
+  --periods US,...       channel periods the login sets (CCFG): 12 values or
+                         one for all, 5000..20000 µs (default 20000)
+  --failsafe US,...      what each channel does when the link is lost (FCFG):
+                         800..2200 µs, 0 = hold, 65535 = no pulse (default 1500).
+                         Only the first transmitter that logs in configures
+                         the device; later logins are refused these (ERR 2)
   --duration S           stop after S seconds
   --status S             seconds between status updates (default 1)
   --max-bytes SIZE       keep the recordings under SIZE (e.g. 500M, 20G) by
@@ -42,7 +50,7 @@ text track in the file. SIGINT or SIGTERM finishes every file and exits 0.
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
-min-free, status, http, rtsp), and one
+min-free, status, http, rtsp, periods, failsafe), and one
 [device NAME] group per vehicle with host, port, cameras (e.g. 0;1) and follow:
 
   [recorder]
@@ -234,6 +242,13 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto bytes = size(value);
     if (!bytes) return "a size like 500M or 20G";
     (name == "max-bytes" ? o.maxBytes : o.minFree) = *bytes;
+  } else if (name == "periods" || name == "failsafe") {
+    auto channels = wirc::parseChannelList(value);
+    if (!channels) return channels.error();
+    auto valid = name == "periods" ? wirc::validate(wirc::Ccfg{*channels})
+                                   : wirc::validate(wirc::Fcfg{*channels});
+    if (valid) return valid->message();
+    (name == "periods" ? o.periods : o.failsafe) = value;
   } else if (name == "camera") {
     auto camera = number(value);
     if (!camera || *camera < 0 || *camera > 255) return "0..255";
@@ -266,6 +281,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"status", required_argument, nullptr, kValue},
                                    {"max-bytes", required_argument, nullptr, kValue},
                                    {"min-free", required_argument, nullptr, kValue},
+                                   {"periods", required_argument, nullptr, kValue},
+                                   {"failsafe", required_argument, nullptr, kValue},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};
   RecorderOptions o;

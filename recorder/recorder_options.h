@@ -47,6 +47,10 @@ struct RecorderOptions {
   uint64_t minFree = 0;
   std::optional<ServerAddress> http;  // unset: no web server
   std::optional<ServerAddress> rtsp;  // unset: no RTSP server
+  // What the login tells the device (CCFG, FCFG), as channel lists; only the
+  // first transmitter's login configures it. Unset: wircsrc's defaults.
+  std::optional<std::string> periods;
+  std::optional<std::string> failsafe;
 };
 
 // The file name extension of a container, with its dot.

@@ -185,6 +185,12 @@ void Recording::handleElementMessage(GstMessage* message) {
     gst_structure_get_uint64(s, "frames-incomplete", &stream->incomplete);
     gst_structure_get_uint64(s, "bytes", &stream->bytes);
     gst_structure_get_uint(s, "battery-mv", &stream->batteryMv);
+    gboolean stale = FALSE;
+    guint64 age = 0;
+    gst_structure_get_boolean(s, "status-stale", &stale);
+    gst_structure_get_uint64(s, "status-age-ms", &age);
+    stream->statusStale = stale;
+    stream->statusAgeMs = age;
     // Rates over the time between two reports, whatever their interval.
     GstClockTime now = runningTime();
     if (GST_CLOCK_TIME_IS_VALID(stream->statsTime) && now > stream->statsTime) {
@@ -309,10 +315,14 @@ void Recording::printStatus() {
   for (auto& s : streams_) {
     double total = static_cast<double>(s->frameCount + s->incomplete);
     double loss = total > 0 ? 100.0 * static_cast<double>(s->incomplete) / total : 0;
-    std::printf("%s%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V  %s\n",
+    // A device that stopped reporting keeps its last battery reading, marked.
+    std::string stale =
+        s->statusStale ? " (stale, " + std::to_string(s->statusAgeMs / 1000) + " s old)" : "";
+    std::printf("%s%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V%s  %s\n",
                 terminal ? "\033[K" : "", s->plan.name.c_str(),
                 static_cast<unsigned long long>(s->frameCount), s->fps, loss, s->kbps,
-                s->batteryMv / 1000.0, std::filesystem::path(s->segment).filename().c_str());
+                s->batteryMv / 1000.0, stale.c_str(),
+                std::filesystem::path(s->segment).filename().c_str());
   }
   std::fflush(stdout);
   statusShown_ = true;
@@ -331,6 +341,8 @@ nlohmann::json Recording::status() const {
         {"loss_percent", total > 0 ? 100.0 * static_cast<double>(s->incomplete) / total : 0.0},
         {"kbps", s->kbps},
         {"battery_v", s->batteryMv / 1000.0},
+        {"status_stale", s->statusStale},
+        {"status_age_ms", s->statusAgeMs},
         {"segment", std::filesystem::path(s->segment).filename().string()},
         {"live", "/live/" + s->plan.name + ".mjpg"}};
     if (rtsp_)

@@ -49,6 +49,8 @@ class Recording {
     GstClockTime statsTime = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
     double fps = 0, kbps = 0;
     guint batteryMv = 0;
+    bool statusStale = false;  // the device stopped reporting; batteryMv is its last word
+    guint64 statusAgeMs = 0;
     bool lost = false;  // the device went away; the next login starts a segment
   };
 

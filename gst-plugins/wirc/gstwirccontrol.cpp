@@ -36,10 +36,12 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "glib_locker.h"
+#include "login_properties.h"
 #include "target_follower.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_tag_meta.h"
@@ -103,6 +105,8 @@ enum {
   PROP_ENABLED,
   PROP_TAKE_CONTROL,
   PROP_HAS_CONTROL,
+  PROP_PERIODS,
+  PROP_FAILSAFE,
 };
 
 enum { SIGNAL_REQUEST_CONTROL, SIGNAL_COUNT };
@@ -129,6 +133,11 @@ struct Settings {
   guint keepaliveMs = DEFAULT_KEEPALIVE;
   gboolean enabled = DEFAULT_ENABLED;
   gboolean takeControl = DEFAULT_TAKE_CONTROL;
+  wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
+  wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
+  // The shared link's settings given: the pacing ones always (the element
+  // is the link's one commander), the login ones when set.
+  std::set<std::string> given = {"pcd-rate", "keepalive", "command-ttl"};
 };
 
 struct WircControlState {
@@ -277,10 +286,12 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
   auto session = wirc::TransmitterSession::acquire(
       {.host = settings.host,
        .port = static_cast<uint16_t>(settings.port),
+       .periods = settings.periods,
+       .failsafe = settings.failsafe,
        .pcdRate = settings.pcdRate,
        .keepalive = std::chrono::milliseconds(settings.keepaliveMs),
        .commandTtl = std::chrono::milliseconds(settings.lostTimeoutMs),
-       .given = {"pcd-rate", "keepalive", "command-ttl"}},
+       .given = settings.given},
       GST_OBJECT_NAME(self));
   if (!session) {
     GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Cannot use the WiRC device's link"),
@@ -465,6 +476,12 @@ static void gst_wirc_control_set_property(GObject* object, guint id, const GValu
     case PROP_TAKE_CONTROL:
       s.takeControl = g_value_get_boolean(value);
       break;
+    case PROP_PERIODS:
+      gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
+      break;
+    case PROP_FAILSAFE:
+      gst::setChannelListProperty(object, "failsafe", value, s.failsafe, s.given);
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
       return;
@@ -565,6 +582,12 @@ static void gst_wirc_control_get_property(GObject* object, guint id, GValue* val
       break;
     case PROP_HAS_CONTROL:
       g_value_set_boolean(value, self->state->hasControl.load());
+      break;
+    case PROP_PERIODS:
+      gst::getChannelListProperty(value, s.periods);
+      break;
+    case PROP_FAILSAFE:
+      gst::getChannelListProperty(value, s.failsafe);
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
@@ -702,6 +725,7 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
       "vehicle)",
       FALSE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS));
   g_object_class_install_property(gobject, PROP_HAS_CONTROL, hasControlSpec);
+  gst::installLoginProperties(gobject, PROP_PERIODS, PROP_FAILSAFE);
   /**
    * GstWircControl::request-control:
    *

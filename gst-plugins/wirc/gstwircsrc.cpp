@@ -41,6 +41,7 @@
 
 #include "frame_buffers.h"
 #include "glib_locker.h"
+#include "login_properties.h"
 #include "wirc/stream_receiver.h"
 #include "wirc/transmitter_session.h"
 
@@ -64,8 +65,12 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_DISCOVERY_ADDRESS "255.255.255.255"
 #define DEFAULT_LOGIN_TIMEOUT 3000
 #define DEFAULT_STATS_INTERVAL 1000
+#define DEFAULT_LINK_TIMEOUT 2000
+#define DEFAULT_MAX_BAD_MESSAGES 100
 
 constexpr size_t kBatch = 16;  // datagrams per recvmmsg
+// The device reports every 500 ms: two missed reports make a status stale.
+constexpr std::chrono::milliseconds kStatusStaleAfter{2 * wirc::kPsdPeriodMs};
 constexpr int kReceiveBufferBytes = 8 << 20;
 
 enum {
@@ -83,6 +88,10 @@ enum {
   PROP_LOGIN_TIMEOUT,
   PROP_STATS_INTERVAL,
   PROP_STATS,
+  PROP_LINK_TIMEOUT,
+  PROP_MAX_BAD_MESSAGES,
+  PROP_PERIODS,
+  PROP_FAILSAFE,
 };
 
 struct Settings {
@@ -98,6 +107,10 @@ struct Settings {
   std::string discoveryAddress = DEFAULT_DISCOVERY_ADDRESS;
   guint loginTimeoutMs = DEFAULT_LOGIN_TIMEOUT;
   guint statsIntervalMs = DEFAULT_STATS_INTERVAL;
+  guint linkTimeoutMs = DEFAULT_LINK_TIMEOUT;
+  guint maxBadMessages = DEFAULT_MAX_BAD_MESSAGES;
+  wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
+  wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
   std::set<std::string> given;  // the shared link's settings the user set
 };
 
@@ -162,10 +175,17 @@ void postStats(GstWircSrc* self) {
   auto session = state->session->sessionStatus();
   gst_structure_set(stats, "session", G_TYPE_STRING, link::linkStateName(session.state), nullptr);
   if (const auto& psd = session.lastStatus) {
+    // A report the device stopped renewing is shown with its age, as stale.
+    auto age = std::chrono::duration_cast<std::chrono::milliseconds>(
+        Clock::now() - session.telemetry->received);
     gst_structure_set(stats, "battery-mv", G_TYPE_UINT, static_cast<guint>(psd->batteryMillivolts),
                       "analog-mv", G_TYPE_UINT, static_cast<guint>(psd->analogMillivolts), "inputs",
-                      G_TYPE_UINT, static_cast<guint>(*session.telemetry->inputs), nullptr);
+                      G_TYPE_UINT, static_cast<guint>(*session.telemetry->inputs), "status-age-ms",
+                      G_TYPE_UINT64, static_cast<guint64>(age.count()), "status-stale",
+                      G_TYPE_BOOLEAN, age > kStatusStaleAfter, nullptr);
   }
+  gst_structure_set(stats, "input-rejected", G_TYPE_UINT64,
+                    static_cast<guint64>(session.inputRejected), nullptr);
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), stats));
 }
 
@@ -215,7 +235,11 @@ wirc::SessionConfig sessionConfig(const Settings& s) {
           .discoveryAddress = s.discoveryAddress,
           .transmitterName = s.transmitterName,
           .priority = static_cast<uint8_t>(s.priority),
+          .periods = s.periods,
+          .failsafe = s.failsafe,
           .loginTimeout = std::chrono::milliseconds(s.loginTimeoutMs),
+          .linkTimeout = std::chrono::milliseconds(s.linkTimeoutMs),
+          .maxBadMessages = s.maxBadMessages,
           .reconnect = s.reconnect != FALSE,
           .given = s.given};
 }
@@ -520,6 +544,19 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
     case PROP_STATS_INTERVAL:
       s.statsIntervalMs = g_value_get_uint(value);
       break;
+    case PROP_LINK_TIMEOUT:
+      s.linkTimeoutMs = g_value_get_uint(value);
+      s.given.insert("link-timeout");
+      break;
+    case PROP_MAX_BAD_MESSAGES:
+      s.maxBadMessages = g_value_get_uint(value);
+      break;
+    case PROP_PERIODS:
+      gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
+      break;
+    case PROP_FAILSAFE:
+      gst::setChannelListProperty(object, "failsafe", value, s.failsafe, s.given);
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
       break;
@@ -572,6 +609,18 @@ static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, 
       break;
     case PROP_STATS_INTERVAL:
       g_value_set_uint(value, s.statsIntervalMs);
+      break;
+    case PROP_LINK_TIMEOUT:
+      g_value_set_uint(value, s.linkTimeoutMs);
+      break;
+    case PROP_MAX_BAD_MESSAGES:
+      g_value_set_uint(value, s.maxBadMessages);
+      break;
+    case PROP_PERIODS:
+      gst::getChannelListProperty(value, s.periods);
+      break;
+    case PROP_FAILSAFE:
+      gst::getChannelListProperty(value, s.failsafe);
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
@@ -675,6 +724,22 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
           "Counters: packets, bytes, frames-complete, "
           "frames-incomplete, packets-duplicate, packets-invalid, packets-foreign, ...",
           GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+
+  g_object_class_install_property(
+      gobject, PROP_LINK_TIMEOUT,
+      g_param_spec_uint("link-timeout", "Link timeout",
+                        "Milliseconds without a status report (PSD, every 500 ms) before the "
+                        "device counts as gone (power cut, out of range) and the link logs in "
+                        "again; 0 = never (at least 1000 otherwise)",
+                        0, 600000, DEFAULT_LINK_TIMEOUT, kReady));
+  g_object_class_install_property(
+      gobject, PROP_MAX_BAD_MESSAGES,
+      g_param_spec_uint("max-bad-messages", "Max bad messages",
+                        "Malformed messages one control connection may bring before the device "
+                        "counts as misbehaving: the connection is dropped and made again after "
+                        "a backoff",
+                        1, 1000000, DEFAULT_MAX_BAD_MESSAGES, kReady));
+  gst::installLoginProperties(gobject, PROP_PERIODS, PROP_FAILSAFE);
 
   gst_element_class_add_static_pad_template(element, &src_template);
   gst_element_class_set_static_metadata(

@@ -6,8 +6,10 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
+#include <optional>
 
-#include "wirc/messages.h"
+#include "wirc/message_stream_parser.h"
 
 namespace wircam::testing {
 
@@ -32,30 +34,83 @@ FullAcceptQueuePeer::FullAcceptQueuePeer() {
   }
 }
 
-RefusingPeer::RefusingPeer(uint16_t code) {
+std::vector<uint8_t> bytesOf(const wirc::Message& message) { return *wirc::encode(message); }
+
+ScriptedPeer::ScriptedPeer(PeerScript script) : script_(std::move(script)) {
   listener_ = std::move(*listenTcp(SocketAddress::loopback(0)));
+  control_ = std::move(*bindUdp(SocketAddress::loopback(0)));
   port_ = localAddress(listener_.get()).port();
   wake_ = UniqueFd(eventfd(0, EFD_CLOEXEC));
-  thread_ = std::thread([this, code] {
-    auto answer = *wirc::encode(wirc::Err{static_cast<uint8_t>(wirc::Command::Tl), code});
-    std::vector<UniqueFd> connections;
+  thread_ = std::thread([this] {
     for (;;) {
       std::array<pollfd, 2> fds = {pollfd{listener_.get(), POLLIN, 0},
                                    pollfd{wake_.get(), POLLIN, 0}};
       if (::poll(fds.data(), fds.size(), -1) <= 0 || (fds[1].revents & POLLIN)) return;
       UniqueFd connection(::accept(listener_.get(), nullptr, nullptr));
       if (!connection.valid()) continue;
-      std::array<uint8_t, 512> request;
-      pollfd p{connection.get(), POLLIN, 0};
-      if (::poll(&p, 1, 2000) > 0 &&
-          ::recv(connection.get(), request.data(), request.size(), 0) > 0)
-        ::send(connection.get(), answer.data(), answer.size(), MSG_NOSIGNAL);
-      connections.push_back(std::move(connection));  // kept open: the client must act on ERR
+      ++connections_;
+      serve(std::move(connection));
     }
   });
 }
 
-RefusingPeer::~RefusingPeer() {
+void ScriptedPeer::play(PeerScript script) {
+  std::lock_guard lock(mutex_);
+  script_ = std::move(script);
+}
+
+std::vector<uint8_t> ScriptedPeer::wst(uint8_t connectionId) const {
+  return bytesOf(
+      wirc::Wst{.connectionId = connectionId, .cameraCount = 1, .controlPort = controlPort()});
+}
+
+void ScriptedPeer::serve(UniqueFd connection) {
+  PeerScript script;
+  {
+    std::lock_guard lock(mutex_);
+    script = script_;
+  }
+  auto woken = [&](int timeoutMs) {
+    pollfd p{wake_.get(), POLLIN, 0};
+    return ::poll(&p, 1, timeoutMs) > 0;
+  };
+  // The login: wait for the TL and learn where status reports go.
+  wirc::MessageStreamParser parser;
+  std::optional<uint16_t> statusPort;
+  std::array<uint8_t, 1024> buffer;
+  for (int i = 0; i < 100 && !statusPort; ++i) {
+    pollfd p{connection.get(), POLLIN, 0};
+    if (::poll(&p, 1, 20) <= 0) continue;
+    ssize_t n = ::recv(connection.get(), buffer.data(), buffer.size(), 0);
+    if (n <= 0) return;
+    parser.feed(std::span(buffer.data(), static_cast<size_t>(n)), [&](const auto& message) {
+      if (message)
+        if (const auto* tl = std::get_if<wirc::Tl>(&*message)) statusPort = tl->statusPort;
+    });
+  }
+  for (const auto& chunk : script.chunks) {
+    ::send(connection.get(), chunk.data(), chunk.size(), MSG_NOSIGNAL);
+    if (woken(20)) return;
+  }
+  for (int i = 0; statusPort && i < script.statusReports; ++i)
+    sendDatagram(control_.get(), SocketAddress::loopback(*statusPort),
+                 bytesOf(wirc::Psd{.batteryMillivolts = 7400}));
+  // The flood goes on until the transmitter hangs up; without one, the
+  // connection stays open and silent until then.
+  for (;;) {
+    if (woken(script.flood.empty() ? 50 : 0)) return;
+    if (!script.flood.empty() &&
+        ::send(connection.get(), script.flood.data(), script.flood.size(),
+               MSG_NOSIGNAL | MSG_DONTWAIT) < 0 &&
+        errno != EAGAIN)
+      return;
+    pollfd p{connection.get(), POLLIN, 0};
+    if (::poll(&p, 1, 0) > 0 && ::recv(connection.get(), buffer.data(), buffer.size(), 0) <= 0)
+      return;
+  }
+}
+
+ScriptedPeer::~ScriptedPeer() {
   uint64_t one = 1;
   if (write(wake_.get(), &one, sizeof one) < 0) {
     // Cannot fail for a fresh eventfd.

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "message_json.h"
+#include "wirc/channel_list.h"
 #include "wirc/discovery.h"
 #include "wirc/message_stream_parser.h"
 #include "wirc/stream_receiver.h"
@@ -276,16 +277,9 @@ int requestControl(const Options& o, uint8_t id) {
 }
 
 wirc::ChannelValues channelList(const std::string& text, const char* what) {
-  std::vector<long> values;
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ',')) values.push_back(integer(item.c_str(), what, 0, 65535));
-  if (values.size() != 1 && values.size() != wirc::kChannelCount)
-    usageError(std::string(what) + " wants 1 or 12 comma-separated values");
-  wirc::ChannelValues channels{};
-  for (size_t i = 0; i < wirc::kChannelCount; ++i)
-    channels[i] = static_cast<uint16_t>(values.size() == 1 ? values[0] : values[i]);
-  return channels;
+  auto channels = wirc::parseChannelList(text);
+  if (!channels) usageError(std::string(what) + ": " + channels.error());
+  return *channels;
 }
 
 void sendConfiguration(wirc::TransmitterSession& session, const wirc::Message& message,

@@ -33,6 +33,10 @@ std::string describe(const LinkEvent& event) {
                        : "control right request denied: " + e.reason;
     }
     std::string operator()(const TelemetryReceived&) const { return "status report"; }
+    std::string operator()(const InputRejected& e) const {
+      return std::to_string(e.count) + " malformed messages from the vehicle in the last second (" +
+             e.detail + ")";
+    }
     std::string operator()(const DeviceRefused& e) const {
       return "the vehicle refused " + e.request + ": error " + std::to_string(e.code) + " (" +
              e.meaning + ")";

@@ -73,8 +73,14 @@ struct DeviceRefused {
   int code;
   std::string meaning;
 };
+// Malformed input from the vehicle, summed up at most once a second (a
+// hostile or broken peer costs a counter, not a message per byte).
+struct InputRejected {
+  uint64_t count;      // since the last summary
+  std::string detail;  // by kind, e.g. "12 bad CRC, 3 unknown commands"
+};
 using LinkEvent = std::variant<StateChanged, ControlRightChanged, ControlRequestAnswered,
-                               TelemetryReceived, DeviceRefused>;
+                               TelemetryReceived, DeviceRefused, InputRejected>;
 std::string describe(const LinkEvent& event);
 
 struct LinkStatus {
@@ -82,9 +88,10 @@ struct LinkStatus {
   std::string reason;
   std::string vehicleAddress;
   bool hasControl = false;
-  std::optional<Telemetry> telemetry;
-  uint64_t logins = 0;  // 1 after the first login, +1 per reconnect
+  std::optional<Telemetry> telemetry;  // the last report, however old (see its `received`)
+  uint64_t logins = 0;                 // 1 after the first login, +1 per reconnect
   uint64_t commandsSent = 0;
+  uint64_t inputRejected = 0;  // malformed messages from the vehicle, all connections
 };
 
 // Listeners: added and removed from any thread. Once remove() returns, the

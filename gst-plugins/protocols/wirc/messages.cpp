@@ -1,6 +1,7 @@
 #include "wirc/messages.h"
 
 #include <cstdio>
+#include <string_view>
 
 #include "common/byte_reader.h"
 #include "common/byte_writer.h"
@@ -64,10 +65,17 @@ std::string channelField(size_t index, const char* what) {
   return "ch" + std::to_string(index + 1) + " " + what;
 }
 
+// Encoding is strict, decoding is not: what wircam sends is printable ASCII,
+// while what a peer sends may be any bytes (a phone that logged in as
+// "Pál’s iPhone" must still be seen to hold the control right).
+enum class TextRule { Strict, Received };
+
 // Text fields are ASCII, fit their field, and hold no zero byte (which would
-// end the text early on the receiving side).
+// end the text early on the receiving side). Received text was made safe to
+// show by readText() and is not checked again.
 std::optional<ProtocolError> checkText(Command command, const char* field, const std::string& text,
-                                       size_t maxLength) {
+                                       size_t maxLength, TextRule rule) {
+  if (rule == TextRule::Received) return std::nullopt;
   if (text.size() > maxLength)
     return fieldError(command, field,
                       std::to_string(text.size()) + " bytes, at most " + std::to_string(maxLength));
@@ -76,6 +84,46 @@ std::optional<ProtocolError> checkText(Command command, const char* field, const
       return fieldError(command, field, "holds a byte outside printable ASCII");
   }
   return std::nullopt;
+}
+
+// Whether `bytes` is UTF-8 by its byte pattern (overlong forms are not
+// looked for: the text is only shown, never interpreted).
+bool isUtf8(std::string_view bytes) {
+  for (size_t i = 0; i < bytes.size();) {
+    auto lead = static_cast<unsigned char>(bytes[i]);
+    size_t extra = lead < 0x80 ? 0
+                   : (lead & 0xE0) == 0xC0 ? 1
+                   : (lead & 0xF0) == 0xE0 ? 2
+                   : (lead & 0xF8) == 0xF0 ? 3
+                                           : 4;
+    if (extra > 3 || bytes.size() - i <= extra) return false;
+    for (size_t k = 1; k <= extra; ++k)
+      if ((static_cast<unsigned char>(bytes[i + k]) & 0xC0) != 0x80) return false;
+    i += extra + 1;
+  }
+  return true;
+}
+
+// A text field a peer sent, up to its first zero byte, made safe to show:
+// UTF-8 stays as it is, anything else is read as Latin-1; control
+// characters become \xNN.
+std::string readText(ByteReader& r, size_t width) {
+  std::string raw = r.readFixedString(width);
+  bool utf8 = isUtf8(raw);
+  std::string text;
+  for (unsigned char c : raw) {
+    if (c < 0x20 || c == 0x7F) {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", c);
+      text += escaped;
+    } else if (c < 0x80 || utf8) {
+      text += static_cast<char>(c);
+    } else {
+      text += static_cast<char>(0xC0 | (c >> 6));
+      text += static_cast<char>(0x80 | (c & 0x3F));
+    }
+  }
+  return text;
 }
 
 void writeVersion(ByteWriter& w, Version v) {
@@ -121,12 +169,12 @@ void encodeBody(const Bcsa& m, ByteWriter& w) {
 void readBody(ByteReader& r, Bcsa& m) {
   m.hardware = readVersion(r);
   m.software = readVersion(r);
-  m.name = r.readFixedString(kNameWidth);
-  m.serial = r.readFixedString(kSerialWidth);
+  m.name = readText(r, kNameWidth);
+  m.serial = readText(r, kSerialWidth);
 }
-std::optional<ProtocolError> check(const Bcsa& m) {
-  if (auto e = checkText(Command::Bcsa, "name", m.name, kNameWidth)) return e;
-  return checkText(Command::Bcsa, "serial", m.serial, kSerialWidth);
+std::optional<ProtocolError> check(const Bcsa& m, TextRule rule = TextRule::Strict) {
+  if (auto e = checkText(Command::Bcsa, "name", m.name, kNameWidth, rule)) return e;
+  return checkText(Command::Bcsa, "serial", m.serial, kSerialWidth, rule);
 }
 
 void encodeBody(const Tl& m, ByteWriter& w) {
@@ -140,11 +188,11 @@ void readBody(ByteReader& r, Tl& m) {
   m.system = r.readU8();
   m.version = readVersion(r);
   m.priority = r.readU8();
-  m.name = r.readFixedString(kNameWidth);
+  m.name = readText(r, kNameWidth);
   m.statusPort = r.readU16Be();
 }
-std::optional<ProtocolError> check(const Tl& m) {
-  return checkText(Command::Tl, "name", m.name, kNameWidth);
+std::optional<ProtocolError> check(const Tl& m, TextRule rule = TextRule::Strict) {
+  return checkText(Command::Tl, "name", m.name, kNameWidth, rule);
 }
 
 void encodeBody(const Dcfg& m, ByteWriter& w) {
@@ -153,12 +201,12 @@ void encodeBody(const Dcfg& m, ByteWriter& w) {
   w.writeU16Be(m.deviceOffMillivolts);
 }
 void readBody(ByteReader& r, Dcfg& m) {
-  m.name = r.readFixedString(kNameWidth);
+  m.name = readText(r, kNameWidth);
   m.cameraOffMillivolts = r.readU16Be();
   m.deviceOffMillivolts = r.readU16Be();
 }
-std::optional<ProtocolError> check(const Dcfg& m) {
-  return checkText(Command::Dcfg, "name", m.name, kNameWidth);
+std::optional<ProtocolError> check(const Dcfg& m, TextRule rule = TextRule::Strict) {
+  return checkText(Command::Dcfg, "name", m.name, kNameWidth, rule);
 }
 
 void encodeBody(const Ccfg& m, ByteWriter& w) { writeChannels(w, m.periods); }
@@ -240,18 +288,18 @@ void encodeBody(const Wcfg& m, ByteWriter& w) {
   w.writeFixedString(m.country, kCountryWidth);
 }
 void readBody(ByteReader& r, Wcfg& m) {
-  m.ssid = r.readFixedString(kSsidWidth);
-  m.password = r.readFixedString(kPasswordWidth);
+  m.ssid = readText(r, kSsidWidth);
+  m.password = readText(r, kPasswordWidth);
   // AP and Sec are 0/1 on the wire; any non-zero byte is taken as 1.
   m.accessPoint = r.readU8() != 0;
   m.secured = r.readU8() != 0;
   m.channel = r.readU8();
-  m.country = r.readFixedString(kCountryWidth);
+  m.country = readText(r, kCountryWidth);
 }
-std::optional<ProtocolError> check(const Wcfg& m) {
-  if (auto e = checkText(Command::Wcfg, "ssid", m.ssid, kSsidWidth)) return e;
-  if (auto e = checkText(Command::Wcfg, "password", m.password, kPasswordWidth)) return e;
-  return checkText(Command::Wcfg, "country", m.country, kCountryWidth - 1);
+std::optional<ProtocolError> check(const Wcfg& m, TextRule rule = TextRule::Strict) {
+  if (auto e = checkText(Command::Wcfg, "ssid", m.ssid, kSsidWidth, rule)) return e;
+  if (auto e = checkText(Command::Wcfg, "password", m.password, kPasswordWidth, rule)) return e;
+  return checkText(Command::Wcfg, "country", m.country, kCountryWidth - 1, rule);
 }
 
 void encodeBody(const Tlr&, ByteWriter&) {}
@@ -266,10 +314,10 @@ void encodeBody(const Tlst& m, ByteWriter& w) {
 void readBody(ByteReader& r, Tlst& m) {
   m.connectionId = r.readU8();
   m.priority = r.readU8();
-  m.name = r.readFixedString(kNameWidth);
+  m.name = readText(r, kNameWidth);
 }
-std::optional<ProtocolError> check(const Tlst& m) {
-  return checkText(Command::Tlst, "name", m.name, kNameWidth);
+std::optional<ProtocolError> check(const Tlst& m, TextRule rule = TextRule::Strict) {
+  return checkText(Command::Tlst, "name", m.name, kNameWidth, rule);
 }
 
 void encodeBody(const Tlend&, ByteWriter&) {}
@@ -289,14 +337,14 @@ void encodeBody(const Agr& m, ByteWriter& w) {
 void readBody(ByteReader& r, Agr& m) {
   m.connectionId = r.readU8();
   m.priority = r.readU8();
-  m.name = r.readFixedString(kNameWidth);
+  m.name = readText(r, kNameWidth);
   m.notification = static_cast<AccessNotification>(r.readU8());
 }
-std::optional<ProtocolError> check(const Agr& m) {
+std::optional<ProtocolError> check(const Agr& m, TextRule rule = TextRule::Strict) {
   if (static_cast<uint8_t>(m.notification) > 3)
     return fieldError(Command::Agr, "notif",
                       std::to_string(static_cast<int>(m.notification)) + " is not 0..3");
-  return checkText(Command::Agr, "name", m.name, kNameWidth);
+  return checkText(Command::Agr, "name", m.name, kNameWidth, rule);
 }
 
 void encodeBody(const Fwup& m, ByteWriter& w) { w.writeBytes(m.md5); }
@@ -368,7 +416,12 @@ Expected<Message, ProtocolError> decodeAs(uint8_t command, std::span<const uint8
     T message;
     ByteReader reader(body);
     readBody(reader, message);
-    if (auto error = check(message)) return unexpected(std::move(*error));
+    std::optional<ProtocolError> error;
+    if constexpr (requires { check(message, TextRule::Received); })
+      error = check(message, TextRule::Received);
+    else
+      error = check(message);
+    if (error) return unexpected(std::move(*error));
     return Message{std::move(message)};
   }
 }

@@ -7,7 +7,10 @@
 //                  \____ CRC-16/XMODEM over ____/
 //
 // encode() refuses values the spec forbids, so no out-of-range pulse or
-// period can be put on the wire through it; decode() applies the same rules.
+// period can be put on the wire through it; decode() applies the same rules
+// except to text: a peer's text fields are taken up to their first zero byte
+// whatever they hold, and made safe to show (UTF-8 kept, other bytes read as
+// Latin-1, control characters escaped as \xNN).
 #pragma once
 
 #include <array>

@@ -1,5 +1,6 @@
 #include "wirc/transmitter_session.h"
 
+#include <netinet/tcp.h>
 #include <sys/epoll.h>
 #include <sys/socket.h>
 
@@ -13,6 +14,7 @@
 
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
+#include "wirc/channel_list.h"
 #include "wirc/discovery.h"
 #include "wirc/message_stream_parser.h"
 
@@ -28,6 +30,10 @@ constexpr milliseconds kFirstBackoff{200};
 constexpr milliseconds kMaxBackoff{5000};
 // Discovery listens this long (at most) for the devices to answer.
 constexpr milliseconds kDiscoveryWindow{1000};
+// One read callback takes at most this much, so a flooding device cannot
+// starve the other links of the event loop.
+constexpr size_t kMaxReadPerWake = 64 * 1024;
+constexpr milliseconds kRejectSummaryPeriod{1000};
 
 // FCFG's special values are not pulses; PCD sends neutral for them.
 link::Pulses pcdFailsafe(const ChannelValues& failsafe) {
@@ -44,12 +50,6 @@ link::PacerConfig pacerConfig(const SessionConfig& config) {
           .ttl = config.commandTtl,
           .failsafe = pcdFailsafe(config.failsafe),
           .keepaliveEarly = EventLoop::kCoalesce};
-}
-
-std::string joined(const ChannelValues& values) {
-  std::string text;
-  for (auto v : values) text += (text.empty() ? "" : ",") + std::to_string(v);
-  return text;
 }
 
 // A setting several users of one link may give: how it reads in a message,
@@ -83,12 +83,13 @@ const std::vector<SharedSetting>& sharedSettings() {
   static const std::vector<SharedSetting> settings = {
       shared("transmitter-name", &SessionConfig::transmitterName, quoted, true),
       shared("priority", &SessionConfig::priority, integer, true),
-      shared("periods", &SessionConfig::periods, joined, true),
-      shared("failsafe", &SessionConfig::failsafe, joined, true),
+      shared("periods", &SessionConfig::periods, formatChannelList, true),
+      shared("failsafe", &SessionConfig::failsafe, formatChannelList, true),
       shared("pcd-rate", &SessionConfig::pcdRate, number, false),
       shared("keepalive", &SessionConfig::keepalive, ms, false),
       shared("command-ttl", &SessionConfig::commandTtl, ms, false),
       shared("login-timeout", &SessionConfig::loginTimeout, ms, false),
+      shared("link-timeout", &SessionConfig::linkTimeout, ms, false),
       shared("reconnect", &SessionConfig::reconnect, flag, false),
   };
   return settings;
@@ -152,6 +153,8 @@ class TransmitterSession::Impl {
   void closeConnection();
   void onPsd();
   void onPacerTimer();
+  void onStatusTimer();
+  void countRejected(Clock::time_point now);
 
   bool sendControl(const Message& message);
   void sendPcd(const link::Pulses& pulses);
@@ -164,6 +167,7 @@ class TransmitterSession::Impl {
   EventLoop::Id psdWatch_ = 0;
   EventLoop::Id attemptTimer_ = 0;
   EventLoop::Id pacerTimer_ = 0;
+  EventLoop::Id statusTimer_ = 0;
 
   // Loop thread only.
   Phase phase_ = Phase::Waiting;
@@ -174,6 +178,11 @@ class TransmitterSession::Impl {
   std::vector<DiscoveredDevice> found_;
   EventLoop::Id tcpWatch_ = 0;
   MessageStreamParser parser_;  // one per connection, for its whole life
+  Clock::time_point lastHeard_;  // login, or the last PSD
+  uint64_t rejectedThisConnection_ = 0;  // malformed messages, weighted
+  uint64_t rejectedUnreported_ = 0;      // since the last summary
+  StreamParserStats reported_;           // parser counters at the last summary
+  Clock::time_point lastSummary_;
 
   // Guards everything below; never held while sending, waiting or emitting.
   mutable std::mutex mutex_;
@@ -204,6 +213,7 @@ TransmitterSession::Impl::Impl(SessionConfig config, link::LinkListeners& listen
   setNonBlocking(pcdSocket_.get());
   psdWatch_ = loop_.watch(psdSocket_.get(), EPOLLIN, [this](uint32_t) { onPsd(); });
   pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
+  statusTimer_ = loop_.addTimer([this] { onStatusTimer(); });
   attemptTimer_ = loop_.addTimer([this] { onAttemptTimer(); });
   loop_.arm(attemptTimer_, Clock::now());
 }
@@ -220,7 +230,7 @@ TransmitterSession::Impl::~Impl() {
     // Log out: stop the streams this session started (best effort, no wait).
     for (const auto& [camera, port] : streams) sendControl(Est{camera});
     closeConnection();
-    for (auto id : {psdWatch_, attemptTimer_, pacerTimer_}) loop_.remove(id);
+    for (auto id : {psdWatch_, attemptTimer_, pacerTimer_, statusTimer_}) loop_.remove(id);
   });
 }
 
@@ -339,8 +349,17 @@ void TransmitterSession::Impl::startConnect(const SocketAddress& device, const s
     std::lock_guard lock(sendMutex_);
     tcp_ = std::move(*fd);
   }
+  // TCP's own keepalive as well, for a device that vanishes while PSD are
+  // off (the link timeout normally notices first).
+  int on = 1, idle = 2, interval = 1, probes = 3;
+  setsockopt(fdNumber, SOL_SOCKET, SO_KEEPALIVE, &on, sizeof on);
+  setsockopt(fdNumber, IPPROTO_TCP, TCP_KEEPIDLE, &idle, sizeof idle);
+  setsockopt(fdNumber, IPPROTO_TCP, TCP_KEEPINTVL, &interval, sizeof interval);
+  setsockopt(fdNumber, IPPROTO_TCP, TCP_KEEPCNT, &probes, sizeof probes);
   phase_ = Phase::Connecting;
   parser_ = MessageStreamParser();
+  reported_ = {};
+  rejectedThisConnection_ = 0;
   tcpWatch_ = loop_.watch(fdNumber, EPOLLOUT, [this](uint32_t events) { onTcp(events); });
   loop_.arm(attemptTimer_, attemptDeadline_);
 }
@@ -355,7 +374,7 @@ void TransmitterSession::Impl::onTcp(uint32_t events) {
     return onConnected();
   }
   std::array<uint8_t, 4096> buffer;
-  for (;;) {
+  for (size_t taken = 0; taken < kMaxReadPerWake; taken += buffer.size()) {
     ssize_t n = ::recv(tcp_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT);
     if (n == 0) return fail("the device closed the connection");
     if (n < 0) {
@@ -371,7 +390,42 @@ void TransmitterSession::Impl::onTcp(uint32_t events) {
                    closed = !tcp_.valid();
                  });
     if (closed) return;
+    countRejected(Clock::now());
+    if (!tcp_.valid()) return;
   }
+}
+
+// Malformed input is counted, summed up once a second, and past
+// maxBadMessages on one connection taken as a misbehaving device.
+void TransmitterSession::Impl::countRejected(Clock::time_point now) {
+  const auto& stats = parser_.stats();
+  // Garbage is counted in bytes: 64 of them weigh as one bad message.
+  uint64_t rejected =
+      stats.badCrc + stats.unknownCommands + stats.invalidMessages + stats.garbageBytes / 64;
+  if (rejected == rejectedThisConnection_) return;
+  rejectedUnreported_ += rejected - rejectedThisConnection_;
+  uint32_t limit;
+  {
+    std::lock_guard lock(mutex_);
+    status_.inputRejected += rejected - rejectedThisConnection_;
+    limit = config_.maxBadMessages;
+  }
+  rejectedThisConnection_ = rejected;
+  if (now - lastSummary_ >= kRejectSummaryPeriod) {
+    auto since = [](uint64_t now, uint64_t then) { return std::to_string(now - then); };
+    publish({link::InputRejected{
+        rejectedUnreported_,
+        since(stats.badCrc, reported_.badCrc) + " bad CRC, " +
+            since(stats.unknownCommands, reported_.unknownCommands) + " unknown commands, " +
+            since(stats.invalidMessages, reported_.invalidMessages) + " invalid, " +
+            since(stats.garbageBytes, reported_.garbageBytes) + " bytes of garbage"}});
+    reported_ = stats;
+    rejectedUnreported_ = 0;
+    lastSummary_ = now;
+  }
+  if (rejectedThisConnection_ > limit)
+    fail("the device sent " + std::to_string(rejectedThisConnection_) +
+         " malformed messages: dropped as misbehaving");
 }
 
 void TransmitterSession::Impl::onConnected() {
@@ -395,6 +449,7 @@ void TransmitterSession::Impl::onLoggedIn(const Wst& wst) {
   phase_ = Phase::LoggedIn;
   backoff_ = kFirstBackoff;
   loop_.disarm(attemptTimer_);
+  lastHeard_ = Clock::now();
   std::map<uint8_t, uint16_t> streams;
   std::string address;
   {
@@ -408,6 +463,7 @@ void TransmitterSession::Impl::onLoggedIn(const Wst& wst) {
     ::connect(pcdSocket_.get(), controlAddress_->raw(), controlAddress_->size());
     streams = streamPorts_;
     address = device_->toString();
+    if (config_.linkTimeout.count() > 0) loop_.arm(statusTimer_, lastHeard_ + config_.linkTimeout);
   }
   changed_.notify_all();
   publish({link::StateChanged{link::LinkState::Live, "logged in to " + address + " as connection " +
@@ -498,6 +554,7 @@ void TransmitterSession::Impl::fail(const std::string& why, Retry retryWhen) {
   bool retryAtOnce = retryWhen == Retry::AtOnceForNewSettings;
   closeConnection();
   loop_.disarm(pacerTimer_);
+  loop_.disarm(statusTimer_);
   link::LinkState state;
   bool retry;
   std::vector<link::LinkEvent> events;
@@ -549,11 +606,27 @@ void TransmitterSession::Impl::onPsd() {
     {
       std::lock_guard lock(mutex_);
       if (!device_ || !device_->sameHost(SocketAddress(from))) continue;  // not our device
+      lastHeard_ = telemetry.received;
       status_.lastStatus = psd;
       status_.telemetry = telemetry;
     }
     publish({link::TelemetryReceived{telemetry}});
   }
+}
+
+void TransmitterSession::Impl::onStatusTimer() {
+  if (phase_ != Phase::LoggedIn) return;
+  milliseconds timeout;
+  {
+    std::lock_guard lock(mutex_);
+    timeout = config_.linkTimeout;
+  }
+  auto silent = Clock::now() - lastHeard_;
+  if (timeout.count() > 0 && silent >= timeout)
+    return fail("no status report from the device for " +
+                std::to_string(std::chrono::duration_cast<milliseconds>(silent).count()) +
+                " ms (link-timeout): it is off, out of range or gone");
+  loop_.arm(statusTimer_, lastHeard_ + timeout);
 }
 
 void TransmitterSession::Impl::onPacerTimer() {
@@ -577,6 +650,9 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
   if (config.keepalive > kMaxKeepalive || config.keepalive.count() <= 0)
     return unexpected("keepalive " + ms(config.keepalive) + " is outside 1.." + ms(kMaxKeepalive) +
                       ": it must stay well below the device's PCD timeout (200..2000 ms)");
+  if (config.linkTimeout.count() > 0 && config.linkTimeout < milliseconds(2 * kPsdPeriodMs))
+    return unexpected("link-timeout " + ms(config.linkTimeout) + " is shorter than two status " +
+                      "reports (" + ms(milliseconds(2 * kPsdPeriodMs)) + "): use 0 (off) or more");
   if (auto tl = encode(Tl{.name = config.transmitterName}); !tl)
     return unexpected("transmitter-name " + quoted(config.transmitterName) +
                       " cannot be sent: " + tl.error().message());

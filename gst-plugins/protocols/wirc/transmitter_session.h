@@ -40,6 +40,12 @@ struct SessionConfig {
   std::chrono::milliseconds keepalive{100};   // PCD repeat while nothing changes
   std::chrono::milliseconds commandTtl{250};  // older commands give way to the failsafe
   std::chrono::milliseconds loginTimeout{3000};
+  // No status report (PSD, every 500 ms) for this long means the device is
+  // gone even if TCP has not noticed (power cut, out of range).
+  std::chrono::milliseconds linkTimeout{2000};
+  // Malformed messages one connection may bring before the device is taken
+  // for misbehaving: the connection is dropped and made again after backoff.
+  uint32_t maxBadMessages = 100;
   bool reconnect = true;
   // The settings this user set, by property name ("transmitter-name",
   // "priority", "pcd-rate", ...). The others defer to another user's.

@@ -286,6 +286,46 @@ TEST(Messages, TruncatedOrOverlongFramesAreRejected) {
   EXPECT_FALSE(decode(frame).has_value());
 }
 
+// An AGR (or TLST) whose name field holds these raw bytes.
+Bytes agrNamed(const std::string& raw) {
+  Bytes body(1 + 1 + 64 + 1, 0);  // ID, priority, name, notification
+  body[0] = 1;
+  body[1] = 5;
+  std::copy(raw.begin(), raw.end(), body.begin() + 2);
+  body.back() = static_cast<uint8_t>(AccessNotification::Revoked);
+  return frameRaw(static_cast<uint8_t>(Command::Agr), body);
+}
+
+TEST(Messages, ReceivedUtf8NamesAreKeptAsTheyAre) {
+  auto decoded = decode(agrNamed("P\xC3\xA1l\xE2\x80\x99s iPhone"));
+  ASSERT_TRUE(decoded.has_value()) << decoded.error().message();
+  EXPECT_EQ(std::get<Agr>(*decoded).name, "Pál’s iPhone");
+}
+
+TEST(Messages, ReceivedLatin1NamesAreShownAsUtf8) {
+  auto decoded = decode(agrNamed("P\xE1l"));
+  ASSERT_TRUE(decoded.has_value()) << decoded.error().message();
+  EXPECT_EQ(std::get<Agr>(*decoded).name, "Pál");
+}
+
+TEST(Messages, ControlCharactersInReceivedTextAreEscaped) {
+  auto decoded = decode(agrNamed("bell\x07"));
+  ASSERT_TRUE(decoded.has_value()) << decoded.error().message();
+  EXPECT_EQ(std::get<Agr>(*decoded).name, "bell\\x07");
+}
+
+TEST(Messages, ReceivedTextEndsAtItsFirstZeroByte) {
+  auto decoded = decode(agrNamed(std::string("short\0garbage", 13)));
+  ASSERT_TRUE(decoded.has_value());
+  EXPECT_EQ(std::get<Agr>(*decoded).name, "short");
+}
+
+TEST(Messages, EncodingTextStaysPrintableAscii) {
+  auto encoded = encode(Tl{.name = "Pál"});
+  ASSERT_FALSE(encoded.has_value());
+  EXPECT_NE(encoded.error().message().find("printable ASCII"), std::string::npos);
+}
+
 TEST(Messages, CommandNamesCoverTheSpec) {
   EXPECT_EQ(commandName(0x13), "CCFG");
   EXPECT_EQ(commandName(0xFF), "ERR");
