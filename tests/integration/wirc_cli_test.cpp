@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "wait_for.h"
 #include "wirc/device.h"
 #include "wirc/transmitter_session.h"
 
@@ -47,6 +48,36 @@ TEST(WircCli, RequestControlExitsZeroWhenGranted) {
   auto run = wircCli("request-control 1 --host 127.0.0.1 --port " + std::to_string(device->port()) +
                      " --priority 5");
   EXPECT_EQ(run.exitCode, 0) << run.output;
+}
+
+TEST(WircCli, WifiNeedsACountryCode) {
+  auto run = wircCli("wifi --ssid lab --host 127.0.0.1");
+  EXPECT_EQ(run.exitCode, 2) << run.output;
+  EXPECT_NE(run.output.find("--country"), std::string::npos) << run.output;
+}
+
+TEST(WircCli, ExtoutSendsBytesToANamedDestination) {
+  auto device = std::move(*Device::start({.port = 0}, nullptr));
+  auto run = wircCli("extout --destination uart --data 'de ad be ef' --host 127.0.0.1 --port " +
+                     std::to_string(device->port()));
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("4 bytes sent to port 0x01"), std::string::npos) << run.output;
+}
+
+TEST(WircCli, ExtoutRefusesMoreBytesThanTheMessageCarries) {
+  auto run = wircCli("extout --destination spi-data --data " + std::string(2 * 255, 'a') +
+                     " --host 127.0.0.1");
+  EXPECT_EQ(run.exitCode, 2) << run.output;
+}
+
+TEST(WircCli, FirmwareUpdateRestartsTheDevice) {
+  auto device = std::move(*Device::start({.port = 0, .restartTime = milliseconds(100)}, nullptr));
+  auto run = wircCli("firmware-update --md5 00112233445566778899aabbccddeeff --host 127.0.0.1 "
+                     "--port " + std::to_string(device->port()));
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_TRUE(testing::waitFor([&] { return device->stats().restarts == 1; }));
+  auto bad = wircCli("firmware-update --md5 0011 --host 127.0.0.1");
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;
 }
 
 }  // namespace

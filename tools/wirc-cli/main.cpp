@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "hex.h"
 #include "message_json.h"
 #include "wirc/channel_list.h"
 #include "wirc/discovery.h"
@@ -42,9 +43,17 @@ Commands:
                                set channel periods (CCFG) and failsafe values (FCFG);
                                12 comma-separated values, or one for all channels
   set-name NAME                rename the device (DCFG; after its next restart)
-  wifi --ssid S [--password-stdin] [--station] [--channel N] [--country CC]
-                               WiFi settings (WCFG); the password is read from
-                               stdin and never printed or logged
+  wifi --ssid S --country CC [--password-stdin] [--station] [--channel N]
+                               WiFi settings (WCFG); CC is the two-letter country
+                               code the radio's channels and power obey (e.g. HU,
+                               US); the password is read from stdin and never
+                               printed or logged
+  extout --destination D --data HEX
+                               send bytes out of an external port (EXTOUT): D is
+                               null (0x00), uart (0x01), spi-data (0x81),
+                               spi-command (0x82) or a number; at most 254 bytes
+  firmware-update --md5 HEX    announce a firmware image by its MD5 (FWUP, 32 hex
+                               digits); the device disconnects everyone and restarts
   stream --camera N --out FILE.mjpeg|DIR [--frames N] [--duration S]
                                save whole frames: concatenated to a file, or one
                                JPEG per frame into a folder
@@ -80,7 +89,7 @@ struct Options {
   uint8_t priority = 0;
   milliseconds timeout{3000};
   // Command-specific.
-  std::optional<std::string> periods, failsafe, ssid, out, country;
+  std::optional<std::string> periods, failsafe, ssid, out, country, destination, data, md5;
   bool passwordStdin = false, station = false, raw = false;
   int camera = 0, channel = 1;
   std::optional<int> frames;
@@ -132,7 +141,10 @@ Options parse(int argc, char** argv) {
     kSteering,
     kThrottle,
     kRaw,
-    kToPort
+    kToPort,
+    kDestination,
+    kData,
+    kMd5
   };
   static const option options[] = {{"host", required_argument, nullptr, kHost},
                                    {"port", required_argument, nullptr, kPort},
@@ -156,6 +168,9 @@ Options parse(int argc, char** argv) {
                                    {"throttle", required_argument, nullptr, kThrottle},
                                    {"raw", no_argument, nullptr, kRaw},
                                    {"to-port", required_argument, nullptr, kToPort},
+                                   {"destination", required_argument, nullptr, kDestination},
+                                   {"data", required_argument, nullptr, kData},
+                                   {"md5", required_argument, nullptr, kMd5},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};
   Options o;
@@ -231,6 +246,15 @@ Options parse(int argc, char** argv) {
         break;
       case kToPort:
         o.toPort = static_cast<uint16_t>(integer(optarg, "--to-port", 1, 65535));
+        break;
+      case kDestination:
+        o.destination = optarg;
+        break;
+      case kData:
+        o.data = optarg;
+        break;
+      case kMd5:
+        o.md5 = optarg;
         break;
       default:
         usageError("unknown option");
@@ -438,18 +462,18 @@ int drive(const Options& o) {
 std::vector<uint8_t> readStdin(bool raw) {
   std::string input((std::istreambuf_iterator<char>(std::cin)), {});
   if (raw) return {input.begin(), input.end()};
-  std::vector<uint8_t> bytes;
-  std::string digits;
-  for (char c : input) {
-    if (std::isxdigit(static_cast<unsigned char>(c)))
-      digits += c;
-    else if (!std::isspace(static_cast<unsigned char>(c)) && c != ',' && c != ':')
-      usageError(std::string("not hex: '") + c + "'");
-  }
-  if (digits.size() % 2) usageError("an odd number of hex digits");
-  for (size_t i = 0; i < digits.size(); i += 2)
-    bytes.push_back(static_cast<uint8_t>(std::stoi(digits.substr(i, 2), nullptr, 16)));
-  return bytes;
+  auto bytes = cli::parseHex(input);
+  if (!bytes) usageError(bytes.error());
+  return *bytes;
+}
+
+// EXTOUT's destinations by the names real devices use, or a number.
+uint8_t destinationOf(const std::string& text) {
+  static const std::map<std::string, uint8_t> names = {
+      {"null", 0x00}, {"uart", 0x01}, {"spi-data", 0x81}, {"spi-command", 0x82}};
+  if (auto found = names.find(text); found != names.end()) return found->second;
+  return static_cast<uint8_t>(
+      integer(text.c_str(), "--destination (null, uart, spi-data, spi-command or 0..255)", 0, 255));
 }
 
 int decodeCommand(const Options& o) {
@@ -532,8 +556,32 @@ int main(int argc, char** argv) {
     std::printf("the device takes the name '%s' at its next restart\n", o.positional[0].c_str());
     return 0;
   }
+  if (command == "extout") {
+    if (!o.destination || !o.data) usageError("extout needs --destination D and --data HEX");
+    auto data = cli::parseHex(*o.data);
+    if (!data) usageError("--data: " + data.error());
+    wirc::Extout message{.destination = destinationOf(*o.destination), .data = *data};
+    if (auto invalid = wirc::validate(message)) usageError(invalid->message());
+    auto session = login(o);
+    sendConfiguration(*session, message, milliseconds(500));
+    std::printf("%zu bytes sent to port 0x%02x\n", data->size(), message.destination);
+    return 0;
+  }
+  if (command == "firmware-update") {
+    if (!o.md5) usageError("firmware-update needs --md5 HEX (32 hex digits)");
+    auto md5 = cli::parseHex(*o.md5);
+    if (!md5 || md5->size() != 16) usageError("--md5 wants 32 hex digits");
+    wirc::Fwup message;
+    std::copy(md5->begin(), md5->end(), message.md5.begin());
+    auto session = login(o);
+    sendConfiguration(*session, message, milliseconds(500));
+    std::printf("firmware update announced: the device disconnects everyone and restarts\n");
+    return 0;
+  }
   if (command == "wifi") {
     if (!o.ssid) usageError("wifi needs --ssid");
+    // The radio's legal channels and power depend on it: no silent default.
+    if (!o.country) usageError("wifi needs --country CC, the two-letter country code (e.g. HU)");
     std::string password;
     if (o.passwordStdin) std::getline(std::cin, password);
     auto session = login(o);
@@ -543,7 +591,7 @@ int main(int argc, char** argv) {
                                  .accessPoint = !o.station,
                                  .secured = !password.empty(),
                                  .channel = static_cast<uint8_t>(o.channel),
-                                 .country = o.country.value_or("")},
+                                 .country = *o.country},
                       milliseconds(500));
     std::printf("WiFi settings sent (password %s); they apply after the device restarts\n",
                 password.empty() ? "none: open network" : "set");
