@@ -53,24 +53,20 @@ struct HttpServer::CameraFeed {
   nlohmann::json detections = nlohmann::json::array();  // the last ones
 };
 
-HttpServer::HttpServer(Content content) : content_(std::move(content)) {}
+HttpServer::HttpServer(Content content, std::chrono::milliseconds idleTimeout)
+    : content_(std::move(content)), idleTimeout_(idleTimeout) {}
 
-Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(const ServerAddress& address,
-                                                                     Content content) {
-  std::unique_ptr<HttpServer> self(new HttpServer(std::move(content)));
+Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
+    const ServerAddress& address, Content content, std::chrono::milliseconds idleTimeout) {
+  std::unique_ptr<HttpServer> self(new HttpServer(std::move(content), idleTimeout));
   self->server_ = soup_server_new("server-header", "wirc-recorder", nullptr);
   GError* error = nullptr;
-  gboolean listening;
-  if (address.host.empty()) {
-    listening = soup_server_listen_all(self->server_, address.port, SoupServerListenOptions(0),
-                                       &error);
-  } else {
-    GSocketAddress* socket = g_inet_socket_address_new_from_string(address.host.c_str(),
-                                                                   address.port);
-    if (!socket) return unexpected("--http: '" + address.host + "' is not an IP address");
-    listening = soup_server_listen(self->server_, socket, SoupServerListenOptions(0), &error);
-    g_object_unref(socket);
-  }
+  GSocketAddress* socket =
+      g_inet_socket_address_new_from_string(address.listenHost().c_str(), address.port);
+  if (!socket) return unexpected("--http: '" + address.host + "' is not an IP address");
+  gboolean listening =
+      soup_server_listen(self->server_, socket, SoupServerListenOptions(0), &error);
+  g_object_unref(socket);
   if (!listening) {
     std::string text = "--http: cannot listen on port " + std::to_string(address.port) + ": " +
                        error->message;
@@ -81,10 +77,13 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(const Serve
   GSList* uris = soup_server_get_uris(self->server_);
   int port = uris ? g_uri_get_port(static_cast<GUri*>(uris->data)) : address.port;
   g_slist_free_full(uris, reinterpret_cast<GDestroyNotify>(g_uri_unref));
-  self->url_ = "http://" + (address.host.empty() ? std::string("localhost") : address.host) + ":" +
-               std::to_string(port) + "/";
+  self->url_ = "http://" + address.listenHost() + ":" + std::to_string(port) + "/";
 
+  soup_server_add_early_handler(self->server_, nullptr, onHeaders, self.get(), nullptr);
   soup_server_add_handler(self->server_, nullptr, onRequest, self.get(), nullptr);
+  g_signal_connect(self->server_, "request-started", G_CALLBACK(onRequestStarted), self.get());
+  g_signal_connect(self->server_, "request-finished", G_CALLBACK(onRequestEnded), self.get());
+  g_signal_connect(self->server_, "request-aborted", G_CALLBACK(onRequestEnded), self.get());
   for (size_t i = 0; i < self->content_.cameras.size(); ++i) {
     auto feed = std::make_unique<CameraFeed>();
     feed->name = self->content_.cameras[i].name;
@@ -147,14 +146,54 @@ HttpServer::~HttpServer() {
   }
 }
 
+// A new request, on a new or a kept-alive connection: too many open at
+// once and its connection is closed; otherwise reads and writes that wait
+// longer than the idle timeout end it (a half-open request holds nothing
+// for long).
+void HttpServer::onRequestStarted(SoupServer*, SoupServerMessage* message, gpointer data) {
+  auto* self = static_cast<HttpServer*>(data);
+  GSocket* socket = soup_server_message_get_socket(message);
+  if (++self->openRequests_ > kMaxRequests) {
+    if (socket) g_socket_shutdown(socket, TRUE, TRUE, nullptr);
+    return;
+  }
+  if (socket)
+    g_socket_set_timeout(
+        socket, static_cast<guint>(std::max<int64_t>(1, (self->idleTimeout_.count() + 999) / 1000)));
+}
+
+void HttpServer::onRequestEnded(SoupServer*, SoupServerMessage*, gpointer data) {
+  --static_cast<HttpServer*>(data)->openRequests_;
+}
+
+// After the headers, before any body: only GET and HEAD are served, so a
+// body (however large it says it is) is refused unread.
+void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*, GHashTable*,
+                           gpointer) {
+  std::string method = soup_server_message_get_method(message);
+  auto* headers = soup_server_message_get_request_headers(message);
+  bool hasBody = soup_message_headers_get_content_length(headers) > 0 ||
+                 soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CHUNKED;
+  if (method == "GET" || method == "HEAD") {
+    if (!hasBody) return;
+  }
+  // libsoup would read the whole body before answering: answer on the
+  // socket now, and close it. Nothing of this request was written yet.
+  std::string answer = method != "GET" && method != "HEAD"
+                           ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD\r\n"
+                           : "HTTP/1.1 413 Content Too Large\r\n";
+  answer += "Content-Length: 0\r\nConnection: close\r\n\r\n";
+  soup_message_body_set_accumulate(soup_server_message_get_request_body(message), FALSE);
+  if (GSocket* socket = soup_server_message_get_socket(message)) {
+    g_socket_send(socket, answer.data(), answer.size(), nullptr, nullptr);
+    g_socket_shutdown(socket, TRUE, TRUE, nullptr);
+  }
+  soup_server_message_set_status(message, SOUP_STATUS_BAD_REQUEST, nullptr);
+}
+
 void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
                            gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
-  std::string method = soup_server_message_get_method(message);
-  if (method != "GET" && method != "HEAD") {
-    respondError(message, SOUP_STATUS_METHOD_NOT_ALLOWED, "only GET and HEAD");
-    return;
-  }
   std::string route = path;
   if (route == "/" || route == "/index.html") {
     respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", self->page());
@@ -303,7 +342,10 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
     nlohmann::json files = nlohmann::json::array();
     std::error_code error;
     for (const auto& entry : fs::directory_iterator(folder, error)) {
-      if (!entry.is_regular_file(error) || !contentTypeOf(entry.path())) continue;
+      // A symbolic link could lead anywhere on the machine: never listed.
+      if (entry.is_symlink(error) || !entry.is_regular_file(error) ||
+          !contentTypeOf(entry.path()))
+        continue;
       auto file = entry.path().filename().string();
       files.push_back({{"name", file},
                        {"bytes", entry.file_size(error)},
@@ -314,18 +356,20 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
     respond(message, SOUP_STATUS_OK, "application/json", files.dump());
     return;
   }
-  // Only plain names of recordings in the folder: no way out of it.
+  // Only plain names of recordings in the folder, never a symbolic link:
+  // no way out of it.
   fs::path file = folder / name;
+  std::error_code error;
   if (name.find('/') != std::string::npos || name[0] == '.' || !contentTypeOf(file) ||
-      !fs::is_regular_file(file)) {
+      fs::is_symlink(fs::symlink_status(file, error)) || !fs::is_regular_file(file, error)) {
     respondError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
     return;
   }
-  GError* error = nullptr;
-  GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &error);
+  GError* mapError = nullptr;
+  GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &mapError);
   if (!mapped) {
-    respondError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR, error->message);
-    g_error_free(error);
+    respondError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR, mapError->message);
+    g_error_free(mapError);
     return;
   }
   GBytes* bytes = g_mapped_file_get_bytes(mapped);

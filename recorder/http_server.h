@@ -7,6 +7,7 @@
 #include <libsoup/soup.h>
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -32,8 +33,14 @@ class HttpServer {
     std::function<std::vector<std::string>()> openSegments;
   };
 
-  static Expected<std::unique_ptr<HttpServer>, std::string> start(const ServerAddress& address,
-                                                                  Content content);
+  // Limits that keep hostile clients from holding the recorder's memory or
+  // connections: a request body is never read (only GET and HEAD are
+  // served), a connection silent for `idleTimeout` is closed, and at most
+  // kMaxRequests are open at once (the rest are closed at once).
+  static constexpr int kMaxRequests = 128;
+  static Expected<std::unique_ptr<HttpServer>, std::string> start(
+      const ServerAddress& address, Content content,
+      std::chrono::milliseconds idleTimeout = std::chrono::seconds(10));
   ~HttpServer();
 
   // "http://HOST:PORT/", with the port the system picked for port 0.
@@ -45,10 +52,14 @@ class HttpServer {
  private:
   struct Client;
   struct CameraFeed;
-  explicit HttpServer(Content content);
+  HttpServer(Content content, std::chrono::milliseconds idleTimeout);
 
   static void onRequest(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
                         gpointer self);
+  static void onHeaders(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
+                        gpointer self);
+  static void onRequestStarted(SoupServer*, SoupServerMessage* message, gpointer self);
+  static void onRequestEnded(SoupServer*, SoupServerMessage* message, gpointer self);
   std::string page() const;  // the live view page with the current state
   void serveLive(SoupServerMessage* message, const std::string& camera);
   void serveEvents(SoupServerMessage* message);
@@ -64,6 +75,8 @@ class HttpServer {
   std::string url_;
   std::vector<std::unique_ptr<CameraFeed>> feeds_;
   std::vector<std::unique_ptr<Client>> eventClients_;
+  std::chrono::milliseconds idleTimeout_;
+  int openRequests_ = 0;  // main loop only
   // Frames queued for the main loop check it: the server may be gone.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

@@ -44,13 +44,17 @@ text track in the file. SIGINT or SIGTERM finishes every file and exits 0.
   --min-free SIZE        delete the oldest finished segments while the disk
                          has less than SIZE free
   --http [HOST]:PORT     web server: live view at /, status at /api/status,
-                         recordings at /recordings (e.g. --http :8080)
-  --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>
+                         recordings at /recordings (e.g. --http :8080). Without
+                         HOST it listens on 127.0.0.1 only; 0.0.0.0:8080 opens
+                         it to the network (it has no authentication yet)
+  --http-idle-timeout S  close an HTTP connection silent for S seconds (default 10)
+  --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>; without
+                         HOST on 127.0.0.1 only
   -h, --help             this text
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
-min-free, status, http, rtsp, periods, failsafe), and one
+min-free, status, http, http-idle-timeout, rtsp, periods, failsafe), and one
 [device NAME] group per vehicle with host, port, cameras (e.g. 0;1) and follow:
 
   [recorder]
@@ -226,6 +230,10 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto address = parseServerAddress(value);
     if (!address) return "[HOST]:PORT, as in :8080 or 127.0.0.1:8080";
     (name == "http" ? o.http : o.rtsp) = *address;
+  } else if (name == "http-idle-timeout") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 0.1 || *seconds > 3600) return "seconds, 0.1..3600";
+    o.httpIdleSeconds = *seconds;
   } else if (name == "detect") {
     o.detectFamily = value;
   } else if (name == "follow") {
@@ -275,6 +283,7 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"bitrate", required_argument, nullptr, kValue},
                                    {"http", required_argument, nullptr, kValue},
                                    {"rtsp", required_argument, nullptr, kValue},
+                                   {"http-idle-timeout", required_argument, nullptr, kValue},
                                    {"detect", required_argument, nullptr, kValue},
                                    {"follow", no_argument, nullptr, kValue},
                                    {"duration", required_argument, nullptr, kValue},

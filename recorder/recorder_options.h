@@ -18,11 +18,13 @@ struct DeviceTarget {
   std::optional<bool> follow;  // unset: the recorder-wide --follow
 };
 
-// Where a server listens: "[HOST]:PORT"; no host means every interface,
-// port 0 one the system picks (the recorder prints it).
+// Where a server listens: "[HOST]:PORT"; no host means this machine only
+// (127.0.0.1; 0.0.0.0 for every interface), port 0 one the system picks
+// (the recorder prints it).
 struct ServerAddress {
   std::string host;
   uint16_t port = 0;
+  std::string listenHost() const { return host.empty() ? "127.0.0.1" : host; }
 };
 std::optional<ServerAddress> parseServerAddress(const std::string& text);
 
@@ -47,6 +49,7 @@ struct RecorderOptions {
   uint64_t minFree = 0;
   std::optional<ServerAddress> http;  // unset: no web server
   std::optional<ServerAddress> rtsp;  // unset: no RTSP server
+  double httpIdleSeconds = 10;        // a connection silent this long is closed
   // What the login tells the device (CCFG, FCFG), as channel lists; only the
   // first transmitter's login configures it. Unset: wircsrc's defaults.
   std::optional<std::string> periods;

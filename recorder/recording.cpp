@@ -85,7 +85,9 @@ std::optional<std::string> Recording::startServers() {
     content.recordingsFolder = options_.outDir;
     content.status = [this] { return status(); };
     content.openSegments = [this] { return openSegments(); };
-    auto server = HttpServer::start(*options_.http, std::move(content));
+    auto server = HttpServer::start(
+        *options_.http, std::move(content),
+        std::chrono::milliseconds(static_cast<int64_t>(options_.httpIdleSeconds * 1000)));
     if (!server) return server.error();
     http_ = std::move(*server);
     log("live view at " + http_->url());

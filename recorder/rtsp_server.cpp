@@ -29,8 +29,7 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
                                                                      std::vector<Camera> cameras) {
   std::unique_ptr<RtspServer> self(new RtspServer());
   self->server_ = gst_rtsp_server_new();
-  gst_rtsp_server_set_address(self->server_,
-                              address.host.empty() ? "0.0.0.0" : address.host.c_str());
+  gst_rtsp_server_set_address(self->server_, address.listenHost().c_str());
   gst_rtsp_server_set_service(self->server_, std::to_string(address.port).c_str());
   GstRTSPMountPoints* mounts = gst_rtsp_server_get_mount_points(self->server_);
   for (auto& camera : cameras) {
@@ -68,7 +67,7 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
   }
   self->source_ = g_source_attach(source, nullptr);
   g_source_unref(source);
-  self->url_ = "rtsp://" + (address.host.empty() ? std::string("localhost") : address.host) + ":" +
+  self->url_ = "rtsp://" + address.listenHost() + ":" +
                std::to_string(gst_rtsp_server_get_bound_port(self->server_));
   return self;
 }

@@ -1,0 +1,126 @@
+// wirc-recorder --http against hostile clients, over raw sockets: a body it
+// never reads, connections it does not keep, files it does not follow, and
+// an address it does not open to the network unless told.
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <sys/socket.h>
+
+#include <fstream>
+#include <thread>
+
+#include "common/socket.h"
+#include "recorder_process.h"
+#include "simulated_device.h"
+#include "wait_for.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+
+long residentKbOf(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
+  return 0;
+}
+
+uint16_t portOf(const std::string& url) {
+  return static_cast<uint16_t>(std::stoi(url.substr(url.rfind(':') + 1)));
+}
+
+// Sends `request` on a fresh connection; the first line of the answer.
+std::string statusLine(uint16_t port, const std::string& request) {
+  auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(port));
+  if (!fd) return "";
+  ::send(fd->get(), request.data(), request.size(), MSG_NOSIGNAL);
+  std::string answer;
+  char chunk[512];
+  pollfd p{fd->get(), POLLIN, 0};
+  while (answer.find("\r\n") == std::string::npos && ::poll(&p, 1, 5000) > 0) {
+    ssize_t n = ::recv(fd->get(), chunk, sizeof chunk, 0);
+    if (n <= 0) break;
+    answer.append(chunk, static_cast<size_t>(n));
+  }
+  return answer.substr(0, answer.find("\r\n"));
+}
+
+struct ServedRecorder {
+  std::unique_ptr<wircam::wirc::Device> device = startSequenceDevice();
+  std::unique_ptr<RecorderProcess> recorder;
+  std::string url;
+  explicit ServedRecorder(std::vector<std::string> extra) {
+    extra.insert(extra.end(), {"--duration", "60"});
+    recorder = std::make_unique<RecorderProcess>(device->port(), extra);
+    url = recorder->waitForLog("http://", milliseconds(10000)).value_or("");
+  }
+};
+
+TEST(WircRecorderHttpLimits, ListensOnThisMachineOnlyUnlessAnAddressIsGiven) {
+  ServedRecorder served({"--http", ":0"});
+  ASSERT_FALSE(served.url.empty()) << served.recorder->log();
+  EXPECT_EQ(served.url.rfind("http://127.0.0.1:", 0), 0u) << served.url;
+}
+
+TEST(WircRecorderHttpLimits, ABodyDeclaredAsAGigabyteIsRefusedUnread) {
+  ServedRecorder served({"--http", "127.0.0.1:0"});
+  ASSERT_FALSE(served.url.empty()) << served.recorder->log();
+  long before = residentKbOf(served.recorder->pid());
+  std::string request =
+      "POST /api/status HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000\r\n\r\n" +
+      std::string(1 << 20, 'x');
+  EXPECT_NE(statusLine(portOf(served.url), request).find("405"), std::string::npos);
+  std::string get = "GET /api/status HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000\r\n\r\n";
+  EXPECT_NE(statusLine(portOf(served.url), get).find("413"), std::string::npos);
+  EXPECT_LT(residentKbOf(served.recorder->pid()) - before, 20 * 1024);
+}
+
+TEST(WircRecorderHttpLimits, HalfOpenRequestsAreClosedAfterTheIdleTimeout) {
+  ServedRecorder served({"--http", "127.0.0.1:0", "--http-idle-timeout", "1"});
+  ASSERT_FALSE(served.url.empty()) << served.recorder->log();
+  std::vector<wircam::UniqueFd> connections;
+  for (int i = 0; i < 50; ++i) {
+    auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(portOf(served.url)));
+    ASSERT_TRUE(fd.has_value());
+    std::string start = "GET / HTTP/1.1\r\nHost: x\r\n";  // and never the end
+    ::send(fd->get(), start.data(), start.size(), MSG_NOSIGNAL);
+    connections.push_back(std::move(*fd));
+  }
+  auto closedByServer = [](const wircam::UniqueFd& fd) {
+    char byte;
+    pollfd p{fd.get(), POLLIN, 0};
+    return ::poll(&p, 1, 0) > 0 && ::recv(fd.get(), &byte, 1, MSG_DONTWAIT) <= 0;
+  };
+  EXPECT_TRUE(waitFor(
+      [&] {
+        for (const auto& fd : connections)
+          if (!closedByServer(fd)) return false;
+        return true;
+      },
+      milliseconds(5000)));
+  // And the server still answers.
+  EXPECT_NE(statusLine(portOf(served.url), "GET /api/status HTTP/1.1\r\nHost: x\r\n\r\n").find("200"),
+            std::string::npos);
+}
+
+TEST(WircRecorderHttpLimits, ASymbolicLinkInTheRecordingsFolderIsNeitherListedNorServed) {
+  ServedRecorder served({"--http", "127.0.0.1:0"});
+  ASSERT_FALSE(served.url.empty()) << served.recorder->log();
+  fs::create_symlink("/etc/passwd", served.recorder->out() / "passwd.jsonl");
+  uint16_t port = portOf(served.url);
+  EXPECT_NE(statusLine(port, "GET /recordings/passwd.jsonl HTTP/1.1\r\nHost: x\r\n\r\n")
+                .find("404"),
+            std::string::npos);
+  auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(port));
+  std::string request = "GET /recordings HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
+  ::send(fd->get(), request.data(), request.size(), MSG_NOSIGNAL);
+  std::string listing;
+  char chunk[4096];
+  ssize_t n;
+  while ((n = ::recv(fd->get(), chunk, sizeof chunk, 0)) > 0) listing.append(chunk, n);
+  EXPECT_EQ(listing.find("passwd"), std::string::npos) << listing;
+}
+
+}  // namespace
