@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <set>
 
+#include "http_routes.h"
 #include "live_view_page.h"
 
 namespace wircam::recorder {
@@ -24,14 +25,6 @@ void respond(SoupServerMessage* message, guint status, const char* type, const s
 
 void respondError(SoupServerMessage* message, guint status, const std::string& text) {
   respond(message, status, "text/plain; charset=utf-8", text + "\n");
-}
-
-const char* contentTypeOf(const fs::path& file) {
-  auto extension = file.extension();
-  if (extension == ".mkv") return "video/x-matroska";
-  if (extension == ".mp4") return "video/mp4";
-  if (extension == ".jsonl") return "application/x-ndjson";
-  return nullptr;  // not a recording
 }
 
 }  // namespace
@@ -194,23 +187,24 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*,
 void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
                            gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
-  std::string route = path;
-  if (route == "/" || route == "/index.html") {
-    respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", self->page());
-  } else if (route == "/api/status") {
-    respond(message, SOUP_STATUS_OK, "application/json", self->content_.status().dump());
-  } else if (route == "/api/events") {
-    self->serveEvents(message);
-  } else if (route.rfind("/live/", 0) == 0 && route.size() > 11 &&
-             route.compare(route.size() - 5, 5, ".mjpg") == 0) {
-    self->serveLive(message, route.substr(6, route.size() - 11));
-  } else if (route == "/recordings" || route == "/recordings/") {
-    self->serveRecordings(message, "");
-  } else if (route.rfind("/recordings/", 0) == 0) {
-    self->serveRecordings(message, route.substr(12));
-  } else {
-    respondError(message, SOUP_STATUS_NOT_FOUND,
-                 "not found; try /, /api/status, /api/events, /live/CAMERA.mjpg or /recordings");
+  auto route = routeOf(path);
+  switch (route.kind) {
+    case Route::Kind::Page:
+      return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", self->page());
+    case Route::Kind::Status:
+      return respond(message, SOUP_STATUS_OK, "application/json", self->content_.status().dump());
+    case Route::Kind::Events:
+      return self->serveEvents(message);
+    case Route::Kind::Live:
+      return self->serveLive(message, route.name);
+    case Route::Kind::RecordingList:
+      return self->serveRecordings(message, "");
+    case Route::Kind::Recording:
+      return self->serveRecordings(message, route.name);
+    case Route::Kind::NotFound:
+      return respondError(
+          message, SOUP_STATUS_NOT_FOUND,
+          "not found; try /, /api/status, /api/events, /live/CAMERA.mjpg or /recordings");
   }
 }
 
@@ -344,7 +338,7 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
     for (const auto& entry : fs::directory_iterator(folder, error)) {
       // A symbolic link could lead anywhere on the machine: never listed.
       if (entry.is_symlink(error) || !entry.is_regular_file(error) ||
-          !contentTypeOf(entry.path()))
+          !isRecordingName(entry.path().filename().string()))
         continue;
       auto file = entry.path().filename().string();
       files.push_back({{"name", file},
@@ -360,8 +354,8 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
   // no way out of it.
   fs::path file = folder / name;
   std::error_code error;
-  if (name.find('/') != std::string::npos || name[0] == '.' || !contentTypeOf(file) ||
-      fs::is_symlink(fs::symlink_status(file, error)) || !fs::is_regular_file(file, error)) {
+  if (!isRecordingName(name) || fs::is_symlink(fs::symlink_status(file, error)) ||
+      !fs::is_regular_file(file, error)) {
     respondError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
     return;
   }
@@ -376,7 +370,7 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
   g_mapped_file_unref(mapped);
   soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
   soup_message_headers_set_content_type(soup_server_message_get_response_headers(message),
-                                        contentTypeOf(file), nullptr);
+                                        recordingContentType(name), nullptr);
   soup_message_body_append_bytes(soup_server_message_get_response_body(message), bytes);
   g_bytes_unref(bytes);
 }

@@ -1,0 +1,27 @@
+// Which of wirc-recorder's web resources a request path names, decided
+// apart from the server so that it can be tested and fuzzed on its own.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace wircam::recorder {
+
+struct Route {
+  enum class Kind { Page, Status, Events, Live, RecordingList, Recording, NotFound };
+  Kind kind = Kind::NotFound;
+  std::string name;  // the camera (Live) or the file (Recording)
+};
+
+// `path` as libsoup hands it over (percent-decoded).
+Route routeOf(std::string_view path);
+
+// A recording may be served by this name: a plain file name (no folder, not
+// hidden) of a video or sidecar. Whether it is a regular file in the folder
+// and not a link is the server's check on the disk.
+bool isRecordingName(std::string_view name);
+
+// The media type a recording is served with, or nullptr for other files.
+const char* recordingContentType(std::string_view name);
+
+}  // namespace wircam::recorder
