@@ -1,0 +1,39 @@
+// Which resource a request path names, and which recording names are served.
+#include "http_routes.h"
+
+#include <gtest/gtest.h>
+
+namespace wircam::recorder {
+namespace {
+
+using Kind = Route::Kind;
+
+TEST(HttpRoutes, NamesEveryResource) {
+  EXPECT_EQ(routeOf("/").kind, Kind::Page);
+  EXPECT_EQ(routeOf("/index.html").kind, Kind::Page);
+  EXPECT_EQ(routeOf("/api/status").kind, Kind::Status);
+  EXPECT_EQ(routeOf("/api/events").kind, Kind::Events);
+  EXPECT_EQ(routeOf("/recordings").kind, Kind::RecordingList);
+  EXPECT_EQ(routeOf("/recordings/").kind, Kind::RecordingList);
+  auto live = routeOf("/live/rover-cam0.mjpg");
+  EXPECT_EQ(live.kind, Kind::Live);
+  EXPECT_EQ(live.name, "rover-cam0");
+  auto file = routeOf("/recordings/rover-cam0-000.mkv");
+  EXPECT_EQ(file.kind, Kind::Recording);
+  EXPECT_EQ(file.name, "rover-cam0-000.mkv");
+  EXPECT_EQ(routeOf("/live/.mjpg").kind, Kind::NotFound);
+  EXPECT_EQ(routeOf("/etc/passwd").kind, Kind::NotFound);
+}
+
+TEST(HttpRoutes, ServesOnlyPlainNamesOfRecordings) {
+  EXPECT_TRUE(isRecordingName("rover-cam0-000.mkv"));
+  EXPECT_TRUE(isRecordingName("rover-cam0-000.jsonl"));
+  EXPECT_TRUE(isRecordingName("rover-cam0-000.mp4"));
+  for (const char* refused : {"", "../secret.mkv", "a/b.mkv", ".hidden.mkv", "stderr.log",
+                              "passwd", "x.mkv.bak"})
+    EXPECT_FALSE(isRecordingName(refused)) << refused;
+  EXPECT_FALSE(isRecordingName(std::string_view("a\0b.mkv", 7)));
+}
+
+}  // namespace
+}  // namespace wircam::recorder

@@ -1,0 +1,49 @@
+// wirc-recorder's command line: the new options and their errors.
+#include "recorder_options.h"
+
+#include <gtest/gtest.h>
+
+namespace wircam::recorder {
+namespace {
+
+Expected<RecorderOptions, std::string> parse(std::vector<std::string> words) {
+  words.insert(words.begin(), "wirc-recorder");
+  std::vector<char*> argv;
+  for (auto& word : words) argv.push_back(word.data());
+  argv.push_back(nullptr);
+  return parseOptions(static_cast<int>(words.size()), argv.data());
+}
+
+TEST(RecorderOptions, ServersListenOnThisMachineUnlessAHostIsGiven) {
+  auto options = parse({"--out", "x", "--http", ":8080", "--rtsp", "0.0.0.0:8554"});
+  ASSERT_TRUE(options.has_value()) << options.error();
+  EXPECT_EQ(options->http->listenHost(), "127.0.0.1");
+  EXPECT_EQ(options->rtsp->listenHost(), "0.0.0.0");
+}
+
+TEST(RecorderOptions, TakesLoginChannelListsTheDeviceWouldAccept) {
+  auto options = parse({"--out", "x", "--periods", "20000", "--failsafe", "1500"});
+  ASSERT_TRUE(options.has_value()) << options.error();
+  EXPECT_EQ(*options->periods, "20000");
+  EXPECT_EQ(*options->failsafe, "1500");
+}
+
+TEST(RecorderOptions, RefusesChannelListsTheDeviceWouldRefuseNamingTheProblem) {
+  auto periods = parse({"--out", "x", "--periods", "100"});
+  ASSERT_FALSE(periods.has_value());
+  EXPECT_NE(periods.error().find("--periods"), std::string::npos) << periods.error();
+  EXPECT_NE(periods.error().find("CCFG"), std::string::npos) << periods.error();
+  auto failsafe = parse({"--out", "x", "--failsafe", "1500,1500"});
+  ASSERT_FALSE(failsafe.has_value());
+  EXPECT_NE(failsafe.error().find("give 1"), std::string::npos) << failsafe.error();
+}
+
+TEST(RecorderOptions, IdleTimeoutIsInSeconds) {
+  auto options = parse({"--out", "x", "--http-idle-timeout", "2.5"});
+  ASSERT_TRUE(options.has_value()) << options.error();
+  EXPECT_DOUBLE_EQ(options->httpIdleSeconds, 2.5);
+  EXPECT_FALSE(parse({"--out", "x", "--http-idle-timeout", "0"}).has_value());
+}
+
+}  // namespace
+}  // namespace wircam::recorder
