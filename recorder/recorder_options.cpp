@@ -35,8 +35,9 @@ text track in the file. SIGINT or SIGTERM finishes every file and exits 0.
                          one for all, 5000..20000 µs (default 20000)
   --failsafe US,...      what each channel does when the link is lost (FCFG):
                          800..2200 µs, 0 = hold, 65535 = no pulse (default 1500).
-                         Only the first transmitter that logs in configures
-                         the device; later logins are refused these (ERR 2)
+                         Every login sends both; the device takes them from the
+                         first transmitter logged in (so they overwrite what
+                         wirc-cli configure set) and refuses them to later ones
   --duration S           stop after S seconds
   --status S             seconds between status updates (default 1)
   --max-bytes SIZE       keep the recordings under SIZE (e.g. 500M, 20G) by
