@@ -266,11 +266,31 @@ gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
   return TRUE;
 }
 
+namespace {
+constexpr guint kFinishSeconds = 10;
+}  // namespace
+
 void Recording::stop(const char* why) {
   stopping_ = true;
   if (why) log(std::string(why) + ": finishing the files (a second signal stops at once)");
   // EOS from every source: each splitmuxsink closes its last segment cleanly.
   gst_element_send_event(pipeline_, gst_event_new_eos());
+  // A splitmuxsink that never received a frame (the device never streamed)
+  // does not pass EOS on, so the pipeline's EOS would never come: finished
+  // segments close within a second or two, so after kFinishSeconds stop.
+  g_timeout_add_seconds(
+      kFinishSeconds,
+      [](gpointer data) {
+        auto* self = static_cast<Recording*>(data);
+        std::string idle;
+        for (const auto& s : self->streams_)
+          if (s->segment.empty()) idle += (idle.empty() ? "" : ", ") + s->plan.name;
+        log("gave up waiting for the pipeline to finish after " + std::to_string(kFinishSeconds) +
+            " s" + (idle.empty() ? "" : " (never received a frame: " + idle + ")"));
+        g_main_loop_quit(self->loop_);
+        return G_SOURCE_REMOVE;
+      },
+      this);
 }
 
 gboolean Recording::onStop(gpointer data) {
