@@ -6,11 +6,11 @@
 #include <sys/socket.h>
 
 #include <array>
-#include <fstream>
 #include <thread>
 #include <mutex>
 
 #include "misbehaving_peers.h"
+#include "process_memory.h"
 #include "wait_for.h"
 #include "wirc/transmitter_session.h"
 
@@ -21,16 +21,10 @@ using std::chrono::milliseconds;
 using testing::bytesOf;
 using testing::PeerScript;
 using testing::ScriptedPeer;
+using testing::residentKb;
 using testing::waitFor;
 using Clock = std::chrono::steady_clock;
 
-long residentKb() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
-  return 0;
-}
 
 std::vector<uint8_t> repeated(const std::vector<uint8_t>& unit, size_t times) {
   std::vector<uint8_t> bytes;

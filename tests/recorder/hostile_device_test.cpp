@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
-#include <fstream>
 
 #include "misbehaving_peers.h"
 #include "recorder_process.h"
+#include "process_memory.h"
 #include "wait_for.h"
 
 namespace {
@@ -14,13 +14,6 @@ namespace {
 using namespace wircam::testing;
 using std::chrono::milliseconds;
 
-long residentKbOf(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
-  return 0;
-}
 
 TEST(WircRecorderHostileDevice, GarbageOnTheControlConnectionCostsACounterNotMemory) {
   ScriptedPeer peer;
@@ -30,10 +23,10 @@ TEST(WircRecorderHostileDevice, GarbageOnTheControlConnectionCostsACounterNotMem
   RecorderProcess recorder(peer.port(), {"--duration", "60"});
   ASSERT_TRUE(waitFor([&] { return peer.connections() >= 2; }, milliseconds(10000)))
       << recorder.log();
-  long early = residentKbOf(recorder.pid());
+  long early = residentKb(recorder.pid());
   // Keep flooding for a few more reconnects.
   ASSERT_TRUE(waitFor([&] { return peer.connections() >= 4; }, milliseconds(15000)));
-  EXPECT_LT(residentKbOf(recorder.pid()) - early, 20 * 1024);
+  EXPECT_LT(residentKb(recorder.pid()) - early, 20 * 1024);
   EXPECT_LT(recorder.log().size(), 64u * 1024) << "the log grows with the garbage";
   EXPECT_NE(recorder.log().find("dropped as misbehaving"), std::string::npos) << recorder.log();
   recorder.signal(SIGINT);

@@ -5,12 +5,12 @@
 #include <poll.h>
 #include <sys/socket.h>
 
-#include <fstream>
 #include <thread>
 
 #include "common/socket.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
+#include "process_memory.h"
 #include "wait_for.h"
 
 namespace {
@@ -19,13 +19,6 @@ namespace fs = std::filesystem;
 using namespace wircam::testing;
 using std::chrono::milliseconds;
 
-long residentKbOf(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
-  return 0;
-}
 
 uint16_t portOf(const std::string& url) {
   return static_cast<uint16_t>(std::stoi(url.substr(url.rfind(':') + 1)));
@@ -67,14 +60,14 @@ TEST(WircRecorderHttpLimits, ListensOnThisMachineOnlyUnlessAnAddressIsGiven) {
 TEST(WircRecorderHttpLimits, ABodyDeclaredAsAGigabyteIsRefusedUnread) {
   ServedRecorder served({"--http", "127.0.0.1:0"});
   ASSERT_FALSE(served.url.empty()) << served.recorder->log();
-  long before = residentKbOf(served.recorder->pid());
+  long before = residentKb(served.recorder->pid());
   std::string request =
       "POST /api/status HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000\r\n\r\n" +
       std::string(1 << 20, 'x');
   EXPECT_NE(statusLine(portOf(served.url), request).find("405"), std::string::npos);
   std::string get = "GET /api/status HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000\r\n\r\n";
   EXPECT_NE(statusLine(portOf(served.url), get).find("413"), std::string::npos);
-  EXPECT_LT(residentKbOf(served.recorder->pid()) - before, 20 * 1024);
+  EXPECT_LT(residentKb(served.recorder->pid()) - before, 20 * 1024);
 }
 
 TEST(WircRecorderHttpLimits, HalfOpenRequestsAreClosedAfterTheIdleTimeout) {
