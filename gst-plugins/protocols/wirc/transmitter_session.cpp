@@ -177,8 +177,8 @@ class TransmitterSession::Impl {
   EventLoop::Id discoveryWatch_ = 0;
   std::vector<DiscoveredDevice> found_;
   EventLoop::Id tcpWatch_ = 0;
-  MessageStreamParser parser_;  // one per connection, for its whole life
-  Clock::time_point lastHeard_;  // login, or the last PSD
+  MessageStreamParser parser_;           // one per connection, for its whole life
+  Clock::time_point lastHeard_;          // login, or the last PSD
   uint64_t rejectedThisConnection_ = 0;  // malformed messages, weighted
   uint64_t rejectedUnreported_ = 0;      // since the last summary
   StreamParserStats reported_;           // parser counters at the last summary
@@ -412,7 +412,7 @@ void TransmitterSession::Impl::countRejected(Clock::time_point now) {
   }
   rejectedThisConnection_ = rejected;
   if (now - lastSummary_ >= kRejectSummaryPeriod) {
-    auto since = [](uint64_t now, uint64_t then) { return std::to_string(now - then); };
+    auto since = [](uint64_t current, uint64_t before) { return std::to_string(current - before); };
     publish({link::InputRejected{
         rejectedUnreported_,
         since(stats.badCrc, reported_.badCrc) + " bad CRC, " +
@@ -592,8 +592,11 @@ void TransmitterSession::Impl::onPsd() {
   sockaddr_in from{};
   socklen_t size = sizeof from;
   ssize_t n;
-  while ((n = ::recvfrom(psdSocket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
-                         reinterpret_cast<sockaddr*>(&from), &size)) >= 0) {
+  // At most a few per wake-up: a flood on this port cannot starve the loop.
+  for (int taken = 0;
+       taken < 16 && (n = ::recvfrom(psdSocket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
+                                     reinterpret_cast<sockaddr*>(&from), &size)) >= 0;
+       ++taken) {
     auto message = decode(std::span(buffer.data(), static_cast<size_t>(n)));
     if (!message || !std::holds_alternative<Psd>(*message)) continue;
     const auto& psd = std::get<Psd>(*message);
