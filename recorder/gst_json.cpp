@@ -32,8 +32,8 @@ nlohmann::json toJson(const GValue* value) {
     nlohmann::json array = nlohmann::json::array();
     guint size = list ? gst_value_list_get_size(value) : gst_value_array_get_size(value);
     for (guint i = 0; i < size; ++i)
-      array.push_back(toJson(list ? gst_value_list_get_value(value, i)
-                                  : gst_value_array_get_value(value, i)));
+      array.push_back(
+          toJson(list ? gst_value_list_get_value(value, i) : gst_value_array_get_value(value, i)));
     return array;
   }
   if (type == GST_TYPE_STRUCTURE) return fieldsOf(gst_value_get_structure(value));

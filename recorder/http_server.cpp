@@ -41,8 +41,8 @@ struct HttpServer::CameraFeed {
   FrameTap* frames;
   int listener = 0;
   std::vector<std::unique_ptr<Client>> clients;
-  std::atomic<int> clientCount{0};  // read on the streaming thread
-  std::atomic<int> width{0}, height{0};  // of the last frame, for the overlay
+  std::atomic<int> clientCount{0};                      // read on the streaming thread
+  std::atomic<int> width{0}, height{0};                 // of the last frame, for the overlay
   nlohmann::json detections = nlohmann::json::array();  // the last ones
 };
 
@@ -61,8 +61,8 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
       soup_server_listen(self->server_, socket, SoupServerListenOptions(0), &error);
   g_object_unref(socket);
   if (!listening) {
-    std::string text = "--http: cannot listen on port " + std::to_string(address.port) + ": " +
-                       error->message;
+    std::string text =
+        "--http: cannot listen on port " + std::to_string(address.port) + ": " + error->message;
     g_error_free(error);
     return unexpected(text);
   }
@@ -151,8 +151,8 @@ void HttpServer::onRequestStarted(SoupServer*, SoupServerMessage* message, gpoin
     return;
   }
   if (socket)
-    g_socket_set_timeout(
-        socket, static_cast<guint>(std::max<int64_t>(1, (self->idleTimeout_.count() + 999) / 1000)));
+    g_socket_set_timeout(socket, static_cast<guint>(std::max<int64_t>(
+                                     1, (self->idleTimeout_.count() + 999) / 1000)));
 }
 
 void HttpServer::onRequestEnded(SoupServer*, SoupServerMessage*, gpointer data) {
@@ -221,17 +221,17 @@ void HttpServer::openStream(SoupServerMessage* message, const char* contentType,
   auto client = std::make_unique<Client>();
   client->message = message;
   Client* raw = client.get();
-  client->wroteHandler = g_signal_connect(
-      message, "wrote-chunk",
-      G_CALLBACK(+[](SoupServerMessage*, guint, gpointer c) { --static_cast<Client*>(c)->inFlight; }),
-      raw);
+  client->wroteHandler = g_signal_connect(message, "wrote-chunk",
+                                          G_CALLBACK(+[](SoupServerMessage*, guint, gpointer c) {
+                                            --static_cast<Client*>(c)->inFlight;
+                                          }),
+                                          raw);
   struct Finished {
     std::vector<std::unique_ptr<Client>>* clients;
     Client* client;
   };
   client->finishedHandler = g_signal_connect_data(
-      message, "finished",
-      G_CALLBACK(+[](SoupServerMessage*, gpointer data) {
+      message, "finished", G_CALLBACK(+[](SoupServerMessage*, gpointer data) {
         // The viewer went away: forget it.
         auto* f = static_cast<Finished*>(data);
         auto& list = *f->clients;
@@ -258,8 +258,8 @@ void HttpServer::send(std::vector<std::unique_ptr<Client>>& clients, GBytes* chu
 }
 
 void HttpServer::serveLive(SoupServerMessage* message, const std::string& camera) {
-  auto feed = std::find_if(feeds_.begin(), feeds_.end(),
-                           [&](const auto& f) { return f->name == camera; });
+  auto feed =
+      std::find_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f->name == camera; });
   if (feed == feeds_.end()) {
     respondError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
     return;
@@ -276,9 +276,9 @@ void HttpServer::sendFrame(size_t camera, GstBuffer* jpeg) {
   GstMapInfo map;
   if (!gst_buffer_map(jpeg, &map, GST_MAP_READ)) return;
   // One part, built in place: a single copy of the frame per delivery.
-  std::string header = std::string("--") + kBoundary +
-                       "\r\nContent-Type: image/jpeg\r\nContent-Length: " +
-                       std::to_string(map.size) + "\r\n\r\n";
+  std::string header =
+      std::string("--") + kBoundary +
+      "\r\nContent-Type: image/jpeg\r\nContent-Length: " + std::to_string(map.size) + "\r\n\r\n";
   GByteArray* part = g_byte_array_sized_new(static_cast<guint>(header.size() + map.size + 2));
   g_byte_array_append(part, reinterpret_cast<const guint8*>(header.data()),
                       static_cast<guint>(header.size()));

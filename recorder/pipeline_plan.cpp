@@ -71,9 +71,10 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
       // The telemetry track is sparse: splitmuxsink lets it run up to 2 s
       // ahead of the video rather than hold the video for it (at 0, the
       // default, the two wait on each other).
-      d += "wircsrc name=" + stream.source + host + port + login + " camera=" + std::to_string(camera) +
-           " ! tee name=t" + i + " t" + i + ". ! queue max-size-time=3000000000 ! " +
-           encoder(options) + "splitmuxsink name=" + stream.muxer +
+      d += "wircsrc name=" + stream.source + host + port + login +
+           " camera=" + std::to_string(camera) + " ! tee name=t" + i + " t" + i +
+           ". ! queue max-size-time=3000000000 ! " + encoder(options) +
+           "splitmuxsink name=" + stream.muxer +
            " async-finalize=true alignment-threshold=2000000000 " +
            muxerSettings(options.container) +
            " max-size-time=" + std::to_string(static_cast<uint64_t>(options.segmentSeconds * 1e9)) +
@@ -93,12 +94,14 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
         d += "t" + i +
              ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=" +
              stream.detector + " quad-decimate=1 family=" + options.detectFamily;
-        if (!stream.controller.empty()) d += " ! wirccontrol name=" + stream.controller + host + port;
+        if (!stream.controller.empty())
+          d += " ! wirccontrol name=" + stream.controller + host + port;
         d += " ! fakesink sync=false async=false ";
       }
       if (!stream.liveSink.empty()) {
-        d += "t" + i + ". ! queue leaky=downstream max-size-buffers=2 ! appsink name=" +
-             stream.liveSink + " sync=false async=false max-buffers=2 drop=true ";
+        d += "t" + i +
+             ". ! queue leaky=downstream max-size-buffers=2 ! appsink name=" + stream.liveSink +
+             " sync=false async=false max-buffers=2 drop=true ";
       }
       plan.streams.push_back(std::move(stream));
     }

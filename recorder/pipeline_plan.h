@@ -13,7 +13,7 @@ namespace wircam::recorder {
 struct StreamPlan {
   std::string device;  // the device's label, made safe for file names
   int camera = 0;
-  std::string name;  // "<device>-cam<N>", also in file names and the live view
+  std::string name;             // "<device>-cam<N>", also in file names and the live view
   std::string source;           // wircsrc
   std::string muxer;            // splitmuxsink
   std::string telemetrySource;  // appsrc feeding the file's text track (Matroska only)

@@ -340,11 +340,11 @@ void Recording::printStatus() {
     // A device that stopped reporting keeps its last battery reading, marked.
     std::string stale =
         s->statusStale ? " (stale, " + std::to_string(s->statusAgeMs / 1000) + " s old)" : "";
-    std::printf("%s%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V%s  %s\n",
-                terminal ? "\033[K" : "", s->plan.name.c_str(),
-                static_cast<unsigned long long>(s->frameCount), s->fps, loss, s->kbps,
-                s->batteryMv / 1000.0, stale.c_str(),
-                std::filesystem::path(s->segment).filename().c_str());
+    std::printf(
+        "%s%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V%s  %s\n",
+        terminal ? "\033[K" : "", s->plan.name.c_str(),
+        static_cast<unsigned long long>(s->frameCount), s->fps, loss, s->kbps,
+        s->batteryMv / 1000.0, stale.c_str(), std::filesystem::path(s->segment).filename().c_str());
   }
   std::fflush(stdout);
   statusShown_ = true;

@@ -46,8 +46,8 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
       if (raw->sources.empty()) return;
       // Same memory, fresh metadata: the appsrc stamps it. The caps carry
       // the frame size, which rtpjpegpay needs.
-      GstBuffer* jpeg = gst_buffer_copy_region(gst_sample_get_buffer(sample),
-                                               GST_BUFFER_COPY_MEMORY, 0, -1);
+      GstBuffer* jpeg =
+          gst_buffer_copy_region(gst_sample_get_buffer(sample), GST_BUFFER_COPY_MEMORY, 0, -1);
       GstSample* fresh = gst_sample_new(jpeg, gst_sample_get_caps(sample), nullptr, nullptr);
       gst_buffer_unref(jpeg);
       for (GstElement* source : raw->sources) gst_app_src_push_sample(GST_APP_SRC(source), fresh);
@@ -95,19 +95,19 @@ void RtspServer::onMediaConfigure(GstRTSPMediaFactory*, GstRTSPMedia* media, gpo
   }
   // When the last client leaves the media is unprepared: stop feeding it.
   g_signal_connect(media, "unprepared", G_CALLBACK(+[](GstRTSPMedia* m, gpointer d) {
-                     auto* mount = static_cast<Mount*>(d);
-                     GstElement* bin = gst_rtsp_media_get_element(m);
-                     std::lock_guard lock(mount->mutex);
-                     auto& list = mount->sources;
+                     auto* unpreparedMount = static_cast<Mount*>(d);
+                     GstElement* mediaBin = gst_rtsp_media_get_element(m);
+                     std::lock_guard lock(unpreparedMount->mutex);
+                     auto& list = unpreparedMount->sources;
                      for (auto it = list.begin(); it != list.end();) {
-                       if (gst_object_has_as_ancestor(GST_OBJECT(*it), GST_OBJECT(bin))) {
+                       if (gst_object_has_as_ancestor(GST_OBJECT(*it), GST_OBJECT(mediaBin))) {
                          gst_object_unref(*it);
                          it = list.erase(it);
                        } else {
                          ++it;
                        }
                      }
-                     gst_object_unref(bin);
+                     gst_object_unref(mediaBin);
                    }),
                    mount);
 }

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "common/expected.h"
@@ -66,6 +67,8 @@ struct GrayView {
   int stride = 0;
 };
 
+// Move-only: the underlying detector is not thread-safe, so two copies may
+// not share it.
 class TagDetector {
  public:
   static Expected<TagDetector, std::string> create(const DetectorOptions& options);
@@ -80,7 +83,8 @@ class TagDetector {
 
   DetectorOptions options_;
   TagFamily family_;
-  std::shared_ptr<apriltag_detector> detector_;
+  std::unique_ptr<apriltag_detector, void (*)(apriltag_detector*)> detector_;
 };
+static_assert(!std::is_copy_constructible_v<TagDetector>);
 
 }  // namespace wircam::vision

@@ -46,9 +46,10 @@ GType scale_get_type() {
 
 struct TjpegDecState {
   int scale = DEFAULT_SCALE;  // guarded by the object lock
+  // Streaming thread only.
   std::unique_ptr<void, decltype(&tjDestroy)> decoder{nullptr, tjDestroy};
   GstVideoCodecState* input = nullptr;
-  int width = 0;
+  int width = 0;  // of the output caps
   int height = 0;
   GstVideoFormat format = GST_VIDEO_FORMAT_UNKNOWN;
 };
@@ -224,9 +225,10 @@ static void gst_tjpeg_dec_set_property(GObject* object, guint id, const GValue* 
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
     return;
   }
+  // A new scale gives the next frame a new size, which renegotiates: the
+  // streaming thread's width and height are its own.
   GST_OBJECT_LOCK(self);
   self->state->scale = g_value_get_enum(value);
-  self->state->width = 0;  // renegotiate
   GST_OBJECT_UNLOCK(self);
 }
 

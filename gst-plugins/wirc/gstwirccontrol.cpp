@@ -31,7 +31,9 @@
 // clang-format on
 #include "gstwirccontrol.h"
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -605,16 +607,24 @@ static void gst_wirc_control_init(GstWircControl* self) {
   gst_base_transform_set_passthrough(GST_BASE_TRANSFORM(self), TRUE);
 }
 
+// "steering-kp" → "Steering kp": the nick gst-inspect shows as the title.
+static const char* nick_of(const char* name) {
+  std::string nick = name;
+  std::replace(nick.begin(), nick.end(), '-', ' ');
+  nick[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(nick[0])));
+  return g_intern_string(nick.c_str());  // static, as G_PARAM_STATIC_STRINGS wants
+}
+
 static void install_double(GObjectClass* gobject, guint id, const char* name, const char* blurb,
                            double min, double max, double value, GParamFlags flags) {
-  g_object_class_install_property(gobject, id,
-                                  g_param_spec_double(name, name, blurb, min, max, value, flags));
+  g_object_class_install_property(
+      gobject, id, g_param_spec_double(name, nick_of(name), blurb, min, max, value, flags));
 }
 
 static void install_uint(GObjectClass* gobject, guint id, const char* name, const char* blurb,
                          guint min, guint max, guint value, GParamFlags flags) {
-  g_object_class_install_property(gobject, id,
-                                  g_param_spec_uint(name, name, blurb, min, max, value, flags));
+  g_object_class_install_property(
+      gobject, id, g_param_spec_uint(name, nick_of(name), blurb, min, max, value, flags));
 }
 
 static void gst_wirc_control_class_init(GstWircControlClass* klass) {

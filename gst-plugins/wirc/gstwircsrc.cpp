@@ -176,8 +176,8 @@ void postStats(GstWircSrc* self) {
   gst_structure_set(stats, "session", G_TYPE_STRING, link::linkStateName(session.state), nullptr);
   if (const auto& psd = session.lastStatus) {
     // A report the device stopped renewing is shown with its age, as stale.
-    auto age = std::chrono::duration_cast<std::chrono::milliseconds>(
-        Clock::now() - session.telemetry->received);
+    auto age = std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() -
+                                                                     session.telemetry->received);
     gst_structure_set(stats, "battery-mv", G_TYPE_UINT, static_cast<guint>(psd->batteryMillivolts),
                       "analog-mv", G_TYPE_UINT, static_cast<guint>(psd->analogMillivolts), "inputs",
                       G_TYPE_UINT, static_cast<guint>(*session.telemetry->inputs), "status-age-ms",
@@ -493,6 +493,20 @@ static gboolean gst_wirc_src_negotiate(GstBaseSrc*) {
 static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* value,
                                       GParamSpec* pspec) {
   auto* self = GST_WIRC_SRC(object);
+  {
+    // The login and the stream use what start() read: a change now would
+    // show in the property but not on the wire, so it is refused, saying so.
+    gst::GLibLocker lock(self);
+    bool running = GST_STATE(self) > GST_STATE_READY || GST_STATE_PENDING(self) > GST_STATE_READY;
+    if (running && (pspec->flags & GST_PARAM_MUTABLE_READY)) {
+      GST_WARNING_OBJECT(self, "%s cannot change while streaming", pspec->name);
+      g_warning(
+          "%s: %s cannot change while the element is PAUSED or PLAYING; set it in "
+          "NULL or READY",
+          GST_OBJECT_NAME(self), pspec->name);
+      return;
+    }
+  }
   gst::GLibLocker lock(self);
   auto& s = self->state->settings;
   switch (id) {

@@ -15,8 +15,7 @@ void installLoginProperties(GObjectClass* klass, guint periodsId, guint failsafe
                           "comma-separated µs values, or one for all, 5000..20000, ch1/ch2, "
                           "ch3/ch4, ch5/ch6 equal. Only the first transmitter to log in "
                           "configures the device",
-                          wirc::formatChannelList(wirc::SessionConfig{}.periods).c_str(),
-                          flags));
+                          wirc::formatChannelList(wirc::SessionConfig{}.periods).c_str(), flags));
   g_object_class_install_property(
       klass, failsafeId,
       g_param_spec_string("failsafe", "Failsafe",

@@ -39,8 +39,9 @@ uint16_t freeUdpPort() {
 }
 
 TEST(HostileDeviceElements, AJunkFloodFromTheDevicesAddressCannotClaimTheStream) {
-  auto device = wirc::Device::start(
-      {.port = 0, .fps = 30}, std::make_shared<sim::JpegSequenceScene>(wircam::testing::sceneFrames()));
+  auto device =
+      wirc::Device::start({.port = 0, .fps = 30},
+                          std::make_shared<sim::JpegSequenceScene>(wircam::testing::sceneFrames()));
   ASSERT_TRUE(device.has_value());
   uint16_t streamPort = freeUdpPort();
   // Junk from the device's own address, another port, before the stream
@@ -55,9 +56,9 @@ TEST(HostileDeviceElements, AJunkFloodFromTheDevicesAddressCannotClaimTheStream)
     }
   });
   std::this_thread::sleep_for(milliseconds(50));
-  GstElement* pipeline = launch("wircsrc name=src host=127.0.0.1 port=" +
-                                std::to_string((*device)->port()) +
-                                " stream-port=" + std::to_string(streamPort) + " ! fakesink");
+  GstElement* pipeline =
+      launch("wircsrc name=src host=127.0.0.1 port=" + std::to_string((*device)->port()) +
+             " stream-port=" + std::to_string(streamPort) + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   EXPECT_TRUE(waitFor([&] { return framesOf(pipeline) >= 10; }));
   flooding = false;
@@ -68,9 +69,9 @@ TEST(HostileDeviceElements, AJunkFloodFromTheDevicesAddressCannotClaimTheStream)
 
 TEST(HostileDeviceElements, ARefusedStreamEndsTheStreamWithTheDevicesReason) {
   wircam::testing::ScriptedPeer peer;
-  peer.play({.chunks = {peer.wst(), wircam::testing::bytesOf(wirc::Err{
-                                        static_cast<uint8_t>(wirc::Command::Stst),
-                                        static_cast<uint16_t>(wirc::ErrorCode::Busy)})}});
+  peer.play({.chunks = {peer.wst(), wircam::testing::bytesOf(
+                                        wirc::Err{static_cast<uint8_t>(wirc::Command::Stst),
+                                                  static_cast<uint16_t>(wirc::ErrorCode::Busy)})}});
   GstElement* pipeline =
       launch("wircsrc host=127.0.0.1 port=" + std::to_string(peer.port()) + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
@@ -84,8 +85,9 @@ TEST(HostileDeviceElements, ARefusedStreamEndsTheStreamWithTheDevicesReason) {
 TEST(HostileDeviceElements, AStatusTheDeviceStoppedRenewingIsMarkedStaleWithItsAge) {
   wircam::testing::ScriptedPeer peer;
   peer.play({.chunks = {peer.wst()}, .statusReports = 1});
-  GstElement* pipeline = launch("wircsrc host=127.0.0.1 link-timeout=10000 stats-interval=200 port=" +
-                                std::to_string(peer.port()) + " ! fakesink");
+  GstElement* pipeline =
+      launch("wircsrc host=127.0.0.1 link-timeout=10000 stats-interval=200 port=" +
+             std::to_string(peer.port()) + " ! fakesink");
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   GstBus* bus = gst_element_get_bus(pipeline);
   bool fresh = false, stale = false;

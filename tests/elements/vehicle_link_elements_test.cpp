@@ -117,6 +117,23 @@ TEST(VehicleLinkElements, LosingTheDeviceWithReconnectOffEndsTheStreamWithTheCau
   gst_object_unref(pipeline);
 }
 
+TEST(VehicleLinkElements, ASettingChangedWhileStreamingIsRefused) {
+  auto device = startDevice();
+  GstElement* pipeline =
+      launch("wircsrc name=src camera=0 host=127.0.0.1 port=" + std::to_string(device->port()) +
+             " ! fakesink");
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  GstElement* src = gst_bin_get_by_name(GST_BIN(pipeline), "src");
+  ASSERT_TRUE(waitFor([&] { return GST_STATE(src) == GST_STATE_PLAYING; }));
+  g_object_set(src, "camera", 1u, nullptr);
+  guint camera = 99;
+  g_object_get(src, "camera", &camera, nullptr);
+  EXPECT_EQ(camera, 0u);
+  gst_object_unref(src);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+}
+
 // A buffer with one tag off to the left: the follower steers.
 GstBuffer* bufferWithATag() {
   GstBuffer* buffer = gst_buffer_new_allocate(nullptr, 16, nullptr);

@@ -16,10 +16,10 @@ namespace {
 
 using namespace wircam;
 using std::chrono::milliseconds;
-using wircam::testing::isSceneFrame;
-using wircam::testing::sceneFrames;
 using wircam::testing::busMessage;
+using wircam::testing::isSceneFrame;
 using wircam::testing::launch;
+using wircam::testing::sceneFrames;
 using wircam::testing::waitFor;
 
 std::unique_ptr<wirc::Device> startDevice(wirc::DeviceConfig config = {}) {
@@ -120,8 +120,8 @@ TEST(WircSrc, TwoCamerasShareOneLoginAndStopSendsEst) {
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   GstElement* a = gst_bin_get_by_name(GST_BIN(pipeline), "a");
   GstElement* b = gst_bin_get_by_name(GST_BIN(pipeline), "b");
-  EXPECT_TRUE(waitFor(
-      [&] { return stat(a, "frames-complete") > 5 && stat(b, "frames-complete") > 5; }));
+  EXPECT_TRUE(
+      waitFor([&] { return stat(a, "frames-complete") > 5 && stat(b, "frames-complete") > 5; }));
   EXPECT_EQ(busMessage(pipeline, milliseconds(0)), "");
   EXPECT_EQ(device->stats().logins, 1u);
   EXPECT_EQ(device->stats().activeStreams, 2u);

@@ -13,7 +13,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!packet) return 0;
   const auto& header = packet->header;
   if (packet->payload.size() != header.length) std::abort();
-  if (packet->payload.data() < data || packet->payload.data() + packet->payload.size() > data + size)
+  if (packet->payload.data() < data ||
+      packet->payload.data() + packet->payload.size() > data + size)
     std::abort();
   std::vector<uint8_t> written;
   writeMjpegHeader(header, written);

@@ -6,8 +6,8 @@
 #include <sys/socket.h>
 
 #include <array>
-#include <thread>
 #include <mutex>
+#include <thread>
 
 #include "misbehaving_peers.h"
 #include "process_memory.h"
@@ -20,11 +20,10 @@ namespace {
 using std::chrono::milliseconds;
 using testing::bytesOf;
 using testing::PeerScript;
-using testing::ScriptedPeer;
 using testing::residentKb;
+using testing::ScriptedPeer;
 using testing::waitFor;
 using Clock = std::chrono::steady_clock;
-
 
 std::vector<uint8_t> repeated(const std::vector<uint8_t>& unit, size_t times) {
   std::vector<uint8_t> bytes;

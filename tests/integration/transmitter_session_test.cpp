@@ -144,8 +144,8 @@ TEST(TransmitterSession, GivesUpOnAPeerThatAcceptsButNeverAnswers) {
 
 TEST(TransmitterSession, ReportsABusyDeviceAsBusyAtOnce) {
   testing::ScriptedPeer peer(
-      {.chunks = {testing::bytesOf(Err{static_cast<uint8_t>(Command::Tl),
-                                       static_cast<uint16_t>(ErrorCode::Busy)})}});
+      {.chunks = {testing::bytesOf(
+           Err{static_cast<uint8_t>(Command::Tl), static_cast<uint16_t>(ErrorCode::Busy)})}});
   auto session = acquire({.host = "127.0.0.1", .port = peer.port(), .reconnect = false});
   auto error = session->waitLoggedIn(milliseconds(3000));
   ASSERT_TRUE(error.has_value());

@@ -72,8 +72,10 @@ TEST(WircCli, ExtoutRefusesMoreBytesThanTheMessageCarries) {
 
 TEST(WircCli, FirmwareUpdateRestartsTheDevice) {
   auto device = std::move(*Device::start({.port = 0, .restartTime = milliseconds(100)}, nullptr));
-  auto run = wircCli("firmware-update --md5 00112233445566778899aabbccddeeff --host 127.0.0.1 "
-                     "--port " + std::to_string(device->port()));
+  auto run = wircCli(
+      "firmware-update --md5 00112233445566778899aabbccddeeff --host 127.0.0.1 "
+      "--port " +
+      std::to_string(device->port()));
   EXPECT_EQ(run.exitCode, 0) << run.output;
   EXPECT_TRUE(testing::waitFor([&] { return device->stats().restarts == 1; }));
   auto bad = wircCli("firmware-update --md5 0011 --host 127.0.0.1");

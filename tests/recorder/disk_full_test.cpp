@@ -33,10 +33,16 @@ struct SmallDisk {
   // Runs the recorder with a tmpfs of `size` at mountPoint, then copies
   // what it left into `saved` (the tmpfs goes with the namespace).
   std::vector<std::string> wrapper(const char* size) const {
-    return {"unshare", "--mount", "--map-root-user", "sh", "-c",
+    return {"unshare",
+            "--mount",
+            "--map-root-user",
+            "sh",
+            "-c",
             "m=$1; s=$2; mkdir -p \"$m\" \"$s\" && mount -t tmpfs -o size=$0 wirc-test \"$m\" "
             "|| exit 125; shift 2; \"$@\"; code=$?; cp -a \"$m\"/. \"$s\"/; exit $code",
-            size, mountPoint.string(), saved.string()};
+            size,
+            mountPoint.string(),
+            saved.string()};
   }
 
   std::vector<fs::path> videos() const {

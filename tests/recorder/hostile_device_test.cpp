@@ -3,17 +3,15 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
-
 #include "misbehaving_peers.h"
-#include "recorder_process.h"
 #include "process_memory.h"
+#include "recorder_process.h"
 #include "wait_for.h"
 
 namespace {
 
 using namespace wircam::testing;
 using std::chrono::milliseconds;
-
 
 TEST(WircRecorderHostileDevice, GarbageOnTheControlConnectionCostsACounterNotMemory) {
   ScriptedPeer peer;

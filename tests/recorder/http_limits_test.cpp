@@ -8,9 +8,9 @@
 #include <thread>
 
 #include "common/socket.h"
+#include "process_memory.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
-#include "process_memory.h"
 #include "wait_for.h"
 
 namespace {
@@ -18,7 +18,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace wircam::testing;
 using std::chrono::milliseconds;
-
 
 uint16_t portOf(const std::string& url) {
   return static_cast<uint16_t>(std::stoi(url.substr(url.rfind(':') + 1)));
@@ -94,8 +93,9 @@ TEST(WircRecorderHttpLimits, HalfOpenRequestsAreClosedAfterTheIdleTimeout) {
       },
       milliseconds(5000)));
   // And the server still answers.
-  EXPECT_NE(statusLine(portOf(served.url), "GET /api/status HTTP/1.1\r\nHost: x\r\n\r\n").find("200"),
-            std::string::npos);
+  EXPECT_NE(
+      statusLine(portOf(served.url), "GET /api/status HTTP/1.1\r\nHost: x\r\n\r\n").find("200"),
+      std::string::npos);
 }
 
 TEST(WircRecorderHttpLimits, ASymbolicLinkInTheRecordingsFolderIsNeitherListedNorServed) {
@@ -103,9 +103,9 @@ TEST(WircRecorderHttpLimits, ASymbolicLinkInTheRecordingsFolderIsNeitherListedNo
   ASSERT_FALSE(served.url.empty()) << served.recorder->log();
   fs::create_symlink("/etc/passwd", served.recorder->out() / "passwd.jsonl");
   uint16_t port = portOf(served.url);
-  EXPECT_NE(statusLine(port, "GET /recordings/passwd.jsonl HTTP/1.1\r\nHost: x\r\n\r\n")
-                .find("404"),
-            std::string::npos);
+  EXPECT_NE(
+      statusLine(port, "GET /recordings/passwd.jsonl HTTP/1.1\r\nHost: x\r\n\r\n").find("404"),
+      std::string::npos);
   auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(port));
   std::string request = "GET /recordings HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
   ::send(fd->get(), request.data(), request.size(), MSG_NOSIGNAL);

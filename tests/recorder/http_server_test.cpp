@@ -30,8 +30,8 @@ Response fetch(const std::string& url, const char* method = "GET") {
   Response response;
   GBytes* body = soup_session_send_and_read(session, message, nullptr, nullptr);
   response.status = soup_message_get_status(message);
-  const char* type = soup_message_headers_get_content_type(
-      soup_message_get_response_headers(message), nullptr);
+  const char* type =
+      soup_message_headers_get_content_type(soup_message_get_response_headers(message), nullptr);
   response.contentType = type ? type : "";
   if (body) {
     gsize size = 0;
@@ -46,7 +46,8 @@ Response fetch(const std::string& url, const char* method = "GET") {
 
 // Reads an endless response (MJPEG, events) until `enough` says so or
 // `limit` bytes arrived.
-std::string readStream(const std::string& url, const std::function<bool(const std::string&)>& enough,
+std::string readStream(const std::string& url,
+                       const std::function<bool(const std::string&)>& enough,
                        size_t limit = 8 << 20) {
   SoupSession* session = soup_session_new_with_options("timeout", 10, nullptr);
   SoupMessage* message = soup_message_new("GET", url.c_str());
@@ -219,9 +220,9 @@ TEST(WircRecorderHttp, LiveViewShowsTheCameraWithTheTagOverlayInChromium) {
   std::string command =
       "timeout 60 chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage "
       "--disable-quic --no-first-run --disable-background-networking --disable-component-update "
-      "--disable-sync --user-data-dir=" + profile.string() +
-      " --window-size=800,600 --timeout=10000 --screenshot=" + shot.string() + " " + live.url +
-      " > /dev/null 2>&1";
+      "--disable-sync --user-data-dir=" +
+      profile.string() + " --window-size=800,600 --timeout=10000 --screenshot=" + shot.string() +
+      " " + live.url + " > /dev/null 2>&1";
   ASSERT_EQ(system(command.c_str()), 0) << command;
   auto picture = readPng(shot);
   ASSERT_EQ(picture.width, 800);

@@ -17,8 +17,8 @@ namespace fs = std::filesystem;
 RecorderProcess::RecorderProcess(uint16_t port, std::vector<std::string> extra,
                                  std::vector<std::string> wrapper) {
   static int count = 0;
-  folder_ = fs::temp_directory_path() / ("wirc-recorder-test-" + std::to_string(getpid()) + "-" +
-                                         std::to_string(++count));
+  folder_ = fs::temp_directory_path() /
+            ("wirc-recorder-test-" + std::to_string(getpid()) + "-" + std::to_string(++count));
   fs::remove_all(folder_);
   fs::create_directories(folder_);
   out_ = folder_ / "out";
@@ -119,8 +119,8 @@ GstPadProbeReturn onVideo(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
 // matroskademux gives UTF-8 text as Pango markup: the JSON's quotes come
 // out as &quot; and so on.
 std::string unescapeMarkup(std::string text) {
-  for (auto [entity, plain] : {std::pair{"&quot;", "\""}, {"&apos;", "'"}, {"&lt;", "<"},
-                               {"&gt;", ">"}, {"&amp;", "&"}}) {
+  for (auto [entity, plain] :
+       {std::pair{"&quot;", "\""}, {"&apos;", "'"}, {"&lt;", "<"}, {"&gt;", ">"}, {"&amp;", "&"}}) {
     std::string e = entity;
     for (size_t at = text.find(e); at != std::string::npos; at = text.find(e, at + 1))
       text.replace(at, e.size(), plain);
@@ -137,8 +137,7 @@ GstPadProbeReturn onText(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   GstMapInfo map;
   if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
     std::string text(reinterpret_cast<const char*>(map.data), map.size);
-    static_cast<Reading*>(data)->contents.telemetry.push_back(markup ? unescapeMarkup(text)
-                                                                     : text);
+    static_cast<Reading*>(data)->contents.telemetry.push_back(markup ? unescapeMarkup(text) : text);
     gst_buffer_unmap(buffer, &map);
   }
   return GST_PAD_PROBE_OK;

@@ -53,7 +53,7 @@ struct Contents {
   int frames = 0;
   bool monotonic = true;  // the frames' timestamps rise
   std::vector<GstClockTime> framePts;
-  std::string videoCaps;  // the video stream's media type, e.g. "image/jpeg"
+  std::string videoCaps;               // the video stream's media type, e.g. "image/jpeg"
   std::vector<std::string> telemetry;  // the text track, one JSON per buffer
 };
 Contents contentsOf(const std::filesystem::path& file);

@@ -16,8 +16,7 @@ TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
   RecorderProcess recorder(device->port(), {"--rtsp", "127.0.0.1:0", "--duration", "60"});
   auto url = recorder.waitForLog("rtsp://", milliseconds(10000));
   ASSERT_TRUE(url) << recorder.log();
-  EXPECT_NE(url->find("/127.0.0.1-" + std::to_string(device->port()) + "/cam0"),
-            std::string::npos);
+  EXPECT_NE(url->find("/127.0.0.1-" + std::to_string(device->port()) + "/cam0"), std::string::npos);
   for (const char* protocols : {"udp", "tcp"}) {
     std::string description = "rtspsrc location=" + *url + " protocols=" + protocols +
                               " ! rtpjpegdepay ! jpegdec ! appsink name=sink";

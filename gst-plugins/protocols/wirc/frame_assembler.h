@@ -2,8 +2,10 @@
 // only when every byte from 0 to the end named by its last packet has arrived
 // and all overlapping copies agreed; anything else is counted and dropped.
 // Frames come out in frame-number order (serial arithmetic, so the counter may
-// wrap at 2^32). Memory is bounded by maxFramesInFlight × maxFrameBytes, and
-// in steady state no packet allocates: buffers are reused through recycle().
+// wrap at 2^32). Memory is bounded by maxFramesInFlight × maxFrameBytes.
+// Packets never allocate; a frame's buffer is allocated once, unless the
+// caller hands emitted buffers back through recycle() (wirc-cli does; wircsrc
+// gives each frame's memory to its GstBuffer instead).
 #pragma once
 
 #include <chrono>

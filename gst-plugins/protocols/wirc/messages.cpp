@@ -91,7 +91,7 @@ std::optional<ProtocolError> checkText(Command command, const char* field, const
 bool isUtf8(std::string_view bytes) {
   for (size_t i = 0; i < bytes.size();) {
     auto lead = static_cast<unsigned char>(bytes[i]);
-    size_t extra = lead < 0x80 ? 0
+    size_t extra = lead < 0x80             ? 0
                    : (lead & 0xE0) == 0xC0 ? 1
                    : (lead & 0xF0) == 0xE0 ? 2
                    : (lead & 0xF8) == 0xF0 ? 3

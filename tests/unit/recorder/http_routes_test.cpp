@@ -29,8 +29,8 @@ TEST(HttpRoutes, ServesOnlyPlainNamesOfRecordings) {
   EXPECT_TRUE(isRecordingName("rover-cam0-000.mkv"));
   EXPECT_TRUE(isRecordingName("rover-cam0-000.jsonl"));
   EXPECT_TRUE(isRecordingName("rover-cam0-000.mp4"));
-  for (const char* refused : {"", "../secret.mkv", "a/b.mkv", ".hidden.mkv", "stderr.log",
-                              "passwd", "x.mkv.bak"})
+  for (const char* refused :
+       {"", "../secret.mkv", "a/b.mkv", ".hidden.mkv", "stderr.log", "passwd", "x.mkv.bak"})
     EXPECT_FALSE(isRecordingName(refused)) << refused;
   EXPECT_FALSE(isRecordingName(std::string_view("a\0b.mkv", 7)));
 }

@@ -327,8 +327,14 @@ TEST(Messages, EncodingTextStaysPrintableAscii) {
 }
 
 TEST(Messages, CommandNamesCoverTheSpec) {
-  EXPECT_EQ(commandName(0x13), "CCFG");
-  EXPECT_EQ(commandName(0xFF), "ERR");
+  // Every message of WiRC v1.3 by its code, as the spec names it.
+  const std::pair<uint8_t, const char*> spec[] = {
+      {0x01, "BCSD"}, {0x02, "BCSA"}, {0x11, "TL"},    {0x12, "DCFG"},   {0x13, "CCFG"},
+      {0x14, "FCFG"}, {0x1A, "WST"},  {0x21, "PCD"},   {0x22, "PSD"},    {0x31, "WCFG"},
+      {0x32, "TLR"},  {0x33, "TLST"}, {0x34, "TLEND"}, {0x35, "AREQ"},   {0x36, "AGR"},
+      {0x37, "FWUP"}, {0x41, "STST"}, {0x42, "EST"},   {0x50, "EXTOUT"}, {0xFF, "ERR"}};
+  for (auto [code, name] : spec) EXPECT_EQ(commandName(code), name) << int(code);
+  EXPECT_EQ(std::size(spec), std::variant_size_v<Message>);
   EXPECT_EQ(commandName(0x99), "0x99");
 }
 
