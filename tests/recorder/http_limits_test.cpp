@@ -69,6 +69,22 @@ TEST(WircRecorderHttpLimits, ABodyDeclaredAsAGigabyteIsRefusedUnread) {
   EXPECT_LT(residentKb(served.recorder->pid()) - before, 20 * 1024);
 }
 
+TEST(WircRecorderHttpLimits, AnEndlessHeaderIsCutOffWithoutHoldingMemory) {
+  ServedRecorder served({"--http", "127.0.0.1:0"});
+  ASSERT_FALSE(served.url.empty()) << served.recorder->log();
+  long before = residentKb(served.recorder->pid());
+  auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(portOf(served.url)));
+  ASSERT_TRUE(fd.has_value());
+  std::string start = "GET / HTTP/1.1\r\nHost: x\r\nX-Big: ";
+  ::send(fd->get(), start.data(), start.size(), MSG_NOSIGNAL);
+  std::string filler(64 * 1024, 'a');
+  size_t sent = 0;
+  while (sent < (64u << 20) && ::send(fd->get(), filler.data(), filler.size(), MSG_NOSIGNAL) > 0)
+    sent += filler.size();
+  EXPECT_LT(sent, 64u << 20) << "64 MB of header and still reading";
+  EXPECT_LT(residentKb(served.recorder->pid()) - before, 20 * 1024);
+}
+
 TEST(WircRecorderHttpLimits, HalfOpenRequestsAreClosedAfterTheIdleTimeout) {
   ServedRecorder served({"--http", "127.0.0.1:0", "--http-idle-timeout", "1"});
   ASSERT_FALSE(served.url.empty()) << served.recorder->log();
