@@ -711,8 +711,8 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
                "buffer) before both channels go to neutral",
                50, 10000, DEFAULT_LOST_TIMEOUT, ready);
   install_double(gobject, PROP_PCD_RATE, "pcd-rate",
-                 "Rate limit: at most this many PCD per second; a changed command leaves at "
-                 "once unless one left less than 1/pcd-rate s ago",
+                 "Rate limit on changes: a changed command leaves at once unless another "
+                 "change left less than 1/pcd-rate s ago (keepalives do not count)",
                  1, 1000, DEFAULT_PCD_RATE, ready);
   install_uint(gobject, PROP_KEEPALIVE, "keepalive",
                "Milliseconds between repeats of an unchanged command; keep it well below the "
