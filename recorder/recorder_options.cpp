@@ -3,6 +3,7 @@
 #include <getopt.h>
 #include <glib.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 
@@ -98,7 +99,7 @@ namespace {
 std::optional<uint64_t> size(const char* text) {
   char* end = nullptr;
   double value = std::strtod(text, &end);
-  if (end == text || value < 0) return std::nullopt;
+  if (end == text || !std::isfinite(value) || value < 0) return std::nullopt;
   std::string unit = end;
   double scale = unit.empty()  ? 1
                  : unit == "K" ? 1e3
@@ -106,14 +107,16 @@ std::optional<uint64_t> size(const char* text) {
                  : unit == "G" ? 1e9
                  : unit == "T" ? 1e12
                                : 0;
-  if (scale == 0) return std::nullopt;
+  // Past 2^64 bytes the cast would be undefined, and no disk is that big.
+  if (scale == 0 || value * scale >= 1.8e19) return std::nullopt;
   return static_cast<uint64_t>(value * scale);
 }
 
 std::optional<double> number(const char* text) {
   char* end = nullptr;
   double value = std::strtod(text, &end);
-  if (end == text || *end != '\0') return std::nullopt;
+  // NaN passes every range check and then casts to garbage: refused here.
+  if (end == text || *end != '\0' || !std::isfinite(value)) return std::nullopt;
   return value;
 }
 

@@ -1,5 +1,7 @@
 #include "message_json.h"
 
+#include <optional>
+
 namespace wircam::wirc {
 
 // Field names as in the structs; nlohmann's macros write both directions.
@@ -63,6 +65,29 @@ namespace wircam::cli {
 
 namespace {
 
+// nlohmann converts a fraction to an integer field with a plain cast, which
+// is undefined past the field's range: such input is refused before.
+bool holdsAFraction(const nlohmann::json& json) {
+  if (json.is_number_float()) return true;
+  if (json.is_structured())
+    for (const auto& item : json)
+      if (holdsAFraction(item)) return true;
+  return false;
+}
+
+// The field a value did not fit (nlohmann wraps 300 into a uint8_t as 44):
+// the message written back must say what the input said.
+std::optional<std::string> misfit(const nlohmann::json& input, const wirc::Message& message) {
+  nlohmann::json written = std::visit([](const auto& m) { return nlohmann::json(m); }, message);
+  if (!written.is_object()) return std::nullopt;
+  for (const auto& [key, value] : input.items()) {
+    if (key == "type" || key == "password" || !written.contains(key)) continue;
+    if (written[key] != value)
+      return "\"" + key + "\": " + value.dump() + " does not fit the field";
+  }
+  return std::nullopt;
+}
+
 template <size_t I = 0>
 Expected<wirc::Message, std::string> messageOfType(const std::string& type,
                                                    const nlohmann::json& json) {
@@ -72,8 +97,9 @@ Expected<wirc::Message, std::string> messageOfType(const std::string& type,
     using T = std::variant_alternative_t<I, wirc::Message>;
     if (wirc::commandName(static_cast<uint8_t>(T::kCommand)) != type)
       return messageOfType<I + 1>(type, json);
-    T message = json.get<T>();
-    return wirc::Message{std::move(message)};
+    wirc::Message message{json.get<T>()};
+    if (auto field = misfit(json, message)) return unexpected(*field);
+    return message;
   }
 }
 
@@ -90,6 +116,7 @@ Expected<wirc::Message, std::string> fromJson(const nlohmann::json& json) {
   try {
     if (!json.is_object() || !json.contains("type"))
       return unexpected(std::string("each line needs a \"type\""));
+    if (holdsAFraction(json)) return unexpected(std::string("numbers are whole numbers here"));
     return messageOfType(json.at("type").get<std::string>(), json);
   } catch (const nlohmann::json::exception& error) {
     return unexpected(std::string(error.what()));

@@ -45,5 +45,13 @@ TEST(RecorderOptions, IdleTimeoutIsInSeconds) {
   EXPECT_FALSE(parse({"--out", "x", "--http-idle-timeout", "0"}).has_value());
 }
 
+TEST(RecorderOptions, RefusesNumbersNoFieldCanHold) {
+  // Found by fuzz_recorder_input: these used to reach a cast that is undefined.
+  EXPECT_FALSE(parse({"--out", "x", "--max-bytes", "1e120"}).has_value());
+  EXPECT_FALSE(parse({"--out", "x", "--max-bytes", "inf"}).has_value());
+  EXPECT_FALSE(parse({"--out", "x", "--device", "127.0.0.1:nan"}).has_value());
+  EXPECT_FALSE(parse({"--out", "x", "--segment", "nan"}).has_value());
+}
+
 }  // namespace
 }  // namespace wircam::recorder
