@@ -6,7 +6,7 @@ int main(int argc, char** argv) {
   // their own so an installed wircam can never be picked up instead.
   g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, TRUE);
   g_setenv("GST_REGISTRY", WIRCAM_TEST_REGISTRY, TRUE);
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   // Sanitized plugins only load where the sanitizer runtime is: in this
   // process, not in GStreamer's separate plugin scanner.
   g_setenv("GST_REGISTRY_FORK", "no", TRUE);
