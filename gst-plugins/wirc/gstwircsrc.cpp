@@ -377,15 +377,6 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
   auto* state = self->state;
   const Settings& settings = state->active;
   drain(state->linkChanged);
-  {
-    std::lock_guard lock(state->refusalMutex);
-    if (!state->refusal.empty()) {
-      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
-                        ("The device refused camera %u", settings.camera),
-                        ("%s", state->refusal.c_str()));
-      return GST_FLOW_ERROR;
-    }
-  }
   auto status = state->session->sessionStatus();
   const char* where = settings.host.empty() ? "(discovery)" : settings.host.c_str();
   if (status.state == link::LinkState::Failed) {
@@ -416,6 +407,17 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
         self, RESOURCE, SETTINGS, ("The device has no camera %u", settings.camera),
         ("It reports %u camera(s): set camera=0..%d", status.cameraCount, status.cameraCount - 1));
     return GST_FLOW_ERROR;
+  }
+  // Checked after the camera count, which explains a refusal of a camera
+  // the device does not have better than the refusal does.
+  {
+    std::lock_guard lock(state->refusalMutex);
+    if (!state->refusal.empty()) {
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
+                        ("The device refused camera %u", settings.camera),
+                        ("%s", state->refusal.c_str()));
+      return GST_FLOW_ERROR;
+    }
   }
   // After a reconnect the device streams from a new port.
   state->receiver->follow(*state->session->deviceAddress(), status.logins);
