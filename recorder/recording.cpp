@@ -3,6 +3,7 @@
 #include <glib-unix.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -273,6 +274,16 @@ constexpr guint kFinishSeconds = 10;
 void Recording::stop(const char* why) {
   stopping_ = true;
   if (why) log(std::string(why) + ": finishing the files (a second signal stops at once)");
+  bool anyRecorded = std::any_of(streams_.begin(), streams_.end(),
+                                 [](const auto& s) { return !s->segment.empty(); });
+  if (!anyRecorded) {
+    // No device ever sent a frame: nothing to finish (and no EOS in flight
+    // while the pipeline is torn down), and not a success.
+    log("nothing was recorded: no device sent a frame");
+    if (exitCode_ == 0) exitCode_ = kExitError;
+    g_main_loop_quit(loop_);
+    return;
+  }
   // EOS from every source: each splitmuxsink closes its last segment cleanly.
   gst_element_send_event(pipeline_, gst_event_new_eos());
   // A splitmuxsink that never received a frame (the device never streamed)

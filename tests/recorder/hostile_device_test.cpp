@@ -30,7 +30,8 @@ TEST(WircRecorderHostileDevice, GarbageOnTheControlConnectionCostsACounterNotMem
   recorder.signal(SIGINT);
   auto start = std::chrono::steady_clock::now();
   recorder.wait();
-  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(10000));
+  // Nothing was recorded, so nothing holds the stop back.
+  EXPECT_LT(std::chrono::steady_clock::now() - start, milliseconds(5000));
 }
 
 }  // namespace
