@@ -72,8 +72,8 @@ each, <same name>.jsonl with one JSON object per event: {"pts": running time
 in ns, "type": "stats"|"detections"|"control"|"session", ...}. The same
 objects are a Matroska file's text track (MP4: the sidecar only).
 
-Exit status: 0 finished cleanly, 1 error, 2 bad arguments, 3 the disk filled
-(the open segments were finished first).
+Exit status: 0 finished cleanly, 1 error (or no device ever sent a frame),
+2 bad arguments, 3 the disk filled (the open segments were finished first).
 )";
 }
 
