@@ -19,6 +19,7 @@ namespace {
 using namespace wircam;
 using std::chrono::milliseconds;
 using wircam::testing::busMessage;
+using wircam::testing::firstErrorOf;
 using wircam::testing::launch;
 using wircam::testing::waitFor;
 
@@ -72,14 +73,11 @@ TEST(HostileDeviceElements, ARefusedStreamEndsTheStreamWithTheDevicesReason) {
   peer.play({.chunks = {peer.wst(), wircam::testing::bytesOf(
                                         wirc::Err{static_cast<uint8_t>(wirc::Command::Stst),
                                                   static_cast<uint16_t>(wirc::ErrorCode::Busy)})}});
-  GstElement* pipeline =
-      launch("wircsrc host=127.0.0.1 port=" + std::to_string(peer.port()) + " ! fakesink");
-  gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  auto error = busMessage(pipeline, milliseconds(3000));
+  auto error =
+      firstErrorOf("wircsrc host=127.0.0.1 port=" + std::to_string(peer.port()) + " ! fakesink",
+                   milliseconds(3000));
   EXPECT_NE(error.find("refused camera 0"), std::string::npos) << error;
   EXPECT_NE(error.find("busy"), std::string::npos) << error;
-  gst_element_set_state(pipeline, GST_STATE_NULL);
-  gst_object_unref(pipeline);
 }
 
 TEST(HostileDeviceElements, AStatusTheDeviceStoppedRenewingIsMarkedStaleWithItsAge) {

@@ -40,4 +40,15 @@ inline std::string busMessage(GstElement* pipeline, std::chrono::milliseconds ti
   return text;
 }
 
+// Plays `description` until its first error (as busMessage gives it, "" if
+// none within `timeout`), then stops it.
+inline std::string firstErrorOf(const std::string& description, std::chrono::milliseconds timeout) {
+  GstElement* pipeline = launch(description);
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  std::string error = busMessage(pipeline, timeout);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+  return error;
+}
+
 }  // namespace wircam::testing

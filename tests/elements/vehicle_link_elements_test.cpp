@@ -17,6 +17,7 @@ namespace {
 using namespace wircam;
 using std::chrono::milliseconds;
 using wircam::testing::busMessage;
+using wircam::testing::firstErrorOf;
 using wircam::testing::launch;
 using wircam::testing::waitFor;
 
@@ -90,16 +91,13 @@ TEST(VehicleLinkElements, ASinkStartingFirstDoesNotOverrideTheSourcesLoginSettin
 TEST(VehicleLinkElements, TwoElementsGivingTheSameDeviceDifferentNamesIsAnErrorNamingBoth) {
   auto device = startDevice({.cameras = 2});
   auto port = std::to_string(device->port());
-  GstElement* pipeline = launch(
+  auto error = firstErrorOf(
       "wircsrc name=first transmitter-name=alice camera=0 host=127.0.0.1 port=" + port +
-      " ! fakesink wircsrc name=second transmitter-name=bob camera=1 host=127.0.0.1 port=" + port +
-      " ! fakesink");
-  gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  auto error = busMessage(pipeline, milliseconds(3000));
+          " ! fakesink wircsrc name=second transmitter-name=bob camera=1 host=127.0.0.1 port=" +
+          port + " ! fakesink",
+      milliseconds(3000));
   for (const char* part : {"transmitter-name", "'alice'", "'bob'", "first", "second"})
     EXPECT_NE(error.find(part), std::string::npos) << error;
-  gst_element_set_state(pipeline, GST_STATE_NULL);
-  gst_object_unref(pipeline);
 }
 
 TEST(VehicleLinkElements, LosingTheDeviceWithReconnectOffEndsTheStreamWithTheCause) {

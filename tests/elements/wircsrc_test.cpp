@@ -17,6 +17,7 @@ namespace {
 using namespace wircam;
 using std::chrono::milliseconds;
 using wircam::testing::busMessage;
+using wircam::testing::firstErrorOf;
 using wircam::testing::isSceneFrame;
 using wircam::testing::launch;
 using wircam::testing::sceneFrames;
@@ -136,24 +137,17 @@ TEST(WircSrc, ReportsAnUnreachableDevice) {
   auto device = startDevice(ephemeral());
   auto port = std::to_string(device->port());
   device.reset();
-  GstElement* pipeline =
-      launch("wircsrc host=127.0.0.1 reconnect=false port=" + port + " ! fakesink");
-  gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  auto error = busMessage(pipeline, milliseconds(5000));
+  auto error = firstErrorOf("wircsrc host=127.0.0.1 reconnect=false port=" + port + " ! fakesink",
+                            milliseconds(5000));
   EXPECT_NE(error.find("Could not log in"), std::string::npos) << error;
-  gst_element_set_state(pipeline, GST_STATE_NULL);
-  gst_object_unref(pipeline);
 }
 
 TEST(WircSrc, ReportsACameraTheDeviceDoesNotHave) {
   auto device = startDevice(ephemeral({.cameras = 1}));
-  GstElement* pipeline = launch(
-      "wircsrc host=127.0.0.1 camera=3 port=" + std::to_string(device->port()) + " ! fakesink");
-  gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  auto error = busMessage(pipeline, milliseconds(5000));
+  auto error = firstErrorOf(
+      "wircsrc host=127.0.0.1 camera=3 port=" + std::to_string(device->port()) + " ! fakesink",
+      milliseconds(5000));
   EXPECT_NE(error.find("no camera 3"), std::string::npos) << error;
-  gst_element_set_state(pipeline, GST_STATE_NULL);
-  gst_object_unref(pipeline);
 }
 
 TEST(WircSrc, FollowsTheDeviceThroughARestart) {
