@@ -6,7 +6,7 @@
  * passing buffer and turns the target tag's bearing and distance into
  * steering and throttle pulses (PID per axis, deadband, slew-rate limit,
  * pulse limits). The device's shared link sends a command the moment it
- * changes (at most `pcd-rate` per second) and repeats it every `keepalive`
+ * changes (at most `pcd-rate` changes per second) and repeats it every `keepalive`
  * ms otherwise, so the device's watchdog stays fed. Buffers pass through
  * untouched, so it can sit before a tee.
  *
@@ -139,7 +139,7 @@ struct Settings {
   wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
   // The shared link's settings given: the pacing ones always (the element
   // is the link's one commander), the login ones when set.
-  std::set<std::string> given = {"pcd-rate", "keepalive", "command-ttl"};
+  std::set<std::string> given = {"pcd-rate", "keepalive", "lost-timeout"};
 };
 
 struct WircControlState {

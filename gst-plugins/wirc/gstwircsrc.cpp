@@ -17,7 +17,8 @@
  * an error naming the cause. Stopping sends EST and logs out, and never
  * waits on the network. Elements naming the same device share its login
  * only when the settings they were given agree (transmitter-name, priority,
- * reconnect, login-timeout); a conflict is an error naming both elements.
+ * reconnect, login-timeout, link-timeout, max-bad-messages, periods,
+ * failsafe); a conflict is an error naming both elements.
  *
  * ## Example launch line
  * |[
@@ -566,6 +567,7 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
       break;
     case PROP_MAX_BAD_MESSAGES:
       s.maxBadMessages = g_value_get_uint(value);
+      s.given.insert("max-bad-messages");
       break;
     case PROP_PERIODS:
       gst::setChannelListProperty(object, "periods", value, s.periods, s.given);

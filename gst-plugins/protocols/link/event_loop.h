@@ -61,9 +61,6 @@ class EventLoop {
   void invoke(const Callback& task);
   bool inLoopThread() const { return std::this_thread::get_id() == thread_.get_id(); }
 
-  // Threads started by this loop: always 1, for the README's thread counts.
-  static constexpr int kThreads = 1;
-
  private:
   using TimerQueue = std::multimap<Clock::time_point, Id>;
   struct Entry {

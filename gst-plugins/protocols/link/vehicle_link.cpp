@@ -12,8 +12,6 @@ const char* linkStateName(LinkState state) {
       return "lost";
     case LinkState::Failed:
       return "failed";
-    case LinkState::Closed:
-      return "closed";
   }
   return "unknown";
 }

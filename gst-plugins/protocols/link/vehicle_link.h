@@ -37,7 +37,6 @@ enum class LinkState {
   Live,        // logged in: commands reach the vehicle
   Lost,        // was live; trying again
   Failed,      // gave up (reconnect off, or a setting the vehicle refuses)
-  Closed,      // the last user let go
 };
 const char* linkStateName(LinkState state);
 

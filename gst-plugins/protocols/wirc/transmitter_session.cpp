@@ -78,6 +78,7 @@ std::string number(double value) {
 }
 std::string ms(milliseconds value) { return std::to_string(value.count()) + " ms"; }
 std::string flag(bool value) { return value ? "true" : "false"; }
+std::string count(uint32_t value) { return std::to_string(value); }
 
 const std::vector<SharedSetting>& sharedSettings() {
   static const std::vector<SharedSetting> settings = {
@@ -87,21 +88,16 @@ const std::vector<SharedSetting>& sharedSettings() {
       shared("failsafe", &SessionConfig::failsafe, formatChannelList, true),
       shared("pcd-rate", &SessionConfig::pcdRate, number, false),
       shared("keepalive", &SessionConfig::keepalive, ms, false),
-      shared("command-ttl", &SessionConfig::commandTtl, ms, false),
+      shared("lost-timeout", &SessionConfig::commandTtl, ms, false),
       shared("login-timeout", &SessionConfig::loginTimeout, ms, false),
       shared("link-timeout", &SessionConfig::linkTimeout, ms, false),
       shared("reconnect", &SessionConfig::reconnect, flag, false),
+      shared("max-bad-messages", &SessionConfig::maxBadMessages, count, false),
   };
   return settings;
 }
 
 }  // namespace
-
-std::vector<std::string> sharedSettingNames() {
-  std::vector<std::string> names;
-  for (const auto& setting : sharedSettings()) names.emplace_back(setting.name);
-  return names;
-}
 
 std::string SessionConfig::key() const {
   if (!host.empty()) return host + ":" + std::to_string(port);
@@ -736,11 +732,6 @@ link::LinkStatus TransmitterSession::status() const { return sessionStatus(); }
 SessionStatus TransmitterSession::sessionStatus() const {
   std::lock_guard lock(impl_->mutex_);
   return impl_->status_;
-}
-
-SessionConfig TransmitterSession::config() const {
-  std::lock_guard lock(impl_->mutex_);
-  return impl_->config_;
 }
 
 std::optional<SocketAddress> TransmitterSession::deviceAddress() const {

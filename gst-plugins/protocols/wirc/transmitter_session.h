@@ -48,7 +48,8 @@ struct SessionConfig {
   uint32_t maxBadMessages = 100;
   bool reconnect = true;
   // The settings this user set, by property name ("transmitter-name",
-  // "priority", "pcd-rate", ...). The others defer to another user's.
+  // "priority", "pcd-rate", "lost-timeout" for commandTtl, ...). The others
+  // defer to another user's.
   std::set<std::string> given;
 
   // Sessions are shared by this key: the device's address, or the discovery
@@ -56,8 +57,6 @@ struct SessionConfig {
   std::string key() const;
 };
 
-// The shared link's settings that a user can set, by property name.
-std::vector<std::string> sharedSettingNames();
 // keepalive must stay well below the device's PCD timeout (200..2000 ms).
 constexpr std::chrono::milliseconds kMaxKeepalive{400};
 
@@ -96,7 +95,6 @@ class TransmitterSession : public link::VehicleLink {
   void requestControl() override;
   link::LinkStatus status() const override;
   SessionStatus sessionStatus() const;
-  SessionConfig config() const;
   // The device's address once known (for filtering the stream's sender).
   std::optional<SocketAddress> deviceAddress() const;
 
