@@ -36,6 +36,8 @@ class CommandPacer {
   Clock::time_point nextDeadline(Clock::time_point now) const;
   // Forget what was sent (a new login): the next poll sends at once.
   void restart();
+  // Whether anyone has given a command yet (until then the failsafe goes).
+  bool commanded() const { return command_.has_value(); }
 
   const PacerConfig& config() const { return config_; }
 

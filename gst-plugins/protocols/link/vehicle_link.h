@@ -45,7 +45,9 @@ struct Telemetry {
   std::optional<double> batteryVolts;
   std::optional<double> analogVolts;
   std::optional<int> rssi;
-  std::optional<uint32_t> inputs;  // digital inputs as bits, input 1 first
+  std::optional<uint32_t> inputs;   // digital inputs as bits, input 1 first
+  std::optional<uint32_t> outputs;  // digital outputs set, as bits (BTEMP)
+  std::map<int, uint8_t> pdmDuty;   // output pin (from 0) → PDM duty 0..255 (BTEMP)
   std::chrono::steady_clock::time_point received;
 };
 

@@ -1,0 +1,165 @@
+#include "btemp/btemp_robot.h"
+
+#include <sys/epoll.h>
+#include <sys/socket.h>
+
+#include <array>
+#include <mutex>
+#include <optional>
+
+#include "btemp/btemp_controller.h"
+#include "common/socket.h"
+
+namespace wircam::btemp {
+
+using link::Clock;
+using link::EventLoop;
+
+class Robot::Impl {
+ public:
+  Impl(RobotConfig config, UniqueFd socket, Logger logger);
+  ~Impl() { loop_.remove(watch_); }
+  void onReadable();
+  // Under mutex_: what to answer `message` from `from` with, if anything.
+  std::optional<Message> obey(const Message& message, const SocketAddress& from,
+                              Clock::time_point now);
+  void expire(Clock::time_point now);
+  Pins pins() const;
+  void log(const std::string& line) {
+    if (logger_) logger_(line);
+  }
+
+  const RobotConfig config_;
+  const NodeInfo self_{randomGuid(), nodeFlags(NodeType::Robot)};
+  UniqueFd socket_;
+  Logger logger_;
+  EventLoop& loop_ = EventLoop::shared();
+  EventLoop::Id watch_ = 0;
+
+  mutable std::mutex mutex_;  // guards what follows
+  std::optional<SocketAddress> controller_;
+  RobotOutputs outputs_;
+  std::array<uint8_t, 4> throttle_{};
+  std::optional<Clock::time_point> lastHeard_, lastPins_;
+  RobotStats stats_;
+};
+
+Robot::Impl::Impl(RobotConfig config, UniqueFd socket, Logger logger)
+    : config_(std::move(config)), socket_(std::move(socket)), logger_(std::move(logger)) {
+  watch_ = loop_.watch(socket_.get(), EPOLLIN, [this](uint32_t) { onReadable(); });
+}
+
+void Robot::Impl::expire(Clock::time_point now) {
+  if (outputs_.failsafe || !lastHeard_ || now - *lastHeard_ <= config_.failInterval) return;
+  outputs_ = RobotOutputs{};
+  throttle_ = {};
+  ++stats_.failsafeEntries;
+  log("BTEMP: the controller went quiet: failsafe (neutral)");
+}
+
+Pins Robot::Impl::pins() const {
+  // Four PDM outputs carry Throt1..4; an output pin reads set while its
+  // channel is above neutral.
+  Pins pins{.inputs = config_.inputs, .pdmMask = 0x0F};
+  for (size_t i = 0; i < 4; ++i) {
+    if (outputs_.pulses[i] > link::kPulseNeutral) pins.outputs |= 1u << i;
+    if (!outputs_.failsafe) pins.pdmActive |= 1u << i;
+    pins.duty.push_back(throttle_[i]);
+  }
+  return pins;
+}
+
+std::optional<Message> Robot::Impl::obey(const Message& message, const SocketAddress& from,
+                                         Clock::time_point now) {
+  if (const auto* ping = std::get_if<Ping>(&message)) {
+    ++stats_.pings;
+    if (ping->sender && !wantsResponse(ping->sender->flags)) return std::nullopt;
+    return Piak{self_};
+  }
+  if (std::holds_alternative<Rctr>(message)) {
+    if (!controller_ || !(*controller_ == from))
+      log("BTEMP: controller " + from.toString() + " registered");
+    controller_ = from;
+    lastHeard_ = now;
+    ++stats_.registrations;
+    return Rcak{};
+  }
+  bool ours = controller_ && *controller_ == from;
+  if (const auto* ctrl = std::get_if<Ctrl>(&message)) {
+    if (!ours) {
+      ++stats_.ctrlForeign;
+      return std::nullopt;
+    }
+    expire(now);
+    if (outputs_.failsafe) log("BTEMP: CTRL from " + from.toString());
+    ++stats_.ctrl;
+    lastHeard_ = now;
+    throttle_ = ctrl->throttle;
+    for (size_t channel = 1; channel <= 4; ++channel)
+      outputs_.pulses[channel - 1] = config_.map.toPulse(channel, ctrl->throttle[channel - 1]);
+    outputs_.failsafe = false;
+    if (lastPins_ && now - *lastPins_ < config_.pinsInterval) return std::nullopt;
+    lastPins_ = now;
+    ++stats_.pinsSent;
+    return pins();
+  }
+  if (std::holds_alternative<Idle>(message) && ours) {
+    lastHeard_ = now;
+    if (lastPins_ && now - *lastPins_ < config_.pinsInterval) return Idle{};
+    lastPins_ = now;
+    ++stats_.pinsSent;
+    return pins();
+  }
+  return std::nullopt;
+}
+
+void Robot::Impl::onReadable() {
+  std::array<uint8_t, 2048> buffer;
+  for (int taken = 0; taken < 64; ++taken) {
+    sockaddr_in raw{};
+    socklen_t size = sizeof raw;
+    ssize_t n = ::recvfrom(socket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
+                           reinterpret_cast<sockaddr*>(&raw), &size);
+    if (n < 0) return;
+    SocketAddress from(raw);
+    auto message = decode(std::span(buffer.data(), static_cast<size_t>(n)));
+    std::optional<Message> answer;
+    {
+      std::lock_guard lock(mutex_);
+      if (!message) {
+        ++stats_.rejected;
+        continue;
+      }
+      answer = obey(*message, from, Clock::now());
+    }
+    if (answer) sendDatagram(socket_.get(), from, encode(*answer));
+  }
+}
+
+Expected<std::unique_ptr<Robot>, std::string> Robot::start(RobotConfig config, Logger logger) {
+  auto address = SocketAddress::resolve(config.bindAddress, config.port);
+  if (!address) return unexpected(address.error());
+  auto socket = bindUdp(*address);
+  if (!socket) return unexpected("BTEMP robot: " + socket.error());
+  setNonBlocking(socket->get());
+  return std::unique_ptr<Robot>(
+      new Robot(std::make_unique<Impl>(std::move(config), std::move(*socket), std::move(logger))));
+}
+
+Robot::Robot(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Robot::~Robot() = default;
+
+uint16_t Robot::port() const { return localAddress(impl_->socket_.get()).port(); }
+
+RobotOutputs Robot::outputs(Clock::time_point now) {
+  std::lock_guard lock(impl_->mutex_);
+  impl_->expire(now);
+  return impl_->outputs_;
+}
+
+RobotStats Robot::stats() const {
+  std::lock_guard lock(impl_->mutex_);
+  return impl_->stats_;
+}
+
+}  // namespace wircam::btemp

@@ -1,0 +1,126 @@
+#include "rcoip/rcoip_receiver.h"
+
+#include <sys/epoll.h>
+#include <sys/socket.h>
+
+#include <array>
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <optional>
+
+#include "common/socket.h"
+
+namespace wircam::rcoip {
+
+using link::Clock;
+using link::EventLoop;
+
+class Receiver::Impl {
+ public:
+  Impl(ReceiverConfig config, UniqueFd socket, Logger logger);
+  ~Impl();
+  void onReadable();
+  void log(const std::string& line) {
+    if (logger_) logger_(line);
+  }
+  // Under mutex_: leaves the outputs at the failsafe once commands stopped.
+  void expire(Clock::time_point now);
+
+  const ReceiverConfig config_;
+  UniqueFd socket_;
+  Logger logger_;
+  EventLoop& loop_ = EventLoop::shared();
+  EventLoop::Id watch_ = 0;
+
+  mutable std::mutex mutex_;  // guards what follows
+  ReceiverOutputs outputs_;
+  std::optional<Clock::time_point> lastCommand_;
+  std::optional<Clock::time_point> lastReply_;
+  ReceiverStats stats_;
+};
+
+Receiver::Impl::Impl(ReceiverConfig config, UniqueFd socket, Logger logger)
+    : config_(std::move(config)), socket_(std::move(socket)), logger_(std::move(logger)) {
+  watch_ = loop_.watch(socket_.get(), EPOLLIN, [this](uint32_t) { onReadable(); });
+}
+
+Receiver::Impl::~Impl() { loop_.remove(watch_); }
+
+void Receiver::Impl::expire(Clock::time_point now) {
+  if (outputs_.failsafe || !lastCommand_ || now - *lastCommand_ <= config_.failInterval) return;
+  outputs_ = ReceiverOutputs{};
+  ++stats_.failsafeEntries;
+  log("RCOIP: no command for " + std::to_string(config_.failInterval.count()) +
+      " ms: failsafe (neutral)");
+}
+
+void Receiver::Impl::onReadable() {
+  std::array<uint8_t, 1500> buffer;
+  for (int taken = 0; taken < 64; ++taken) {
+    sockaddr_in from{};
+    socklen_t size = sizeof from;
+    ssize_t n = ::recvfrom(socket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
+                           reinterpret_cast<sockaddr*>(&from), &size);
+    if (n < 0) return;
+    auto now = Clock::now();
+    auto command = decodeCommand(std::span(buffer.data(), static_cast<size_t>(n)));
+    bool reply = false;
+    {
+      std::lock_guard lock(mutex_);
+      if (!command) {
+        ++stats_.rejected;
+        continue;
+      }
+      expire(now);
+      if (outputs_.failsafe) log("RCOIP: commands from " + SocketAddress(from).toString());
+      // Channels a command leaves out read as 0, as the text says.
+      for (size_t channel = 1; channel <= link::kChannels; ++channel) {
+        uint8_t byte = channel <= command->channels.size() ? command->channels[channel - 1] : 0;
+        outputs_.pulses[channel - 1] = config_.map.toPulse(channel, byte);
+      }
+      outputs_.failsafe = false;
+      lastCommand_ = now;
+      ++stats_.commands;
+      reply = !lastReply_ || now - *lastReply_ >= config_.replyInterval;
+      if (reply) {
+        lastReply_ = now;
+        ++stats_.replies;
+      }
+    }
+    if (!reply) continue;
+    Reply status{.battery = static_cast<uint8_t>(
+                     std::lround(std::clamp(config_.batteryVolts / 15.0, 0.0, 1.0) * 255))};
+    if (!config_.replyWithoutRssi) status.rssi = config_.rssi;
+    sendDatagram(socket_.get(), SocketAddress(from), encode(status));
+  }
+}
+
+Expected<std::unique_ptr<Receiver>, std::string> Receiver::start(ReceiverConfig config,
+                                                                 Logger logger) {
+  auto address = SocketAddress::resolve(config.bindAddress, config.port);
+  if (!address) return unexpected(address.error());
+  auto socket = bindUdp(*address);
+  if (!socket) return unexpected("RCOIP receiver: " + socket.error());
+  setNonBlocking(socket->get());
+  return std::unique_ptr<Receiver>(new Receiver(
+      std::make_unique<Impl>(std::move(config), std::move(*socket), std::move(logger))));
+}
+
+Receiver::Receiver(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Receiver::~Receiver() = default;
+
+uint16_t Receiver::port() const { return localAddress(impl_->socket_.get()).port(); }
+
+ReceiverOutputs Receiver::outputs(Clock::time_point now) {
+  std::lock_guard lock(impl_->mutex_);
+  impl_->expire(now);
+  return impl_->outputs_;
+}
+
+ReceiverStats Receiver::stats() const {
+  std::lock_guard lock(impl_->mutex_);
+  return impl_->stats_;
+}
+
+}  // namespace wircam::rcoip

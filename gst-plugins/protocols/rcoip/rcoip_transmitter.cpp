@@ -1,0 +1,243 @@
+#include "rcoip/rcoip_transmitter.h"
+
+#include <sys/epoll.h>
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <array>
+#include <mutex>
+
+#include "common/socket.h"
+#include "link/command_pacer.h"
+#include "link/event_loop.h"
+#include "link/link_registry.h"
+#include "link/reject_tally.h"
+
+namespace wircam::rcoip {
+
+using link::Clock;
+using link::EventLoop;
+using std::chrono::milliseconds;
+
+namespace {
+
+std::string ms(milliseconds value) { return std::to_string(value.count()) + "ms"; }
+
+Expected<std::monostate, std::string> validate(const TransmitterConfig& c) {
+  if (c.channelCount < 1 || c.channelCount > link::kChannels)
+    return unexpected("channels=" + std::to_string(c.channelCount) + ": RCOIP carries 1.." +
+                      std::to_string(link::kChannels) + " of the vehicle's channels here");
+  if (c.failInterval <= milliseconds(kReplyIntervalMs))
+    return unexpected("fail interval " + ms(c.failInterval) +
+                      " must be longer than the receiver's reply interval (1000ms)");
+  if (c.keepalive.count() <= 0 || c.keepalive >= c.failInterval)
+    return unexpected("keepalive " + ms(c.keepalive) +
+                      " must be above 0 and below the fail interval (" + ms(c.failInterval) +
+                      "), or the receiver fails safe between two commands");
+  return std::monostate{};
+}
+
+}  // namespace
+
+std::string TransmitterConfig::settings() const {
+  std::string text = "channels=" + std::to_string(channelCount) + " keepalive=" + ms(keepalive) +
+                     " fail-interval=" + ms(failInterval) + " lost-timeout=" + ms(commandTtl) +
+                     " rate=" + std::to_string(static_cast<int>(rateLimit));
+  if (auto overrides = map.toString(); !overrides.empty()) text += " map=" + overrides;
+  return text;
+}
+
+class Transmitter::Impl {
+ public:
+  Impl(TransmitterConfig config, SocketAddress receiver, UniqueFd socket,
+       link::LinkListeners& listeners);
+  ~Impl();
+
+  void onReadable();
+  void onPacerTimer();
+  void onSilenceTimer();
+  void send(const link::Pulses& pulses);
+  void publish(const std::vector<link::LinkEvent>& events) {
+    for (const auto& event : events) listeners_.emit(event);
+  }
+
+  const TransmitterConfig config_;
+  const SocketAddress receiver_;
+  UniqueFd socket_;
+  link::LinkListeners& listeners_;
+  EventLoop& loop_ = EventLoop::shared();
+  EventLoop::Id watch_ = 0, pacerTimer_ = 0, silenceTimer_ = 0;
+
+  link::RejectTally rejected_;  // loop thread only
+
+  // Guards what follows; never held while sending or emitting.
+  mutable std::mutex mutex_;
+  link::CommandPacer pacer_;
+  TransmitterStatus status_;
+  Clock::time_point lastReply_{};
+};
+
+Transmitter::Impl::Impl(TransmitterConfig config, SocketAddress receiver, UniqueFd socket,
+                        link::LinkListeners& listeners)
+    : config_(std::move(config)),
+      receiver_(receiver),
+      socket_(std::move(socket)),
+      listeners_(listeners),
+      pacer_({.keepalive = config_.keepalive,
+              .minInterval = std::chrono::microseconds(
+                  static_cast<int64_t>(1e6 / std::clamp(config_.rateLimit, 1.0, 1000.0))),
+              .ttl = config_.commandTtl,
+              .failsafe = config_.failsafe,
+              .keepaliveEarly = EventLoop::kCoalesce}) {
+  status_.vehicleAddress = receiver_.toString();
+  status_.hasControl = true;
+  status_.reason = "waiting for the receiver's first reply";
+  watch_ = loop_.watch(socket_.get(), EPOLLIN, [this](uint32_t) { onReadable(); });
+  pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
+  silenceTimer_ = loop_.addTimer([this] { onSilenceTimer(); });
+  loop_.arm(pacerTimer_, Clock::now());
+}
+
+Transmitter::Impl::~Impl() {
+  loop_.invoke([this] {
+    for (auto id : {watch_, pacerTimer_, silenceTimer_}) loop_.remove(id);
+  });
+  // The last word is the failsafe, so the vehicle stops now rather than
+  // after its fail interval.
+  send(config_.failsafe);
+}
+
+void Transmitter::Impl::send(const link::Pulses& pulses) {
+  Command command;
+  for (size_t channel = 1; channel <= config_.channelCount; ++channel)
+    command.channels.push_back(config_.map.toByte(channel, pulses[channel - 1]));
+  if (sendDatagram(socket_.get(), receiver_, encode(command))) {
+    std::lock_guard lock(mutex_);
+    ++status_.commandsSent;
+  }
+}
+
+void Transmitter::Impl::onPacerTimer() {
+  auto now = Clock::now();
+  std::optional<link::Pulses> due;
+  Clock::time_point next;
+  {
+    std::lock_guard lock(mutex_);
+    due = pacer_.poll(now);
+    next = pacer_.nextDeadline(now);
+  }
+  if (due) send(*due);
+  loop_.arm(pacerTimer_, next);
+}
+
+void Transmitter::Impl::onReadable() {
+  std::array<uint8_t, 512> buffer;
+  std::vector<link::LinkEvent> events;
+  // A bounded number per wake-up: a flood cannot starve the other links.
+  for (int taken = 0; taken < 64; ++taken) {
+    sockaddr_in from{};
+    socklen_t size = sizeof from;
+    ssize_t n = ::recvfrom(socket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
+                           reinterpret_cast<sockaddr*>(&from), &size);
+    if (n < 0) break;
+    auto now = Clock::now();
+    if (!(SocketAddress(from) == receiver_)) {
+      std::lock_guard lock(mutex_);
+      ++status_.foreignDatagrams;
+      continue;
+    }
+    auto reply = decodeReply(std::span(buffer.data(), static_cast<size_t>(n)));
+    if (!reply) {
+      rejected_.count(decodeErrorName(reply.error()));
+      std::lock_guard lock(mutex_);
+      status_.inputRejected = rejected_.total();
+      continue;
+    }
+    link::Telemetry telemetry{.batteryVolts = reply->batteryVolts(), .received = now};
+    if (reply->rssi) telemetry.rssi = *reply->rssi;
+    {
+      std::lock_guard lock(mutex_);
+      lastReply_ = now;
+      ++status_.replies;
+      status_.lastReply = *reply;
+      status_.telemetry = telemetry;
+      if (status_.state != link::LinkState::Live) {
+        bool again = status_.state == link::LinkState::Lost;
+        status_.state = link::LinkState::Live;
+        status_.reason.clear();
+        ++status_.logins;
+        events.push_back(link::StateChanged{
+            link::LinkState::Live,
+            (again ? "replies again from " : "replies from ") + receiver_.toString()});
+      }
+    }
+    events.push_back(link::TelemetryReceived{telemetry});
+    loop_.arm(silenceTimer_, now + config_.failInterval);
+  }
+  if (auto summary = rejected_.summary(Clock::now())) events.push_back(*summary);
+  publish(events);
+}
+
+void Transmitter::Impl::onSilenceTimer() {
+  auto now = Clock::now();
+  std::string reason;
+  {
+    std::lock_guard lock(mutex_);
+    if (status_.state != link::LinkState::Live) return;
+    auto silent = now - lastReply_;
+    if (silent < config_.failInterval) return loop_.arm(silenceTimer_, lastReply_ + config_.failInterval);
+    reason = "no reply from " + receiver_.toString() + " for " +
+             std::to_string(std::chrono::duration_cast<milliseconds>(silent).count()) +
+             " ms (fail interval): it is off, out of range or gone";
+    status_.state = link::LinkState::Lost;
+    status_.reason = reason;
+  }
+  publish({link::StateChanged{link::LinkState::Lost, reason}});
+}
+
+Expected<std::shared_ptr<Transmitter>, std::string> Transmitter::acquire(
+    const TransmitterConfig& config) {
+  if (auto valid = validate(config); !valid) return unexpected(valid.error());
+  static link::LinkRegistry<Transmitter> registry;
+  return registry.acquire(
+      config.key(), config.settings(),
+      [&]() -> Expected<std::shared_ptr<Transmitter>, std::string> {
+        auto receiver = SocketAddress::resolve(config.host, config.port);
+        if (!receiver) return unexpected(receiver.error());
+        auto socket = bindUdp(*SocketAddress::resolve("", 0));
+        if (!socket) return unexpected(socket.error());
+        setNonBlocking(socket->get());
+        std::shared_ptr<Transmitter> link(new Transmitter());
+        link->impl_ =
+            std::make_unique<Impl>(config, *receiver, std::move(*socket), link->listeners_);
+        return link;
+      });
+}
+
+Transmitter::~Transmitter() = default;
+
+void Transmitter::setCommand(const link::Pulses& pulses) {
+  auto now = Clock::now();
+  std::optional<link::Pulses> due;
+  Clock::time_point next;
+  {
+    std::lock_guard lock(impl_->mutex_);
+    due = impl_->pacer_.offer(pulses, now);
+    next = impl_->pacer_.nextDeadline(now);
+  }
+  // A change leaves now, from this thread.
+  if (due) impl_->send(*due);
+  impl_->loop_.armIfEarlier(impl_->pacerTimer_, next);
+}
+
+void Transmitter::requestControl() {
+  impl_->publish({link::ControlRequestAnswered{
+      true, "RCOIP has no control right: the transmitter always steers"}});
+}
+
+TransmitterStatus Transmitter::transmitterStatus() const {
+  std::lock_guard lock(impl_->mutex_);
+  return impl_->status_;
+}
+
+}  // namespace wircam::rcoip
