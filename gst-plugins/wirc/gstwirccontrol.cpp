@@ -23,9 +23,20 @@
  * once. The `request-control` action signal (or `take-control=true`, at each
  * login) asks the device for it with AREQ.
  *
- * ## Example launch line
+ * The vehicle may speak WiRC, RCOIP or BTEMP (`protocol`), whatever the
+ * video comes from: the same follower, limits and failsafe steer all three.
+ * RCOIP sends channels 1..8 as bytes (800..2200 µs → 0..255) to a receiver
+ * that has no control right to give; BTEMP registers with the robot (the
+ * control right) and sends channels 1..4 as Throt1..4 in CTRL every
+ * `keepalive` ms. Status reports (battery, RSSI, pins) and link changes are
+ * posted as `wirc-vehicle` element messages.
+ *
+ * ## Example launch lines
  * |[
  * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! apriltagdetect quad-decimate=1 ! wirccontrol host=127.0.0.1 target-id=0 target-distance=1.0 ! fakesink
+ * ]|
+ * |[
+ * gst-launch-1.0 v4l2src ! videoconvert ! apriltagdetect ! wirccontrol protocol=rcoip host=192.168.4.1 port=9048 ! fakesink
  * ]|
  */
 // clang-format on
@@ -42,6 +53,7 @@
 #include <string>
 #include <vector>
 
+#include "control_link.h"
 #include "glib_locker.h"
 #include "login_properties.h"
 #include "target_follower.h"
@@ -57,8 +69,8 @@ using namespace wircam;
 using Clock = std::chrono::steady_clock;
 
 #define DEFAULT_HOST ""
-#define DEFAULT_PORT 1984
-#define DEFAULT_PROTOCOL "wirc"
+#define DEFAULT_PORT 0
+#define DEFAULT_PROTOCOL gst::VehicleProtocol::Wirc
 #define DEFAULT_TARGET_ID -1
 #define DEFAULT_STEERING_CHANNEL 1
 #define DEFAULT_THROTTLE_CHANNEL 2
@@ -118,7 +130,7 @@ GParamSpec* hasControlSpec;
 struct Settings {
   std::string host = DEFAULT_HOST;
   guint port = DEFAULT_PORT;
-  std::string protocol = DEFAULT_PROTOCOL;
+  gst::VehicleProtocol protocol = DEFAULT_PROTOCOL;
   gint targetId = DEFAULT_TARGET_ID;
   guint steeringChannel = DEFAULT_STEERING_CHANNEL;
   guint throttleChannel = DEFAULT_THROTTLE_CHANNEL;
@@ -133,6 +145,7 @@ struct Settings {
   guint lostTimeoutMs = DEFAULT_LOST_TIMEOUT;
   double pcdRate = DEFAULT_PCD_RATE;
   guint keepaliveMs = DEFAULT_KEEPALIVE;
+  bool keepaliveSet = false;
   gboolean enabled = DEFAULT_ENABLED;
   gboolean takeControl = DEFAULT_TAKE_CONTROL;
   wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
@@ -153,7 +166,7 @@ struct WircControlState {
   bool warnedWithoutControl = false;
 
   // Set in start(), cleared in stop(); the link's listener runs on the event loop.
-  std::shared_ptr<wirc::TransmitterSession> session;
+  std::shared_ptr<link::VehicleLink> session;
   int sessionListener = 0;
   std::atomic<bool> hasControl{false};
 };
@@ -232,8 +245,20 @@ static void on_link_event(GstWircControl* self, const link::LinkEvent& event) {
                                                state->hasControl.load(), "request", G_TYPE_STRING,
                                                answer->granted ? "granted" : "denied", "reason",
                                                G_TYPE_STRING, answer->reason.c_str(), nullptr));
+  } else if (const auto* report = std::get_if<link::TelemetryReceived>(&event)) {
+    gst_element_post_message(
+        GST_ELEMENT(self), gst_message_new_element(
+                               GST_OBJECT(self), gst::vehicleStatusStructure(report->telemetry)));
   } else if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
-    std::shared_ptr<wirc::TransmitterSession> session;
+    // The vehicle's link, for the application and the recorder's telemetry.
+    gst_element_post_message(
+        GST_ELEMENT(self),
+        gst_message_new_element(
+            GST_OBJECT(self),
+            gst_structure_new("wirc-vehicle", "event", G_TYPE_STRING,
+                              link::describe(event).c_str(), "state", G_TYPE_STRING,
+                              link::linkStateName(changed->state), nullptr)));
+    std::shared_ptr<link::VehicleLink> session;
     {
       gst::GLibLocker lock(self);
       if (state->settings.takeControl) session = state->session;
@@ -244,7 +269,7 @@ static void on_link_event(GstWircControl* self, const link::LinkEvent& event) {
 }
 
 static void gst_wirc_control_request_control(GstWircControl* self) {
-  std::shared_ptr<wirc::TransmitterSession> session;
+  std::shared_ptr<link::VehicleLink> session;
   {
     gst::GLibLocker lock(self);
     session = self->state->session;
@@ -264,10 +289,11 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
     gst::GLibLocker lock(self);
     settings = state->settings;
   }
-  if (settings.protocol != "wirc") {
+  if (settings.protocol == gst::VehicleProtocol::Btemp &&
+      std::max(settings.steeringChannel, settings.throttleChannel) > 4) {
     GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS,
-                      ("protocol '%s' is not available", settings.protocol.c_str()),
-                      ("This build speaks protocol=wirc only; RCOIP and BTEMP are planned."));
+                      ("BTEMP carries channels 1..4 only (Throt1..Throt4)"),
+                      ("Set steering-channel and throttle-channel within 1..4."));
     return FALSE;
   }
   if (settings.steeringChannel == settings.throttleChannel) {
@@ -285,18 +311,21 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
   }
   // The commander's pacing settings are the link's; another element that
   // gave different ones is named in the error.
-  auto session = wirc::TransmitterSession::acquire(
-      {.host = settings.host,
+  auto session = gst::acquireControlLink(
+      {.protocol = settings.protocol,
+       .host = settings.host,
        .port = static_cast<uint16_t>(settings.port),
+       .rateLimit = settings.pcdRate,
+       .keepalive = std::chrono::milliseconds(settings.keepaliveMs),
+       .keepaliveGiven = settings.keepaliveSet,
+       .commandTtl = std::chrono::milliseconds(settings.lostTimeoutMs),
        .periods = settings.periods,
        .failsafe = settings.failsafe,
-       .pcdRate = settings.pcdRate,
-       .keepalive = std::chrono::milliseconds(settings.keepaliveMs),
-       .commandTtl = std::chrono::milliseconds(settings.lostTimeoutMs),
        .given = settings.given},
       GST_OBJECT_NAME(self));
   if (!session) {
-    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Cannot use the WiRC device's link"),
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS,
+                      ("Cannot use the %s vehicle's link", gst::protocolName(settings.protocol)),
                       ("%s", session.error().c_str()));
     return FALSE;
   }
@@ -318,14 +347,14 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
 static gboolean gst_wirc_control_stop(GstBaseTransform* transform) {
   auto* self = GST_WIRC_CONTROL(transform);
   auto* state = self->state;
-  std::shared_ptr<wirc::TransmitterSession> session;
+  std::shared_ptr<link::VehicleLink> session;
   {
     gst::GLibLocker lock(self);
     session = std::move(state->session);
   }
   if (session) {
     session->removeListener(state->sessionListener);
-    session->setCommand(wirc::neutralChannels());
+    session->setCommand(link::neutralPulses());
   }
   state->follower.reset();
   return TRUE;
@@ -356,7 +385,7 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
                                     std::chrono::steady_clock::now());
   const auto& command = step.command;
 
-  wirc::ChannelValues pulses = wirc::neutralChannels();
+  link::Pulses pulses = link::neutralPulses();
   pulses[settings.steeringChannel - 1] = command.steeringPulse;
   pulses[settings.throttleChannel - 1] = command.throttlePulse;
   state->session->setCommand(pulses);
@@ -368,8 +397,9 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
   } else if (steering && !state->warnedWithoutControl) {
     state->warnedWithoutControl = true;
     GST_ELEMENT_WARNING(self, RESOURCE, WRITE, ("Steering without the control right"),
-                        ("Another transmitter controls the vehicle: the commands are not sent. "
-                         "Emit request-control (or set take-control=true) to ask for it."));
+                        ("The commands are not sent: another WiRC transmitter holds the right (emit "
+                         "request-control or set take-control=true to ask for it), or the BTEMP "
+                         "robot has not answered the registration yet."));
   }
 
   gst_element_post_message(
@@ -401,7 +431,7 @@ static void gst_wirc_control_set_property(GObject* object, guint id, const GValu
       s.port = g_value_get_uint(value);
       break;
     case PROP_PROTOCOL:
-      s.protocol = g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_PROTOCOL;
+      s.protocol = static_cast<gst::VehicleProtocol>(g_value_get_enum(value));
       break;
     case PROP_TARGET_ID:
       s.targetId = g_value_get_int(value);
@@ -471,6 +501,7 @@ static void gst_wirc_control_set_property(GObject* object, guint id, const GValu
       break;
     case PROP_KEEPALIVE:
       s.keepaliveMs = g_value_get_uint(value);
+      s.keepaliveSet = true;
       break;
     case PROP_ENABLED:
       s.enabled = g_value_get_boolean(value);
@@ -505,7 +536,7 @@ static void gst_wirc_control_get_property(GObject* object, guint id, GValue* val
       g_value_set_uint(value, s.port);
       break;
     case PROP_PROTOCOL:
-      g_value_set_string(value, s.protocol.c_str());
+      g_value_set_enum(value, static_cast<gint>(s.protocol));
       break;
     case PROP_TARGET_ID:
       g_value_set_int(value, s.targetId);
@@ -642,16 +673,19 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
   g_object_class_install_property(
       gobject, PROP_HOST,
       g_param_spec_string("host", "Host",
-                          "Address of the WiRC device (the same as wircsrc's: they share one "
-                          "login); empty = discover",
+                          "Address of the vehicle (for WiRC the same as wircsrc's: they share "
+                          "one login); empty = discover (WiRC) or probe the broadcast ports "
+                          "(BTEMP); RCOIP needs one",
                           DEFAULT_HOST, ready));
-  install_uint(gobject, PROP_PORT, "port", "TCP control port of the device", 1, 65535, DEFAULT_PORT,
-               ready);
+  install_uint(gobject, PROP_PORT, "port",
+               "The vehicle's port: WiRC TCP control port, RCOIP receiver or BTEMP robot UDP "
+               "port (0 = the protocol's default: 1984, 9048, 16980)",
+               0, 65535, DEFAULT_PORT, ready);
   g_object_class_install_property(
       gobject, PROP_PROTOCOL,
-      g_param_spec_string("protocol", "Protocol",
-                          "Vehicle protocol: wirc (rcoip and btemp are planned)", DEFAULT_PROTOCOL,
-                          ready));
+      g_param_spec_enum("protocol", "Protocol",
+                        "What the vehicle speaks; the camera may be any video source",
+                        gst::vehicleProtocolType(), static_cast<gint>(DEFAULT_PROTOCOL), ready));
   g_object_class_install_property(
       gobject, PROP_TARGET_ID,
       g_param_spec_int("target-id", "Target id",

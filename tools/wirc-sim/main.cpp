@@ -12,6 +12,7 @@
 #include <string>
 
 #include "follow_scene.h"
+#include "vehicle_control.h"
 #include "jpeg_sequence_scene.h"
 #include "wirc/device.h"
 
@@ -54,6 +55,13 @@ Scene:
   --target-speed M/S   target speed (default 0.3)
   --start-distance M   camera to target at the start (default 1.2)
   --follow-distance M  set point the summary measures against (default 1.0)
+  --control wirc|rcoip|btemp  what steers the car (default wirc: the PCD above).
+                       rcoip: an RCOIP receiver (replies at most once a second,
+                       to the sender only, fails safe after 2 s); btemp: a
+                       BTEMP robot (answers PING, RCTR and CTRL, sends PINS).
+                       The camera streams over WiRC MJPEG either way
+  --control-port N     UDP port of that receiver or robot (default 9048 for
+                       rcoip, 16980 for btemp; 0 = pick a free one, printed)
   --steering-channel N PCD channel steering the car, 1..8 (default 1; 2000 = left)
   --throttle-channel N PCD channel driving the car, 1..8 (default 2; 1500 = stop)
   --truth FILE         write the truth per frame as JSON lines
@@ -102,6 +110,8 @@ enum Option {
   kSteeringChannel,
   kThrottleChannel,
   kTruth,
+  kControl,
+  kControlPort,
   kLoss,
   kBurstLoss,
   kBurstLength,
@@ -140,6 +150,8 @@ const option kOptions[] = {
     {"steering-channel", required_argument, nullptr, kSteeringChannel},
     {"throttle-channel", required_argument, nullptr, kThrottleChannel},
     {"truth", required_argument, nullptr, kTruth},
+    {"control", required_argument, nullptr, kControl},
+    {"control-port", required_argument, nullptr, kControlPort},
     {"loss", required_argument, nullptr, kLoss},
     {"burst-loss", required_argument, nullptr, kBurstLoss},
     {"burst-length", required_argument, nullptr, kBurstLength},
@@ -205,6 +217,8 @@ int main(int argc, char** argv) {
   sim::FollowSceneConfig scene;
   std::optional<std::string> framesDir, truthPath;
   std::optional<double> duration;
+  std::string control = "wirc";
+  std::optional<uint16_t> controlPort;
 
   int opt;
   while ((opt = getopt_long(argc, argv, "h", kOptions, nullptr)) != -1) {
@@ -295,6 +309,14 @@ int main(int argc, char** argv) {
       case kTruth:
         truthPath = optarg;
         break;
+      case kControl:
+        control = optarg;
+        if (control != "wirc" && control != "rcoip" && control != "btemp")
+          usageError("--control is wirc, rcoip or btemp");
+        break;
+      case kControlPort:
+        controlPort = static_cast<uint16_t>(number(optarg, "control-port", 0, 65535));
+        break;
       case kLoss:
         device.impairments.loss = number(optarg, "loss", 0, 1);
         break;
@@ -360,6 +382,16 @@ int main(int argc, char** argv) {
   auto logger = [](const std::string& line) {
     std::fprintf(stderr, "%s wirc-sim: %s\n", timestamp().c_str(), line.c_str());
   };
+  auto vehicle = sim::startVehicleControl(control, device.bindAddress, controlPort, logger);
+  if (!vehicle) {
+    std::fprintf(stderr, "wirc-sim: %s\n", vehicle.error().c_str());
+    return 1;
+  }
+  if (*vehicle) {
+    device.carControl = [control = vehicle->get()](wirc::DeviceClock::time_point now) {
+      return control->outputs(now);
+    };
+  }
   auto started = wirc::Device::start(device, deviceScene, logger);
   if (!started) {
     std::fprintf(stderr, "wirc-sim: %s\n", started.error().c_str());
@@ -367,6 +399,9 @@ int main(int argc, char** argv) {
   }
   auto& sim = *started;
   std::printf("wirc-sim: listening on %s:%u\n", device.bindAddress.c_str(), sim->port());
+  if (*vehicle)
+    std::printf("wirc-sim: %s on %s:%u\n", (*vehicle)->description().c_str(),
+                device.bindAddress.c_str(), (*vehicle)->port());
   std::fflush(stdout);
 
   timespec wait{};
@@ -390,6 +425,7 @@ int main(int argc, char** argv) {
   std::printf("  failsafe entries   %llu\n",
               static_cast<unsigned long long>(stats.failsafeEntries));
   std::printf("  ERR sent           %llu\n", static_cast<unsigned long long>(stats.errSent));
+  if (*vehicle) std::printf("  %s\n", (*vehicle)->summary().c_str());
   if (follow) {
     auto s = follow->summary();
     std::printf(

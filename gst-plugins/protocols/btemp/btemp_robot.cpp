@@ -62,7 +62,7 @@ Pins Robot::Impl::pins() const {
   // channel is above neutral.
   Pins pins{.inputs = config_.inputs, .pdmMask = 0x0F};
   for (size_t i = 0; i < 4; ++i) {
-    if (outputs_.pulses[i] > link::kPulseNeutral) pins.outputs |= 1u << i;
+    if (outputs_.pulses[i] > link::kPulseNeutral + 10) pins.outputs |= 1u << i;
     if (!outputs_.failsafe) pins.pdmActive |= 1u << i;
     pins.duty.push_back(throttle_[i]);
   }

@@ -294,7 +294,7 @@ void Device::Impl::tickFrame(DeviceClock::time_point now) {
   }
   lastTick_ = now;
   if (!scene_) return;
-  scene_->advance(now, localOutputs_);
+  scene_->advance(now, config_.carControl ? config_.carControl(now) : localOutputs_);
   for (int camera = 0; camera < config_.cameras; ++camera) {
     std::vector<uint8_t> jpeg;
     for (auto& [key, stream] : streams_) {

@@ -52,6 +52,9 @@ struct DeviceConfig {
   uint16_t batteryMillivolts = 8400;
   uint16_t emptyBatteryMillivolts = 6000;
   Impairments impairments;
+  // When set, the car obeys these outputs (another protocol's receiver, as
+  // wirc-sim --control rcoip|btemp) instead of the PCD it receives.
+  std::function<ChannelOutputs(DeviceClock::time_point)> carControl;
 };
 
 struct DeviceStats {
