@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "cousin_commands.h"
 #include "hex.h"
 #include "message_json.h"
 #include "wirc/channel_list.h"
@@ -63,12 +64,25 @@ Commands:
                                udpsrc ! wircdepay)
   drive --steering US --throttle US [--duration S]
                                send these pulses for at most 10 s, then neutral
+                               (steering on channel 1, throttle on channel 2)
   decode [--raw]               read messages (hex text, or raw bytes with --raw) on
                                stdin; print one JSON object per message
   encode [--raw]               read JSON objects (one per line) on stdin; print
                                each message as hex (or raw bytes with --raw)
 
+RCOIP and BTEMP vehicles (--protocol rcoip|btemp; port default 9048, 16980):
+  drive --protocol P --host H --port N --steering US --throttle US --duration S
+                               steer, then neutral; prints each status reply
+                               (RCOIP battery and RSSI, BTEMP pins)
+  info --protocol P --host H [--port N]
+                               the vehicle's status (RCOIP: sends neutral
+                               commands, which the receiver answers)
+  discover --protocol btemp [--host H --port N]
+                               PING the broadcast ports 16980..17079 (or one
+                               robot) and list the robots that answer
+
 Connection options (all commands but decode/encode):
+  --protocol wirc|rcoip|btemp  what the vehicle speaks (default wirc)
   --host ADDR                  device address (default: discover)
   --port N                     control port (default 1984)
   --device NAME                when discovering: the name or serial to pick
@@ -81,8 +95,10 @@ Exit codes: 0 success, 1 failure (device unreachable, refused, ERR), 2 bad usage
 )";
 
 struct Options {
+  std::string protocol = "wirc";
   std::string host;
   uint16_t port = wirc::kDefaultPort;
+  bool portGiven = false;
   std::string device;
   std::string discoveryAddress = "255.255.255.255";
   std::string name = "wirc-cli";
@@ -144,7 +160,8 @@ Options parse(int argc, char** argv) {
     kToPort,
     kDestination,
     kData,
-    kMd5
+    kMd5,
+    kProtocol
   };
   static const option options[] = {{"host", required_argument, nullptr, kHost},
                                    {"port", required_argument, nullptr, kPort},
@@ -171,6 +188,7 @@ Options parse(int argc, char** argv) {
                                    {"destination", required_argument, nullptr, kDestination},
                                    {"data", required_argument, nullptr, kData},
                                    {"md5", required_argument, nullptr, kMd5},
+                                   {"protocol", required_argument, nullptr, kProtocol},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};
   Options o;
@@ -186,6 +204,12 @@ Options parse(int argc, char** argv) {
         break;
       case kPort:
         o.port = static_cast<uint16_t>(integer(optarg, "--port", 1, 65535));
+        o.portGiven = true;
+        break;
+      case kProtocol:
+        o.protocol = optarg;
+        if (o.protocol != "wirc" && o.protocol != "rcoip" && o.protocol != "btemp")
+          usageError("--protocol is wirc, rcoip or btemp, not '" + o.protocol + "'");
         break;
       case kDevice:
         o.device = optarg;
@@ -530,6 +554,25 @@ int main(int argc, char** argv) {
     if (o.positional.size() != n)
       usageError(command + " takes " + std::to_string(n) + " argument(s)");
   };
+  if (o.protocol != "wirc") {
+    cli::CousinOptions cousin{.protocol = o.protocol,
+                              .host = o.host,
+                              .port = static_cast<uint16_t>(o.portGiven ? o.port : 0),
+                              .broadcastAddress = o.discoveryAddress,
+                              .timeout = o.timeout,
+                              .steering = o.steering.value_or(1500),
+                              .throttle = o.throttle.value_or(1500),
+                              .seconds = std::min(o.duration > 0 ? o.duration : 1.0, 10.0)};
+    if (command == "drive") {
+      if (!o.steering || !o.throttle)
+        usageError("drive needs --steering US and --throttle US (800..2200)");
+      return cli::driveCousin(cousin);
+    }
+    if (command == "info") return cli::infoCousin(cousin);
+    if (command == "discover" && o.protocol == "btemp") return cli::discoverBtemp(cousin);
+    usageError(command + " is for WiRC devices only (--protocol " + o.protocol +
+               " has drive, info" + (o.protocol == "btemp" ? ", discover)" : ")"));
+  }
   if (command == "discover") return discover(o);
   if (command == "info") return info(o);
   if (command == "transmitters") return transmitters(o);
