@@ -43,9 +43,9 @@ std::string ControllerConfig::key() const {
 }
 
 std::string ControllerConfig::settings() const {
-  std::string text = "ctrl-period=" + ms(ctrlPeriod) + " keepalive-timeout=" +
-                     ms(keepaliveTimeout) + " lost-timeout=" + ms(commandTtl) +
-                     " rate=" + std::to_string(static_cast<int>(rateLimit));
+  std::string text =
+      "ctrl-period=" + ms(ctrlPeriod) + " keepalive-timeout=" + ms(keepaliveTimeout) +
+      " lost-timeout=" + ms(commandTtl) + " rate=" + std::to_string(static_cast<int>(rateLimit));
   if (auto overrides = map.toString(); !overrides.empty()) text += " map=" + overrides;
   return text;
 }
@@ -166,8 +166,8 @@ void Controller::Impl::onPhaseTimer() {
     status_.hasControl = false;
   }
   loop_.disarm(pacerTimer_);
-  publish({link::StateChanged{link::LinkState::Lost, reason},
-           link::ControlRightChanged{false, ""}});
+  publish(
+      {link::StateChanged{link::LinkState::Lost, reason}, link::ControlRightChanged{false, ""}});
   loop_.arm(phaseTimer_, now);
 }
 
@@ -190,10 +190,12 @@ void Controller::Impl::onPacerTimer() {
   if (!commanded) {
     // Nothing worthwhile to send: IDLE tells the robot we are still here.
     send(Idle{}, *robot);
-    return loop_.arm(pacerTimer_, now + kIdlePeriod);
+    return loop_.armIfEarlier(pacerTimer_, now + kIdlePeriod);
   }
   if (due) send(ctrlOf(*due), *robot);
-  loop_.arm(pacerTimer_, next);
+  // Not arm(): a command set while this ran may have armed an earlier wake
+  // (computed after `next`), which must not be pushed back.
+  loop_.armIfEarlier(pacerTimer_, next);
 }
 
 void Controller::Impl::onReadable() {
@@ -211,8 +213,8 @@ void Controller::Impl::onReadable() {
       std::lock_guard lock(mutex_);
       // Until a robot answers, only answers to our probes count.
       bool foreign = robot_ ? !(from == *robot_)
-                            : !config_.host.empty() && !from.sameHost(
-                                                           *SocketAddress::resolve(config_.host, 0));
+                            : !config_.host.empty() &&
+                                  !from.sameHost(*SocketAddress::resolve(config_.host, 0));
       if (foreign) {
         ++status_.foreignDatagrams;
         continue;
@@ -256,8 +258,8 @@ void Controller::Impl::handle(const Message& message, const SocketAddress& from,
     std::string robot = status_.vehicleAddress + " (" + formatGuid(status_.robot->node) + ")";
     lock.unlock();
     events.push_back(link::StateChanged{
-        link::LinkState::Live, (again ? "registered again with robot " : "registered with robot ") +
-                                   robot});
+        link::LinkState::Live,
+        (again ? "registered again with robot " : "registered with robot ") + robot});
     events.push_back(link::ControlRightChanged{true, ""});
     loop_.arm(pacerTimer_, now);
     loop_.arm(phaseTimer_, now + config_.keepaliveTimeout);
@@ -289,8 +291,7 @@ Expected<std::shared_ptr<Controller>, std::string> Controller::acquire(
                       ms(config.keepaliveTimeout) + ")");
   static link::LinkRegistry<Controller> registry;
   return registry.acquire(
-      config.key(), config.settings(),
-      [&]() -> Expected<std::shared_ptr<Controller>, std::string> {
+      config.key(), config.settings(), [&]() -> Expected<std::shared_ptr<Controller>, std::string> {
         if (!config.host.empty())
           if (auto robot = SocketAddress::resolve(config.host, config.port); !robot)
             return unexpected(robot.error());

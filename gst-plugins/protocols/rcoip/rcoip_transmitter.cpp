@@ -127,7 +127,9 @@ void Transmitter::Impl::onPacerTimer() {
     next = pacer_.nextDeadline(now);
   }
   if (due) send(*due);
-  loop_.arm(pacerTimer_, next);
+  // Not arm(): a command set while this ran may have armed an earlier wake
+  // (computed after `next`), which must not be pushed back.
+  loop_.armIfEarlier(pacerTimer_, next);
 }
 
 void Transmitter::Impl::onReadable() {
@@ -185,7 +187,8 @@ void Transmitter::Impl::onSilenceTimer() {
     std::lock_guard lock(mutex_);
     if (status_.state != link::LinkState::Live) return;
     auto silent = now - lastReply_;
-    if (silent < config_.failInterval) return loop_.arm(silenceTimer_, lastReply_ + config_.failInterval);
+    if (silent < config_.failInterval)
+      return loop_.arm(silenceTimer_, lastReply_ + config_.failInterval);
     reason = "no reply from " + receiver_.toString() + " for " +
              std::to_string(std::chrono::duration_cast<milliseconds>(silent).count()) +
              " ms (fail interval): it is off, out of range or gone";
@@ -199,19 +202,18 @@ Expected<std::shared_ptr<Transmitter>, std::string> Transmitter::acquire(
     const TransmitterConfig& config) {
   if (auto valid = validate(config); !valid) return unexpected(valid.error());
   static link::LinkRegistry<Transmitter> registry;
-  return registry.acquire(
-      config.key(), config.settings(),
-      [&]() -> Expected<std::shared_ptr<Transmitter>, std::string> {
-        auto receiver = SocketAddress::resolve(config.host, config.port);
-        if (!receiver) return unexpected(receiver.error());
-        auto socket = bindUdp(*SocketAddress::resolve("", 0));
-        if (!socket) return unexpected(socket.error());
-        setNonBlocking(socket->get());
-        std::shared_ptr<Transmitter> link(new Transmitter());
-        link->impl_ =
-            std::make_unique<Impl>(config, *receiver, std::move(*socket), link->listeners_);
-        return link;
-      });
+  return registry.acquire(config.key(), config.settings(),
+                          [&]() -> Expected<std::shared_ptr<Transmitter>, std::string> {
+                            auto receiver = SocketAddress::resolve(config.host, config.port);
+                            if (!receiver) return unexpected(receiver.error());
+                            auto socket = bindUdp(*SocketAddress::resolve("", 0));
+                            if (!socket) return unexpected(socket.error());
+                            setNonBlocking(socket->get());
+                            std::shared_ptr<Transmitter> link(new Transmitter());
+                            link->impl_ = std::make_unique<Impl>(
+                                config, *receiver, std::move(*socket), link->listeners_);
+                            return link;
+                          });
 }
 
 Transmitter::~Transmitter() = default;

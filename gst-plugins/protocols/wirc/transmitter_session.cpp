@@ -639,7 +639,9 @@ void TransmitterSession::Impl::onPacerTimer() {
     next = pacer_.nextDeadline(now);
   }
   if (due) sendPcd(*due);
-  loop_.arm(pacerTimer_, next);
+  // Not arm(): a command set while this ran may have armed an earlier wake
+  // (computed after `next`), which must not be pushed back.
+  loop_.armIfEarlier(pacerTimer_, next);
 }
 
 // ---------------------------------------------------------------------------
