@@ -36,6 +36,16 @@ std::string encoder(const RecorderOptions& options) {
          std::to_string(options.h264Kbps) + " key-int-max=15 ! h264parse ! ";
 }
 
+// wirccontrol's properties for the vehicle the device's tags steer: the
+// WiRC device itself, or the RCOIP receiver or BTEMP robot of control=.
+std::string controlOf(const DeviceTarget& device) {
+  if (!device.control)
+    return (device.host.empty() ? "" : " host=" + device.host) +
+           " port=" + std::to_string(device.port);
+  const auto& c = *device.control;
+  return " protocol=" + c.protocol + " host=" + c.host + " port=" + std::to_string(c.port);
+}
+
 }  // namespace
 
 PipelinePlan planPipeline(const RecorderOptions& options, const std::string& startTime) {
@@ -95,7 +105,7 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
              ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=" +
              stream.detector + " quad-decimate=1 family=" + options.detectFamily;
         if (!stream.controller.empty())
-          d += " ! wirccontrol name=" + stream.controller + host + port;
+          d += " ! wirccontrol name=" + stream.controller + controlOf(device);
         d += " ! fakesink sync=false async=false ";
       }
       if (!stream.liveSink.empty()) {

@@ -19,8 +19,12 @@ JPEG frames muxed as they arrive (no re-encoding) or transcoded to H.264,
 with the telemetry in a JSON-lines sidecar per segment and, in Matroska, as a
 text track in the file. SIGINT or SIGTERM finishes every file and exits 0.
 
-  --device HOST[:PORT]   a device to record (default port 1984); repeatable.
+  --device HOST[:PORT][,control=URI]
+                         a device to record (default port 1984); repeatable.
                          Without --device the device is found by discovery.
+                         control=rcoip://H:P or btemp://H:P: with --follow,
+                         steer that RCOIP receiver or BTEMP robot instead of
+                         the WiRC device (whose camera is still recorded)
   --config FILE          read devices and options from an INI file (below)
   --camera N             camera to record (default 0); repeatable
   --out DIR              where the files go (created if missing)
@@ -57,7 +61,8 @@ text track in the file. SIGINT or SIGTERM finishes every file and exits 0.
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
 min-free, status, http, http-idle-timeout, rtsp, periods, failsafe), and one
-[device NAME] group per vehicle with host, port, cameras (e.g. 0;1) and follow:
+[device NAME] group per vehicle with host, port, cameras (e.g. 0;1), follow
+and control (rcoip://H:P or btemp://H:P, as on the command line):
 
   [recorder]
   out=recordings
@@ -69,7 +74,7 @@ min-free, status, http, http-idle-timeout, rtsp, periods, failsafe), and one
 
 Files: DIR/<device>-cam<N>-<start time>-<segment>.mkv (or .mp4) and, beside
 each, <same name>.jsonl with one JSON object per event: {"pts": running time
-in ns, "type": "stats"|"detections"|"control"|"session", ...}. The same
+in ns, "type": "stats"|"detections"|"control"|"session"|"vehicle", ...}. The same
 objects are a Matroska file's text track (MP4: the sidecar only).
 
 Exit status: 0 finished cleanly, 1 error (or no device ever sent a frame),
@@ -120,8 +125,17 @@ std::optional<double> number(const char* text) {
   return value;
 }
 
-Expected<DeviceTarget, std::string> deviceTarget(const std::string& text) {
+Expected<DeviceTarget, std::string> deviceTarget(const std::string& argument) {
   DeviceTarget target;
+  std::string text = argument.substr(0, argument.find(','));
+  if (text.size() < argument.size()) {
+    std::string extra = argument.substr(text.size() + 1);
+    if (extra.rfind("control=", 0) != 0)
+      return unexpected("--device " + argument + ": after the comma only control=URI");
+    auto control = parseControlTarget(extra.substr(8));
+    if (!control) return unexpected("--device " + argument + ": " + control.error());
+    target.control = *control;
+  }
   auto colon = text.rfind(':');
   target.host = text.substr(0, colon);
   if (colon != std::string::npos) {
@@ -192,8 +206,12 @@ Expected<std::vector<DeviceTarget>, std::string> loadConfig(const char* path, Re
           for (gsize i = 0; i < n; ++i) device.cameras.push_back(list.get()[i]);
         } else if (key == "follow") {
           device.follow = text == "true" || text == "1";
+        } else if (key == "control") {
+          auto control = parseControlTarget(text);
+          if (!control) return unexpected(where + ": " + control.error());
+          device.control = *control;
         } else {
-          return unexpected(where + ": unknown key (host, port, cameras, follow)");
+          return unexpected(where + ": unknown key (host, port, cameras, follow, control)");
         }
       }
       if (device.host.empty()) return unexpected(std::string(path) + " [" + group + "] needs host");
@@ -273,6 +291,28 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
 
 }  // namespace
 
+Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri) {
+  auto scheme = uri.find("://");
+  ControlTarget target;
+  target.protocol = uri.substr(0, scheme);
+  if (scheme == std::string::npos ||
+      (target.protocol != "wirc" && target.protocol != "rcoip" && target.protocol != "btemp"))
+    return unexpected("control '" + uri + "' is not rcoip://HOST:PORT, btemp://HOST:PORT or " +
+                      "wirc://HOST:PORT");
+  std::string address = uri.substr(scheme + 3);
+  auto colon = address.rfind(':');
+  target.host = address.substr(0, colon);
+  if (colon != std::string::npos) {
+    auto port = number(address.substr(colon + 1).c_str());
+    if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
+      return unexpected("control '" + uri + "': a port is 1..65535");
+    target.port = static_cast<uint16_t>(*port);
+  }
+  if (target.host.empty() || target.host.find_first_of("/ \"'") != std::string::npos)
+    return unexpected("control '" + uri + "' needs a host, as in rcoip://192.168.4.1:9048");
+  return target;
+}
+
 Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   enum { kDevice = 1000, kConfig, kValue };
   // Every other long option is applied by applyOption() under its own name.
@@ -340,6 +380,9 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   for (auto& device : o.devices) {
     if (device.cameras.empty()) device.cameras = o.cameras;
     if (!device.follow) device.follow = o.follow;
+    if (device.control && !*device.follow)
+      return unexpected("device " + device.label +
+                        " has control=, which steers only with follow (--follow or follow=true)");
     if (*device.follow && o.detectFamily.empty())
       return unexpected("device " + device.label + " follows, which needs detect=FAMILY");
   }

@@ -10,12 +10,24 @@
 
 namespace wircam::recorder {
 
+// What steers a following vehicle when it is not the WiRC device itself:
+// "rcoip://HOST:PORT" or "btemp://HOST:PORT" (":PORT" optional: 9048,
+// 16980; "wirc://" names another WiRC device).
+struct ControlTarget {
+  std::string protocol;  // wirc, rcoip or btemp
+  std::string host;
+  uint16_t port = 0;  // 0: the protocol's default
+  bool operator==(const ControlTarget&) const = default;
+};
+Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri);
+
 struct DeviceTarget {
   std::string host;  // empty: discover
   uint16_t port = 1984;
-  std::string label;           // in file names: the host, or the config section's name
-  std::vector<int> cameras;    // empty: the recorder-wide --camera list
-  std::optional<bool> follow;  // unset: the recorder-wide --follow
+  std::string label;                     // in file names: the host, or the config section's name
+  std::vector<int> cameras;              // empty: the recorder-wide --camera list
+  std::optional<bool> follow;            // unset: the recorder-wide --follow
+  std::optional<ControlTarget> control;  // unset: steer the WiRC device itself
 };
 
 // Where a server listens: "[HOST]:PORT"; no host means this machine only

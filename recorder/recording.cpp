@@ -206,6 +206,16 @@ void Recording::handleElementMessage(GstMessage* message) {
     writeTelemetry(*stream, line, now);
     return;
   }
+  if (type == "wirc-vehicle") {
+    // The steered vehicle's own link (RCOIP, BTEMP, or WiRC) and its status
+    // reports: battery, RSSI, pins.
+    if (const char* state = gst_structure_get_string(s, "state"))
+      log(stream->plan.name + ": vehicle " + gst_structure_get_string(s, "event") + " (" + state +
+          ")");
+    line["type"] = "vehicle";
+    writeTelemetry(*stream, line, runningTime());
+    return;
+  }
   if (type != "apriltag" && type != "wirc-control") return;
   // Detections and commands belong to a frame: its timestamp is their time.
   line["type"] = type == "apriltag" ? "detections" : "control";

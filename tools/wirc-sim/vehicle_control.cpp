@@ -21,11 +21,12 @@ class RcoipControl : public VehicleControl {
   }
   uint16_t port() const override { return receiver_->port(); }
   std::string description() const override { return "RCOIP receiver"; }
+  uint64_t commandsReceived() const override { return receiver_->stats().commands; }
   std::string summary() const override {
     auto s = receiver_->stats();
     return "RCOIP              " + std::to_string(s.commands) + " commands (" +
-           std::to_string(s.rejected) + " rejected), " + std::to_string(s.replies) +
-           " replies, " + std::to_string(s.failsafeEntries) + " failsafe entries";
+           std::to_string(s.rejected) + " rejected), " + std::to_string(s.replies) + " replies, " +
+           std::to_string(s.failsafeEntries) + " failsafe entries";
   }
 
  private:
@@ -41,13 +42,14 @@ class BtempControl : public VehicleControl {
   }
   uint16_t port() const override { return robot_->port(); }
   std::string description() const override { return "BTEMP robot"; }
+  uint64_t commandsReceived() const override { return robot_->stats().ctrl; }
   std::string summary() const override {
     auto s = robot_->stats();
     return "BTEMP              " + std::to_string(s.ctrl) + " CTRL (" +
            std::to_string(s.ctrlForeign) + " from unregistered, " + std::to_string(s.rejected) +
-           " rejected), " + std::to_string(s.pings) + " PING, " +
-           std::to_string(s.registrations) + " RCTR, " + std::to_string(s.pinsSent) + " PINS, " +
-           std::to_string(s.failsafeEntries) + " failsafe entries";
+           " rejected), " + std::to_string(s.pings) + " PING, " + std::to_string(s.registrations) +
+           " RCTR, " + std::to_string(s.pinsSent) + " PINS, " + std::to_string(s.failsafeEntries) +
+           " failsafe entries";
   }
 
  private:

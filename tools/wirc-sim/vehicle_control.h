@@ -18,8 +18,9 @@ class VehicleControl {
   virtual ~VehicleControl() = default;
   virtual wirc::ChannelOutputs outputs(wirc::DeviceClock::time_point now) = 0;
   virtual uint16_t port() const = 0;
-  virtual std::string description() const = 0;  // "RCOIP receiver"
-  virtual std::string summary() const = 0;       // one line of counters
+  virtual std::string description() const = 0;    // "RCOIP receiver"
+  virtual std::string summary() const = 0;        // one line of counters
+  virtual uint64_t commandsReceived() const = 0;  // valid ones, from the controller
 };
 
 // "wirc" gives no VehicleControl (the device's own PCD steers); an unset

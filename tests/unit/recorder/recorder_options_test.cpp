@@ -53,5 +53,23 @@ TEST(RecorderOptions, RefusesNumbersNoFieldCanHold) {
   EXPECT_FALSE(parse({"--out", "x", "--segment", "nan"}).has_value());
 }
 
+TEST(RecorderOptions, ADeviceMaySteerAnotherVehicleThroughControl) {
+  auto options = parse({"--out", "x", "--detect", "tag36h11", "--follow", "--device",
+                        "10.0.0.2:1985,control=rcoip://10.0.0.3:9050", "--device", "10.0.0.4"});
+  ASSERT_TRUE(options.has_value()) << options.error();
+  EXPECT_EQ(options->devices[0].host, "10.0.0.2");
+  EXPECT_EQ(options->devices[0].port, 1985);
+  EXPECT_EQ(options->devices[0].control, (ControlTarget{"rcoip", "10.0.0.3", 9050}));
+  EXPECT_FALSE(options->devices[1].control);
+  EXPECT_EQ(parseControlTarget("btemp://robot")->port, 0);  // the protocol's default
+  for (const char* bad : {"rcoip:/x", "tcp://x:1", "rcoip://", "rcoip://x:0", "rcoip://x:70000",
+                          "btemp://x:1.5", "rcoip://a b:1"})
+    EXPECT_FALSE(parseControlTarget(bad)) << bad;
+  // Without follow, control= would steer nothing: said, not ignored.
+  auto unfollowed = parse({"--out", "x", "--device", "10.0.0.2,control=rcoip://10.0.0.3"});
+  ASSERT_FALSE(unfollowed.has_value());
+  EXPECT_NE(unfollowed.error().find("follow"), std::string::npos) << unfollowed.error();
+}
+
 }  // namespace
 }  // namespace wircam::recorder
