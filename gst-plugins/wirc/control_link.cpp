@@ -69,11 +69,10 @@ Expected<std::shared_ptr<link::VehicleLink>, std::string> acquireControlLink(
                                                       user));
     case VehicleProtocol::Rcoip: {
       if (s.host.empty())
-        return unexpected(std::string("RCOIP has no discovery: set host to the receiver's address"));
-      rcoip::TransmitterConfig config{.host = s.host,
-                                      .port = port,
-                                      .commandTtl = s.commandTtl,
-                                      .rateLimit = s.rateLimit};
+        return unexpected(
+            std::string("RCOIP has no discovery: set host to the receiver's address"));
+      rcoip::TransmitterConfig config{
+          .host = s.host, .port = port, .commandTtl = s.commandTtl, .rateLimit = s.rateLimit};
       if (s.keepaliveGiven) config.keepalive = s.keepalive;
       return upcast(rcoip::Transmitter::acquire(config));
     }

@@ -247,17 +247,17 @@ static void on_link_event(GstWircControl* self, const link::LinkEvent& event) {
                                                G_TYPE_STRING, answer->reason.c_str(), nullptr));
   } else if (const auto* report = std::get_if<link::TelemetryReceived>(&event)) {
     gst_element_post_message(
-        GST_ELEMENT(self), gst_message_new_element(
-                               GST_OBJECT(self), gst::vehicleStatusStructure(report->telemetry)));
+        GST_ELEMENT(self),
+        gst_message_new_element(GST_OBJECT(self), gst::vehicleStatusStructure(report->telemetry)));
   } else if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
     // The vehicle's link, for the application and the recorder's telemetry.
     gst_element_post_message(
         GST_ELEMENT(self),
         gst_message_new_element(
             GST_OBJECT(self),
-            gst_structure_new("wirc-vehicle", "event", G_TYPE_STRING,
-                              link::describe(event).c_str(), "state", G_TYPE_STRING,
-                              link::linkStateName(changed->state), nullptr)));
+            gst_structure_new("wirc-vehicle", "event", G_TYPE_STRING, link::describe(event).c_str(),
+                              "state", G_TYPE_STRING, link::linkStateName(changed->state),
+                              nullptr)));
     std::shared_ptr<link::VehicleLink> session;
     {
       gst::GLibLocker lock(self);
@@ -311,18 +311,18 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
   }
   // The commander's pacing settings are the link's; another element that
   // gave different ones is named in the error.
-  auto session = gst::acquireControlLink(
-      {.protocol = settings.protocol,
-       .host = settings.host,
-       .port = static_cast<uint16_t>(settings.port),
-       .rateLimit = settings.pcdRate,
-       .keepalive = std::chrono::milliseconds(settings.keepaliveMs),
-       .keepaliveGiven = settings.keepaliveSet,
-       .commandTtl = std::chrono::milliseconds(settings.lostTimeoutMs),
-       .periods = settings.periods,
-       .failsafe = settings.failsafe,
-       .given = settings.given},
-      GST_OBJECT_NAME(self));
+  auto session =
+      gst::acquireControlLink({.protocol = settings.protocol,
+                               .host = settings.host,
+                               .port = static_cast<uint16_t>(settings.port),
+                               .rateLimit = settings.pcdRate,
+                               .keepalive = std::chrono::milliseconds(settings.keepaliveMs),
+                               .keepaliveGiven = settings.keepaliveSet,
+                               .commandTtl = std::chrono::milliseconds(settings.lostTimeoutMs),
+                               .periods = settings.periods,
+                               .failsafe = settings.failsafe,
+                               .given = settings.given},
+                              GST_OBJECT_NAME(self));
   if (!session) {
     GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS,
                       ("Cannot use the %s vehicle's link", gst::protocolName(settings.protocol)),
@@ -396,10 +396,11 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
     state->warnedWithoutControl = false;
   } else if (steering && !state->warnedWithoutControl) {
     state->warnedWithoutControl = true;
-    GST_ELEMENT_WARNING(self, RESOURCE, WRITE, ("Steering without the control right"),
-                        ("The commands are not sent: another WiRC transmitter holds the right (emit "
-                         "request-control or set take-control=true to ask for it), or the BTEMP "
-                         "robot has not answered the registration yet."));
+    GST_ELEMENT_WARNING(
+        self, RESOURCE, WRITE, ("Steering without the control right"),
+        ("The commands are not sent: another WiRC transmitter holds the right (emit "
+         "request-control or set take-control=true to ask for it), or the BTEMP "
+         "robot has not answered the registration yet."));
   }
 
   gst_element_post_message(

@@ -21,14 +21,17 @@ using std::chrono::milliseconds;
 std::string describeStatus(const link::Telemetry& t) {
   std::string text;
   char part[64];
-  if (t.batteryVolts) std::snprintf(part, sizeof part, "battery %.2f V", *t.batteryVolts), text += part;
+  if (t.batteryVolts)
+    std::snprintf(part, sizeof part, "battery %.2f V", *t.batteryVolts), text += part;
   if (t.rssi) text += std::string(text.empty() ? "" : ", ") + "RSSI " + std::to_string(*t.rssi);
-  if (t.inputs) std::snprintf(part, sizeof part, "%sinputs 0x%x", text.empty() ? "" : ", ", *t.inputs), text += part;
-  if (t.outputs)
-    std::snprintf(part, sizeof part, ", outputs 0x%x", *t.outputs), text += part;
+  if (t.inputs)
+    std::snprintf(part, sizeof part, "%sinputs 0x%x", text.empty() ? "" : ", ", *t.inputs),
+        text += part;
+  if (t.outputs) std::snprintf(part, sizeof part, ", outputs 0x%x", *t.outputs), text += part;
   if (!t.pdmDuty.empty()) {
     text += ", PDM duty";
-    for (auto [pin, duty] : t.pdmDuty) text += " " + std::to_string(pin) + "=" + std::to_string(duty);
+    for (auto [pin, duty] : t.pdmDuty)
+      text += " " + std::to_string(pin) + "=" + std::to_string(duty);
   }
   return text;
 }
@@ -71,8 +74,7 @@ class Session {
 
 Expected<std::shared_ptr<link::VehicleLink>, std::string> open(const CousinOptions& o) {
   if (o.protocol == "rcoip") {
-    if (o.host.empty())
-      return unexpected(std::string("RCOIP has no discovery: give --host"));
+    if (o.host.empty()) return unexpected(std::string("RCOIP has no discovery: give --host"));
     auto link = rcoip::Transmitter::acquire(
         {.host = o.host, .port = o.port ? o.port : rcoip::kDefaultReceiverPort});
     if (!link) return unexpected(link.error());
@@ -95,8 +97,7 @@ int driveCousin(const CousinOptions& o) {
   // commands at once (its replies come back while driving).
   if (o.protocol == "btemp" && !session.waitFor(o.timeout, false)) {
     std::fprintf(stderr, "wirc-cli: no BTEMP robot registered within %lld ms (%s)\n",
-                 static_cast<long long>(o.timeout.count()),
-                 session.link().status().reason.c_str());
+                 static_cast<long long>(o.timeout.count()), session.link().status().reason.c_str());
     return 1;
   }
   link::Pulses pulses = link::neutralPulses();
@@ -121,8 +122,7 @@ int infoCousin(const CousinOptions& o) {
   // RCOIP answers only commands: the link's keepalive (neutral) asks.
   if (!session.waitFor(o.timeout, true)) {
     std::fprintf(stderr, "wirc-cli: no status report within %lld ms (%s)\n",
-                 static_cast<long long>(o.timeout.count()),
-                 session.link().status().reason.c_str());
+                 static_cast<long long>(o.timeout.count()), session.link().status().reason.c_str());
     return 1;
   }
   auto status = session.link().status();

@@ -12,8 +12,8 @@
 #include <string>
 
 #include "follow_scene.h"
-#include "vehicle_control.h"
 #include "jpeg_sequence_scene.h"
+#include "vehicle_control.h"
 #include "wirc/device.h"
 
 using namespace wircam;

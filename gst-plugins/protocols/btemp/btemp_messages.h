@@ -70,10 +70,10 @@ struct Idle {
   bool operator==(const Idle&) const = default;
 };
 struct Pins {
-  uint32_t inputs = 0;     // InMask: inputs that are set
-  uint32_t outputs = 0;    // OutMask: outputs that are set
-  uint32_t pdmMask = 0;    // outputs able to do PDM/PWM
-  uint32_t pdmActive = 0;  // of those, the ones doing it now
+  uint32_t inputs = 0;        // InMask: inputs that are set
+  uint32_t outputs = 0;       // OutMask: outputs that are set
+  uint32_t pdmMask = 0;       // outputs able to do PDM/PWM
+  uint32_t pdmActive = 0;     // of those, the ones doing it now
   std::vector<uint8_t> duty;  // one per bit of pdmMask, lowest pin first
   bool operator==(const Pins&) const = default;
 };

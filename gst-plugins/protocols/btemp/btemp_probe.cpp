@@ -47,7 +47,8 @@ Expected<std::vector<FoundRobot>, std::string> discoverRobots(std::chrono::milli
     }
     auto wait = std::min(end, nextProbe) - Clock::now();
     pollfd p{socket->get(), POLLIN, 0};
-    if (::poll(&p, 1, static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(wait).count())) <= 0)
+    if (::poll(&p, 1,
+               static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(wait).count())) <= 0)
       continue;
     std::array<uint8_t, 1500> buffer;
     sockaddr_in from{};
