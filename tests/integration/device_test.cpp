@@ -10,6 +10,7 @@
 #include "jpeg_sequence_scene.h"
 #include "raw_transmitter.h"
 #include "scene_frames.h"
+#include "wait_for.h"
 #include "wirc/frame_assembler.h"
 
 namespace wircam::wirc {
@@ -220,8 +221,9 @@ TEST(Device, PcdDrivesTheOutputsAndItsAbsenceMeansFailsafeAndDisconnect) {
   while (tx.receive(milliseconds(1500))) {
   }
   EXPECT_TRUE(tx.closedByDevice());
+  // The outputs are published after the close, on the device's next turn.
+  EXPECT_TRUE(testing::waitFor([&] { return device->outputs().failsafe; }, milliseconds(1000)));
   auto outputs = device->outputs();
-  EXPECT_TRUE(outputs.failsafe);
   EXPECT_EQ(outputs.pulses[0], 1700);  // held
   EXPECT_EQ(outputs.pulses[1], 1400);
   EXPECT_EQ(outputs.pulses[2], 0);

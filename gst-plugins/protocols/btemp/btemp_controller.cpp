@@ -102,8 +102,7 @@ Controller::Impl::Impl(ControllerConfig config, UniqueFd socket, link::LinkListe
       socket_(std::move(socket)),
       listeners_(listeners),
       pacer_({.keepalive = config_.ctrlPeriod,
-              .minInterval = std::chrono::microseconds(
-                  static_cast<int64_t>(1e6 / std::clamp(config_.rateLimit, 1.0, 1000.0))),
+              .minInterval = link::intervalOf(config_.rateLimit),
               .ttl = config_.commandTtl,
               .failsafe = config_.failsafe,
               .keepaliveEarly = EventLoop::kCoalesce}) {
@@ -201,34 +200,27 @@ void Controller::Impl::onPacerTimer() {
 void Controller::Impl::onReadable() {
   std::array<uint8_t, 2048> buffer;
   std::vector<link::LinkEvent> events;
-  for (int taken = 0; taken < 64; ++taken) {
-    sockaddr_in raw{};
-    socklen_t size = sizeof raw;
-    ssize_t n = ::recvfrom(socket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
-                           reinterpret_cast<sockaddr*>(&raw), &size);
-    if (n < 0) break;
-    SocketAddress from(raw);
-    auto now = Clock::now();
+  receiveDatagrams(socket_.get(), buffer, 64, [&](auto datagram, const SocketAddress& from) {
     {
       std::lock_guard lock(mutex_);
-      // Until a robot answers, only answers to our probes count.
+      // Until a robot answers, only answers from the named host count.
       bool foreign = robot_ ? !(from == *robot_)
                             : !config_.host.empty() &&
                                   !from.sameHost(*SocketAddress::resolve(config_.host, 0));
       if (foreign) {
         ++status_.foreignDatagrams;
-        continue;
+        return;
       }
     }
-    auto message = decode(std::span(buffer.data(), static_cast<size_t>(n)));
+    auto message = decode(datagram);
     if (!message) {
       rejected_.count(decodeErrorName(message.error()));
       std::lock_guard lock(mutex_);
       status_.inputRejected = rejected_.total();
-      continue;
+      return;
     }
-    handle(*message, from, now, events);
-  }
+    handle(*message, from, Clock::now(), events);
+  });
   if (auto summary = rejected_.summary(Clock::now())) events.push_back(*summary);
   publish(events);
 }

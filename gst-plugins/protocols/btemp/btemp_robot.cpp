@@ -115,25 +115,19 @@ std::optional<Message> Robot::Impl::obey(const Message& message, const SocketAdd
 
 void Robot::Impl::onReadable() {
   std::array<uint8_t, 2048> buffer;
-  for (int taken = 0; taken < 64; ++taken) {
-    sockaddr_in raw{};
-    socklen_t size = sizeof raw;
-    ssize_t n = ::recvfrom(socket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
-                           reinterpret_cast<sockaddr*>(&raw), &size);
-    if (n < 0) return;
-    SocketAddress from(raw);
-    auto message = decode(std::span(buffer.data(), static_cast<size_t>(n)));
+  receiveDatagrams(socket_.get(), buffer, 64, [&](auto datagram, const SocketAddress& from) {
+    auto message = decode(datagram);
     std::optional<Message> answer;
     {
       std::lock_guard lock(mutex_);
       if (!message) {
         ++stats_.rejected;
-        continue;
+        return;
       }
       answer = obey(*message, from, Clock::now());
     }
     if (answer) sendDatagram(socket_.get(), from, encode(*answer));
-  }
+  });
 }
 
 Expected<std::unique_ptr<Robot>, std::string> Robot::start(RobotConfig config, Logger logger) {

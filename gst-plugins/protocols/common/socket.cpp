@@ -127,4 +127,17 @@ bool sendDatagram(int fd, const SocketAddress& to, std::span<const uint8_t> byte
   return sent == static_cast<ssize_t>(bytes.size());
 }
 
+void receiveDatagrams(
+    int fd, std::span<uint8_t> buffer, int most,
+    const std::function<void(std::span<const uint8_t>, const SocketAddress&)>& handle) {
+  for (int taken = 0; taken < most; ++taken) {
+    sockaddr_in from{};
+    socklen_t size = sizeof from;
+    ssize_t n = ::recvfrom(fd, buffer.data(), buffer.size(), MSG_DONTWAIT,
+                           reinterpret_cast<sockaddr*>(&from), &size);
+    if (n < 0) return;
+    handle(buffer.first(static_cast<size_t>(n)), SocketAddress(from));
+  }
+}
+
 }  // namespace wircam

@@ -5,6 +5,7 @@
 #include <netinet/in.h>
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 
@@ -82,5 +83,12 @@ std::string errnoText(int error);
 
 // One datagram; false when the kernel did not take it whole.
 bool sendDatagram(int fd, const SocketAddress& to, std::span<const uint8_t> bytes);
+
+// Reads what is waiting on a non-blocking UDP socket, at most `most`
+// datagrams, so that a flood cannot starve the other work of an event loop;
+// each goes to `handle` with its sender.
+void receiveDatagrams(
+    int fd, std::span<uint8_t> buffer, int most,
+    const std::function<void(std::span<const uint8_t>, const SocketAddress&)>& handle);
 
 }  // namespace wircam

@@ -4,6 +4,10 @@
 
 namespace wircam::link {
 
+std::chrono::microseconds intervalOf(double perSecond) {
+  return std::chrono::microseconds(static_cast<int64_t>(1e6 / std::clamp(perSecond, 1.0, 1000.0)));
+}
+
 Pulses CommandPacer::effective(Clock::time_point now) const {
   if (!command_ || now - commandTime_ > config_.ttl) return config_.failsafe;
   return *command_;

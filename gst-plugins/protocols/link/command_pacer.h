@@ -12,6 +12,9 @@
 
 namespace wircam::link {
 
+// The spacing a rate limit of `perSecond` changes means (1..1000 per second).
+std::chrono::microseconds intervalOf(double perSecond);
+
 struct PacerConfig {
   std::chrono::milliseconds keepalive{100};
   std::chrono::microseconds minInterval{0};  // 1 / rate limit, between changes

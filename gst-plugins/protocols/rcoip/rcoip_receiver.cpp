@@ -57,23 +57,18 @@ void Receiver::Impl::expire(Clock::time_point now) {
 
 void Receiver::Impl::onReadable() {
   std::array<uint8_t, 1500> buffer;
-  for (int taken = 0; taken < 64; ++taken) {
-    sockaddr_in from{};
-    socklen_t size = sizeof from;
-    ssize_t n = ::recvfrom(socket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
-                           reinterpret_cast<sockaddr*>(&from), &size);
-    if (n < 0) return;
+  receiveDatagrams(socket_.get(), buffer, 64, [&](auto datagram, const SocketAddress& from) {
     auto now = Clock::now();
-    auto command = decodeCommand(std::span(buffer.data(), static_cast<size_t>(n)));
+    auto command = decodeCommand(datagram);
     bool reply = false;
     {
       std::lock_guard lock(mutex_);
       if (!command) {
         ++stats_.rejected;
-        continue;
+        return;
       }
       expire(now);
-      if (outputs_.failsafe) log("RCOIP: commands from " + SocketAddress(from).toString());
+      if (outputs_.failsafe) log("RCOIP: commands from " + from.toString());
       // Channels a command leaves out read as 0, as the text says.
       for (size_t channel = 1; channel <= link::kChannels; ++channel) {
         uint8_t byte = channel <= command->channels.size() ? command->channels[channel - 1] : 0;
@@ -88,12 +83,12 @@ void Receiver::Impl::onReadable() {
         ++stats_.replies;
       }
     }
-    if (!reply) continue;
+    if (!reply) return;
     Reply status{.battery = static_cast<uint8_t>(
                      std::lround(std::clamp(config_.batteryVolts / 15.0, 0.0, 1.0) * 255))};
     if (!config_.replyWithoutRssi) status.rssi = config_.rssi;
-    sendDatagram(socket_.get(), SocketAddress(from), encode(status));
-  }
+    sendDatagram(socket_.get(), from, encode(status));
+  });
 }
 
 Expected<std::unique_ptr<Receiver>, std::string> Receiver::start(ReceiverConfig config,

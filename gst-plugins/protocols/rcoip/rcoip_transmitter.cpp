@@ -84,8 +84,7 @@ Transmitter::Impl::Impl(TransmitterConfig config, SocketAddress receiver, Unique
       socket_(std::move(socket)),
       listeners_(listeners),
       pacer_({.keepalive = config_.keepalive,
-              .minInterval = std::chrono::microseconds(
-                  static_cast<int64_t>(1e6 / std::clamp(config_.rateLimit, 1.0, 1000.0))),
+              .minInterval = link::intervalOf(config_.rateLimit),
               .ttl = config_.commandTtl,
               .failsafe = config_.failsafe,
               .keepaliveEarly = EventLoop::kCoalesce}) {
@@ -135,47 +134,37 @@ void Transmitter::Impl::onPacerTimer() {
 void Transmitter::Impl::onReadable() {
   std::array<uint8_t, 512> buffer;
   std::vector<link::LinkEvent> events;
-  // A bounded number per wake-up: a flood cannot starve the other links.
-  for (int taken = 0; taken < 64; ++taken) {
-    sockaddr_in from{};
-    socklen_t size = sizeof from;
-    ssize_t n = ::recvfrom(socket_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT,
-                           reinterpret_cast<sockaddr*>(&from), &size);
-    if (n < 0) break;
+  receiveDatagrams(socket_.get(), buffer, 64, [&](auto datagram, const SocketAddress& from) {
     auto now = Clock::now();
-    if (!(SocketAddress(from) == receiver_)) {
-      std::lock_guard lock(mutex_);
+    std::lock_guard lock(mutex_);
+    if (!(from == receiver_)) {
       ++status_.foreignDatagrams;
-      continue;
+      return;
     }
-    auto reply = decodeReply(std::span(buffer.data(), static_cast<size_t>(n)));
+    auto reply = decodeReply(datagram);
     if (!reply) {
       rejected_.count(decodeErrorName(reply.error()));
-      std::lock_guard lock(mutex_);
       status_.inputRejected = rejected_.total();
-      continue;
+      return;
     }
     link::Telemetry telemetry{.batteryVolts = reply->batteryVolts(), .received = now};
     if (reply->rssi) telemetry.rssi = *reply->rssi;
-    {
-      std::lock_guard lock(mutex_);
-      lastReply_ = now;
-      ++status_.replies;
-      status_.lastReply = *reply;
-      status_.telemetry = telemetry;
-      if (status_.state != link::LinkState::Live) {
-        bool again = status_.state == link::LinkState::Lost;
-        status_.state = link::LinkState::Live;
-        status_.reason.clear();
-        ++status_.logins;
-        events.push_back(link::StateChanged{
-            link::LinkState::Live,
-            (again ? "replies again from " : "replies from ") + receiver_.toString()});
-      }
+    lastReply_ = now;
+    ++status_.replies;
+    status_.lastReply = *reply;
+    status_.telemetry = telemetry;
+    if (status_.state != link::LinkState::Live) {
+      bool again = status_.state == link::LinkState::Lost;
+      status_.state = link::LinkState::Live;
+      status_.reason.clear();
+      ++status_.logins;
+      events.push_back(link::StateChanged{
+          link::LinkState::Live,
+          (again ? "replies again from " : "replies from ") + receiver_.toString()});
     }
     events.push_back(link::TelemetryReceived{telemetry});
-    loop_.arm(silenceTimer_, now + config_.failInterval);
-  }
+  });
+  if (!events.empty()) loop_.arm(silenceTimer_, Clock::now() + config_.failInterval);
   if (auto summary = rejected_.summary(Clock::now())) events.push_back(*summary);
   publish(events);
 }

@@ -44,9 +44,8 @@ link::Pulses pcdFailsafe(const ChannelValues& failsafe) {
 }
 
 link::PacerConfig pacerConfig(const SessionConfig& config) {
-  auto interval = std::chrono::duration<double>(1.0 / std::clamp(config.pcdRate, 1.0, 1000.0));
   return {.keepalive = config.keepalive,
-          .minInterval = std::chrono::duration_cast<std::chrono::microseconds>(interval),
+          .minInterval = link::intervalOf(config.pcdRate),
           .ttl = config.commandTtl,
           .failsafe = pcdFailsafe(config.failsafe),
           .keepaliveEarly = EventLoop::kCoalesce};
