@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include "btemp/btemp_robot.h"
+#include "rcoip/rcoip_receiver.h"
 #include "wait_for.h"
 #include "wirc/device.h"
 #include "wirc/transmitter_session.h"
@@ -80,6 +82,45 @@ TEST(WircCli, FirmwareUpdateRestartsTheDevice) {
   EXPECT_TRUE(testing::waitFor([&] { return device->stats().restarts == 1; }));
   auto bad = wircCli("firmware-update --md5 0011 --host 127.0.0.1");
   EXPECT_EQ(bad.exitCode, 2) << bad.output;
+}
+
+// The cousin vehicles' command lines, word for word as the README gives them.
+TEST(WircCli, DrivesAnRcoipReceiverThenNeutralAndShowsItsBattery) {
+  auto receiver = rcoip::Receiver::start({.port = 0});
+  ASSERT_TRUE(receiver);
+  auto run = wircCli("drive --protocol rcoip --host 127.0.0.1 --port " +
+                     std::to_string((*receiver)->port()) +
+                     " --steering 1800 --throttle 1600 --duration 1");
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("battery 11.12 V"), std::string::npos) << run.output;
+  auto outputs = (*receiver)->outputs(std::chrono::steady_clock::now());
+  EXPECT_GT((*receiver)->stats().commands, 1u);
+  EXPECT_NEAR(outputs.pulses[1], 1500, 6) << "the last command was not neutral";
+}
+
+TEST(WircCli, DrivesABtempRobotAndShowsItsPins) {
+  auto robot = btemp::Robot::start({.port = 0});
+  ASSERT_TRUE(robot);
+  std::string where = " --host 127.0.0.1 --port " + std::to_string((*robot)->port());
+  auto drive =
+      wircCli("drive --protocol btemp" + where + " --steering 1800 --throttle 1600 --duration 1");
+  EXPECT_EQ(drive.exitCode, 0) << drive.output;
+  EXPECT_NE(drive.output.find("PDM duty"), std::string::npos) << drive.output;
+  EXPECT_GT((*robot)->stats().ctrl, 5u);
+  EXPECT_NEAR((*robot)->outputs(std::chrono::steady_clock::now()).pulses[1], 1500, 6);
+  auto info = wircCli("info --protocol btemp" + where);
+  EXPECT_EQ(info.exitCode, 0) << info.output;
+  EXPECT_NE(info.output.find("(robot)"), std::string::npos) << info.output;
+  auto found = wircCli("discover --protocol btemp" + where + " --timeout 500");
+  EXPECT_EQ(found.exitCode, 0) << found.output;
+  EXPECT_NE(found.output.find("robot"), std::string::npos) << found.output;
+}
+
+TEST(WircCli, SaysWhenNoRcoipReceiverAnswers) {
+  auto run = wircCli("info --protocol rcoip --host 127.0.0.1 --port 9 --timeout 1200");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("no status report"), std::string::npos) << run.output;
+  EXPECT_EQ(wircCli("transmitters --protocol rcoip --host 127.0.0.1").exitCode, 2);
 }
 
 }  // namespace
