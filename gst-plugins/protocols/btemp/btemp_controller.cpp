@@ -80,6 +80,8 @@ class Controller::Impl {
 
   const ControllerConfig config_;
   const NodeInfo self_{randomGuid(), nodeFlags(NodeType::Controller)};
+  // The host named in the settings, resolved once (unset: broadcast probing).
+  std::optional<SocketAddress> namedHost_;
   UniqueFd socket_;
   link::LinkListeners& listeners_;
   EventLoop& loop_ = EventLoop::shared();
@@ -107,6 +109,8 @@ Controller::Impl::Impl(ControllerConfig config, UniqueFd socket, link::LinkListe
               .failsafe = config_.failsafe,
               .keepaliveEarly = EventLoop::kCoalesce}) {
   status_.reason = "looking for the robot";
+  if (!config_.host.empty())
+    if (auto host = SocketAddress::resolve(config_.host, config_.port)) namedHost_ = *host;
   watch_ = loop_.watch(socket_.get(), EPOLLIN, [this](uint32_t) { onReadable(); });
   phaseTimer_ = loop_.addTimer([this] { onPhaseTimer(); });
   pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
@@ -204,9 +208,7 @@ void Controller::Impl::onReadable() {
     {
       std::lock_guard lock(mutex_);
       // Until a robot answers, only answers from the named host count.
-      bool foreign = robot_ ? !(from == *robot_)
-                            : !config_.host.empty() &&
-                                  !from.sameHost(*SocketAddress::resolve(config_.host, 0));
+      bool foreign = robot_ ? !(from == *robot_) : namedHost_ && !from.sameHost(*namedHost_);
       if (foreign) {
         ++status_.foreignDatagrams;
         return;
