@@ -48,8 +48,9 @@ std::string controlOf(const DeviceTarget& device) {
 
 }  // namespace
 
-PipelinePlan planPipeline(const RecorderOptions& options, const std::string& startTime) {
+PipelinePlan planPipeline(const RecorderOptions& options) {
   PipelinePlan plan;
+  plan.transcoded = options.codec != Codec::kJpeg;
   std::string& d = plan.description;
   bool live = options.http || options.rtsp;
   size_t index = 0;
@@ -68,37 +69,29 @@ PipelinePlan planPipeline(const RecorderOptions& options, const std::string& sta
       stream.name = stream.device + "-cam" + std::to_string(camera);
       stream.source = "src" + i;
       stream.muxer = "mux" + i;
-      if (options.container == Container::kMatroska) stream.telemetrySource = "tel" + i;
+      stream.telemetrySource = "tel" + i;
       if (!options.detectFamily.empty()) stream.detector = "det" + i;
       if (!options.detectFamily.empty() && *device.follow && !controlled) {
         stream.controller = "ctl" + i;
         controlled = true;  // one controller per vehicle: the first camera's
       }
       if (live) stream.liveSink = "live" + i;
-      auto location = (std::filesystem::path(options.outDir) /
-                       (stream.name + "-" + startTime + "-%03d" + extensionOf(options.container)))
+      // Only if the recorder could not name a file (it always can).
+      auto fallback = (std::filesystem::path(options.outDir) /
+                       (stream.name + "-unnamed-%03d" + extensionOf(options.container)))
                           .string();
-      // The telemetry track is sparse: splitmuxsink lets it run up to 2 s
-      // ahead of the video rather than hold the video for it (at 0, the
-      // default, the two wait on each other).
+      // wait-for-device: a recorder started before its vehicle waits for it.
       d += "wircsrc name=" + stream.source + host + port + login +
-           " camera=" + std::to_string(camera) + " ! tee name=t" + i + " t" + i +
-           ". ! queue max-size-time=3000000000 ! " + encoder(options) +
-           "splitmuxsink name=" + stream.muxer +
-           " async-finalize=true alignment-threshold=2000000000 " +
-           muxerSettings(options.container) +
-           " max-size-time=" + std::to_string(static_cast<uint64_t>(options.segmentSeconds * 1e9)) +
-           " max-size-bytes=" + std::to_string(options.segmentBytes) + " location=\"" + location +
-           "\" ";
-      if (!stream.telemetrySource.empty()) {
-        // The telemetry never blocks the main loop: past 1 MB waiting it
-        // drops. (mp4mux would hold every fragment until the sparse text
-        // track has data, so MP4 keeps its telemetry in the sidecar only.)
-        d += "appsrc name=" + stream.telemetrySource +
-             " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
-             "caps=\"text/x-raw,format=(string)utf8\" ! " +
-             stream.muxer + ".subtitle_%u ";
-      }
+           " camera=" + std::to_string(camera) + " wait-for-device=true ! tee name=t" + i + " t" +
+           i + ". ! queue max-size-time=3000000000 ! " + encoder(options) +
+           "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
+           muxerSettings(options.container) + " location=\"" + fallback + "\" ";
+      // The telemetry never blocks the main loop: past 1 MB waiting it
+      // drops. Its track is called "telemetry" (a stream tag).
+      d += "appsrc name=" + stream.telemetrySource +
+           " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
+           "caps=\"text/x-raw,format=(string)utf8\" ! taginject tags=\"title=telemetry\" ! " +
+           stream.muxer + ".subtitle_%u ";
       if (!stream.detector.empty()) {
         // Detection must never hold the recording back: its queue drops.
         d += "t" + i +

@@ -16,7 +16,7 @@ struct StreamPlan {
   std::string name;             // "<device>-cam<N>", also in file names and the live view
   std::string source;           // wircsrc
   std::string muxer;            // splitmuxsink
-  std::string telemetrySource;  // appsrc feeding the file's text track (Matroska only)
+  std::string telemetrySource;  // appsrc feeding the file's text track
   std::string detector;         // apriltagdetect, with --detect
   std::string controller;       // wirccontrol, on the first camera of a following device
   std::string liveSink;         // appsink of the frames as they arrive, with --http/--rtsp
@@ -25,12 +25,14 @@ struct StreamPlan {
 struct PipelinePlan {
   std::string description;
   std::vector<StreamPlan> streams;
+  bool transcoded = false;  // frames pass an encoder that makes key frames on request
 };
 
 // Per stream: wircsrc → tee → queue → [decode → x264enc →] splitmuxsink,
-// an appsrc of telemetry text into the same splitmuxsink (Matroska), and, when asked
+// an appsrc of telemetry text into the same splitmuxsink, and, when asked
 // for, a leaky branch to AprilTag detection (→ wirccontrol) and one to an
-// appsink for the live view and RTSP. `startTime` goes into file names.
-PipelinePlan planPipeline(const RecorderOptions& options, const std::string& startTime);
+// appsink for the live view and RTSP. splitmuxsink never cuts on its own:
+// the recorder's SegmentSplitter tells it where (and names the files).
+PipelinePlan planPipeline(const RecorderOptions& options);
 
 }  // namespace wircam::recorder

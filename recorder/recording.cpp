@@ -11,17 +11,11 @@
 #include <string_view>
 
 #include "gst_json.h"
+#include "segment_inspector.h"
 
 namespace wircam::recorder {
 
 namespace {
-
-std::string startTime() {
-  std::time_t now = std::time(nullptr);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
-  return text;
-}
 
 void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
 
@@ -30,7 +24,8 @@ void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n"
 Recording::Recording(RecorderOptions options)
     : options_(std::move(options)),
       retention_(options_.outDir, {options_.maxBytes, options_.minFree}, log),
-      disk_(options_.outDir) {}
+      disk_(options_.outDir),
+      index_(options_.outDir) {}
 
 Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     const RecorderOptions& options) {
@@ -46,7 +41,12 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
         "(tools/install-deps installs it)");
 
   std::unique_ptr<Recording> recording(new Recording(options));
-  auto plan = planPipeline(options, startTime());
+  // Segments the index lacks (a crash's last one, or a lost index).
+  if (size_t added = recording->index_.reconcile(inspectSegment))
+    log("indexed " + std::to_string(added) + " segment(s) missing from " +
+        recording->index_.path().string());
+  recording->index_.save();
+  auto plan = planPipeline(options);
   GError* parseError = nullptr;
   recording->pipeline_ = gst_parse_launch(plan.description.c_str(), &parseError);
   if (parseError) {
@@ -55,15 +55,28 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     return unexpected("cannot build the pipeline (are the wircam plugins on GST_PLUGIN_PATH?): " +
                       message);
   }
+  auto elementNamed = [&](const std::string& name) {
+    GstElement* found = gst_bin_get_by_name(GST_BIN(recording->pipeline_), name.c_str());
+    gst_object_unref(found);  // the pipeline keeps it
+    return found;
+  };
+  SegmentLimits limits{
+      .maxDuration = static_cast<uint64_t>(options.segmentSeconds * GST_SECOND),
+      .maxBytes = options.segmentBytes};
   for (auto& streamPlan : plan.streams) {
     auto stream = std::make_unique<Stream>();
     stream->plan = streamPlan;
-    if (!streamPlan.telemetrySource.empty()) {
-      GstElement* source =
-          gst_bin_get_by_name(GST_BIN(recording->pipeline_), streamPlan.telemetrySource.c_str());
-      stream->track.emplace(source);
-      gst_object_unref(source);  // the pipeline keeps it
-    }
+    stream->stateSinceUnixMs = g_get_real_time() / 1000;
+    stream->planner = std::make_unique<SegmentPlanner>(
+        options.outDir, streamPlan.name, extensionOf(options.container), limits);
+    stream->track.emplace(elementNamed(streamPlan.telemetrySource));
+    stream->telemetry = std::make_unique<TelemetryRouter>(*stream->planner, &*stream->track);
+    stream->splitter = std::make_unique<SegmentSplitter>(
+        SegmentSplitter::Parts{.source = elementNamed(streamPlan.source),
+                               .splitmux = elementNamed(streamPlan.muxer),
+                               .track = &*stream->track,
+                               .transcoded = plan.transcoded},
+        *stream->planner, [telemetry = stream->telemetry.get()] { telemetry->flushEarly(); });
     if (!streamPlan.liveSink.empty()) {
       GstElement* sink =
           gst_bin_get_by_name(GST_BIN(recording->pipeline_), streamPlan.liveSink.c_str());
@@ -136,13 +149,46 @@ GstClockTime Recording::runningTime() const {
   return now;
 }
 
-void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime pts) {
-  line["pts"] = pts;
-  std::string text = line.dump();
-  stream.sidecar.write(text);
-  // Before the first segment opens (the login comes before the first frame)
-  // a text buffer could open a segment of its own: the sidecar keeps those.
-  if (stream.track && !stream.segment.empty()) stream.track->write(text, pts);
+int64_t Recording::unixMsOf(GstClockTime time) const {
+  int64_t now = g_get_real_time() / 1000;
+  GstClockTime running = runningTime();
+  if (!GST_CLOCK_TIME_IS_VALID(running) || !GST_CLOCK_TIME_IS_VALID(time)) return now;
+  return now - GST_CLOCK_DIFF(time, running) / static_cast<int64_t>(GST_MSECOND);
+}
+
+void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime time) {
+  if (!GST_CLOCK_TIME_IS_VALID(time)) return;
+  stream.telemetry->write(std::move(line), time, unixMsOf(time));
+  if (auto failure = stream.telemetry->takeWriteFailure()) log(*failure);
+}
+
+void Recording::onSegmentClosed(Stream& stream, const std::string& file) {
+  auto planned = stream.planner->segmentOf(file);
+  if (!planned) return;
+  std::error_code error;
+  index_.add({.camera = stream.plan.name,
+              .file = std::filesystem::path(file).filename().string(),
+              .startUtc = SegmentPlanner::isoUtc(planned->startUnixMs),
+              .durationSeconds = planned->durationSeconds(),
+              .frames = planned->frames,
+              .bytes = std::filesystem::file_size(file, error)});
+  auto open = openSegments();
+  updateIndex(retention_.enforce({open.begin(), open.end()}));
+}
+
+void Recording::updateIndex(const std::vector<std::string>& deleted) {
+  for (const auto& file : deleted) index_.remove(std::filesystem::path(file).filename().string());
+  if (!index_.save()) log("cannot write " + index_.path().string());
+}
+
+void Recording::followLinkState(Stream& stream, const std::string& linkState) {
+  std::string state = stream.state;
+  if (linkState == "live") state = "live";
+  // Until the first login the device is awaited; afterwards it went away.
+  else if (stream.state != "waiting for device") state = "offline";
+  if (state == stream.state) return;
+  stream.state = state;
+  stream.stateSinceUnixMs = g_get_real_time() / 1000;
 }
 
 void Recording::handleElementMessage(GstMessage* message) {
@@ -152,34 +198,22 @@ void Recording::handleElementMessage(GstMessage* message) {
   std::string type = gst_structure_get_name(s);
   if (type == "splitmuxsink-fragment-opened") {
     stream->segment = gst_structure_get_string(s, "location");
-    if (!stream->sidecar.open(stream->segment)) log("cannot write " + stream->sidecar.path());
     return;
   }
   if (type == "splitmuxsink-fragment-closed") {
-    auto open = openSegments();
-    retention_.enforce({open.begin(), open.end()});
+    onSegmentClosed(*stream, gst_structure_get_string(s, "location"));
     return;
   }
 
   nlohmann::json line = toJson(s);
   if (type == "wirc-session") {
-    // Link events: losses, logins, the control right, refusals. A login
-    // after a loss starts a new segment, so the gap falls between two files.
+    // Link events: losses, logins, the control right, refusals. (A loss
+    // ends the segment by itself: the planner cuts at the gap in frames.)
     std::string event = gst_structure_get_string(s, "event");
     log(stream->plan.name + ": " + event);
     line["type"] = "session";
     writeTelemetry(*stream, line, runningTime());
-    const char* state = gst_structure_get_string(s, "state");
-    if (!state) return;
-    if (std::string_view(state) == "lost") stream->lost = true;
-    // Only a login after a loss splits: the first login's event may or may
-    // not arrive, depending on when wircsrc began listening.
-    if (std::string_view(state) == "live" && stream->lost) {
-      stream->lost = false;
-      GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline_), stream->plan.muxer.c_str());
-      g_signal_emit_by_name(sink, "split-now");
-      gst_object_unref(sink);
-    }
+    if (const char* state = gst_structure_get_string(s, "state")) followLinkState(*stream, state);
     return;
   }
   if (type == "wirc-stats") {
@@ -288,9 +322,10 @@ void Recording::stop(const char* why) {
                                  [](const auto& s) { return !s->segment.empty(); });
   if (!anyRecorded) {
     // No device ever sent a frame: nothing to finish (and no EOS in flight
-    // while the pipeline is torn down), and not a success.
+    // while the pipeline is torn down). Stopped by a signal while waiting
+    // is how a service ends; a --duration that recorded nothing failed.
     log("nothing was recorded: no device sent a frame");
-    if (exitCode_ == 0) exitCode_ = kExitError;
+    if (exitCode_ == 0 && !stoppedBySignal_) exitCode_ = kExitError;
     g_main_loop_quit(loop_);
     return;
   }
@@ -322,8 +357,14 @@ gboolean Recording::onStop(gpointer data) {
     g_main_loop_quit(self->loop_);
     return G_SOURCE_CONTINUE;
   }
+  self->stoppedBySignal_ = true;
   self->stop("stopping");
   return G_SOURCE_CONTINUE;
+}
+
+gboolean Recording::onDurationOver(gpointer data) {
+  static_cast<Recording*>(data)->stop("--duration is over");
+  return G_SOURCE_REMOVE;
 }
 
 gboolean Recording::onTick(gpointer data) {
@@ -341,7 +382,7 @@ void Recording::guardDisk() {
   // Old segments may make room (--max-bytes/--min-free); if not, stop while
   // the open segments can still be finished.
   auto open = openSegments();
-  retention_.enforce({open.begin(), open.end()});
+  updateIndex(retention_.enforce({open.begin(), open.end()}));
   if (!disk_.nearlyFull(rate)) return;
   log("the disk under " + options_.outDir + " is full (" + std::to_string(disk_.free() >> 20) +
       " MiB free, " + std::to_string(DiskGuard::reserveFor(rate) >> 20) +
@@ -356,6 +397,10 @@ void Recording::printStatus() {
   // On a terminal the lines are redrawn in place; in a log, appended.
   if (terminal && statusShown_) std::printf("\033[%zuA", streams_.size());
   for (auto& s : streams_) {
+    if (s->state == "waiting for device") {
+      std::printf("%s%-20s waiting for device\n", terminal ? "\033[K" : "", s->plan.name.c_str());
+      continue;
+    }
     double total = static_cast<double>(s->frameCount + s->incomplete);
     double loss = total > 0 ? 100.0 * static_cast<double>(s->incomplete) / total : 0;
     // A device that stopped reporting keeps its last battery reading, marked.
@@ -379,6 +424,8 @@ nlohmann::json Recording::status() const {
         {"name", s->plan.name},
         {"device", s->plan.device},
         {"camera", s->plan.camera},
+        {"state", s->state},
+        {"state_since_utc", SegmentPlanner::isoUtc(s->stateSinceUnixMs)},
         {"frames", s->frameCount},
         {"fps", s->fps},
         {"loss_percent", total > 0 ? 100.0 * static_cast<double>(s->incomplete) / total : 0.0},
@@ -412,7 +459,8 @@ int Recording::run() {
   gst_bus_add_watch(bus, onBusMessage, this);
   g_unix_signal_add(SIGINT, onStop, this);
   g_unix_signal_add(SIGTERM, onStop, this);
-  if (options_.duration) g_timeout_add(static_cast<guint>(*options_.duration * 1000), onStop, this);
+  if (options_.duration)
+    g_timeout_add(static_cast<guint>(*options_.duration * 1000), onDurationOver, this);
   g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this);
 
   if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE) {
@@ -430,7 +478,6 @@ int Recording::run() {
   gst_object_unref(bus);
   gst_element_set_state(pipeline_, GST_STATE_NULL);
   printStatus();
-  for (auto& s : streams_) s->sidecar.close();
   return exitCode_;
 }
 

@@ -18,9 +18,12 @@
 #include "http_server.h"
 #include "pipeline_plan.h"
 #include "recorder_options.h"
+#include "recording_index.h"
 #include "retention.h"
 #include "rtsp_server.h"
-#include "telemetry_log.h"
+#include "segment_planner.h"
+#include "segment_splitter.h"
+#include "telemetry_router.h"
 #include "telemetry_track.h"
 
 namespace wircam::recorder {
@@ -41,29 +44,38 @@ class Recording {
  private:
   struct Stream {
     StreamPlan plan;
-    TelemetryLog sidecar;
+    std::unique_ptr<SegmentPlanner> planner;
     std::optional<TelemetryTrack> track;
+    std::unique_ptr<TelemetryRouter> telemetry;
+    std::unique_ptr<SegmentSplitter> splitter;
     std::unique_ptr<FrameTap> frames;  // with --http or --rtsp
-    std::string segment;
+    std::string segment;               // the file being written
     guint64 frameCount = 0, incomplete = 0, bytes = 0;
     GstClockTime statsTime = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
     double fps = 0, kbps = 0;
     guint batteryMv = 0;
     bool statusStale = false;  // the device stopped reporting; batteryMv is its last word
     guint64 statusAgeMs = 0;
-    bool lost = false;  // the device went away; the next login starts a segment
+    // "waiting for device" until the first login, then "live" or "offline".
+    std::string state = "waiting for device";
+    int64_t stateSinceUnixMs = 0;
   };
 
   explicit Recording(RecorderOptions options);
   std::optional<std::string> startServers();  // the problem, if any
   static gboolean onBusMessage(GstBus* bus, GstMessage* message, gpointer self);
-  static gboolean onStop(gpointer self);
+  static gboolean onStop(gpointer self);  // SIGINT, SIGTERM
+  static gboolean onDurationOver(gpointer self);
   static gboolean onTick(gpointer self);
   void stop(const char* why);
   void handleElementMessage(GstMessage* message);
   void handleError(GstMessage* message);
-  void writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime pts);
+  void writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime runningTime);
+  void onSegmentClosed(Stream& stream, const std::string& file);
+  void followLinkState(Stream& stream, const std::string& linkState);
+  void updateIndex(const std::vector<std::string>& deleted);
   GstClockTime runningTime() const;
+  int64_t unixMsOf(GstClockTime runningTime) const;
   void printStatus();
   void guardDisk();
   nlohmann::json status() const;
@@ -73,6 +85,7 @@ class Recording {
   RecorderOptions options_;
   Retention retention_;
   DiskGuard disk_;
+  RecordingIndex index_;
   GstElement* pipeline_ = nullptr;
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Stream>> streams_;
@@ -80,6 +93,7 @@ class Recording {
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<RtspServer> rtsp_;
   bool stopping_ = false;
+  bool stoppedBySignal_ = false;
   int exitCode_ = 0;
   bool statusShown_ = false;
 };

@@ -23,8 +23,9 @@ struct Segment {
 
 }  // namespace
 
-void Retention::enforce(const std::set<std::string>& open) {
-  if (!active()) return;
+std::vector<std::string> Retention::enforce(const std::set<std::string>& open) {
+  std::vector<std::string> deleted;
+  if (!active()) return deleted;
   std::vector<Segment> segments;
   uint64_t total = 0;
   std::error_code error;
@@ -47,9 +48,11 @@ void Retention::enforce(const std::set<std::string>& open) {
     fs::remove(segment.video, error);
     fs::remove(fs::path(segment.video).replace_extension(".jsonl"), error);
     total -= segment.bytes;
+    deleted.push_back(segment.video.string());
     logger_("deleted " + segment.video.filename().string() +
             (overSize ? " (over --max-bytes)" : " (under --min-free)"));
   }
+  return deleted;
 }
 
 }  // namespace wircam::recorder

@@ -6,6 +6,7 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace wircam::recorder {
 
@@ -20,7 +21,8 @@ class Retention {
   Retention(std::string folder, RetentionLimits limits, Logger logger);
 
   // Deletes oldest segments until the limits hold; never one in `open`.
-  void enforce(const std::set<std::string>& open);
+  // Returns the videos deleted.
+  std::vector<std::string> enforce(const std::set<std::string>& open);
   bool active() const { return limits_.maxBytes > 0 || limits_.minFree > 0; }
 
  private:

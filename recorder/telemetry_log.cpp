@@ -2,35 +2,27 @@
 
 namespace wircam::recorder {
 
-bool TelemetryLog::open(const std::string& segment) {
-  close();
-  auto dot = segment.rfind('.');
-  path_ = (dot == std::string::npos ? segment : segment.substr(0, dot)) + ".jsonl";
-  file_ = std::fopen(path_.c_str(), "w");
-  opened_ = true;
-  for (const auto& line : early_) writeLine(line);
-  early_.clear();
-  return file_ != nullptr;
-}
+TelemetryLog::TelemetryLog(const std::string& segment) : path_(pathFor(segment)) {}
 
-void TelemetryLog::close() {
+TelemetryLog::~TelemetryLog() {
   if (file_) std::fclose(file_);
-  file_ = nullptr;
 }
 
-void TelemetryLog::write(const std::string& json) {
-  if (!opened_) {
-    if (early_.size() < kMaxEarlyLines) early_.push_back(json);
-    return;
-  }
-  writeLine(json);
+std::string TelemetryLog::pathFor(const std::string& segment) {
+  auto dot = segment.rfind('.');
+  auto slash = segment.rfind('/');
+  bool hasExtension = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+  return (hasExtension ? segment.substr(0, dot) : segment) + ".jsonl";
 }
 
-void TelemetryLog::writeLine(const std::string& json) {
-  if (!file_) return;
+bool TelemetryLog::write(const std::string& json) {
+  // Appending: a late line for a segment whose sidecar was closed reopens it.
+  if (!file_) file_ = std::fopen(path_.c_str(), "a");
+  if (!file_) return false;
   std::fputs(json.c_str(), file_);
   std::fputc('\n', file_);
   std::fflush(file_);
+  return true;
 }
 
 }  // namespace wircam::recorder

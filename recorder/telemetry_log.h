@@ -1,38 +1,28 @@
-// The JSON-lines sidecar of one stream's current segment: one object per
-// event, each with the pipeline running time ("pts") it belongs to.
+// The JSON-lines sidecar of one segment: one object per line, appended and
+// flushed as it comes, so a crash loses at most the line being written.
 #pragma once
 
 #include <cstdio>
 #include <string>
-#include <vector>
 
 namespace wircam::recorder {
 
 class TelemetryLog {
  public:
-  TelemetryLog() = default;
+  // The sidecar of the video file `segment`: the same name, ".jsonl".
+  explicit TelemetryLog(const std::string& segment);
   TelemetryLog(const TelemetryLog&) = delete;
   TelemetryLog& operator=(const TelemetryLog&) = delete;
-  ~TelemetryLog() { close(); }
+  ~TelemetryLog();
 
-  // Starts the sidecar of a new segment (`segment` is the video's path).
-  bool open(const std::string& segment);
-  void close();
-  // `json` is one complete object; it is written as one line and flushed,
-  // so a crash loses at most the line being written. Lines that come
-  // before the first segment opens (the login, the control right) wait for
-  // it, up to kMaxEarlyLines.
-  void write(const std::string& json);
-  static constexpr size_t kMaxEarlyLines = 256;
+  static std::string pathFor(const std::string& segment);
+  // Opened on the first line (a segment may get none); false if it cannot be.
+  bool write(const std::string& json);
   const std::string& path() const { return path_; }
 
  private:
-  void writeLine(const std::string& json);
-
-  FILE* file_ = nullptr;
   std::string path_;
-  bool opened_ = false;  // a segment has been opened once
-  std::vector<std::string> early_;
+  FILE* file_ = nullptr;
 };
 
 }  // namespace wircam::recorder

@@ -6,11 +6,19 @@ namespace wircam::recorder {
 
 void TelemetryTrack::write(const std::string& json, GstClockTime pts) {
   if (!GST_CLOCK_TIME_IS_VALID(pts)) return;
+  GstBuffer* buffer =
+      json.empty() ? gst_buffer_new() : gst_buffer_new_memdup(json.data(), json.size());
+  // The lock spans the push so that buffers enter the appsrc in time order.
+  std::lock_guard lock(mutex_);
   last_ = std::max(last_, pts);
-  GstBuffer* buffer = gst_buffer_new_memdup(json.data(), json.size());
   GST_BUFFER_PTS(buffer) = last_;
   GST_BUFFER_DURATION(buffer) = GST_MSECOND;  // an event, not a caption to read
   gst_app_src_push_buffer(GST_APP_SRC(source_), buffer);
+}
+
+GstClockTime TelemetryTrack::last() const {
+  std::lock_guard lock(mutex_);
+  return last_;
 }
 
 }  // namespace wircam::recorder

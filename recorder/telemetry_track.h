@@ -4,6 +4,7 @@
 
 #include <gst/gst.h>
 
+#include <mutex>
 #include <string>
 
 namespace wircam::recorder {
@@ -19,9 +20,19 @@ class TelemetryTrack {
   // time already written; its own "pts" field keeps the exact time.
   void write(const std::string& json, GstClockTime pts);
 
+  // An empty buffer at a key frame's time. splitmuxsink hands a GOP to the
+  // muxer only once every track's input has passed its end, so a sparse
+  // track would hold the video back (and mp4mux waits for every track):
+  // this tells both that the telemetry has nothing before `pts`.
+  void heartbeat(GstClockTime pts) { write({}, pts); }
+
+  // The time of the newest buffer.
+  GstClockTime last() const;
+
  private:
   GstElement* source_;
-  GstClockTime last_ = 0;
+  mutable std::mutex mutex_;  // lines come from the main loop, heartbeats from streaming
+  GstClockTime last_ = 0;     // guarded by mutex_
 };
 
 }  // namespace wircam::recorder

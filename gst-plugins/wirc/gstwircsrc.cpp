@@ -14,7 +14,9 @@
  * Going to PAUSED does not wait for the device: the login runs on the
  * process's event loop, and a device that is not logged in to within
  * `login-timeout` (or is lost with `reconnect=false`) ends the stream with
- * an error naming the cause. Stopping sends EST and logs out, and never
+ * an error naming the cause, unless `wait-for-device` is set: then the
+ * login is retried with backoff until the device appears (a recorder
+ * started before its vehicle). Stopping sends EST and logs out, and never
  * waits on the network. Elements naming the same device share its login
  * only when the settings they were given agree (transmitter-name, priority,
  * reconnect, login-timeout, link-timeout, max-bad-messages, periods,
@@ -68,6 +70,7 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_STATS_INTERVAL 1000
 #define DEFAULT_LINK_TIMEOUT 2000
 #define DEFAULT_MAX_BAD_MESSAGES 100
+#define DEFAULT_WAIT_FOR_DEVICE FALSE
 
 constexpr size_t kBatch = 16;  // datagrams per recvmmsg
 // The device reports every 500 ms: two missed reports make a status stale.
@@ -93,6 +96,7 @@ enum {
   PROP_MAX_BAD_MESSAGES,
   PROP_PERIODS,
   PROP_FAILSAFE,
+  PROP_WAIT_FOR_DEVICE,
 };
 
 struct Settings {
@@ -110,6 +114,7 @@ struct Settings {
   guint statsIntervalMs = DEFAULT_STATS_INTERVAL;
   guint linkTimeoutMs = DEFAULT_LINK_TIMEOUT;
   guint maxBadMessages = DEFAULT_MAX_BAD_MESSAGES;
+  gboolean waitForDevice = DEFAULT_WAIT_FOR_DEVICE;
   wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
   wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
   std::set<std::string> given;  // the shared link's settings the user set
@@ -392,7 +397,7 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
     return GST_FLOW_ERROR;
   }
   if (status.state != link::LinkState::Live) {
-    if (status.logins == 0 && Clock::now() >= state->loginDeadline) {
+    if (status.logins == 0 && !settings.waitForDevice && Clock::now() >= state->loginDeadline) {
       GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
                         ("Could not log in to the WiRC device %s", where),
                         ("no login within %u ms%s%s. Check host/port, or leave host empty to "
@@ -558,6 +563,9 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
       s.loginTimeoutMs = g_value_get_uint(value);
       s.given.insert("login-timeout");
       break;
+    case PROP_WAIT_FOR_DEVICE:
+      s.waitForDevice = g_value_get_boolean(value);
+      break;
     case PROP_STATS_INTERVAL:
       s.statsIntervalMs = g_value_get_uint(value);
       break;
@@ -621,6 +629,9 @@ static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, 
       break;
     case PROP_DISCOVERY_ADDRESS:
       g_value_set_string(value, s.discoveryAddress.c_str());
+      break;
+    case PROP_WAIT_FOR_DEVICE:
+      g_value_set_boolean(value, s.waitForDevice);
       break;
     case PROP_LOGIN_TIMEOUT:
       g_value_set_uint(value, s.loginTimeoutMs);
@@ -757,6 +768,12 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
                         "counts as misbehaving: the connection is dropped and made again after "
                         "a backoff",
                         1, 1000000, DEFAULT_MAX_BAD_MESSAGES, kReady));
+  g_object_class_install_property(
+      gobject, PROP_WAIT_FOR_DEVICE,
+      g_param_spec_boolean("wait-for-device", "Wait for device",
+                           "Keep trying to log in (with backoff) until the device appears, "
+                           "instead of failing after login-timeout; needs reconnect=true",
+                           DEFAULT_WAIT_FOR_DEVICE, kReady));
   gst::installLoginProperties(gobject, PROP_PERIODS, PROP_FAILSAFE);
 
   gst_element_class_add_static_pad_template(element, &src_template);

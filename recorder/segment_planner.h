@@ -1,0 +1,85 @@
+// Where one stream's segments begin, decided from the frames as they come
+// out of the source, before any queue: a segment ends at its length, at its
+// byte limit, or at a gap in the frames (the device was lost), and the next
+// begins with the frame after. Deciding this up front (rather than learning
+// it from splitmuxsink a GOP later) is what lets every telemetry line be
+// written into the segment its time falls in the moment it is written.
+//
+// GStreamer-free: times are pipeline running times in nanoseconds, wall
+// clock times Unix milliseconds. Thread-safe: frames come on the source's
+// streaming thread, bytes on the muxer's, look-ups on the main loop.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace wircam::recorder {
+
+struct PlannedSegment {
+  std::string path;           // the video file
+  int64_t startUnixMs = 0;    // wall clock time of its first frame
+  uint64_t start = 0;         // running time of its first frame
+  uint64_t lastFrame = 0;     // running time of its last frame so far
+  uint64_t frames = 0;
+  uint64_t bytes = 0;         // what reached the muxer, counted toward the byte limit
+  // How long the file plays: its frames' span and one frame period more.
+  double durationSeconds() const;
+};
+
+struct SegmentLimits {
+  uint64_t maxDuration = 0;   // ns; 0 = none
+  uint64_t maxBytes = 0;      // 0 = none
+  uint64_t maxGap = 500'000'000;  // ns between two frames inside one file
+};
+
+class SegmentPlanner {
+ public:
+  // Files are named `<folder>/<stem>-YYYYMMDDTHHMMSSZ<extension>` after the
+  // UTC time of their first frame, with "-2", "-3"... only when a file of
+  // that name exists already.
+  SegmentPlanner(std::filesystem::path folder, std::string stem, std::string extension,
+                 SegmentLimits limits);
+
+  enum class Cut { kNone, kFirst, kNext };
+  // A frame left the source at running time `pts`, wall clock `unixMs`.
+  // kFirst: it opens the first segment; kNext: it ends the current segment
+  // and opens another (the caller has the muxer split there).
+  Cut onFrame(uint64_t pts, int64_t unixMs);
+  // Bytes of the current segment reached the muxer; past the limit, the
+  // next frame starts a new segment.
+  void addBytes(uint64_t bytes);
+
+  // The segment a time belongs to: the last that started at or before it
+  // (times before the first frame belong to the first segment).
+  std::optional<PlannedSegment> segmentAt(uint64_t runningTime) const;
+  std::optional<PlannedSegment> segmentOf(const std::string& path) const;
+  // The segment whose start is nearest `time`: splitmuxsink names a new file
+  // by its first buffer, whose decoding time may be a little earlier.
+  std::optional<PlannedSegment> segmentStartingNear(uint64_t time) const;
+  std::optional<PlannedSegment> current() const;
+
+  // "20261122T143205Z", the form file names use.
+  static std::string compactUtc(int64_t unixMs);
+  // "2026-11-22T14:32:05.123Z", the form telemetry and the index use.
+  static std::string isoUtc(int64_t unixMs);
+
+ private:
+  std::string nameFor(int64_t unixMs);
+
+  const std::filesystem::path folder_;
+  const std::string stem_, extension_;
+  const SegmentLimits limits_;
+  mutable std::mutex mutex_;
+  std::vector<PlannedSegment> segments_;  // guarded by mutex_; the newest last
+  std::set<std::string> used_;            // guarded by mutex_: names given out
+  bool splitPending_ = false;             // guarded by mutex_: the byte limit was reached
+  // Past segments kept for look-ups of late telemetry and closing files.
+  static constexpr size_t kKept = 16;
+};
+
+}  // namespace wircam::recorder

@@ -1,0 +1,125 @@
+#include "segment_splitter.h"
+
+#include <gst/video/video-event.h>
+
+namespace wircam::recorder {
+
+namespace {
+
+// A buffer's running time on its pad's segment; what splitmuxsink also
+// measures GOPs by (decoding time when there is one).
+GstClockTime runningTimeOf(const GstSegment& segment, GstBuffer* buffer) {
+  return gst_segment_to_running_time(&segment, GST_FORMAT_TIME, GST_BUFFER_DTS_OR_PTS(buffer));
+}
+
+// Keeps a pad's current segment, so buffers' running times can be known.
+void keepSegment(GstPadProbeInfo* info, GstSegment& segment) {
+  GstEvent* event = GST_PAD_PROBE_INFO_EVENT(info);
+  if (GST_EVENT_TYPE(event) == GST_EVENT_SEGMENT) gst_event_copy_segment(event, &segment);
+}
+
+}  // namespace
+
+SegmentSplitter::SegmentSplitter(Parts parts, SegmentPlanner& planner,
+                                 std::function<void()> onFirstSegment)
+    : parts_(parts), planner_(planner), onFirstSegment_(std::move(onFirstSegment)) {
+  gst_segment_init(&sourceSegment_, GST_FORMAT_TIME);
+  gst_segment_init(&muxerSegment_, GST_FORMAT_TIME);
+  constexpr auto kDataProbe =
+      static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM);
+  sourcePad_ = gst_element_get_static_pad(parts_.source, "src");
+  sourceProbe_ = gst_pad_add_probe(sourcePad_, kDataProbe, onSourceData, this, nullptr);
+  muxerPad_ = gst_element_get_static_pad(parts_.splitmux, "video");
+  if (muxerPad_) muxerProbe_ = gst_pad_add_probe(muxerPad_, kDataProbe, onMuxerInput, this, nullptr);
+  muxerAdded_ = g_signal_connect(parts_.splitmux, "muxer-added", G_CALLBACK(onMuxerAdded), this);
+  formatLocation_ = g_signal_connect(parts_.splitmux, "format-location-full",
+                                     G_CALLBACK(onFormatLocation), this);
+}
+
+SegmentSplitter::~SegmentSplitter() {
+  g_signal_handler_disconnect(parts_.splitmux, muxerAdded_);
+  g_signal_handler_disconnect(parts_.splitmux, formatLocation_);
+  gst_pad_remove_probe(sourcePad_, sourceProbe_);
+  gst_object_unref(sourcePad_);
+  if (muxerPad_) {
+    gst_pad_remove_probe(muxerPad_, muxerProbe_);
+    gst_object_unref(muxerPad_);
+  }
+}
+
+int64_t SegmentSplitter::unixMsOf(GstClockTime runningTime) const {
+  int64_t now = g_get_real_time() / 1000;
+  GstClockTime running = gst_element_get_current_running_time(parts_.source);
+  if (!GST_CLOCK_TIME_IS_VALID(running) || !GST_CLOCK_TIME_IS_VALID(runningTime)) return now;
+  return now - GST_CLOCK_DIFF(runningTime, running) / static_cast<int64_t>(GST_MSECOND);
+}
+
+GstPadProbeReturn SegmentSplitter::onSourceData(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  auto* self = static_cast<SegmentSplitter*>(data);
+  if (GST_PAD_PROBE_INFO_TYPE(info) & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) {
+    keepSegment(info, self->sourceSegment_);
+    return GST_PAD_PROBE_OK;
+  }
+  GstClockTime time = runningTimeOf(self->sourceSegment_, GST_PAD_PROBE_INFO_BUFFER(info));
+  if (!GST_CLOCK_TIME_IS_VALID(time)) return GST_PAD_PROBE_OK;
+  switch (self->planner_.onFrame(time, self->unixMsOf(time))) {
+    case SegmentPlanner::Cut::kNone:
+      break;
+    case SegmentPlanner::Cut::kFirst:
+      self->onFirstSegment_();
+      break;
+    case SegmentPlanner::Cut::kNext:
+      // The encoder makes this very frame a key frame (the event travels
+      // just ahead of it), and splitmuxsink starts the next file there.
+      if (self->parts_.transcoded)
+        gst_pad_push_event(pad, gst_video_event_new_downstream_force_key_unit(
+                                    GST_BUFFER_PTS(GST_PAD_PROBE_INFO_BUFFER(info)),
+                                    GST_CLOCK_TIME_NONE, time, TRUE, 0));
+      g_signal_emit_by_name(self->parts_.splitmux, "split-at-running-time", time);
+      break;
+  }
+  return GST_PAD_PROBE_OK;
+}
+
+GstPadProbeReturn SegmentSplitter::onMuxerInput(GstPad*, GstPadProbeInfo* info, gpointer data) {
+  auto* self = static_cast<SegmentSplitter*>(data);
+  if (GST_PAD_PROBE_INFO_TYPE(info) & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) {
+    keepSegment(info, self->muxerSegment_);
+    return GST_PAD_PROBE_OK;
+  }
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  self->planner_.addBytes(gst_buffer_get_size(buffer));
+  if (self->parts_.track && !GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_DELTA_UNIT))
+    self->parts_.track->heartbeat(gst_segment_to_running_time(
+        &self->muxerSegment_, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer)));
+  return GST_PAD_PROBE_OK;
+}
+
+void SegmentSplitter::onMuxerAdded(GstElement*, GstElement* muxer, gpointer data) {
+  static_cast<SegmentSplitter*>(data)->muxer_ = muxer;
+}
+
+gchar* SegmentSplitter::onFormatLocation(GstElement*, guint, GstSample* first, gpointer data) {
+  auto* self = static_cast<SegmentSplitter*>(data);
+  GstBuffer* buffer = first ? gst_sample_get_buffer(first) : nullptr;
+  const GstSegment* segment = first ? gst_sample_get_segment(first) : nullptr;
+  if (!buffer || !segment) return nullptr;  // splitmuxsink's own location pattern then
+  GstClockTime start = runningTimeOf(*segment, buffer);
+  auto planned = self->planner_.segmentStartingNear(start);
+  if (!planned) return nullptr;
+  // The muxer writes running times: shifted by the file's start, each file
+  // begins at 0. Its pads get their segments (again) after this returns.
+  if (GstElement* muxer = self->muxer_.load()) {
+    GstIterator* pads = gst_element_iterate_sink_pads(muxer);
+    GValue item = G_VALUE_INIT;
+    while (gst_iterator_next(pads, &item) == GST_ITERATOR_OK) {
+      gst_pad_set_offset(GST_PAD(g_value_get_object(&item)), -static_cast<gint64>(start));
+      g_value_reset(&item);
+    }
+    g_value_unset(&item);
+    gst_iterator_free(pads);
+  }
+  return g_strdup(planned->path.c_str());
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,55 @@
+// Makes one stream's splitmuxsink cut its files where the SegmentPlanner
+// says, and makes every file start at timestamp 0 with a key frame:
+// - a probe on the source's pad shows each frame to the planner and, at a
+//   cut, asks splitmuxsink to split at that frame's time (forcing a key
+//   frame there first when the stream is transcoded);
+// - a probe on splitmuxsink's video input counts bytes for the planner and
+//   sends the telemetry track's heartbeat at each key frame;
+// - each new file is named by the planner, and its muxer's inputs are
+//   offset by the file's start so that its timeline begins at 0.
+#pragma once
+
+#include <gst/gst.h>
+
+#include <atomic>
+#include <functional>
+
+#include "segment_planner.h"
+#include "telemetry_track.h"
+
+namespace wircam::recorder {
+
+class SegmentSplitter {
+ public:
+  struct Parts {
+    GstElement* source;     // wircsrc
+    GstElement* splitmux;   // splitmuxsink
+    TelemetryTrack* track;  // null: no text track
+    bool transcoded;        // key frames come from an encoder that can be asked for one
+  };
+  // `onFirstSegment` runs on the source's thread when the first frame comes.
+  SegmentSplitter(Parts parts, SegmentPlanner& planner, std::function<void()> onFirstSegment);
+  ~SegmentSplitter();
+  SegmentSplitter(const SegmentSplitter&) = delete;
+  SegmentSplitter& operator=(const SegmentSplitter&) = delete;
+
+ private:
+  static GstPadProbeReturn onSourceData(GstPad* pad, GstPadProbeInfo* info, gpointer self);
+  static GstPadProbeReturn onMuxerInput(GstPad* pad, GstPadProbeInfo* info, gpointer self);
+  static void onMuxerAdded(GstElement* splitmux, GstElement* muxer, gpointer self);
+  static gchar* onFormatLocation(GstElement* splitmux, guint fragment, GstSample* first,
+                                 gpointer self);
+  int64_t unixMsOf(GstClockTime runningTime) const;
+
+  Parts parts_;
+  SegmentPlanner& planner_;
+  std::function<void()> onFirstSegment_;
+  GstPad* sourcePad_ = nullptr;
+  GstPad* muxerPad_ = nullptr;
+  gulong sourceProbe_ = 0, muxerProbe_ = 0, muxerAdded_ = 0, formatLocation_ = 0;
+  GstSegment sourceSegment_{};  // the source's segment, on its thread
+  GstSegment muxerSegment_{};   // the video input's, on the muxer's input thread
+  std::atomic<GstElement*> muxer_{nullptr};  // the muxer of the newest file (splitmuxsink's)
+};
+
+}  // namespace wircam::recorder
