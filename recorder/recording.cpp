@@ -198,6 +198,8 @@ void Recording::handleElementMessage(GstMessage* message) {
   std::string type = gst_structure_get_name(s);
   if (type == "splitmuxsink-fragment-opened") {
     stream->segment = gst_structure_get_string(s, "location");
+    stream->telemetry->segmentOpened(stream->segment);
+    if (auto failure = stream->telemetry->takeWriteFailure()) log(*failure);
     return;
   }
   if (type == "splitmuxsink-fragment-closed") {

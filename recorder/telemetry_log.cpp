@@ -15,10 +15,14 @@ std::string TelemetryLog::pathFor(const std::string& segment) {
   return (hasExtension ? segment.substr(0, dot) : segment) + ".jsonl";
 }
 
-bool TelemetryLog::write(const std::string& json) {
+bool TelemetryLog::create() {
   // Appending: a late line for a segment whose sidecar was closed reopens it.
   if (!file_) file_ = std::fopen(path_.c_str(), "a");
-  if (!file_) return false;
+  return file_ != nullptr;
+}
+
+bool TelemetryLog::write(const std::string& json) {
+  if (!create()) return false;
   std::fputs(json.c_str(), file_);
   std::fputc('\n', file_);
   std::fflush(file_);

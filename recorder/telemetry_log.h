@@ -16,7 +16,9 @@ class TelemetryLog {
   ~TelemetryLog();
 
   static std::string pathFor(const std::string& segment);
-  // Opened on the first line (a segment may get none); false if it cannot be.
+  // Creates the file (appending if it exists); false if it cannot be.
+  bool create();
+  // Creates the file first if need be; false if it cannot be written.
   bool write(const std::string& json);
   const std::string& path() const { return path_; }
 

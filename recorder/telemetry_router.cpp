@@ -39,9 +39,19 @@ void TelemetryRouter::place(Line line, const PlannedSegment& segment) {
   // A line late for a segment whose file has moved on stays in the sidecar:
   // in the text track it would land in the next file.
   if (!track_) return;
-  auto trackSegment = planner_.segmentAt(track_->last());
-  if (trackSegment && trackSegment->start > segment.start) return;
-  track_->write(text, time);
+  track_->write(text, time, [&](GstClockTime newest) {
+    auto trackSegment = planner_.segmentAt(newest);
+    return trackSegment && trackSegment->start > segment.start;
+  });
+}
+
+void TelemetryRouter::segmentOpened(const std::string& segment) {
+  std::lock_guard lock(mutex_);
+  auto& sidecar = sidecarOf(segment);
+  if (!sidecar.create() && sidecar.path() != failedPath_) {
+    failedPath_ = sidecar.path();
+    failure_ = "cannot write " + sidecar.path();
+  }
 }
 
 TelemetryLog& TelemetryRouter::sidecarOf(const std::string& segment) {

@@ -30,6 +30,9 @@ class TelemetryRouter {
   void write(nlohmann::json line, uint64_t runningTime, int64_t unixMs);
   // The first segment began: the lines that waited for it are written.
   void flushEarly();
+  // A segment's file was opened: its sidecar exists from then on, even if
+  // no line comes.
+  void segmentOpened(const std::string& segment);
   // The sidecars a problem was met writing, once each (for the log).
   std::optional<std::string> takeWriteFailure();
 

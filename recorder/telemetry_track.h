@@ -4,6 +4,7 @@
 
 #include <gst/gst.h>
 
+#include <functional>
 #include <mutex>
 #include <string>
 
@@ -18,7 +19,10 @@ class TelemetryTrack {
   // little out of order (a detection is stamped with its frame's time, a
   // little after later statistics). Such a line is placed at the latest
   // time already written; its own "pts" field keeps the exact time.
-  void write(const std::string& json, GstClockTime pts);
+  // `tooLate`, asked with the newest buffer's time under the same lock as
+  // the heartbeats, may refuse it (the file has moved on); false if so.
+  bool write(const std::string& json, GstClockTime pts,
+             const std::function<bool(GstClockTime newest)>& tooLate = {});
 
   // An empty buffer at a key frame's time. splitmuxsink hands a GOP to the
   // muxer only once every track's input has passed its end, so a sparse

@@ -135,7 +135,8 @@ GstPadProbeReturn onText(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   bool markup = format && std::string(format) == "pango-markup";
   gst_caps_unref(caps);
   GstMapInfo map;
-  if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+  // Empty buffers are the recorder's heartbeats (they carry no line).
+  if (gst_buffer_get_size(buffer) > 0 && gst_buffer_map(buffer, &map, GST_MAP_READ)) {
     std::string text(reinterpret_cast<const char*>(map.data), map.size);
     static_cast<Reading*>(data)->contents.telemetry.push_back(markup ? unescapeMarkup(text) : text);
     gst_buffer_unmap(buffer, &map);

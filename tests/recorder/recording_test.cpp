@@ -205,8 +205,18 @@ TEST(WircRecorder, DeletesTheOldestSegmentsToStayUnderMaxBytes) {
   EXPECT_LT(videos.size(), 5u);  // about 6 one-second segments were made
   // Checked when a segment closes: at most the newest one beyond the cap.
   EXPECT_LE(total, 400000 + 2 * largest);
-  // The oldest went first: segment 000 is gone.
-  EXPECT_EQ(videos.front().string().find("-000.mkv"), std::string::npos) << videos.front();
+  // The oldest went first: what was deleted is older than what is left
+  // (names carry the UTC start), and the index lists only what is left.
+  auto log = recorder.log();
+  auto at = log.find("deleted ");
+  ASSERT_NE(at, std::string::npos) << log;
+  std::string firstDeleted = log.substr(at + 8, log.find(' ', at + 8) - at - 8);
+  EXPECT_LT(firstDeleted, videos.front().filename().string());
+  std::ifstream indexFile(recorder.out() / "index.json");
+  auto index = nlohmann::json::parse(indexFile);
+  ASSERT_EQ(index["segments"].size(), videos.size());
+  for (size_t i = 0; i < videos.size(); ++i)
+    EXPECT_EQ(index["segments"][i]["file"], videos[i].filename().string());
   for (const auto& video : videos)
     EXPECT_TRUE(fs::exists(fs::path(video).replace_extension(".jsonl")));
 }

@@ -1,0 +1,119 @@
+// Where segments begin: at the first frame, at their length, at the byte
+// limit and at a gap in the frames; and which segment a time belongs to.
+#include "segment_planner.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+using wircam::recorder::SegmentLimits;
+using wircam::recorder::SegmentPlanner;
+using Cut = SegmentPlanner::Cut;
+
+constexpr uint64_t kSecond = 1'000'000'000;
+constexpr uint64_t kFrame = kSecond / 15;
+constexpr int64_t kNoon = 1795348800000;  // 2026-11-22T12:00:00Z
+
+class SegmentPlannerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = fs::temp_directory_path() / ("segment-planner-" + std::to_string(getpid()));
+    fs::create_directories(folder_);
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+  SegmentPlanner planner(SegmentLimits limits) {
+    return SegmentPlanner(folder_, "rover-cam0", ".mkv", limits);
+  }
+  // Frames at 15 fps from `from` for `count` frames; the cuts they made.
+  static std::vector<uint64_t> feed(SegmentPlanner& p, uint64_t from, int count) {
+    std::vector<uint64_t> cuts;
+    for (int i = 0; i < count; ++i) {
+      uint64_t pts = from + static_cast<uint64_t>(i) * kFrame;
+      if (p.onFrame(pts, kNoon + static_cast<int64_t>(pts / 1'000'000)) != Cut::kNone)
+        cuts.push_back(pts);
+    }
+    return cuts;
+  }
+  fs::path folder_;
+};
+
+TEST_F(SegmentPlannerTest, TheFirstFrameOpensTheFirstSegmentNamedByItsUtcTime) {
+  auto p = planner({.maxDuration = 10 * kSecond});
+  EXPECT_FALSE(p.current());
+  EXPECT_EQ(p.onFrame(5 * kSecond, kNoon), Cut::kFirst);
+  EXPECT_EQ(p.onFrame(5 * kSecond + kFrame, kNoon + 66), Cut::kNone);
+  auto open = p.current();
+  ASSERT_TRUE(open);
+  EXPECT_EQ(open->path, (folder_ / "rover-cam0-20261122T120000Z.mkv").string());
+  EXPECT_EQ(open->start, 5 * kSecond);
+  EXPECT_EQ(open->frames, 2u);
+}
+
+TEST_F(SegmentPlannerTest, CutsAtTheSegmentLengthOnTheFrameThatReachesIt) {
+  auto p = planner({.maxDuration = 2 * kSecond});
+  auto cuts = feed(p, 0, 15 * 5);  // 5 s
+  ASSERT_EQ(cuts.size(), 3u);      // 0, 2 and 4 s
+  EXPECT_EQ(cuts[0], 0u);
+  EXPECT_GE(cuts[1], 2 * kSecond);
+  EXPECT_LT(cuts[1], 2 * kSecond + kFrame);
+  EXPECT_NEAR(static_cast<double>(cuts[2] - cuts[1]), 2e9, static_cast<double>(kFrame));
+}
+
+TEST_F(SegmentPlannerTest, AGapInTheFramesEndsTheSegmentAndTheNextFrameOpensAnother) {
+  auto p = planner({.maxDuration = 60 * kSecond});
+  feed(p, 0, 30);
+  uint64_t back = 30 * kFrame + 5 * kSecond;  // the device was gone for 5 s
+  EXPECT_EQ(p.onFrame(back, kNoon + 7000), Cut::kNext);
+  EXPECT_EQ(p.current()->start, back);
+  // A hiccup shorter than the limit does not cut.
+  EXPECT_EQ(p.onFrame(back + 400'000'000, kNoon + 7400), Cut::kNone);
+}
+
+TEST_F(SegmentPlannerTest, TheByteLimitCutsAtTheNextFrame) {
+  auto p = planner({.maxBytes = 1000});
+  p.onFrame(0, kNoon);
+  p.addBytes(600);
+  EXPECT_EQ(p.onFrame(kFrame, kNoon), Cut::kNone);
+  p.addBytes(600);
+  EXPECT_EQ(p.onFrame(2 * kFrame, kNoon), Cut::kNext);
+  EXPECT_EQ(p.current()->bytes, 0u);
+}
+
+TEST_F(SegmentPlannerTest, NamesThatWouldCollideGetACounter) {
+  std::ofstream(folder_ / "rover-cam0-20261122T120000Z.mkv") << "from an earlier run";
+  auto p = planner({.maxDuration = kSecond / 2});
+  p.onFrame(0, kNoon);
+  EXPECT_EQ(fs::path(p.current()->path).filename(), "rover-cam0-20261122T120000Z-2.mkv");
+  p.onFrame(kSecond / 2, kNoon + 500);  // the same second
+  EXPECT_EQ(fs::path(p.current()->path).filename(), "rover-cam0-20261122T120000Z-3.mkv");
+}
+
+TEST_F(SegmentPlannerTest, ATimeBelongsToTheLastSegmentStartedAtOrBeforeIt) {
+  auto p = planner({.maxDuration = 2 * kSecond});
+  EXPECT_FALSE(p.segmentAt(0));
+  feed(p, kSecond, 15 * 5);  // segments at 1, 3 and 5 s
+  EXPECT_EQ(p.segmentAt(0)->start, kSecond);  // before the first frame: the first
+  EXPECT_EQ(p.segmentAt(2 * kSecond)->start, kSecond);
+  auto second = p.segmentAt(3 * kSecond + kFrame);
+  EXPECT_GE(second->start, 3 * kSecond);
+  EXPECT_LT(second->start, 3 * kSecond + kFrame);
+  EXPECT_EQ(p.segmentOf(second->path)->start, second->start);
+  EXPECT_EQ(p.segmentStartingNear(second->start - 1000)->path, second->path);
+}
+
+TEST_F(SegmentPlannerTest, ASegmentLastsItsFramesSpanAndOnePeriod) {
+  auto p = planner({});
+  feed(p, 0, 16);
+  EXPECT_NEAR(p.current()->durationSeconds(), 16.0 / 15, 1e-6);
+}
+
+TEST(SegmentPlannerUtc, FormatsForNamesAndForTelemetry) {
+  EXPECT_EQ(SegmentPlanner::compactUtc(kNoon + 5123), "20261122T120005Z");
+  EXPECT_EQ(SegmentPlanner::isoUtc(kNoon + 5123), "2026-11-22T12:00:05.123Z");
+}
+
+}  // namespace
