@@ -30,10 +30,10 @@ std::string muxerSettings(Container container) {
 std::string encoder(const RecorderOptions& options) {
   if (options.codec == Codec::kJpeg) return "";
   // zerolatency: no B-frames and no look-ahead, so the live recording does
-  // not lag; a key frame every 15 frames (1 s at 15 fps) lets segments end near
-  // their length and bounds what a crash can lose.
+  // not lag. The recorder asks for a key frame at each cut and every 0.5 s
+  // (SegmentSplitter); key-int-max is only a backstop.
   return "tjpegdec ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
-         std::to_string(options.h264Kbps) + " key-int-max=15 ! h264parse ! ";
+         std::to_string(options.h264Kbps) + " key-int-max=60 ! h264parse ! ";
 }
 
 // wirccontrol's properties for the vehicle the device's tags steer: the

@@ -60,15 +60,14 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     gst_object_unref(found);  // the pipeline keeps it
     return found;
   };
-  SegmentLimits limits{
-      .maxDuration = static_cast<uint64_t>(options.segmentSeconds * GST_SECOND),
-      .maxBytes = options.segmentBytes};
+  SegmentLimits limits{.maxDuration = static_cast<uint64_t>(options.segmentSeconds * GST_SECOND),
+                       .maxBytes = options.segmentBytes};
   for (auto& streamPlan : plan.streams) {
     auto stream = std::make_unique<Stream>();
     stream->plan = streamPlan;
     stream->stateSinceUnixMs = g_get_real_time() / 1000;
-    stream->planner = std::make_unique<SegmentPlanner>(
-        options.outDir, streamPlan.name, extensionOf(options.container), limits);
+    stream->planner = std::make_unique<SegmentPlanner>(options.outDir, streamPlan.name,
+                                                       extensionOf(options.container), limits);
     stream->track.emplace(elementNamed(streamPlan.telemetrySource));
     stream->telemetry = std::make_unique<TelemetryRouter>(*stream->planner, &*stream->track);
     stream->splitter = std::make_unique<SegmentSplitter>(
@@ -185,7 +184,8 @@ void Recording::followLinkState(Stream& stream, const std::string& linkState) {
   std::string state = stream.state;
   if (linkState == "live") state = "live";
   // Until the first login the device is awaited; afterwards it went away.
-  else if (stream.state != "waiting for device") state = "offline";
+  else if (stream.state != "waiting for device")
+    state = "offline";
   if (state == stream.state) return;
   stream.state = state;
   stream.stateSinceUnixMs = g_get_real_time() / 1000;

@@ -9,8 +9,9 @@ namespace wircam::recorder {
 namespace fs = std::filesystem;
 
 nlohmann::json toJson(const IndexEntry& e) {
-  return {{"camera", e.camera},   {"file", e.file},     {"start_utc", e.startUtc},
-          {"duration_s", e.durationSeconds}, {"frames", e.frames}, {"bytes", e.bytes}};
+  return {{"camera", e.camera},      {"file", e.file},
+          {"start_utc", e.startUtc}, {"duration_s", e.durationSeconds},
+          {"frames", e.frames},      {"bytes", e.bytes}};
 }
 
 namespace {
@@ -53,7 +54,8 @@ RecordingIndex::RecordingIndex(fs::path folder) : folder_(std::move(folder)) {
 
 size_t RecordingIndex::reconcile(const Inspector& inspect, const std::set<std::string>& open) {
   std::error_code error;
-  std::erase_if(entries_, [&](const IndexEntry& e) { return !fs::exists(folder_ / e.file, error); });
+  std::erase_if(entries_,
+                [&](const IndexEntry& e) { return !fs::exists(folder_ / e.file, error); });
   std::set<std::string> known;
   for (const auto& e : entries_) known.insert(e.file);
   std::vector<fs::path> missing;
@@ -76,10 +78,9 @@ size_t RecordingIndex::reconcile(const Inspector& inspect, const std::set<std::s
 void RecordingIndex::add(IndexEntry entry) {
   remove(entry.file);
   // Oldest first; names of one camera sort by time, entries of all by start.
-  auto at = std::upper_bound(entries_.begin(), entries_.end(), entry,
-                             [](const IndexEntry& a, const IndexEntry& b) {
-                               return a.startUtc < b.startUtc;
-                             });
+  auto at = std::upper_bound(
+      entries_.begin(), entries_.end(), entry,
+      [](const IndexEntry& a, const IndexEntry& b) { return a.startUtc < b.startUtc; });
   entries_.insert(at, std::move(entry));
 }
 

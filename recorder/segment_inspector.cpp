@@ -82,8 +82,9 @@ std::optional<IndexEntry> inspectSegment(const std::filesystem::path& file) {
   std::error_code error;
   entry.bytes = std::filesystem::file_size(file, error);
   entry.frames = span.frames;
-  GstClockTime period =
-      span.lastDuration ? span.lastDuration : (span.last - span.first) / std::max<uint64_t>(span.frames - 1, 1);
+  GstClockTime period = span.lastDuration
+                            ? span.lastDuration
+                            : (span.last - span.first) / std::max<uint64_t>(span.frames - 1, 1);
   entry.durationSeconds = static_cast<double>(span.last - span.first + period) / GST_SECOND;
   if (auto name = parseSegmentName(entry.file)) {
     entry.camera = name->camera;
@@ -92,7 +93,8 @@ std::optional<IndexEntry> inspectSegment(const std::filesystem::path& file) {
     auto written = std::chrono::file_clock::to_sys(std::filesystem::last_write_time(file, error));
     auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(written.time_since_epoch());
     entry.camera = file.stem().string();
-    entry.startUtc = SegmentPlanner::isoUtc(ms.count() - static_cast<int64_t>(entry.durationSeconds * 1000));
+    entry.startUtc =
+        SegmentPlanner::isoUtc(ms.count() - static_cast<int64_t>(entry.durationSeconds * 1000));
   }
   return entry;
 }

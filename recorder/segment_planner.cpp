@@ -68,8 +68,8 @@ SegmentPlanner::Cut SegmentPlanner::onFrame(uint64_t pts, int64_t unixMs) {
   }
   if (cut != Cut::kNone) {
     splitPending_ = false;
-    segments_.push_back({.path = nameFor(unixMs), .startUnixMs = unixMs, .start = pts,
-                         .lastFrame = pts});
+    segments_.push_back(
+        {.path = nameFor(unixMs), .startUnixMs = unixMs, .start = pts, .lastFrame = pts});
     if (segments_.size() > kKept) segments_.erase(segments_.begin());
   }
   PlannedSegment& open = segments_.back();

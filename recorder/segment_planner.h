@@ -21,19 +21,19 @@
 namespace wircam::recorder {
 
 struct PlannedSegment {
-  std::string path;           // the video file
-  int64_t startUnixMs = 0;    // wall clock time of its first frame
-  uint64_t start = 0;         // running time of its first frame
-  uint64_t lastFrame = 0;     // running time of its last frame so far
+  std::string path;         // the video file
+  int64_t startUnixMs = 0;  // wall clock time of its first frame
+  uint64_t start = 0;       // running time of its first frame
+  uint64_t lastFrame = 0;   // running time of its last frame so far
   uint64_t frames = 0;
-  uint64_t bytes = 0;         // what reached the muxer, counted toward the byte limit
+  uint64_t bytes = 0;  // what reached the muxer, counted toward the byte limit
   // How long the file plays: its frames' span and one frame period more.
   double durationSeconds() const;
 };
 
 struct SegmentLimits {
-  uint64_t maxDuration = 0;   // ns; 0 = none
-  uint64_t maxBytes = 0;      // 0 = none
+  uint64_t maxDuration = 0;       // ns; 0 = none
+  uint64_t maxBytes = 0;          // 0 = none
   uint64_t maxGap = 500'000'000;  // ns between two frames inside one file
 };
 

@@ -30,14 +30,17 @@ SegmentSplitter::SegmentSplitter(Parts parts, SegmentPlanner& planner,
   sourcePad_ = gst_element_get_static_pad(parts_.source, "src");
   sourceProbe_ = gst_pad_add_probe(sourcePad_, kDataProbe, onSourceData, this, nullptr);
   muxerPad_ = gst_element_get_static_pad(parts_.splitmux, "video");
-  if (muxerPad_) muxerProbe_ = gst_pad_add_probe(muxerPad_, kDataProbe, onMuxerInput, this, nullptr);
+  if (muxerPad_)
+    muxerProbe_ = gst_pad_add_probe(muxerPad_, kDataProbe, onMuxerInput, this, nullptr);
   muxerAdded_ = g_signal_connect(parts_.splitmux, "muxer-added", G_CALLBACK(onMuxerAdded), this);
-  formatLocation_ = g_signal_connect(parts_.splitmux, "format-location-full",
-                                     G_CALLBACK(onFormatLocation), this);
+  sinkAdded_ = g_signal_connect(parts_.splitmux, "sink-added", G_CALLBACK(onSinkAdded), nullptr);
+  formatLocation_ =
+      g_signal_connect(parts_.splitmux, "format-location-full", G_CALLBACK(onFormatLocation), this);
 }
 
 SegmentSplitter::~SegmentSplitter() {
   g_signal_handler_disconnect(parts_.splitmux, muxerAdded_);
+  g_signal_handler_disconnect(parts_.splitmux, sinkAdded_);
   g_signal_handler_disconnect(parts_.splitmux, formatLocation_);
   gst_pad_remove_probe(sourcePad_, sourceProbe_);
   gst_object_unref(sourcePad_);
@@ -62,22 +65,26 @@ GstPadProbeReturn SegmentSplitter::onSourceData(GstPad* pad, GstPadProbeInfo* in
   }
   GstClockTime time = runningTimeOf(self->sourceSegment_, GST_PAD_PROBE_INFO_BUFFER(info));
   if (!GST_CLOCK_TIME_IS_VALID(time)) return GST_PAD_PROBE_OK;
-  switch (self->planner_.onFrame(time, self->unixMsOf(time))) {
-    case SegmentPlanner::Cut::kNone:
-      break;
-    case SegmentPlanner::Cut::kFirst:
-      self->onFirstSegment_();
-      break;
-    case SegmentPlanner::Cut::kNext:
-      // The encoder makes this very frame a key frame (the event travels
-      // just ahead of it), and splitmuxsink starts the next file there.
-      if (self->parts_.transcoded)
-        gst_pad_push_event(pad, gst_video_event_new_downstream_force_key_unit(
-                                    GST_BUFFER_PTS(GST_PAD_PROBE_INFO_BUFFER(info)),
-                                    GST_CLOCK_TIME_NONE, time, TRUE, 0));
-      g_signal_emit_by_name(self->parts_.splitmux, "split-at-running-time", time);
-      break;
+  auto cut = self->planner_.onFrame(time, self->unixMsOf(time));
+  if (cut == SegmentPlanner::Cut::kFirst) self->onFirstSegment_();
+  // The encoder makes this very frame a key frame (the event travels just
+  // ahead of it): at a cut, and every kKeyFrameInterval, whatever the frame
+  // rate, because splitmuxsink holds the newest GOP and the muxer writes
+  // whole GOPs, which is what a crash loses.
+  // The first frame is one anyway, and must not be asked for: x264enc
+  // (GStreamer 1.22) measures that request against a segment it has not
+  // set up yet, and then ignores every later one.
+  if (cut == SegmentPlanner::Cut::kFirst) self->lastKeyFrame_ = time;
+  bool due = time >= self->lastKeyFrame_ + kKeyFrameInterval;
+  if (self->parts_.transcoded && (cut == SegmentPlanner::Cut::kNext || due)) {
+    gst_pad_push_event(pad, gst_video_event_new_downstream_force_key_unit(
+                                GST_BUFFER_PTS(GST_PAD_PROBE_INFO_BUFFER(info)),
+                                GST_CLOCK_TIME_NONE, time, TRUE, 0));
+    self->lastKeyFrame_ = time;
   }
+  // splitmuxsink starts the next file at this frame.
+  if (cut == SegmentPlanner::Cut::kNext)
+    g_signal_emit_by_name(self->parts_.splitmux, "split-at-running-time", time);
   return GST_PAD_PROBE_OK;
 }
 
@@ -89,14 +96,23 @@ GstPadProbeReturn SegmentSplitter::onMuxerInput(GstPad*, GstPadProbeInfo* info, 
   }
   GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
   self->planner_.addBytes(gst_buffer_get_size(buffer));
-  if (self->parts_.track && !GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_DELTA_UNIT))
-    self->parts_.track->heartbeat(gst_segment_to_running_time(
-        &self->muxerSegment_, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer)));
+  // At every frame, not only key frames: mp4mux, too, waits for every
+  // track before it writes, and would otherwise hold a GOP's worth.
+  if (self->parts_.track)
+    self->parts_.track->heartbeat(
+        gst_segment_to_running_time(&self->muxerSegment_, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer)));
   return GST_PAD_PROBE_OK;
 }
 
 void SegmentSplitter::onMuxerAdded(GstElement*, GstElement* muxer, gpointer data) {
   static_cast<SegmentSplitter*>(data)->muxer_ = muxer;
+}
+
+void SegmentSplitter::onSinkAdded(GstElement*, GstElement* sink, gpointer) {
+  // filesink gathers 64 KB before it writes: minutes of a low-rate stream
+  // that a crash would lose. The muxers write in pieces of a frame or more.
+  if (g_object_class_find_property(G_OBJECT_GET_CLASS(sink), "buffer-mode"))
+    gst_util_set_object_arg(G_OBJECT(sink), "buffer-mode", "unbuffered");
 }
 
 gchar* SegmentSplitter::onFormatLocation(GstElement*, guint, GstSample* first, gpointer data) {

@@ -2,7 +2,7 @@
 // says, and makes every file start at timestamp 0 with a key frame:
 // - a probe on the source's pad shows each frame to the planner and, at a
 //   cut, asks splitmuxsink to split at that frame's time (forcing a key
-//   frame there first when the stream is transcoded);
+//   frame there first when the stream is transcoded, as every 0.5 s);
 // - a probe on splitmuxsink's video input counts bytes for the planner and
 //   sends the telemetry track's heartbeat at each key frame;
 // - each new file is named by the planner, and its muxer's inputs are
@@ -37,6 +37,7 @@ class SegmentSplitter {
   static GstPadProbeReturn onSourceData(GstPad* pad, GstPadProbeInfo* info, gpointer self);
   static GstPadProbeReturn onMuxerInput(GstPad* pad, GstPadProbeInfo* info, gpointer self);
   static void onMuxerAdded(GstElement* splitmux, GstElement* muxer, gpointer self);
+  static void onSinkAdded(GstElement* splitmux, GstElement* sink, gpointer);
   static gchar* onFormatLocation(GstElement* splitmux, guint fragment, GstSample* first,
                                  gpointer self);
   int64_t unixMsOf(GstClockTime runningTime) const;
@@ -46,9 +47,11 @@ class SegmentSplitter {
   std::function<void()> onFirstSegment_;
   GstPad* sourcePad_ = nullptr;
   GstPad* muxerPad_ = nullptr;
-  gulong sourceProbe_ = 0, muxerProbe_ = 0, muxerAdded_ = 0, formatLocation_ = 0;
-  GstSegment sourceSegment_{};  // the source's segment, on its thread
-  GstSegment muxerSegment_{};   // the video input's, on the muxer's input thread
+  gulong sourceProbe_ = 0, muxerProbe_ = 0, muxerAdded_ = 0, sinkAdded_ = 0, formatLocation_ = 0;
+  static constexpr GstClockTime kKeyFrameInterval = GST_SECOND / 2;
+  GstSegment sourceSegment_{};               // the source's segment, on its thread
+  GstClockTime lastKeyFrame_ = 0;            // asked of the encoder, on the source's thread
+  GstSegment muxerSegment_{};                // the video input's, on the muxer's input thread
   std::atomic<GstElement*> muxer_{nullptr};  // the muxer of the newest file (splitmuxsink's)
 };
 

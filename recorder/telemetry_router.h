@@ -50,10 +50,10 @@ class TelemetryRouter {
   const SegmentPlanner& planner_;
   TelemetryTrack* track_;
   std::mutex mutex_;
-  std::deque<Line> early_;                               // guarded by mutex_
-  std::deque<std::unique_ptr<TelemetryLog>> sidecars_;   // guarded by mutex_; the newest last
-  std::optional<std::string> failure_;                   // guarded by mutex_
-  std::string failedPath_;                               // guarded by mutex_
+  std::deque<Line> early_;                              // guarded by mutex_
+  std::deque<std::unique_ptr<TelemetryLog>> sidecars_;  // guarded by mutex_; the newest last
+  std::optional<std::string> failure_;                  // guarded by mutex_
+  std::string failedPath_;                              // guarded by mutex_
 };
 
 }  // namespace wircam::recorder

@@ -33,7 +33,8 @@ RecorderProcess::RecorderProcess(uint16_t port, std::vector<std::string> extra,
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
-    if (!freopen("/dev/null", "w", stdout) || !freopen(log.c_str(), "w", stderr)) _exit(126);
+    std::string status = folder_ / "stdout.log";
+    if (!freopen(status.c_str(), "w", stdout) || !freopen(log.c_str(), "w", stderr)) _exit(126);
     execvp(argv[0], argv.data());
     _exit(127);
   }
@@ -54,6 +55,11 @@ int RecorderProcess::wait() {
 }
 
 void RecorderProcess::signal(int number) { kill(pid_, number); }
+
+std::string RecorderProcess::statusLines() const {
+  std::ifstream in(folder_ / "stdout.log");
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 std::vector<fs::path> RecorderProcess::files(const std::string& extension) const {
   std::vector<fs::path> found;

@@ -33,6 +33,8 @@ class RecorderProcess {
   std::vector<std::filesystem::path> files(const std::string& extension) const;
   // Everything the recorder wrote to stderr so far.
   std::string log() const;
+  // Its status display (stdout) so far.
+  std::string statusLines() const;
   // The first word starting with `prefix` in the log (e.g. "http://"), or
   // nullopt after `timeout`.
   std::optional<std::string> waitForLog(const std::string& prefix,

@@ -27,8 +27,12 @@ class RecordingIndexTest : public ::testing::Test {
 };
 
 IndexEntry entry(const std::string& file, const std::string& start) {
-  return {.camera = "rover-cam0", .file = file, .startUtc = start, .durationSeconds = 5,
-          .frames = 75, .bytes = 1000};
+  return {.camera = "rover-cam0",
+          .file = file,
+          .startUtc = start,
+          .durationSeconds = 5,
+          .frames = 75,
+          .bytes = 1000};
 }
 
 TEST_F(RecordingIndexTest, KeepsEntriesInTimeOrderAndReadsBackWhatItSaved) {
@@ -61,7 +65,7 @@ TEST_F(RecordingIndexTest, ReconcilingAddsTheFilesItLacksAndDropsTheDeleted) {
       {(folder_ / "open-cam0-20261122T120010Z.mkv").string()});
   EXPECT_EQ(added, 2u);
   EXPECT_EQ(inspected, (std::vector<std::string>{"rover-cam0-20261122T120000Z.mkv",
-                                                  "rover-cam0-20261122T120005Z.mkv"}));
+                                                 "rover-cam0-20261122T120005Z.mkv"}));
   ASSERT_EQ(index.entries().size(), 2u);
   EXPECT_EQ(index.entries()[0].startUtc, "2026-11-22T12:00:00.000Z");
 }

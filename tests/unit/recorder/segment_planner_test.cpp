@@ -95,7 +95,7 @@ TEST_F(SegmentPlannerTest, NamesThatWouldCollideGetACounter) {
 TEST_F(SegmentPlannerTest, ATimeBelongsToTheLastSegmentStartedAtOrBeforeIt) {
   auto p = planner({.maxDuration = 2 * kSecond});
   EXPECT_FALSE(p.segmentAt(0));
-  feed(p, kSecond, 15 * 5);  // segments at 1, 3 and 5 s
+  feed(p, kSecond, 15 * 5);                   // segments at 1, 3 and 5 s
   EXPECT_EQ(p.segmentAt(0)->start, kSecond);  // before the first frame: the first
   EXPECT_EQ(p.segmentAt(2 * kSecond)->start, kSecond);
   auto second = p.segmentAt(3 * kSecond + kFrame);

@@ -1,0 +1,27 @@
+#include "http_fetch.h"
+
+#include <libsoup/soup.h>
+
+namespace wircam::testing {
+
+Response fetch(const std::string& url, const char* method) {
+  SoupSession* session = soup_session_new();
+  SoupMessage* message = soup_message_new(method, url.c_str());
+  Response response;
+  GBytes* body = soup_session_send_and_read(session, message, nullptr, nullptr);
+  response.status = soup_message_get_status(message);
+  const char* type =
+      soup_message_headers_get_content_type(soup_message_get_response_headers(message), nullptr);
+  response.contentType = type ? type : "";
+  if (body) {
+    gsize size = 0;
+    auto* data = static_cast<const char*>(g_bytes_get_data(body, &size));
+    response.body.assign(data, size);
+    g_bytes_unref(body);
+  }
+  g_object_unref(message);
+  g_object_unref(session);
+  return response;
+}
+
+}  // namespace wircam::testing

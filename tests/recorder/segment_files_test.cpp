@@ -1,0 +1,209 @@
+// Recordings people can trust, checked with ffprobe and ffmpeg on the real
+// files: each segment starts at 0 on a key frame and decodes whole, has the
+// length asked for, is named by its UTC start, has a sidecar on its own
+// timeline, holds no gap from an outage, and a recorder started before its
+// device waits for it.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "http_fetch.h"
+#include "recorder_process.h"
+#include "simulated_device.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+
+std::string run(const std::string& command) {
+  std::string output;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return "popen failed";
+  char chunk[4096];
+  while (size_t n = fread(chunk, 1, sizeof chunk, pipe)) output.append(chunk, n);
+  pclose(pipe);
+  return output;
+}
+
+struct ProbedFrame {
+  bool key;
+  double pts;
+};
+
+// The video frames as ffprobe decodes them, in presentation order.
+std::vector<ProbedFrame> probeFrames(const fs::path& file) {
+  std::istringstream csv(run("ffprobe -v error -select_streams v:0 -show_frames -show_entries "
+                             "frame=key_frame,pts_time -of csv=p=0 '" +
+                             file.string() + "'"));
+  std::vector<ProbedFrame> frames;
+  for (std::string line; std::getline(csv, line);) {
+    int key = 0;
+    double pts = 0;
+    if (std::sscanf(line.c_str(), "%d,%lf", &key, &pts) == 2) frames.push_back({key == 1, pts});
+  }
+  return frames;
+}
+
+double probeDuration(const fs::path& file) {
+  return std::stod("0" + run("ffprobe -v error -show_entries format=duration -of csv=p=0 '" +
+                             file.string() + "'"));
+}
+
+int probePackets(const fs::path& file) {
+  return std::stoi("0" + run("ffprobe -v error -select_streams v:0 -count_packets -show_entries "
+                             "stream=nb_read_packets -of csv=p=0 '" +
+                             file.string() + "'"));
+}
+
+// "rover-cam0-20261122T143205Z.mkv" → seconds since the epoch.
+std::optional<std::time_t> utcOfName(const std::string& name) {
+  auto at = name.rfind("-20");
+  std::tm tm{};
+  if (at == std::string::npos ||
+      std::sscanf(name.c_str() + at + 1, "%4d%2d%2dT%2d%2d%2dZ", &tm.tm_year, &tm.tm_mon,
+                  &tm.tm_mday, &tm.tm_hour, &tm.tm_min, &tm.tm_sec) != 6)
+    return std::nullopt;
+  tm.tm_year -= 1900;
+  tm.tm_mon -= 1;
+  return timegm(&tm);
+}
+
+std::vector<nlohmann::json> sidecarOf(const fs::path& video) {
+  std::ifstream in(fs::path(video).replace_extension(".jsonl"));
+  std::vector<nlohmann::json> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+  return lines;
+}
+
+struct Format {
+  const char* codec;
+  const char* container;
+};
+
+class SegmentFiles : public ::testing::TestWithParam<Format> {};
+
+TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
+  auto [codec, container] = GetParam();
+  auto device = startSequenceDevice();
+  std::time_t launched = std::time(nullptr);
+  RecorderProcess recorder(device->port(), {"--segment", "3", "--duration", "11", "--codec",
+                                            codec, "--format", container});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto videos = recorder.files(std::string(".") + container);
+  ASSERT_GE(videos.size(), 3u);
+  std::time_t expectedStart = launched;  // the first within the login's time
+  for (size_t i = 0; i < videos.size(); ++i) {
+    const auto& video = videos[i];
+    SCOPED_TRACE(video.filename().string());
+    auto frames = probeFrames(video);
+    ASSERT_GT(frames.size(), 10u);
+    EXPECT_TRUE(frames.front().key);
+    EXPECT_LT(frames.front().pts, 0.1);
+    // Every packet decodes to a frame, without a word from the decoder.
+    EXPECT_EQ(static_cast<int>(frames.size()), probePackets(video));
+    EXPECT_EQ(run("ffmpeg -v error -i '" + video.string() + "' -f null -"), "");
+    double duration = probeDuration(video);
+    if (i + 1 < videos.size()) {
+      EXPECT_NEAR(duration, 3.0, 1.0);  // the last ends when the recording does
+    }
+    // Named by the wall clock time of its first frame.
+    auto named = utcOfName(video.filename().string());
+    ASSERT_TRUE(named);
+    EXPECT_NEAR(static_cast<double>(*named), static_cast<double>(expectedStart), 2.0);
+    expectedStart = *named + static_cast<std::time_t>(duration + 0.5);
+    // Its sidecar is on its own timeline, every line within the file.
+    auto lines = sidecarOf(video);
+    ASSERT_FALSE(lines.empty());
+    for (const auto& line : lines) {
+      ASSERT_TRUE(line.contains("pts") && line.contains("utc")) << line;
+      EXPECT_LE(line["pts"].get<double>() / 1e9, duration + 0.1) << line;
+      EXPECT_EQ(line["utc"].get<std::string>().back(), 'Z') << line;
+    }
+  }
+  // The login is in the first segment, in the sidecar and in the file.
+  std::string sidecar, track;
+  for (const auto& line : sidecarOf(videos[0])) sidecar += line.dump();
+  for (const auto& line : contentsOf(videos[0]).telemetry) track += line;
+  EXPECT_NE(sidecar.find("logged in"), std::string::npos);
+  EXPECT_NE(track.find("logged in"), std::string::npos);
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, SegmentFiles,
+                         ::testing::Values(Format{"jpeg", "mkv"}, Format{"h264", "mkv"},
+                                           Format{"h264", "mp4"}),
+                         [](const auto& format) {
+                           return std::string(format.param.codec) + "_" + format.param.container;
+                         });
+
+TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
+  auto device = startSequenceDevice();
+  uint16_t port = device->port();
+  RecorderProcess recorder(port, {"--segment", "60"});
+  std::this_thread::sleep_for(milliseconds(3000));
+  device.reset();
+  std::this_thread::sleep_for(milliseconds(5000));
+  device = startSequenceDevice(port);
+  ASSERT_TRUE(device);
+  std::this_thread::sleep_for(milliseconds(4000));
+  recorder.signal(SIGINT);
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto videos = recorder.files(".mkv");
+  ASSERT_EQ(videos.size(), 2u);
+  for (const auto& video : videos) {
+    auto frames = probeFrames(video);
+    ASSERT_GT(frames.size(), 15u) << video;
+    double widest = 0;
+    for (size_t i = 1; i < frames.size(); ++i)
+      widest = std::max(widest, frames[i].pts - frames[i - 1].pts);
+    EXPECT_LE(widest, 0.5) << video;
+  }
+}
+
+TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {
+  uint16_t port;
+  {
+    auto probe = startSequenceDevice();
+    port = probe->port();
+  }
+  RecorderProcess recorder(port, {"--segment", "60", "--http", "127.0.0.1:0"});
+  auto url = recorder.waitForLog("http://", milliseconds(5000));
+  ASSERT_TRUE(url) << recorder.log();
+  std::this_thread::sleep_for(milliseconds(2500));  // login attempts fail meanwhile
+  EXPECT_NE(recorder.statusLines().find("waiting for device"), std::string::npos);
+  auto status = nlohmann::json::parse(fetch(*url + "api/status").body);
+  EXPECT_EQ(status["streams"][0]["state"], "waiting for device") << status;
+  auto device = startSequenceDevice(port);
+  ASSERT_TRUE(device);
+  std::this_thread::sleep_for(milliseconds(5000));  // the backoff, then 2-3 s of frames
+  status = nlohmann::json::parse(fetch(*url + "api/status").body);
+  EXPECT_EQ(status["streams"][0]["state"], "live") << status;
+  recorder.signal(SIGTERM);
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto videos = recorder.files(".mkv");
+  ASSERT_EQ(videos.size(), 1u);
+  EXPECT_GT(probeFrames(videos[0]).size(), 15u);
+}
+
+TEST(SegmentFilesStartUp, StoppedWhileWaitingItEndsCleanly) {
+  uint16_t port;
+  {
+    auto probe = startSequenceDevice();
+    port = probe->port();
+  }
+  RecorderProcess recorder(port, {"--segment", "60"});
+  std::this_thread::sleep_for(milliseconds(2000));
+  recorder.signal(SIGTERM);
+  EXPECT_EQ(recorder.wait(), 0) << recorder.log();
+  EXPECT_NE(recorder.log().find("nothing was recorded"), std::string::npos) << recorder.log();
+}
+
+}  // namespace
