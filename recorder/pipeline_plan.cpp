@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "telemetry_track_flags.h"
+
 namespace wircam::recorder {
 
 namespace {
@@ -87,11 +89,14 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
            "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
            muxerSettings(options.container) + " location=\"" + fallback + "\" ";
       // The telemetry never blocks the main loop: past 1 MB waiting it
-      // drops. Its track is called "telemetry" (a stream tag).
+      // drops. Its track is named by a stream tag (in Matroska a
+      // placeholder, rewritten when the file is finished: telemetry_track_flags.h).
+      std::string title(options.container == Container::kMatroska ? kTelemetryTrackPlaceholder
+                                                                  : kTelemetryTrackName);
       d += "appsrc name=" + stream.telemetrySource +
            " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
-           "caps=\"text/x-raw,format=(string)utf8\" ! taginject tags=\"title=telemetry\" ! " +
-           stream.muxer + ".subtitle_%u ";
+           "caps=\"text/x-raw,format=(string)utf8\" ! taginject tags=\"title=" +
+           title + "\" ! " + stream.muxer + ".subtitle_%u ";
       if (!stream.detector.empty()) {
         // Detection must never hold the recording back: its queue drops.
         d += "t" + i +

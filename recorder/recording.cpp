@@ -12,6 +12,7 @@
 
 #include "gst_json.h"
 #include "segment_inspector.h"
+#include "telemetry_track_flags.h"
 
 namespace wircam::recorder {
 
@@ -42,7 +43,11 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
 
   std::unique_ptr<Recording> recording(new Recording(options));
   // Segments the index lacks (a crash's last one, or a lost index).
-  if (size_t added = recording->index_.reconcile(inspectSegment))
+  auto inspect = [](const std::filesystem::path& file) {
+    markTelemetryTrack(file);  // a file the recorder did not finish
+    return inspectSegment(file);
+  };
+  if (size_t added = recording->index_.reconcile(inspect))
     log("indexed " + std::to_string(added) + " segment(s) missing from " +
         recording->index_.path().string());
   recording->index_.save();
@@ -162,6 +167,7 @@ void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime
 }
 
 void Recording::onSegmentClosed(Stream& stream, const std::string& file) {
+  markTelemetryTrack(file);
   auto planned = stream.planner->segmentOf(file);
   if (!planned) return;
   std::error_code error;

@@ -41,9 +41,10 @@ struct ProbedFrame {
 
 // The video frames as ffprobe decodes them, in presentation order.
 std::vector<ProbedFrame> probeFrames(const fs::path& file) {
-  std::istringstream csv(run("ffprobe -v error -select_streams v:0 -show_frames -show_entries "
-                             "frame=key_frame,pts_time -of csv=p=0 '" +
-                             file.string() + "'"));
+  std::istringstream csv(
+      run("ffprobe -v error -select_streams v:0 -show_frames -show_entries "
+          "frame=key_frame,pts_time -of csv=p=0 '" +
+          file.string() + "'"));
   std::vector<ProbedFrame> frames;
   for (std::string line; std::getline(csv, line);) {
     int key = 0;
@@ -95,8 +96,8 @@ TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
   auto [codec, container] = GetParam();
   auto device = startSequenceDevice();
   std::time_t launched = std::time(nullptr);
-  RecorderProcess recorder(device->port(), {"--segment", "3", "--duration", "11", "--codec",
-                                            codec, "--format", container});
+  RecorderProcess recorder(device->port(), {"--segment", "3", "--duration", "11", "--codec", codec,
+                                            "--format", container});
   ASSERT_EQ(recorder.wait(), 0) << recorder.log();
   auto videos = recorder.files(std::string(".") + container);
   ASSERT_GE(videos.size(), 3u);
@@ -120,6 +121,11 @@ TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
     ASSERT_TRUE(named);
     EXPECT_NEAR(static_cast<double>(*named), static_cast<double>(expectedStart), 2.0);
     expectedStart = *named + static_cast<std::time_t>(duration + 0.5);
+    // The telemetry track is named, and players do not show it by default.
+    EXPECT_EQ(run("ffprobe -v error -select_streams s:0 -show_entries "
+                  "stream_disposition=default,forced:stream_tags=title -of csv=p=0 '" +
+                  video.string() + "'"),
+              std::string(container) == "mkv" ? "0,0,telemetry\n" : "0,0\n");
     // Its sidecar is on its own timeline, every line within the file.
     auto lines = sidecarOf(video);
     ASSERT_FALSE(lines.empty());
