@@ -17,15 +17,16 @@ std::string fileSafe(std::string text) {
   return text;
 }
 
-// The muxer inside splitmuxsink. Crash safety: Matroska clusters of at most
-// 1 s, MP4 fragments of 1 s, so a killed recorder leaves the open segment
-// playable up to its last second.
+// The muxer inside splitmuxsink. Crash safety: Matroska clusters and MP4
+// fragments of at most 0.5 s (the muxers write a cluster or fragment whole),
+// so a killed recorder leaves the open segment playable up to about its
+// last second.
 std::string muxerSettings(Container container) {
   if (container == Container::kMp4)
     return "muxer-factory=mp4mux "
-           "muxer-properties=\"properties,fragment-duration=(guint)1000\"";
+           "muxer-properties=\"properties,fragment-duration=(guint)500\"";
   return "muxer-factory=matroskamux "
-         "muxer-properties=\"properties,max-cluster-duration=(gint64)1000000000\"";
+         "muxer-properties=\"properties,max-cluster-duration=(gint64)500000000\"";
 }
 
 // What the frames pass through between the tee and the muxer.

@@ -78,7 +78,6 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     stream->splitter = std::make_unique<SegmentSplitter>(
         SegmentSplitter::Parts{.source = elementNamed(streamPlan.source),
                                .splitmux = elementNamed(streamPlan.muxer),
-                               .track = &*stream->track,
                                .transcoded = plan.transcoded},
         *stream->planner, [telemetry = stream->telemetry.get()] { telemetry->flushEarly(); });
     if (!streamPlan.liveSink.empty()) {
@@ -375,6 +374,15 @@ gboolean Recording::onDurationOver(gpointer data) {
   return G_SOURCE_REMOVE;
 }
 
+gboolean Recording::onHeartbeat(gpointer data) {
+  auto* self = static_cast<Recording*>(data);
+  // At the newest frame the source has sent, never ahead of the video, and
+  // only once the first frame has opened a file.
+  for (auto& s : self->streams_)
+    if (auto open = s->planner->current()) s->track->heartbeat(open->lastFrame);
+  return G_SOURCE_CONTINUE;
+}
+
 gboolean Recording::onTick(gpointer data) {
   auto* self = static_cast<Recording*>(data);
   self->printStatus();
@@ -470,6 +478,7 @@ int Recording::run() {
   if (options_.duration)
     g_timeout_add(static_cast<guint>(*options_.duration * 1000), onDurationOver, this);
   g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this);
+  g_timeout_add(TelemetryTrack::kHeartbeatInterval / GST_MSECOND, onHeartbeat, this);
 
   if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE) {
     // The error itself comes on the bus; show it.

@@ -67,6 +67,7 @@ class Recording {
   static gboolean onStop(gpointer self);  // SIGINT, SIGTERM
   static gboolean onDurationOver(gpointer self);
   static gboolean onTick(gpointer self);
+  static gboolean onHeartbeat(gpointer self);
   void stop(const char* why);
   void handleElementMessage(GstMessage* message);
   void handleError(GstMessage* message);

@@ -24,7 +24,6 @@ SegmentSplitter::SegmentSplitter(Parts parts, SegmentPlanner& planner,
                                  std::function<void()> onFirstSegment)
     : parts_(parts), planner_(planner), onFirstSegment_(std::move(onFirstSegment)) {
   gst_segment_init(&sourceSegment_, GST_FORMAT_TIME);
-  gst_segment_init(&muxerSegment_, GST_FORMAT_TIME);
   constexpr auto kDataProbe =
       static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM);
   sourcePad_ = gst_element_get_static_pad(parts_.source, "src");
@@ -91,16 +90,9 @@ GstPadProbeReturn SegmentSplitter::onSourceData(GstPad* pad, GstPadProbeInfo* in
 GstPadProbeReturn SegmentSplitter::onMuxerInput(GstPad*, GstPadProbeInfo* info, gpointer data) {
   auto* self = static_cast<SegmentSplitter*>(data);
   if (GST_PAD_PROBE_INFO_TYPE(info) & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) {
-    keepSegment(info, self->muxerSegment_);
     return GST_PAD_PROBE_OK;
   }
-  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
-  self->planner_.addBytes(gst_buffer_get_size(buffer));
-  // At every frame, not only key frames: mp4mux, too, waits for every
-  // track before it writes, and would otherwise hold a GOP's worth.
-  if (self->parts_.track)
-    self->parts_.track->heartbeat(
-        gst_segment_to_running_time(&self->muxerSegment_, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer)));
+  self->planner_.addBytes(gst_buffer_get_size(GST_PAD_PROBE_INFO_BUFFER(info)));
   return GST_PAD_PROBE_OK;
 }
 

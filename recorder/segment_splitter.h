@@ -3,8 +3,7 @@
 // - a probe on the source's pad shows each frame to the planner and, at a
 //   cut, asks splitmuxsink to split at that frame's time (forcing a key
 //   frame there first when the stream is transcoded, as every 0.5 s);
-// - a probe on splitmuxsink's video input counts bytes for the planner and
-//   sends the telemetry track's heartbeat at each key frame;
+// - a probe on splitmuxsink's video input counts bytes for the planner;
 // - each new file is named by the planner, and its muxer's inputs are
 //   offset by the file's start so that its timeline begins at 0.
 #pragma once
@@ -15,17 +14,15 @@
 #include <functional>
 
 #include "segment_planner.h"
-#include "telemetry_track.h"
 
 namespace wircam::recorder {
 
 class SegmentSplitter {
  public:
   struct Parts {
-    GstElement* source;     // wircsrc
-    GstElement* splitmux;   // splitmuxsink
-    TelemetryTrack* track;  // null: no text track
-    bool transcoded;        // key frames come from an encoder that can be asked for one
+    GstElement* source;    // wircsrc
+    GstElement* splitmux;  // splitmuxsink
+    bool transcoded;       // key frames come from an encoder that can be asked for one
   };
   // `onFirstSegment` runs on the source's thread when the first frame comes.
   SegmentSplitter(Parts parts, SegmentPlanner& planner, std::function<void()> onFirstSegment);
@@ -51,7 +48,6 @@ class SegmentSplitter {
   static constexpr GstClockTime kKeyFrameInterval = GST_SECOND / 2;
   GstSegment sourceSegment_{};               // the source's segment, on its thread
   GstClockTime lastKeyFrame_ = 0;            // asked of the encoder, on the source's thread
-  GstSegment muxerSegment_{};                // the video input's, on the muxer's input thread
   std::atomic<GstElement*> muxer_{nullptr};  // the muxer of the newest file (splitmuxsink's)
 };
 

@@ -24,11 +24,14 @@ class TelemetryTrack {
   bool write(const std::string& json, GstClockTime pts,
              const std::function<bool(GstClockTime newest)>& tooLate = {});
 
-  // An empty buffer at a key frame's time. splitmuxsink hands a GOP to the
-  // muxer only once every track's input has passed its end, so a sparse
-  // track would hold the video back (and mp4mux waits for every track):
-  // this tells both that the telemetry has nothing before `pts`.
-  void heartbeat(GstClockTime pts) { write({}, pts); }
+  // An empty buffer, sent every kHeartbeatInterval with the current time.
+  // splitmuxsink hands a GOP to the muxer only once every track's input has
+  // passed its end, so a sparse track would hold the video back (and
+  // mp4mux waits for every track): this tells both that the telemetry has
+  // nothing before `now`. (From a timer rather than with each frame: a
+  // GOP is one frame in JPEG, and each heartbeat costs a few thread wake-ups.)
+  void heartbeat(GstClockTime now) { write({}, now); }
+  static constexpr GstClockTime kHeartbeatInterval = GST_SECOND / 8;
 
   // The time of the newest buffer.
   GstClockTime last() const;
