@@ -1,0 +1,84 @@
+// The recorder's pipeline for each codec/container pair and option, as
+// parsed from a command line: what it names, what it holds, what it must not.
+#include "pipeline_plan.h"
+
+#include <gtest/gtest.h>
+
+#include <initializer_list>
+#include <set>
+
+namespace {
+
+using namespace wircam::recorder;
+
+RecorderOptions optionsOf(std::initializer_list<const char*> args) {
+  std::vector<char*> argv{const_cast<char*>("wirc-recorder")};
+  for (const char* a : args) argv.push_back(const_cast<char*>(a));
+  auto options = parseOptions(static_cast<int>(argv.size()), argv.data());
+  EXPECT_TRUE(options) << (options ? "" : options.error());
+  return options ? *options : RecorderOptions{};
+}
+
+bool has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
+  auto plan = planPipeline(optionsOf({"--device", "10.0.0.2", "--out", "/rec"}));
+  ASSERT_EQ(plan.streams.size(), 1u);
+  const auto& s = plan.streams[0];
+  EXPECT_EQ(s.name, "10.0.0.2-cam0");
+  EXPECT_FALSE(plan.transcoded);
+  const auto& d = plan.description;
+  EXPECT_TRUE(has(d, "wircsrc name=" + s.source + " host=10.0.0.2 port=1984"));
+  EXPECT_TRUE(has(d, "wait-for-device=true"));
+  EXPECT_TRUE(has(d, "splitmuxsink name=" + s.muxer + " async-finalize=true"));
+  EXPECT_TRUE(has(d, "matroskamux"));
+  EXPECT_TRUE(has(d, "appsrc name=" + s.telemetrySource));
+  EXPECT_TRUE(has(d, s.muxer + ".subtitle_%u"));
+  EXPECT_TRUE(has(d, "title=telemetry-json-lines"));  // renamed when finished
+  // The recorder cuts the files: splitmuxsink has no limits of its own,
+  // and the old threshold workaround is gone.
+  auto splitmux = d.substr(d.find("splitmuxsink"), d.find("location=") - d.find("splitmuxsink"));
+  EXPECT_FALSE(has(splitmux, "max-size-time")) << splitmux;
+  EXPECT_FALSE(has(splitmux, "max-size-bytes")) << splitmux;
+  EXPECT_FALSE(has(d, "alignment-threshold"));
+  EXPECT_FALSE(has(d, "x264enc"));
+  EXPECT_TRUE(s.detector.empty() && s.controller.empty() && s.liveSink.empty());
+}
+
+TEST(PipelinePlan, H264InMp4IsTranscodedAndKeepsTheTextTrack) {
+  auto plan = planPipeline(
+      optionsOf({"--device", "rover", "--out", "/rec", "--codec", "h264", "--format", "mp4"}));
+  EXPECT_TRUE(plan.transcoded);
+  EXPECT_TRUE(has(plan.description, "x264enc"));
+  EXPECT_TRUE(has(plan.description, "muxer-factory=mp4mux"));
+  EXPECT_TRUE(has(plan.description, "title=telemetry\""));
+  EXPECT_TRUE(has(plan.description, ".subtitle_%u"));
+}
+
+TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
+  auto plan = planPipeline(
+      optionsOf({"--device", "a", "--device", "b", "--camera", "0", "--camera", "1", "--out",
+                 "/rec", "--detect", "tag36h11", "--follow", "--http", ":0"}));
+  ASSERT_EQ(plan.streams.size(), 4u);
+  std::set<std::string> names;
+  for (const auto& s : plan.streams) {
+    names.insert(s.source);
+    EXPECT_FALSE(s.detector.empty());
+    EXPECT_FALSE(s.liveSink.empty());
+  }
+  EXPECT_EQ(names.size(), 4u);  // element names do not collide
+  EXPECT_FALSE(plan.streams[0].controller.empty());
+  EXPECT_TRUE(plan.streams[1].controller.empty());
+  EXPECT_FALSE(plan.streams[2].controller.empty());
+  EXPECT_TRUE(has(plan.description, "family=tag36h11"));
+}
+
+TEST(PipelinePlan, AControlUriSteersItsVehicle) {
+  auto plan = planPipeline(optionsOf({"--device", "127.0.0.1:2000,control=rcoip://10.0.0.9:9000",
+                                      "--out", "/rec", "--detect", "tag36h11", "--follow"}));
+  EXPECT_TRUE(has(plan.description, "protocol=rcoip host=10.0.0.9 port=9000"));
+}
+
+}  // namespace
