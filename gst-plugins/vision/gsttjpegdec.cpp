@@ -19,8 +19,12 @@
 
 #include <turbojpeg.h>
 
+#include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
+
+#include "scoped_map.h"
 
 GST_DEBUG_CATEGORY_STATIC(tjpeg_dec_debug);
 #define GST_CAT_DEFAULT tjpeg_dec_debug
@@ -120,24 +124,86 @@ static GstFlowReturn drop_with_warning(GstVideoDecoder* decoder, GstVideoCodecFr
   return gst_video_decoder_drop_frame(decoder, frame);
 }
 
+namespace {
+
+using wircam::gst::ScopedBufferMap;
+using wircam::gst::ScopedVideoFrameMap;
+
+struct JpegHeader {
+  int width = 0, height = 0, subsampling = 0;
+};
+
+// The JPEG's size and subsampling, or nothing (the handle is renewed: a
+// failed call can leave it mid-frame).
+std::optional<JpegHeader> read_header(TjpegDecState* state, const ScopedBufferMap& in,
+                                      std::string* why) {
+  JpegHeader header;
+  int colorspace = 0;
+  if (tjDecompressHeader3(state->decoder.get(), in.data(), in.size(), &header.width, &header.height,
+                          &header.subsampling, &colorspace) == 0 &&
+      header.width > 0 && header.height > 0)
+    return header;
+  *why = tjGetErrorStr2(state->decoder.get());
+  state->decoder.reset(tjInitDecompress());
+  return std::nullopt;
+}
+
+// Sets (again) the output caps when the decoded size changes or none are set.
+bool ensure_output_state(GstVideoDecoder* decoder, TjpegDecState* state, int width, int height) {
+  if (width == state->width && height == state->height &&
+      gst_pad_has_current_caps(GST_VIDEO_DECODER_SRC_PAD(decoder)))
+    return true;
+  state->format = preferred_format(decoder);
+  GstVideoCodecState* output =
+      gst_video_decoder_set_output_state(decoder, state->format, width, height, state->input);
+  gst_video_codec_state_unref(output);
+  if (!gst_video_decoder_negotiate(decoder)) return false;
+  state->width = width;
+  state->height = height;
+  return true;
+}
+
+// Decodes into the mapped output frame; TurboJPEG's return code.
+int decode_into(TjpegDecState* state, const ScopedBufferMap& in, const JpegHeader& header,
+                GstVideoFrame* video) {
+  tjhandle tj = state->decoder.get();
+  if (state->format != GST_VIDEO_FORMAT_I420) {
+    int pixelFormat = state->format == GST_VIDEO_FORMAT_GRAY8 ? TJPF_GRAY
+                      : state->format == GST_VIDEO_FORMAT_RGB ? TJPF_RGB
+                                                              : TJPF_BGRX;
+    return tjDecompress2(tj, in.data(), in.size(),
+                         static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(video, 0)),
+                         state->width, GST_VIDEO_FRAME_PLANE_STRIDE(video, 0), state->height,
+                         pixelFormat, TJFLAG_FASTDCT);
+  }
+  unsigned char* planes[3];
+  int strides[3];
+  for (int p = 0; p < 3; ++p) {
+    planes[p] = static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(video, p));
+    strides[p] = GST_VIDEO_FRAME_PLANE_STRIDE(video, p);
+  }
+  int rc = tjDecompressToYUVPlanes(tj, in.data(), in.size(), planes, state->width, strides,
+                                   state->height, TJFLAG_FASTDCT);
+  if (header.subsampling == TJSAMP_GRAY) {  // a grayscale JPEG has no chroma: make it neutral
+    for (int p = 1; p < 3; ++p)
+      for (int y = 0; y < GST_VIDEO_FRAME_COMP_HEIGHT(video, p); ++y)
+        memset(planes[p] + y * strides[p], 128, GST_VIDEO_FRAME_COMP_WIDTH(video, p));
+  }
+  return rc;
+}
+
+}  // namespace
+
 static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder,
                                                 GstVideoCodecFrame* frame) {
   auto* self = GST_TJPEG_DEC(decoder);
   auto* state = self->state;
-  tjhandle tj = state->decoder.get();
-  GstMapInfo in;
-  if (!gst_buffer_map(frame->input_buffer, &in, GST_MAP_READ))
-    return drop_with_warning(decoder, frame, "unreadable buffer");
+  ScopedBufferMap in(frame->input_buffer, GST_MAP_READ);
+  if (!in) return drop_with_warning(decoder, frame, "unreadable buffer");
+  std::string why;
+  auto header = read_header(state, in, &why);
+  if (!header) return drop_with_warning(decoder, frame, why.c_str());
 
-  int width = 0, height = 0, subsampling = 0, colorspace = 0;
-  if (tjDecompressHeader3(tj, in.data, in.size, &width, &height, &subsampling, &colorspace) != 0 ||
-      width <= 0 || height <= 0) {
-    gst_buffer_unmap(frame->input_buffer, &in);
-    std::string why = tjGetErrorStr2(tj);
-    // A failed call can leave the handle mid-frame: start the next on a new one.
-    state->decoder.reset(tjInitDecompress());
-    return drop_with_warning(decoder, frame, why.c_str());
-  }
   int scale;
   {
     GST_OBJECT_LOCK(self);
@@ -145,72 +211,39 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder,
     GST_OBJECT_UNLOCK(self);
   }
   tjscalingfactor factor{1, scale};
-  int outWidth = TJSCALED(width, factor), outHeight = TJSCALED(height, factor);
-
-  if (outWidth != state->width || outHeight != state->height ||
-      !gst_pad_has_current_caps(GST_VIDEO_DECODER_SRC_PAD(decoder))) {
-    state->format = preferred_format(decoder);
-    GstVideoCodecState* output = gst_video_decoder_set_output_state(
-        decoder, state->format, outWidth, outHeight, state->input);
-    gst_video_codec_state_unref(output);
-    if (!gst_video_decoder_negotiate(decoder)) {
-      gst_buffer_unmap(frame->input_buffer, &in);
-      gst_video_decoder_drop_frame(decoder, frame);
-      return GST_FLOW_NOT_NEGOTIATED;
-    }
-    state->width = outWidth;
-    state->height = outHeight;
+  if (!ensure_output_state(decoder, state, TJSCALED(header->width, factor),
+                           TJSCALED(header->height, factor))) {
+    gst_video_decoder_drop_frame(decoder, frame);
+    return GST_FLOW_NOT_NEGOTIATED;
   }
-  if (state->format == GST_VIDEO_FORMAT_I420 && subsampling != TJSAMP_420 &&
-      subsampling != TJSAMP_GRAY) {
-    gst_buffer_unmap(frame->input_buffer, &in);
+  if (state->format == GST_VIDEO_FORMAT_I420 && header->subsampling != TJSAMP_420 &&
+      header->subsampling != TJSAMP_GRAY) {
     gst_video_decoder_drop_frame(decoder, frame);
     GST_ELEMENT_ERROR(
         decoder, STREAM, FORMAT, ("tjpegdec gives I420 only for 4:2:0 or grayscale JPEGs"),
         ("This stream has TurboJPEG subsampling %d: ask for GRAY8, RGB or BGRx instead "
          "(e.g. tjpegdec ! video/x-raw,format=RGB)",
-         subsampling));
+         header->subsampling));
     return GST_FLOW_NOT_NEGOTIATED;
   }
 
   GstFlowReturn flow = gst_video_decoder_allocate_output_frame(decoder, frame);
   if (flow != GST_FLOW_OK) {
-    gst_buffer_unmap(frame->input_buffer, &in);
     gst_video_decoder_drop_frame(decoder, frame);
     return flow;
   }
-  GstVideoCodecState* output = gst_video_decoder_get_output_state(decoder);
-  GstVideoFrame video;
-  gst_video_frame_map(&video, &output->info, frame->output_buffer, GST_MAP_WRITE);
   int rc;
-  if (state->format == GST_VIDEO_FORMAT_I420) {
-    unsigned char* planes[3] = {static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 0)),
-                                static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 1)),
-                                static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 2))};
-    int strides[3] = {GST_VIDEO_FRAME_PLANE_STRIDE(&video, 0),
-                      GST_VIDEO_FRAME_PLANE_STRIDE(&video, 1),
-                      GST_VIDEO_FRAME_PLANE_STRIDE(&video, 2)};
-    rc = tjDecompressToYUVPlanes(tj, in.data, in.size, planes, outWidth, strides, outHeight,
-                                 TJFLAG_FASTDCT);
-    if (subsampling == TJSAMP_GRAY) {  // a grayscale JPEG has no chroma: make it neutral
-      for (int p = 1; p < 3; ++p)
-        for (int y = 0; y < GST_VIDEO_FRAME_COMP_HEIGHT(&video, p); ++y)
-          memset(planes[p] + y * strides[p], 128, GST_VIDEO_FRAME_COMP_WIDTH(&video, p));
-    }
-  } else {
-    int pixelFormat = state->format == GST_VIDEO_FORMAT_GRAY8 ? TJPF_GRAY
-                      : state->format == GST_VIDEO_FORMAT_RGB ? TJPF_RGB
-                                                              : TJPF_BGRX;
-    rc = tjDecompress2(
-        tj, in.data, in.size, static_cast<unsigned char*>(GST_VIDEO_FRAME_PLANE_DATA(&video, 0)),
-        outWidth, GST_VIDEO_FRAME_PLANE_STRIDE(&video, 0), outHeight, pixelFormat, TJFLAG_FASTDCT);
+  {
+    GstVideoCodecState* output = gst_video_decoder_get_output_state(decoder);
+    ScopedVideoFrameMap video(&output->info, frame->output_buffer, GST_MAP_WRITE);
+    gst_video_codec_state_unref(output);
+    if (!video) return drop_with_warning(decoder, frame, "unwritable output buffer");
+    rc = decode_into(state, in, *header, video.get());
   }
-  gst_video_frame_unmap(&video);
-  gst_video_codec_state_unref(output);
-  gst_buffer_unmap(frame->input_buffer, &in);
   // TurboJPEG warnings (e.g. a few corrupt bytes) still give a full image.
+  tjhandle tj = state->decoder.get();
   if (rc != 0 && tjGetErrorCode(tj) == TJERR_FATAL) {
-    std::string why = tjGetErrorStr2(tj);
+    why = tjGetErrorStr2(tj);
     state->decoder.reset(tjInitDecompress());
     return drop_with_warning(decoder, frame, why.c_str());
   }
