@@ -12,13 +12,13 @@ FrameTap::FrameTap(GstElement* appsink) : appsink_(appsink) {
 FrameTap::~FrameTap() { g_signal_handler_disconnect(appsink_, handler_); }
 
 int FrameTap::listen(Listener listener) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   listeners_[nextId_] = std::move(listener);
   return nextId_++;
 }
 
 void FrameTap::forget(int id) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   listeners_.erase(id);
 }
 
@@ -27,7 +27,7 @@ GstFlowReturn FrameTap::onNewSample(GstElement* appsink, gpointer data) {
   GstSample* sample = gst_app_sink_pull_sample(GST_APP_SINK(appsink));
   if (!sample) return GST_FLOW_EOS;
   {
-    std::lock_guard lock(self->mutex_);
+    MutexLock lock(self->mutex_);
     for (auto& [id, listener] : self->listeners_) listener(sample);
   }
   gst_sample_unref(sample);

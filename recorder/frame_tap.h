@@ -6,7 +6,8 @@
 
 #include <functional>
 #include <map>
-#include <mutex>
+
+#include "common/mutex.h"
 
 namespace wircam::recorder {
 
@@ -31,9 +32,9 @@ class FrameTap {
 
   GstElement* appsink_;
   gulong handler_ = 0;
-  std::mutex mutex_;  // guards listeners_ and nextId_
-  std::map<int, Listener> listeners_;
-  int nextId_ = 1;
+  Mutex mutex_;
+  std::map<int, Listener> listeners_ WIRCAM_GUARDED_BY(mutex_);
+  int nextId_ WIRCAM_GUARDED_BY(mutex_) = 1;
 };
 
 }  // namespace wircam::recorder

@@ -4,14 +4,16 @@
 
 #include <algorithm>
 
+#include "common/mutex.h"
+
 namespace wircam::recorder {
 
 // One camera's mount point and the appsrc of its media while it is playing.
 struct RtspServer::Mount {
   Camera camera;
   int listener = 0;
-  std::mutex mutex;  // guards sources (the streaming thread pushes into them)
-  std::vector<GstElement*> sources;
+  Mutex mutex;  // the streaming thread pushes into the sources
+  std::vector<GstElement*> sources WIRCAM_GUARDED_BY(mutex);
 };
 
 namespace {
@@ -42,7 +44,7 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
     gst_rtsp_mount_points_add_factory(mounts, camera.path.c_str(), factory);
     Mount* raw = mount.get();
     mount->listener = camera.frames->listen([raw](GstSample* sample) {
-      std::lock_guard lock(raw->mutex);
+      MutexLock lock(raw->mutex);
       if (raw->sources.empty()) return;
       // Same memory, fresh metadata: the appsrc stamps it. The caps carry
       // the frame size, which rtpjpegpay needs.
@@ -75,7 +77,7 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
 RtspServer::~RtspServer() {
   for (auto& mount : mounts_) {
     mount->camera.frames->forget(mount->listener);
-    std::lock_guard lock(mount->mutex);
+    MutexLock lock(mount->mutex);
     for (GstElement* source : mount->sources) gst_object_unref(source);
     mount->sources.clear();
   }
@@ -90,14 +92,14 @@ void RtspServer::onMediaConfigure(GstRTSPMediaFactory*, GstRTSPMedia* media, gpo
   gst_object_unref(bin);
   if (!source) return;
   {
-    std::lock_guard lock(mount->mutex);
+    MutexLock lock(mount->mutex);
     mount->sources.push_back(source);
   }
   // When the last client leaves the media is unprepared: stop feeding it.
   g_signal_connect(media, "unprepared", G_CALLBACK(+[](GstRTSPMedia* m, gpointer d) {
                      auto* unpreparedMount = static_cast<Mount*>(d);
                      GstElement* mediaBin = gst_rtsp_media_get_element(m);
-                     std::lock_guard lock(unpreparedMount->mutex);
+                     MutexLock lock(unpreparedMount->mutex);
                      auto& list = unpreparedMount->sources;
                      for (auto it = list.begin(); it != list.end();) {
                        if (gst_object_has_as_ancestor(GST_OBJECT(*it), GST_OBJECT(mediaBin))) {

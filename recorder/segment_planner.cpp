@@ -56,7 +56,7 @@ std::string SegmentPlanner::nameFor(int64_t unixMs) {
 }
 
 SegmentPlanner::Cut SegmentPlanner::onFrame(uint64_t pts, int64_t unixMs) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   Cut cut = Cut::kNone;
   if (segments_.empty()) {
     cut = Cut::kFirst;
@@ -79,7 +79,7 @@ SegmentPlanner::Cut SegmentPlanner::onFrame(uint64_t pts, int64_t unixMs) {
 }
 
 void SegmentPlanner::addBytes(uint64_t bytes) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   if (segments_.empty()) return;
   PlannedSegment& open = segments_.back();
   open.bytes += bytes;
@@ -87,7 +87,7 @@ void SegmentPlanner::addBytes(uint64_t bytes) {
 }
 
 std::optional<PlannedSegment> SegmentPlanner::segmentAt(uint64_t runningTime) const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   if (segments_.empty()) return std::nullopt;
   for (auto it = segments_.rbegin(); it != segments_.rend(); ++it)
     if (it->start <= runningTime) return *it;
@@ -95,14 +95,14 @@ std::optional<PlannedSegment> SegmentPlanner::segmentAt(uint64_t runningTime) co
 }
 
 std::optional<PlannedSegment> SegmentPlanner::segmentOf(const std::string& path) const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   for (const auto& segment : segments_)
     if (segment.path == path) return segment;
   return std::nullopt;
 }
 
 std::optional<PlannedSegment> SegmentPlanner::segmentStartingNear(uint64_t time) const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   const PlannedSegment* nearest = nullptr;
   auto distance = [time](uint64_t start) { return start > time ? start - time : time - start; };
   for (const auto& segment : segments_)
@@ -112,7 +112,7 @@ std::optional<PlannedSegment> SegmentPlanner::segmentStartingNear(uint64_t time)
 }
 
 std::optional<PlannedSegment> SegmentPlanner::current() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   if (segments_.empty()) return std::nullopt;
   return segments_.back();
 }

@@ -12,11 +12,12 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
+
+#include "common/mutex.h"
 
 namespace wircam::recorder {
 
@@ -69,15 +70,15 @@ class SegmentPlanner {
   static std::string isoUtc(int64_t unixMs);
 
  private:
-  std::string nameFor(int64_t unixMs);
+  std::string nameFor(int64_t unixMs) WIRCAM_REQUIRES(mutex_);
 
   const std::filesystem::path folder_;
   const std::string stem_, extension_;
   const SegmentLimits limits_;
-  mutable std::mutex mutex_;
-  std::vector<PlannedSegment> segments_;  // guarded by mutex_; the newest last
-  std::set<std::string> used_;            // guarded by mutex_: names given out
-  bool splitPending_ = false;             // guarded by mutex_: the byte limit was reached
+  mutable Mutex mutex_;
+  std::vector<PlannedSegment> segments_ WIRCAM_GUARDED_BY(mutex_);  // the newest last
+  std::set<std::string> used_ WIRCAM_GUARDED_BY(mutex_);            // names given out
+  bool splitPending_ WIRCAM_GUARDED_BY(mutex_) = false;             // the byte limit was reached
   // Past segments kept for look-ups of late telemetry and closing files.
   static constexpr size_t kKept = 16;
 };

@@ -9,7 +9,7 @@ constexpr size_t kOpenSidecars = 2;
 }  // namespace
 
 void TelemetryRouter::write(nlohmann::json line, uint64_t runningTime, int64_t unixMs) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   auto segment = planner_.segmentAt(runningTime);
   if (!segment) {
     if (early_.size() < kMaxEarlyLines) early_.push_back({std::move(line), runningTime, unixMs});
@@ -19,7 +19,7 @@ void TelemetryRouter::write(nlohmann::json line, uint64_t runningTime, int64_t u
 }
 
 void TelemetryRouter::flushEarly() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   auto first = planner_.current();
   if (!first) return;
   for (auto& line : early_) place(std::move(line), *first);
@@ -46,7 +46,7 @@ void TelemetryRouter::place(Line line, const PlannedSegment& segment) {
 }
 
 void TelemetryRouter::segmentOpened(const std::string& segment) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   auto& sidecar = sidecarOf(segment);
   if (!sidecar.create() && sidecar.path() != failedPath_) {
     failedPath_ = sidecar.path();
@@ -64,7 +64,7 @@ TelemetryLog& TelemetryRouter::sidecarOf(const std::string& segment) {
 }
 
 std::optional<std::string> TelemetryRouter::takeWriteFailure() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return std::exchange(failure_, std::nullopt);
 }
 

@@ -8,11 +8,11 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
+#include "common/mutex.h"
 #include "segment_planner.h"
 #include "telemetry_log.h"
 #include "telemetry_track.h"
@@ -44,16 +44,16 @@ class TelemetryRouter {
     uint64_t runningTime;
     int64_t unixMs;
   };
-  void place(Line line, const PlannedSegment& segment);
-  TelemetryLog& sidecarOf(const std::string& segment);
+  void place(Line line, const PlannedSegment& segment) WIRCAM_REQUIRES(mutex_);
+  TelemetryLog& sidecarOf(const std::string& segment) WIRCAM_REQUIRES(mutex_);
 
   const SegmentPlanner& planner_;
   TelemetryTrack* track_;
-  std::mutex mutex_;
-  std::deque<Line> early_;                              // guarded by mutex_
-  std::deque<std::unique_ptr<TelemetryLog>> sidecars_;  // guarded by mutex_; the newest last
-  std::optional<std::string> failure_;                  // guarded by mutex_
-  std::string failedPath_;                              // guarded by mutex_
+  Mutex mutex_;
+  std::deque<Line> early_ WIRCAM_GUARDED_BY(mutex_);
+  std::deque<std::unique_ptr<TelemetryLog>> sidecars_ WIRCAM_GUARDED_BY(mutex_);  // newest last
+  std::optional<std::string> failure_ WIRCAM_GUARDED_BY(mutex_);
+  std::string failedPath_ WIRCAM_GUARDED_BY(mutex_);
 };
 
 }  // namespace wircam::recorder

@@ -8,7 +8,7 @@ bool TelemetryTrack::write(const std::string& json, GstClockTime pts,
                            const std::function<bool(GstClockTime newest)>& tooLate) {
   if (!GST_CLOCK_TIME_IS_VALID(pts)) return false;
   // The lock spans the push so that buffers enter the appsrc in time order.
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   if (tooLate && tooLate(last_)) return false;
   GstBuffer* buffer =
       json.empty() ? gst_buffer_new() : gst_buffer_new_memdup(json.data(), json.size());
@@ -20,7 +20,7 @@ bool TelemetryTrack::write(const std::string& json, GstClockTime pts,
 }
 
 GstClockTime TelemetryTrack::last() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return last_;
 }
 

@@ -5,8 +5,9 @@
 #include <gst/gst.h>
 
 #include <functional>
-#include <mutex>
 #include <string>
+
+#include "common/mutex.h"
 
 namespace wircam::recorder {
 
@@ -38,8 +39,8 @@ class TelemetryTrack {
 
  private:
   GstElement* source_;
-  mutable std::mutex mutex_;  // lines come from the main loop, heartbeats from streaming
-  GstClockTime last_ = 0;     // guarded by mutex_
+  mutable Mutex mutex_;  // lines and heartbeats come from the main loop, early lines from streaming
+  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;
 };
 
 }  // namespace wircam::recorder

@@ -18,6 +18,7 @@
 #include <memory>
 #include <mutex>
 
+#include "common/mutex.h"
 #include "frame_buffers.h"
 #include "glib_locker.h"
 #include "wirc/frame_assembler.h"
@@ -42,8 +43,8 @@ struct WircDepayState {
   // Held back until the first frame's caps are out: sticky events must go
   // caps before segment.
   GstEvent* pendingSegment = nullptr;
-  std::mutex statsMutex;  // guards stats, read by the property
-  wirc::AssemblerStats stats;
+  Mutex statsMutex;  // the stats property reads stats
+  wirc::AssemblerStats stats WIRCAM_GUARDED_BY(statsMutex);
 };
 
 }  // namespace
@@ -120,7 +121,7 @@ static GstFlowReturn gst_wirc_depay_chain(GstPad*, GstObject* parent, GstBuffer*
   }
   assembler.expire(Clock::now(), collect);
   {
-    std::lock_guard lock(self->state->statsMutex);
+    MutexLock lock(self->state->statsMutex);
     self->state->stats = assembler.stats();
   }
   GstClockTime arrival = GST_BUFFER_PTS(buffer);
@@ -177,7 +178,7 @@ static void gst_wirc_depay_get_property(GObject* object, guint id, GValue* value
                                         GParamSpec* pspec) {
   auto* self = GST_WIRC_DEPAY(object);
   if (id == PROP_STATS) {
-    std::lock_guard lock(self->state->statsMutex);
+    MutexLock lock(self->state->statsMutex);
     g_value_take_boxed(value, gst::statsStructure(self->state->stats, 0));
   } else if (id == PROP_FRAME_TIMEOUT) {
     gst::GLibLocker lock(self);

@@ -42,6 +42,7 @@
 #include <set>
 #include <string>
 
+#include "common/mutex.h"
 #include "frame_buffers.h"
 #include "glib_locker.h"
 #include "login_properties.h"
@@ -143,11 +144,11 @@ struct WircSrcState {
   int height = 0;
   Clock::time_point nextStats;
 
-  std::mutex refusalMutex;  // guards refusal, written on the event loop
-  std::string refusal;      // the device refused this camera's STST
+  Mutex refusalMutex;                                   // refusal is written on the event loop
+  std::string refusal WIRCAM_GUARDED_BY(refusalMutex);  // the device refused this camera's STST
 
-  std::mutex statsMutex;  // guards the copy read by the stats property
-  wirc::StreamReceiverStats stats;
+  Mutex statsMutex;  // the stats property reads the copy
+  wirc::StreamReceiverStats stats WIRCAM_GUARDED_BY(statsMutex);
 };
 
 }  // namespace
@@ -166,7 +167,7 @@ namespace {
 
 void publishStats(GstWircSrc* self) {
   auto* state = self->state;
-  std::lock_guard lock(state->statsMutex);
+  MutexLock lock(state->statsMutex);
   state->stats = state->receiver->stats();
 }
 
@@ -174,7 +175,7 @@ void postStats(GstWircSrc* self) {
   auto* state = self->state;
   GstStructure* stats;
   {
-    std::lock_guard lock(state->statsMutex);
+    MutexLock lock(state->statsMutex);
     stats = gst::statsStructure(state->stats.assembler, state->stats.packetsForeign);
   }
   // The device's latest status report rides along, for recorders and UIs.
@@ -226,7 +227,7 @@ void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
   if (const auto* refused = std::get_if<link::DeviceRefused>(&event);
       refused && refused->request == "STST") {
     {
-      std::lock_guard lock(state->refusalMutex);
+      MutexLock lock(state->refusalMutex);
       state->refusal = text;
     }
     signal(state->linkChanged);
@@ -298,7 +299,10 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   state->receiver.emplace(wirc::FrameAssemblerConfig{
       .frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)});
   state->streaming = false;
-  state->refusal.clear();
+  {
+    MutexLock lock(state->refusalMutex);
+    state->refusal.clear();
+  }
   state->width = state->height = 0;
   state->loginDeadline = Clock::now() + std::chrono::milliseconds(settings.loginTimeoutMs + 500);
   state->nextStats = Clock::now() + std::chrono::milliseconds(settings.statsIntervalMs);
@@ -417,7 +421,7 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
   // Checked after the camera count, which explains a refusal of a camera
   // the device does not have better than the refusal does.
   {
-    std::lock_guard lock(state->refusalMutex);
+    MutexLock lock(state->refusalMutex);
     if (!state->refusal.empty()) {
       GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
                         ("The device refused camera %u", settings.camera),
@@ -592,9 +596,10 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
 static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, GParamSpec* pspec) {
   auto* self = GST_WIRC_SRC(object);
   if (id == PROP_STATS) {
-    std::lock_guard lock(self->state->statsMutex);
-    const auto& stats = self->state->stats;
-    g_value_take_boxed(value, gst::statsStructure(stats.assembler, stats.packetsForeign));
+    auto* state = self->state;
+    MutexLock lock(state->statsMutex);
+    g_value_take_boxed(value,
+                       gst::statsStructure(state->stats.assembler, state->stats.packetsForeign));
     return;
   }
   gst::GLibLocker lock(self);

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "btemp/btemp_controller.h"
+#include "common/mutex.h"
 #include "common/socket.h"
 
 namespace wircam::btemp {
@@ -20,11 +21,11 @@ class Robot::Impl {
   Impl(RobotConfig config, UniqueFd socket, Logger logger);
   ~Impl() { loop_.remove(watch_); }
   void onReadable();
-  // Under mutex_: what to answer `message` from `from` with, if anything.
+  // What to answer `message` from `from` with, if anything.
   std::optional<Message> obey(const Message& message, const SocketAddress& from,
-                              Clock::time_point now);
-  void expire(Clock::time_point now);
-  Pins pins() const;
+                              Clock::time_point now) WIRCAM_REQUIRES(mutex_);
+  void expire(Clock::time_point now) WIRCAM_REQUIRES(mutex_);
+  Pins pins() const WIRCAM_REQUIRES(mutex_);
   void log(const std::string& line) {
     if (logger_) logger_(line);
   }
@@ -36,12 +37,13 @@ class Robot::Impl {
   EventLoop& loop_ = EventLoop::shared();
   EventLoop::Id watch_ = 0;
 
-  mutable std::mutex mutex_;  // guards what follows
-  std::optional<SocketAddress> controller_;
-  RobotOutputs outputs_;
-  std::array<uint8_t, 4> throttle_{};
-  std::optional<Clock::time_point> lastHeard_, lastPins_;
-  RobotStats stats_;
+  mutable Mutex mutex_;
+  std::optional<SocketAddress> controller_ WIRCAM_GUARDED_BY(mutex_);
+  RobotOutputs outputs_ WIRCAM_GUARDED_BY(mutex_);
+  std::array<uint8_t, 4> throttle_ WIRCAM_GUARDED_BY(mutex_){};
+  std::optional<Clock::time_point> lastHeard_ WIRCAM_GUARDED_BY(mutex_);
+  std::optional<Clock::time_point> lastPins_ WIRCAM_GUARDED_BY(mutex_);
+  RobotStats stats_ WIRCAM_GUARDED_BY(mutex_);
 };
 
 Robot::Impl::Impl(RobotConfig config, UniqueFd socket, Logger logger)
@@ -119,7 +121,7 @@ void Robot::Impl::onReadable() {
     auto message = decode(datagram);
     std::optional<Message> answer;
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       if (!message) {
         ++stats_.rejected;
         return;
@@ -146,13 +148,13 @@ Robot::~Robot() = default;
 uint16_t Robot::port() const { return localAddress(impl_->socket_.get()).port(); }
 
 RobotOutputs Robot::outputs(Clock::time_point now) {
-  std::lock_guard lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   impl_->expire(now);
   return impl_->outputs_;
 }
 
 RobotStats Robot::stats() const {
-  std::lock_guard lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   return impl_->stats_;
 }
 

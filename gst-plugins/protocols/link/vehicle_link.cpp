@@ -44,7 +44,7 @@ std::string describe(const LinkEvent& event) {
 }
 
 int LinkListeners::add(Listener listener) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   int id = next_++;
   listeners_[id] = std::make_shared<const Listener>(std::move(listener));
   return id;
@@ -53,7 +53,7 @@ int LinkListeners::add(Listener listener) {
 void LinkListeners::remove(int id) {
   // Waits for a running emit (unless this thread is the one emitting).
   std::lock_guard emitting(emitting_);
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   listeners_.erase(id);
 }
 
@@ -61,7 +61,7 @@ void LinkListeners::emit(const LinkEvent& event) {
   std::lock_guard emitting(emitting_);
   std::vector<std::shared_ptr<const Listener>> current;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     current.reserve(listeners_.size());
     for (const auto& [id, listener] : listeners_) current.push_back(listener);
   }

@@ -16,6 +16,8 @@
 #include <variant>
 #include <vector>
 
+#include "common/mutex.h"
+
 namespace wircam::link {
 
 // Pulse width per channel in µs, channel 1 first. WiRC has twelve
@@ -109,9 +111,9 @@ class LinkListeners {
   void emit(const LinkEvent& event);
 
  private:
-  std::mutex mutex_;  // guards listeners_ and next_; not held while one runs
-  std::map<int, std::shared_ptr<const Listener>> listeners_;
-  int next_ = 1;
+  Mutex mutex_;  // not held while a listener runs
+  std::map<int, std::shared_ptr<const Listener>> listeners_ WIRCAM_GUARDED_BY(mutex_);
+  int next_ WIRCAM_GUARDED_BY(mutex_) = 1;
   std::recursive_mutex emitting_;  // held while listeners run (emit may nest)
 };
 

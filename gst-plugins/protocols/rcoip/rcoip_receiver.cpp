@@ -9,6 +9,7 @@
 #include <mutex>
 #include <optional>
 
+#include "common/mutex.h"
 #include "common/socket.h"
 
 namespace wircam::rcoip {
@@ -24,8 +25,8 @@ class Receiver::Impl {
   void log(const std::string& line) {
     if (logger_) logger_(line);
   }
-  // Under mutex_: leaves the outputs at the failsafe once commands stopped.
-  void expire(Clock::time_point now);
+  // Leaves the outputs at the failsafe once commands stopped.
+  void expire(Clock::time_point now) WIRCAM_REQUIRES(mutex_);
 
   const ReceiverConfig config_;
   UniqueFd socket_;
@@ -33,11 +34,11 @@ class Receiver::Impl {
   EventLoop& loop_ = EventLoop::shared();
   EventLoop::Id watch_ = 0;
 
-  mutable std::mutex mutex_;  // guards what follows
-  ReceiverOutputs outputs_;
-  std::optional<Clock::time_point> lastCommand_;
-  std::optional<Clock::time_point> lastReply_;
-  ReceiverStats stats_;
+  mutable Mutex mutex_;
+  ReceiverOutputs outputs_ WIRCAM_GUARDED_BY(mutex_);
+  std::optional<Clock::time_point> lastCommand_ WIRCAM_GUARDED_BY(mutex_);
+  std::optional<Clock::time_point> lastReply_ WIRCAM_GUARDED_BY(mutex_);
+  ReceiverStats stats_ WIRCAM_GUARDED_BY(mutex_);
 };
 
 Receiver::Impl::Impl(ReceiverConfig config, UniqueFd socket, Logger logger)
@@ -62,7 +63,7 @@ void Receiver::Impl::onReadable() {
     auto command = decodeCommand(datagram);
     bool reply = false;
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       if (!command) {
         ++stats_.rejected;
         return;
@@ -108,13 +109,13 @@ Receiver::~Receiver() = default;
 uint16_t Receiver::port() const { return localAddress(impl_->socket_.get()).port(); }
 
 ReceiverOutputs Receiver::outputs(Clock::time_point now) {
-  std::lock_guard lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   impl_->expire(now);
   return impl_->outputs_;
 }
 
 ReceiverStats Receiver::stats() const {
-  std::lock_guard lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   return impl_->stats_;
 }
 
