@@ -172,6 +172,10 @@ TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
       widest = std::max(widest, frames[i].pts - frames[i - 1].pts);
     EXPECT_LE(widest, 0.5) << video;
   }
+  // The loss is in the telemetry of the segment it ended.
+  std::string first;
+  for (const auto& line : sidecarOf(videos[0])) first += line.dump();
+  EXPECT_NE(first.find("link lost: the device closed the connection"), std::string::npos);
 }
 
 TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {

@@ -3,9 +3,10 @@
 #include "recording_index.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <fstream>
+
+#include "temp_folder_test.h"
 
 namespace {
 
@@ -14,16 +15,9 @@ using wircam::recorder::IndexEntry;
 using wircam::recorder::parseSegmentName;
 using wircam::recorder::RecordingIndex;
 
-class RecordingIndexTest : public ::testing::Test {
+class RecordingIndexTest : public wircam::testing::TempFolderTest {
  protected:
-  void SetUp() override {
-    folder_ = fs::temp_directory_path() / ("recording-index-" + std::to_string(getpid()));
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
-  void TearDown() override { fs::remove_all(folder_); }
   void touch(const std::string& name) { std::ofstream(folder_ / name) << "video"; }
-  fs::path folder_;
 };
 
 IndexEntry entry(const std::string& file, const std::string& start) {

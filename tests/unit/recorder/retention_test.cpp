@@ -3,26 +3,20 @@
 #include "retention.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "disk_guard.h"
+#include "temp_folder_test.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace wircam::recorder;
 
-class RetentionTest : public ::testing::Test {
+class RetentionTest : public wircam::testing::TempFolderTest {
  protected:
-  void SetUp() override {
-    folder_ = fs::temp_directory_path() / ("retention-" + std::to_string(getpid()));
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
-  void TearDown() override { fs::remove_all(folder_); }
   // A segment of `bytes` (and a 100-byte sidecar) written `age` seconds ago.
   std::string segment(const std::string& name, size_t bytes, int age) {
     auto video = folder_ / name;
@@ -31,7 +25,6 @@ class RetentionTest : public ::testing::Test {
     fs::last_write_time(video, fs::file_time_type::clock::now() - std::chrono::seconds(age));
     return video.string();
   }
-  fs::path folder_;
 };
 
 TEST_F(RetentionTest, DeletesTheOldestUntilUnderTheCapButNeverAnOpenSegment) {

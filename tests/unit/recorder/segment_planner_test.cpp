@@ -3,9 +3,10 @@
 #include "segment_planner.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <fstream>
+
+#include "temp_folder_test.h"
 
 namespace {
 
@@ -18,13 +19,8 @@ constexpr uint64_t kSecond = 1'000'000'000;
 constexpr uint64_t kFrame = kSecond / 15;
 constexpr int64_t kNoon = 1795348800000;  // 2026-11-22T12:00:00Z
 
-class SegmentPlannerTest : public ::testing::Test {
+class SegmentPlannerTest : public wircam::testing::TempFolderTest {
  protected:
-  void SetUp() override {
-    folder_ = fs::temp_directory_path() / ("segment-planner-" + std::to_string(getpid()));
-    fs::create_directories(folder_);
-  }
-  void TearDown() override { fs::remove_all(folder_); }
   SegmentPlanner planner(SegmentLimits limits) {
     return SegmentPlanner(folder_, "rover-cam0", ".mkv", limits);
   }
@@ -38,7 +34,6 @@ class SegmentPlannerTest : public ::testing::Test {
     }
     return cuts;
   }
-  fs::path folder_;
 };
 
 TEST_F(SegmentPlannerTest, TheFirstFrameOpensTheFirstSegmentNamedByItsUtcTime) {
