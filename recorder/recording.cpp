@@ -13,6 +13,7 @@
 #include "gst_json.h"
 #include "segment_inspector.h"
 #include "telemetry_track_flags.h"
+#include "wall_clock.h"
 
 namespace wircam::recorder {
 
@@ -80,12 +81,8 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
                                .splitmux = elementNamed(streamPlan.muxer),
                                .transcoded = plan.transcoded},
         *stream->planner, [telemetry = stream->telemetry.get()] { telemetry->flushEarly(); });
-    if (!streamPlan.liveSink.empty()) {
-      GstElement* sink =
-          gst_bin_get_by_name(GST_BIN(recording->pipeline_), streamPlan.liveSink.c_str());
-      stream->frames = std::make_unique<FrameTap>(sink);
-      gst_object_unref(sink);
-    }
+    if (!streamPlan.liveSink.empty())
+      stream->frames = std::make_unique<FrameTap>(elementNamed(streamPlan.liveSink));
     for (const auto* element :
          {&streamPlan.source, &streamPlan.muxer, &streamPlan.detector, &streamPlan.controller})
       if (!element->empty()) recording->streamByElement_[*element] = stream.get();
@@ -152,16 +149,9 @@ GstClockTime Recording::runningTime() const {
   return now;
 }
 
-int64_t Recording::unixMsOf(GstClockTime time) const {
-  int64_t now = g_get_real_time() / 1000;
-  GstClockTime running = runningTime();
-  if (!GST_CLOCK_TIME_IS_VALID(running) || !GST_CLOCK_TIME_IS_VALID(time)) return now;
-  return now - GST_CLOCK_DIFF(time, running) / static_cast<int64_t>(GST_MSECOND);
-}
-
 void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime time) {
   if (!GST_CLOCK_TIME_IS_VALID(time)) return;
-  stream.telemetry->write(std::move(line), time, unixMsOf(time));
+  stream.telemetry->write(std::move(line), time, unixMsOf(pipeline_, time));
   if (auto failure = stream.telemetry->takeWriteFailure()) log(*failure);
 }
 

@@ -76,7 +76,6 @@ class Recording {
   void followLinkState(Stream& stream, const std::string& linkState);
   void updateIndex(const std::vector<std::string>& deleted);
   GstClockTime runningTime() const;
-  int64_t unixMsOf(GstClockTime runningTime) const;
   void printStatus();
   void guardDisk();
   nlohmann::json status() const;

@@ -2,6 +2,8 @@
 
 #include <gst/video/video-event.h>
 
+#include "wall_clock.h"
+
 namespace wircam::recorder {
 
 namespace {
@@ -49,13 +51,6 @@ SegmentSplitter::~SegmentSplitter() {
   }
 }
 
-int64_t SegmentSplitter::unixMsOf(GstClockTime runningTime) const {
-  int64_t now = g_get_real_time() / 1000;
-  GstClockTime running = gst_element_get_current_running_time(parts_.source);
-  if (!GST_CLOCK_TIME_IS_VALID(running) || !GST_CLOCK_TIME_IS_VALID(runningTime)) return now;
-  return now - GST_CLOCK_DIFF(runningTime, running) / static_cast<int64_t>(GST_MSECOND);
-}
-
 GstPadProbeReturn SegmentSplitter::onSourceData(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   auto* self = static_cast<SegmentSplitter*>(data);
   if (GST_PAD_PROBE_INFO_TYPE(info) & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) {
@@ -64,7 +59,7 @@ GstPadProbeReturn SegmentSplitter::onSourceData(GstPad* pad, GstPadProbeInfo* in
   }
   GstClockTime time = runningTimeOf(self->sourceSegment_, GST_PAD_PROBE_INFO_BUFFER(info));
   if (!GST_CLOCK_TIME_IS_VALID(time)) return GST_PAD_PROBE_OK;
-  auto cut = self->planner_.onFrame(time, self->unixMsOf(time));
+  auto cut = self->planner_.onFrame(time, unixMsOf(self->parts_.source, time));
   if (cut == SegmentPlanner::Cut::kFirst) self->onFirstSegment_();
   // The encoder makes this very frame a key frame (the event travels just
   // ahead of it): at a cut, and every kKeyFrameInterval, whatever the frame

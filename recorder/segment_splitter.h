@@ -37,7 +37,6 @@ class SegmentSplitter {
   static void onSinkAdded(GstElement* splitmux, GstElement* sink, gpointer);
   static gchar* onFormatLocation(GstElement* splitmux, guint fragment, GstSample* first,
                                  gpointer self);
-  int64_t unixMsOf(GstClockTime runningTime) const;
 
   Parts parts_;
   SegmentPlanner& planner_;
