@@ -16,8 +16,9 @@ const char* usage() {
 
 Records the cameras of one or more WiRC devices into segmented files, the
 JPEG frames muxed as they arrive (no re-encoding) or transcoded to H.264,
-with the telemetry in a JSON-lines sidecar per segment and, in Matroska, as a
-text track in the file. SIGINT or SIGTERM finishes every file and exits 0.
+with the telemetry in a JSON-lines sidecar per segment and as a text track in
+the file. A device that is off is waited for. SIGINT or SIGTERM finishes every
+file and exits 0.
 
   --device HOST[:PORT][,control=URI]
                          a device to record (default port 1984); repeatable.
@@ -72,13 +73,17 @@ and control (rcoip://H:P or btemp://H:P, as on the command line):
   cameras=0;1
   follow=true
 
-Files: DIR/<device>-cam<N>-<start time>-<segment>.mkv (or .mp4) and, beside
-each, <same name>.jsonl with one JSON object per event: {"pts": running time
-in ns, "type": "stats"|"detections"|"control"|"session"|"vehicle", ...}. The same
-objects are a Matroska file's text track (MP4: the sidecar only).
+Files: DIR/<device>-cam<N>-YYYYMMDDTHHMMSSZ.mkv (or .mp4), named by the UTC
+time of their first frame, each starting at 0 on a key frame; a segment also
+ends where the device was lost. Beside each, <same name>.jsonl with one JSON
+object per event: {"pts": ns on the segment's timeline, "utc": "...Z", "type":
+"stats"|"detections"|"control"|"session"|"vehicle", ...}; the same objects are
+the file's text track "telemetry". DIR/index.json lists the finished segments
+(camera, file, start_utc, duration_s, frames, bytes).
 
-Exit status: 0 finished cleanly, 1 error (or no device ever sent a frame),
-2 bad arguments, 3 the disk filled (the open segments were finished first).
+Exit status: 0 finished cleanly (or stopped by a signal before any frame),
+1 error (or --duration ended with nothing recorded), 2 bad arguments, 3 the
+disk filled (the open segments were finished first).
 )";
 }
 
