@@ -75,7 +75,7 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     stream->planner = std::make_unique<SegmentPlanner>(options.outDir, streamPlan.name,
                                                        extensionOf(options.container), limits);
     stream->track.emplace(elementNamed(streamPlan.telemetrySource));
-    stream->telemetry = std::make_unique<TelemetryRouter>(*stream->planner, &*stream->track);
+    stream->telemetry = std::make_unique<TelemetryRouter>(*stream->planner, *stream->track);
     stream->splitter = std::make_unique<SegmentSplitter>(
         SegmentSplitter::Parts{.source = elementNamed(streamPlan.source),
                                .splitmux = elementNamed(streamPlan.muxer),

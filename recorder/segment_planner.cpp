@@ -55,7 +55,8 @@ std::string SegmentPlanner::nameFor(int64_t unixMs) {
   }
 }
 
-SegmentPlanner::Cut SegmentPlanner::onFrame(uint64_t pts, int64_t unixMs) {
+SegmentPlanner::Cut SegmentPlanner::onFrame(uint64_t pts,
+                                            const std::function<int64_t()>& unixMsNow) {
   MutexLock lock(mutex_);
   Cut cut = Cut::kNone;
   if (segments_.empty()) {
@@ -68,6 +69,7 @@ SegmentPlanner::Cut SegmentPlanner::onFrame(uint64_t pts, int64_t unixMs) {
   }
   if (cut != Cut::kNone) {
     splitPending_ = false;
+    int64_t unixMs = unixMsNow();
     segments_.push_back(
         {.path = nameFor(unixMs), .startUnixMs = unixMs, .start = pts, .lastFrame = pts});
     if (segments_.size() > kKept) segments_.erase(segments_.begin());

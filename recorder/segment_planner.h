@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -47,10 +48,11 @@ class SegmentPlanner {
                  SegmentLimits limits);
 
   enum class Cut { kNone, kFirst, kNext };
-  // A frame left the source at running time `pts`, wall clock `unixMs`.
-  // kFirst: it opens the first segment; kNext: it ends the current segment
-  // and opens another (the caller has the muxer split there).
-  Cut onFrame(uint64_t pts, int64_t unixMs);
+  // A frame left the source at running time `pts`. kFirst: it opens the
+  // first segment; kNext: it ends the current segment and opens another
+  // (the caller has the muxer split there). `unixMsNow` (the frame's wall
+  // clock time, for the name) is asked only when a segment opens.
+  Cut onFrame(uint64_t pts, const std::function<int64_t()>& unixMsNow);
   // Bytes of the current segment reached the muxer; past the limit, the
   // next frame starts a new segment.
   void addBytes(uint64_t bytes);

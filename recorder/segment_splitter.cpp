@@ -59,7 +59,8 @@ GstPadProbeReturn SegmentSplitter::onSourceData(GstPad* pad, GstPadProbeInfo* in
   }
   GstClockTime time = runningTimeOf(self->sourceSegment_, GST_PAD_PROBE_INFO_BUFFER(info));
   if (!GST_CLOCK_TIME_IS_VALID(time)) return GST_PAD_PROBE_OK;
-  auto cut = self->planner_.onFrame(time, unixMsOf(self->parts_.source, time));
+  auto cut =
+      self->planner_.onFrame(time, [self, time] { return unixMsOf(self->parts_.source, time); });
   if (cut == SegmentPlanner::Cut::kFirst) self->onFirstSegment_();
   // The encoder makes this very frame a key frame (the event travels just
   // ahead of it): at a cut, and every kKeyFrameInterval, whatever the frame

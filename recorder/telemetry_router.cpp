@@ -38,8 +38,7 @@ void TelemetryRouter::place(Line line, const PlannedSegment& segment) {
   }
   // A line late for a segment whose file has moved on stays in the sidecar:
   // in the text track it would land in the next file.
-  if (!track_) return;
-  track_->write(text, time, [&](GstClockTime newest) {
+  track_.write(text, time, [&](GstClockTime newest) {
     auto trackSegment = planner_.segmentAt(newest);
     return trackSegment && trackSegment->start > segment.start;
   });

@@ -21,8 +21,8 @@ namespace wircam::recorder {
 
 class TelemetryRouter {
  public:
-  // `track` may be null (no text track); both are borrowed.
-  TelemetryRouter(const SegmentPlanner& planner, TelemetryTrack* track)
+  // Both are borrowed.
+  TelemetryRouter(const SegmentPlanner& planner, TelemetryTrack& track)
       : planner_(planner), track_(track) {}
 
   // Thread-safe. Lines from before the first frame (the login, the control
@@ -48,7 +48,7 @@ class TelemetryRouter {
   TelemetryLog& sidecarOf(const std::string& segment) WIRCAM_REQUIRES(mutex_);
 
   const SegmentPlanner& planner_;
-  TelemetryTrack* track_;
+  TelemetryTrack& track_;
   Mutex mutex_;
   std::deque<Line> early_ WIRCAM_GUARDED_BY(mutex_);
   std::deque<std::unique_ptr<TelemetryLog>> sidecars_ WIRCAM_GUARDED_BY(mutex_);  // newest last

@@ -21,21 +21,21 @@ class TelemetryTrack {
   // little after later statistics). Such a line is placed at the latest
   // time already written; its own "pts" field keeps the exact time.
   // `tooLate`, asked with the newest buffer's time under the same lock as
-  // the heartbeats, may refuse it (the file has moved on); false if so.
-  bool write(const std::string& json, GstClockTime pts,
+  // the heartbeats, may refuse it (the file has moved on): then nothing is
+  // written.
+  void write(const std::string& json, GstClockTime pts,
              const std::function<bool(GstClockTime newest)>& tooLate = {});
 
-  // An empty buffer, sent every kHeartbeatInterval with the current time.
-  // splitmuxsink hands a GOP to the muxer only once every track's input has
-  // passed its end, so a sparse track would hold the video back (and
-  // mp4mux waits for every track): this tells both that the telemetry has
-  // nothing before `now`. (From a timer rather than with each frame: a
-  // GOP is one frame in JPEG, and each heartbeat costs a few thread wake-ups.)
-  void heartbeat(GstClockTime now) { write({}, now); }
+  // An empty buffer, sent every kHeartbeatInterval at the newest frame's
+  // time. splitmuxsink hands a GOP to the muxer only once every track's
+  // input has passed its end, so a sparse track would hold the video back
+  // (and mp4mux waits for every track): this tells both that the telemetry
+  // has nothing before `frameTime`. (From a timer rather than with each
+  // frame: a GOP is one frame in JPEG, and each heartbeat costs a few
+  // thread wake-ups. Not ahead of the video: the text would only wait in
+  // splitmuxsink for it.)
+  void heartbeat(GstClockTime frameTime) { write({}, frameTime); }
   static constexpr GstClockTime kHeartbeatInterval = GST_SECOND / 8;
-
-  // The time of the newest buffer.
-  GstClockTime last() const;
 
  private:
   GstElement* source_;

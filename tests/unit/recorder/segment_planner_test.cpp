@@ -19,6 +19,11 @@ constexpr uint64_t kSecond = 1'000'000'000;
 constexpr uint64_t kFrame = kSecond / 15;
 constexpr int64_t kNoon = 1795348800000;  // 2026-11-22T12:00:00Z
 
+// A wall clock that says `unixMs`.
+std::function<int64_t()> at(int64_t unixMs) {
+  return [unixMs] { return unixMs; };
+}
+
 class SegmentPlannerTest : public wircam::testing::TempFolderTest {
  protected:
   SegmentPlanner planner(SegmentLimits limits) {
@@ -29,7 +34,7 @@ class SegmentPlannerTest : public wircam::testing::TempFolderTest {
     std::vector<uint64_t> cuts;
     for (int i = 0; i < count; ++i) {
       uint64_t pts = from + static_cast<uint64_t>(i) * kFrame;
-      if (p.onFrame(pts, kNoon + static_cast<int64_t>(pts / 1'000'000)) != Cut::kNone)
+      if (p.onFrame(pts, at(kNoon + static_cast<int64_t>(pts / 1'000'000))) != Cut::kNone)
         cuts.push_back(pts);
     }
     return cuts;
@@ -39,8 +44,8 @@ class SegmentPlannerTest : public wircam::testing::TempFolderTest {
 TEST_F(SegmentPlannerTest, TheFirstFrameOpensTheFirstSegmentNamedByItsUtcTime) {
   auto p = planner({.maxDuration = 10 * kSecond});
   EXPECT_FALSE(p.current());
-  EXPECT_EQ(p.onFrame(5 * kSecond, kNoon), Cut::kFirst);
-  EXPECT_EQ(p.onFrame(5 * kSecond + kFrame, kNoon + 66), Cut::kNone);
+  EXPECT_EQ(p.onFrame(5 * kSecond, at(kNoon)), Cut::kFirst);
+  EXPECT_EQ(p.onFrame(5 * kSecond + kFrame, at(kNoon + 66)), Cut::kNone);
   auto open = p.current();
   ASSERT_TRUE(open);
   EXPECT_EQ(open->path, (folder_ / "rover-cam0-20261122T120000Z.mkv").string());
@@ -62,28 +67,28 @@ TEST_F(SegmentPlannerTest, AGapInTheFramesEndsTheSegmentAndTheNextFrameOpensAnot
   auto p = planner({.maxDuration = 60 * kSecond});
   feed(p, 0, 30);
   uint64_t back = 30 * kFrame + 5 * kSecond;  // the device was gone for 5 s
-  EXPECT_EQ(p.onFrame(back, kNoon + 7000), Cut::kNext);
+  EXPECT_EQ(p.onFrame(back, at(kNoon + 7000)), Cut::kNext);
   EXPECT_EQ(p.current()->start, back);
   // A hiccup shorter than the limit does not cut.
-  EXPECT_EQ(p.onFrame(back + 400'000'000, kNoon + 7400), Cut::kNone);
+  EXPECT_EQ(p.onFrame(back + 400'000'000, at(kNoon + 7400)), Cut::kNone);
 }
 
 TEST_F(SegmentPlannerTest, TheByteLimitCutsAtTheNextFrame) {
   auto p = planner({.maxBytes = 1000});
-  p.onFrame(0, kNoon);
+  p.onFrame(0, at(kNoon));
   p.addBytes(600);
-  EXPECT_EQ(p.onFrame(kFrame, kNoon), Cut::kNone);
+  EXPECT_EQ(p.onFrame(kFrame, at(kNoon)), Cut::kNone);
   p.addBytes(600);
-  EXPECT_EQ(p.onFrame(2 * kFrame, kNoon), Cut::kNext);
+  EXPECT_EQ(p.onFrame(2 * kFrame, at(kNoon)), Cut::kNext);
   EXPECT_EQ(p.current()->bytes, 0u);
 }
 
 TEST_F(SegmentPlannerTest, NamesThatWouldCollideGetACounter) {
   std::ofstream(folder_ / "rover-cam0-20261122T120000Z.mkv") << "from an earlier run";
   auto p = planner({.maxDuration = kSecond / 2});
-  p.onFrame(0, kNoon);
+  p.onFrame(0, at(kNoon));
   EXPECT_EQ(fs::path(p.current()->path).filename(), "rover-cam0-20261122T120000Z-2.mkv");
-  p.onFrame(kSecond / 2, kNoon + 500);  // the same second
+  p.onFrame(kSecond / 2, at(kNoon + 500));  // the same second
   EXPECT_EQ(fs::path(p.current()->path).filename(), "rover-cam0-20261122T120000Z-3.mkv");
 }
 
