@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cousin_commands.h"
+#include "positions_command.h"
 #include "hex.h"
 #include "message_json.h"
 #include "wirc/channel_list.h"
@@ -81,6 +82,19 @@ RCOIP and BTEMP vehicles (--protocol rcoip|btemp; port default 9048, 16980):
                                PING the broadcast ports 16980..17079 (or one
                                robot) and list the robots that answer
 
+Marvelmind indoor positions:
+  positions --marvelmind HOST:PORT --beacon ADDR[,ADDR...] --count N
+                               ask the dashboard for the beacon's position (at
+                               --rate HZ, default 10) and print N new ones, one
+                               JSON object per line: {"beacon":5,"x":1.234,
+                               "y":-0.5,"z":0.25,"timestamp":12.5} (metres;
+                               seconds of the dashboard's clock). Exits 1 when
+                               no new position comes for --timeout MS.
+                               --listen PORT: stream mode, the dashboard pushes
+                               to PORT; --units cm|mm: what to ask for (default
+                               cm); --timestamp 64|ms: the dashboard's unit
+                               (default 1/64 s, as the protocol text)
+
 Connection options (all commands but decode/encode):
   --protocol wirc|rcoip|btemp  what the vehicle speaks (default wirc)
   --host ADDR                  device address (default: discover)
@@ -113,6 +127,7 @@ struct Options {
   double duration = 0;
   std::optional<int> steering, throttle;
   std::vector<std::string> positional;
+  cli::PositionsOptions positions;
 };
 
 [[noreturn]] void usageError(const std::string& message) {
@@ -161,7 +176,14 @@ Options parse(int argc, char** argv) {
     kDestination,
     kData,
     kMd5,
-    kProtocol
+    kProtocol,
+    kMarvelmind,
+    kBeacon,
+    kCount,
+    kListen,
+    kRate,
+    kUnits,
+    kTimestampUnit
   };
   static const option options[] = {{"host", required_argument, nullptr, kHost},
                                    {"port", required_argument, nullptr, kPort},
@@ -189,6 +211,13 @@ Options parse(int argc, char** argv) {
                                    {"data", required_argument, nullptr, kData},
                                    {"md5", required_argument, nullptr, kMd5},
                                    {"protocol", required_argument, nullptr, kProtocol},
+                                   {"marvelmind", required_argument, nullptr, kMarvelmind},
+                                   {"beacon", required_argument, nullptr, kBeacon},
+                                   {"count", required_argument, nullptr, kCount},
+                                   {"listen", required_argument, nullptr, kListen},
+                                   {"rate", required_argument, nullptr, kRate},
+                                   {"units", required_argument, nullptr, kUnits},
+                                   {"timestamp", required_argument, nullptr, kTimestampUnit},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};
   Options o;
@@ -279,6 +308,35 @@ Options parse(int argc, char** argv) {
         break;
       case kMd5:
         o.md5 = optarg;
+        break;
+      case kMarvelmind:
+        o.positions.dashboard = optarg;
+        break;
+      case kBeacon:
+        o.positions.beacons = optarg;
+        break;
+      case kCount:
+        o.positions.count = static_cast<int>(integer(optarg, "--count", 1, 100000000));
+        break;
+      case kListen:
+        o.positions.listenPort = static_cast<uint16_t>(integer(optarg, "--listen", 0, 65535));
+        break;
+      case kRate:
+        o.positions.rate = static_cast<double>(integer(optarg, "--rate", 1, 100));
+        break;
+      case kUnits:
+        if (std::string(optarg) != "cm" && std::string(optarg) != "mm")
+          usageError("--units is cm or mm");
+        o.positions.resolution = std::string(optarg) == "mm"
+                                     ? marvelmind::Resolution::kMillimetres
+                                     : marvelmind::Resolution::kCentimetres;
+        break;
+      case kTimestampUnit:
+        if (std::string(optarg) != "64" && std::string(optarg) != "ms")
+          usageError("--timestamp is 64 (1/64 s) or ms");
+        o.positions.timestampUnit = std::string(optarg) == "ms"
+                                        ? marvelmind::TimestampUnit::kMilliseconds
+                                        : marvelmind::TimestampUnit::kSixtyFourths;
         break;
       default:
         usageError("unknown option");
@@ -554,6 +612,12 @@ int main(int argc, char** argv) {
     if (o.positional.size() != n)
       usageError(command + " takes " + std::to_string(n) + " argument(s)");
   };
+  if (command == "positions") {
+    if (o.positions.dashboard.empty() || o.positions.beacons.empty())
+      usageError("positions needs --marvelmind HOST:PORT and --beacon ADDR");
+    o.positions.timeout = o.timeout;
+    return cli::printPositions(o.positions);
+  }
   if (o.protocol != "wirc") {
     cli::CousinOptions cousin{.protocol = o.protocol,
                               .host = o.host,

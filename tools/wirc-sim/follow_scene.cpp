@@ -93,6 +93,7 @@ FollowScene::FollowScene(FollowSceneConfig config, vision::TagFamily family)
     tags_.push_back(std::move(tag));
   }
   tags_[0].pose = target_;
+  shared_ = {car_, target_};
 }
 
 FollowScene::~FollowScene() {
@@ -127,6 +128,10 @@ void FollowScene::step(double seconds, const wirc::ChannelOutputs& outputs) {
     time_ += dt;
   }
   ++ticks_;
+  {
+    std::lock_guard lock(sharedMutex_);
+    shared_ = {car_, target_};
+  }
   if (time_ >= kSettleSeconds) {
     double bearing = std::abs(bearingDeg());
     double error = std::abs(distance() - config_.followDistance);
@@ -137,6 +142,11 @@ void FollowScene::step(double seconds, const wirc::ChannelOutputs& outputs) {
     summary_.maxDistanceError = std::max(summary_.maxDistanceError, error);
   }
   writeTruth();
+}
+
+FollowScene::Truth FollowScene::truthNow() const {
+  std::lock_guard lock(sharedMutex_);
+  return shared_;
 }
 
 void FollowScene::moveTarget(double dt) {
@@ -331,12 +341,16 @@ std::vector<uint8_t> FollowScene::renderJpeg(int camera) {
 
 void FollowScene::writeTruth() {
   if (!truth_) return;
+  // unix_ms: wall-clock time, to match the truth with recordings' utc.
+  auto unixMs = std::chrono::duration_cast<std::chrono::milliseconds>(
+                    std::chrono::system_clock::now().time_since_epoch())
+                    .count();
   std::fprintf(truth_,
-               "{\"tick\":%llu,\"t\":%.4f,\"car\":{\"x\":%.4f,\"y\":%.4f,\"theta\":%.5f},"
+               "{\"tick\":%llu,\"unix_ms\":%lld,\"t\":%.4f,\"car\":{\"x\":%.4f,\"y\":%.4f,\"theta\":%.5f},"
                "\"target\":{\"x\":%.4f,\"y\":%.4f,\"theta\":%.5f},\"bearing_deg\":%.3f,"
                "\"distance_m\":%.4f,\"distance_error_m\":%.4f,\"failsafe\":%s,"
                "\"steering_us\":%u,\"throttle_us\":%u,\"tags\":[",
-               static_cast<unsigned long long>(ticks_), time_, car_.x, car_.y, car_.theta,
+               static_cast<unsigned long long>(ticks_), static_cast<long long>(unixMs), time_, car_.x, car_.y, car_.theta,
                target_.x, target_.y, target_.theta, bearingDeg(), distance(),
                distance() - config_.followDistance, lastOutputs_.failsafe ? "true" : "false",
                lastOutputs_.pulses[config_.steeringChannel - 1],

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -88,6 +89,12 @@ class FollowScene : public wirc::DeviceScene {
   cv::Mat renderBgr() const;
 
   const Pose2& car() const { return car_; }
+  // The car and the target as of the last step, for other threads (the
+  // simulated Marvelmind dashboard reads its beacons' truth here).
+  struct Truth {
+    Pose2 car, target;
+  };
+  Truth truthNow() const;
   const Pose2& target() const { return target_; }
   std::vector<TagView> tagViews() const;
   double bearingDeg() const;  // target direction seen from the car, + = left
@@ -124,6 +131,8 @@ class FollowScene : public wirc::DeviceScene {
   double time_ = 0;
   std::optional<wirc::DeviceClock::time_point> lastAdvance_;
   FILE* truth_ = nullptr;
+  mutable std::mutex sharedMutex_;
+  Truth shared_;  // guarded by sharedMutex_
   std::unique_ptr<void, int (*)(void*)> encoder_;  // TurboJPEG, kept across frames
   uint64_t ticks_ = 0;
   double bearingSum_ = 0;

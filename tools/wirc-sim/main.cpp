@@ -4,6 +4,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -13,6 +14,8 @@
 
 #include "follow_scene.h"
 #include "jpeg_sequence_scene.h"
+#include "marvelmind/position_client.h"
+#include "marvelmind_dashboard.h"
 #include "vehicle_control.h"
 #include "wirc/device.h"
 
@@ -65,6 +68,20 @@ Scene:
   --steering-channel N PCD channel steering the car, 1..8 (default 1; 2000 = left)
   --throttle-channel N PCD channel driving the car, 1..8 (default 2; 1500 = stop)
   --truth FILE         write the truth per frame as JSON lines
+
+Marvelmind indoor positions:
+  --marvelmind PORT    run a Marvelmind dashboard on UDP PORT (0 = pick a free
+                       one, printed) reporting the scene's truth: the first
+                       beacon rides on the car, the second on the target,
+                       further ones stand still
+  --marvelmind-beacons A[,B...]  beacon addresses, 1..254 (default 5)
+  --marvelmind-rate HZ measurements per second (default 16)
+  --marvelmind-noise M standard deviation of each coordinate (default 0.02 m)
+  --marvelmind-dropout P  probability a measurement is missed (default 0)
+  --marvelmind-push HOST:PORT  also push each measurement there (stream mode)
+  --marvelmind-push-units cm|mm  what the pushes carry (default cm)
+  --marvelmind-timestamp 64|ms  timestamp unit: 1/64 s as the protocol text
+                       says (default), or ms as newer dashboards
 
 Impairments of the video stream (all seeded by --seed, repeatable):
   --loss P             probability a packet is lost (0..1)
@@ -122,6 +139,14 @@ enum Option {
   kReservedBits,
   kStray,
   kSeed,
+  kMarvelmind,
+  kMarvelmindBeacons,
+  kMarvelmindRate,
+  kMarvelmindNoise,
+  kMarvelmindDropout,
+  kMarvelmindPush,
+  kMarvelmindPushUnits,
+  kMarvelmindTimestamp,
 };
 
 const option kOptions[] = {
@@ -162,6 +187,14 @@ const option kOptions[] = {
     {"reserved-bits", no_argument, nullptr, kReservedBits},
     {"stray", required_argument, nullptr, kStray},
     {"seed", required_argument, nullptr, kSeed},
+    {"marvelmind", required_argument, nullptr, kMarvelmind},
+    {"marvelmind-beacons", required_argument, nullptr, kMarvelmindBeacons},
+    {"marvelmind-rate", required_argument, nullptr, kMarvelmindRate},
+    {"marvelmind-noise", required_argument, nullptr, kMarvelmindNoise},
+    {"marvelmind-dropout", required_argument, nullptr, kMarvelmindDropout},
+    {"marvelmind-push", required_argument, nullptr, kMarvelmindPush},
+    {"marvelmind-push-units", required_argument, nullptr, kMarvelmindPushUnits},
+    {"marvelmind-timestamp", required_argument, nullptr, kMarvelmindTimestamp},
     {"help", no_argument, nullptr, 'h'},
     {nullptr, 0, nullptr, 0},
 };
@@ -174,7 +207,7 @@ const option kOptions[] = {
 double number(const char* text, const char* option, double min, double max) {
   char* end = nullptr;
   double value = std::strtod(text, &end);
-  if (end == text || *end != '\0' || value < min || value > max) {
+  if (end == text || *end != '\0' || !std::isfinite(value) || value < min || value > max) {
     std::ostringstream message;
     message << "--" << option << " wants a number in " << min << ".." << max << ", not '" << text
             << "'";
@@ -200,6 +233,20 @@ std::vector<int> idList(const char* text) {
   return ids;
 }
 
+// Where the dashboard's beacons truly are: on the car and on the target, at
+// the camera's height, then posts standing along the y = -3 m line. Without
+// a rendered world (--frames) every beacon stands at the origin.
+sim::MarvelmindDashboard::TruthSource beaconTruth(const sim::FollowScene* scene) {
+  double height = scene ? scene->config().cameraHeight : 0;
+  return [scene, height](size_t index) -> std::array<double, 3> {
+    if (!scene) return {0, 0, 0};
+    auto truth = scene->truthNow();
+    if (index == 0) return {truth.car.x, truth.car.y, height};
+    if (index == 1) return {truth.target.x, truth.target.y, height};
+    return {2.0 * static_cast<double>(index - 1), -3, 1};
+  };
+}
+
 std::string timestamp() {
   using namespace std::chrono;
   auto now = system_clock::now();
@@ -219,6 +266,12 @@ int main(int argc, char** argv) {
   std::optional<double> duration;
   std::string control = "wirc";
   std::optional<uint16_t> controlPort;
+  std::optional<sim::DashboardConfig> dashboard;
+  auto dashboardConfig = [&]() -> sim::DashboardConfig& {
+    if (!dashboard) dashboard.emplace();
+    return *dashboard;
+  };
+  bool dashboardPort = false;
 
   int opt;
   while ((opt = getopt_long(argc, argv, "h", kOptions, nullptr)) != -1) {
@@ -348,6 +401,49 @@ int main(int argc, char** argv) {
       case kSeed:
         device.impairments.seed = static_cast<uint32_t>(number(optarg, "seed", 0, 4294967295.0));
         break;
+      case kMarvelmind:
+        dashboardConfig().port = static_cast<uint16_t>(number(optarg, "marvelmind", 0, 65535));
+        dashboardPort = true;
+        break;
+      case kMarvelmindBeacons: {
+        auto beacons = marvelmind::parseBeacons(optarg);
+        if (!beacons) usageError("--marvelmind-beacons: " + beacons.error());
+        dashboardConfig().beacons = *beacons;
+        break;
+      }
+      case kMarvelmindRate:
+        dashboardConfig().rate = number(optarg, "marvelmind-rate", 0.1, 100);
+        break;
+      case kMarvelmindNoise:
+        dashboardConfig().noise = number(optarg, "marvelmind-noise", 0, 10);
+        break;
+      case kMarvelmindDropout:
+        dashboardConfig().dropout = number(optarg, "marvelmind-dropout", 0, 1);
+        break;
+      case kMarvelmindPush: {
+        std::string text = optarg;
+        auto colon = text.rfind(':');
+        auto port = number(colon == std::string::npos ? "" : optarg + colon + 1,
+                           "marvelmind-push", 1, 65535);
+        auto address = SocketAddress::resolve(text.substr(0, colon), static_cast<uint16_t>(port));
+        if (!address) usageError("--marvelmind-push: " + address.error());
+        dashboardConfig().pushTo = *address;
+        break;
+      }
+      case kMarvelmindPushUnits:
+        if (std::string(optarg) != "cm" && std::string(optarg) != "mm")
+          usageError("--marvelmind-push-units is cm or mm");
+        dashboardConfig().pushResolution = std::string(optarg) == "mm"
+                                               ? marvelmind::Resolution::kMillimetres
+                                               : marvelmind::Resolution::kCentimetres;
+        break;
+      case kMarvelmindTimestamp:
+        if (std::string(optarg) != "64" && std::string(optarg) != "ms")
+          usageError("--marvelmind-timestamp is 64 (1/64 s) or ms");
+        dashboardConfig().timestampUnit = std::string(optarg) == "ms"
+                                              ? marvelmind::TimestampUnit::kMilliseconds
+                                              : marvelmind::TimestampUnit::kSixtyFourths;
+        break;
       default:
         usageError("unknown option");
     }
@@ -355,6 +451,7 @@ int main(int argc, char** argv) {
   if (optind < argc) usageError(std::string("unexpected argument '") + argv[optind] + "'");
   if (device.serial.size() > wirc::kSerialWidth) usageError("--serial is at most 7 characters");
   if (device.name.size() > wirc::kNameWidth) usageError("--name is at most 64 characters");
+  if (dashboard && !dashboardPort) usageError("the --marvelmind-* options need --marvelmind PORT");
 
   std::shared_ptr<wirc::DeviceScene> deviceScene;
   sim::FollowScene* follow = nullptr;
@@ -402,6 +499,19 @@ int main(int argc, char** argv) {
   if (*vehicle)
     std::printf("wirc-sim: %s on %s:%u\n", (*vehicle)->description().c_str(),
                 device.bindAddress.c_str(), (*vehicle)->port());
+  std::unique_ptr<sim::MarvelmindDashboard> positions;
+  if (dashboard) {
+    dashboard->bindAddress = device.bindAddress;
+    dashboard->seed = device.impairments.seed;
+    auto running = sim::MarvelmindDashboard::start(*dashboard, beaconTruth(follow));
+    if (!running) {
+      std::fprintf(stderr, "wirc-sim: %s\n", running.error().c_str());
+      return 1;
+    }
+    positions = std::move(*running);
+    std::printf("wirc-sim: Marvelmind dashboard on %s:%u\n", device.bindAddress.c_str(),
+                positions->port());
+  }
   std::fflush(stdout);
 
   timespec wait{};
@@ -411,6 +521,8 @@ int main(int argc, char** argv) {
   }
   int caught = duration ? sigtimedwait(&signals, nullptr, &wait) : sigwaitinfo(&signals, nullptr);
   sim->stop();
+  std::string dashboardSummary = positions ? positions->summary() : "";
+  positions.reset();
 
   auto stats = sim->stats();
   std::printf("wirc-sim summary:%s\n", caught > 0 ? " (stopped by signal)" : "");
@@ -426,6 +538,7 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(stats.failsafeEntries));
   std::printf("  ERR sent           %llu\n", static_cast<unsigned long long>(stats.errSent));
   if (*vehicle) std::printf("  %s\n", (*vehicle)->summary().c_str());
+  if (dashboard) std::printf("  %s\n", dashboardSummary.c_str());
   if (follow) {
     auto s = follow->summary();
     std::printf(
