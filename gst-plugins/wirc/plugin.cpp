@@ -1,6 +1,7 @@
 // The "wirc" GStreamer plugin: elements that speak the WiRC protocols.
 #include <gst/gst.h>
 
+#include "gstmarvelmindpositions.h"
 #include "gstwirccontrol.h"
 #include "gstwircdepay.h"
 #include "gstwircsrc.h"
@@ -8,7 +9,9 @@
 static gboolean plugin_init(GstPlugin* plugin) {
   return gst_element_register(plugin, "wircsrc", GST_RANK_NONE, GST_TYPE_WIRC_SRC) &&
          gst_element_register(plugin, "wircdepay", GST_RANK_NONE, GST_TYPE_WIRC_DEPAY) &&
-         gst_element_register(plugin, "wirccontrol", GST_RANK_NONE, GST_TYPE_WIRC_CONTROL);
+         gst_element_register(plugin, "wirccontrol", GST_RANK_NONE, GST_TYPE_WIRC_CONTROL) &&
+         gst_element_register(plugin, "marvelmindpositions", GST_RANK_NONE,
+                              GST_TYPE_MARVELMIND_POSITIONS);
 }
 
 #define PACKAGE "wircam"
