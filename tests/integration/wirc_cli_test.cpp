@@ -3,9 +3,12 @@
 
 #include <array>
 #include <cstdio>
+#include <regex>
+#include <sstream>
 #include <string>
 
 #include "btemp/btemp_robot.h"
+#include "marvelmind_dashboard.h"
 #include "rcoip/rcoip_receiver.h"
 #include "wait_for.h"
 #include "wirc/device.h"
@@ -121,6 +124,40 @@ TEST(WircCli, SaysWhenNoRcoipReceiverAnswers) {
   EXPECT_EQ(run.exitCode, 1) << run.output;
   EXPECT_NE(run.output.find("no status report"), std::string::npos) << run.output;
   EXPECT_EQ(wircCli("transmitters --protocol rcoip --host 127.0.0.1").exitCode, 2);
+}
+
+TEST(WircCli, PrintsMarvelmindPositionsOnePerLineInTheExactForm) {
+  auto dashboard = sim::MarvelmindDashboard::start(
+      {.beacons = {5, 6}, .rate = 20, .noise = 0},
+      [](size_t index) { return std::array<double, 3>{1.25, -0.5 - static_cast<double>(index), 0.3}; });
+  ASSERT_TRUE(dashboard) << dashboard.error();
+  auto address = "--marvelmind 127.0.0.1:" + std::to_string((*dashboard)->port());
+  auto run = wircCli("positions " + address + " --beacon 6 --count 4");
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  // Scripts rely on this exact form: beacon, x, y, z (metres), timestamp (s).
+  std::regex line(
+      R"(\{"beacon":6,"x":1\.250,"y":-1\.500,"z":0\.300,"timestamp":[0-9]+\.[0-9]{3}\})");
+  std::istringstream lines(run.output);
+  std::string text;
+  int count = 0;
+  double previous = -1;
+  while (std::getline(lines, text)) {
+    EXPECT_TRUE(std::regex_match(text, line)) << text;
+    double timestamp = std::stod(text.substr(text.rfind(':') + 1));
+    EXPECT_GT(timestamp, previous);  // each a new measurement
+    previous = timestamp;
+    ++count;
+  }
+  EXPECT_EQ(count, 4);
+}
+
+TEST(WircCli, PositionsExitOneWhenTheDashboardIsSilent) {
+  auto run = wircCli("positions --marvelmind 127.0.0.1:9 --beacon 5 --count 1 --timeout 300");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("no reply from the dashboard at 127.0.0.1:9"), std::string::npos)
+      << run.output;
+  EXPECT_EQ(wircCli("positions --marvelmind 127.0.0.1 --beacon 5 --count 1").exitCode, 2);
+  EXPECT_EQ(wircCli("positions --marvelmind 127.0.0.1:9 --beacon 300 --count 1").exitCode, 2);
 }
 
 }  // namespace
