@@ -26,6 +26,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "common/mutex.h"
@@ -96,12 +97,6 @@ GType timestampUnitType() {
   return type;
 }
 
-// A position as the pipeline sees it.
-struct TimedPosition {
-  mm::Position position;
-  GstClockTime runningTime;
-};
-
 // How many positions per beacon are kept to match frames against: at 100 Hz
 // a little over half a second, more than any frame waits.
 constexpr size_t kHistory = 64;
@@ -110,7 +105,7 @@ struct PositionsState {
   mm::ClientConfig config;  // guarded by the object lock
   bool running = false;     // guarded by the object lock: settings are fixed then
   Mutex mutex;              // never held while the client is destroyed
-  std::map<uint8_t, std::deque<TimedPosition>> history WIRCAM_GUARDED_BY(mutex);
+  std::map<uint8_t, std::deque<mm::Position>> history WIRCAM_GUARDED_BY(mutex);
   std::shared_ptr<mm::PositionClient> client WIRCAM_GUARDED_BY(mutex);
 };
 
@@ -134,8 +129,15 @@ static GstStaticPadTemplate sink_template =
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS_ANY);
 
-// The pipeline's running time of an instant on the steady clock.
+// The pipeline's running time of an instant on the steady clock; none
+// before PLAYING (the base time is not set yet).
 static GstClockTime running_time_of(GstElement* element, mm::Clock::time_point instant) {
+  GstState current;
+  {
+    gst::GLibLocker lock(element);
+    current = GST_STATE(element);
+  }
+  if (current != GST_STATE_PLAYING) return GST_CLOCK_TIME_NONE;
   GstClock* clock = gst_element_get_clock(element);
   if (!clock) return GST_CLOCK_TIME_NONE;
   GstClockTime now = gst_clock_get_time(clock);
@@ -155,7 +157,7 @@ static void on_position_event(GstMarvelmindPositions* self, const mm::PositionEv
     {
       MutexLock lock(state->mutex);
       auto& history = state->history[p.beacon];
-      history.push_back({p, runningTime});
+      history.push_back(p);
       if (history.size() > kHistory) history.pop_front();
     }
     s = gst_structure_new("marvelmind-position", "beacon", G_TYPE_UINT, guint{p.beacon}, "x",
@@ -218,32 +220,50 @@ static gboolean gst_marvelmind_positions_stop(GstBaseTransform* transform) {
   return TRUE;
 }
 
+// The instant on the steady clock of a running time, while PLAYING.
+static std::optional<mm::Clock::time_point> steady_time_of(GstElement* element,
+                                                          GstClockTime runningTime) {
+  GstClock* clock = gst_element_get_clock(element);
+  if (!clock) return std::nullopt;
+  auto steadyNow = mm::Clock::now();
+  GstClockTime now = gst_clock_get_time(clock);
+  gst_object_unref(clock);
+  auto ago = static_cast<int64_t>(now - gst_element_get_base_time(element)) -
+             static_cast<int64_t>(runningTime);
+  return steadyNow - std::chrono::nanoseconds(ago);
+}
+
 static GstFlowReturn gst_marvelmind_positions_transform_ip(GstBaseTransform* transform,
                                                            GstBuffer* buffer) {
   auto* state = GST_MARVELMIND_POSITIONS(transform)->state;
   GstClockTime frameTime =
       gst_segment_to_running_time(&transform->segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
   if (!GST_CLOCK_TIME_IS_VALID(frameTime)) return GST_FLOW_OK;
+  // Matched on the steady clock, where the client stamps its positions.
+  auto frameInstant = steady_time_of(GST_ELEMENT(transform), frameTime);
+  if (!frameInstant) return GST_FLOW_OK;
   MutexLock lock(state->mutex);
   for (const auto& [beacon, history] : state->history) {
-    const TimedPosition* nearest = nullptr;
-    guint64 best = G_MAXUINT64;
-    for (const auto& timed : history) {
-      if (!GST_CLOCK_TIME_IS_VALID(timed.runningTime)) continue;
-      guint64 distance = timed.runningTime > frameTime ? timed.runningTime - frameTime
-                                                       : frameTime - timed.runningTime;
-      if (distance < best) best = distance, nearest = &timed;
+    const mm::Position* nearest = nullptr;
+    auto best = mm::Clock::duration::max();
+    for (const auto& position : history) {
+      auto distance = std::chrono::abs(*frameInstant - position.measured);
+      if (distance < best) best = distance, nearest = &position;
     }
     if (!nearest) continue;
-    if (!gst_buffer_is_writable(buffer)) break;  // in place: base transform made it so
+    auto offset = std::chrono::duration_cast<std::chrono::nanoseconds>(*frameInstant -
+                                                                       nearest->measured)
+                      .count();
     WircPositionMeta* meta = gst_buffer_add_wirc_position_meta(buffer);
     meta->beacon = beacon;
-    meta->x = nearest->position.x;
-    meta->y = nearest->position.y;
-    meta->z = nearest->position.z;
-    meta->dashboard_time = nearest->position.timestamp;
-    meta->running_time = nearest->runningTime;
-    meta->offset = static_cast<gint64>(frameTime) - static_cast<gint64>(nearest->runningTime);
+    meta->x = nearest->x;
+    meta->y = nearest->y;
+    meta->z = nearest->z;
+    meta->dashboard_time = nearest->timestamp;
+    meta->offset = offset;
+    meta->running_time = offset <= static_cast<int64_t>(frameTime)
+                             ? frameTime - static_cast<GstClockTime>(offset)
+                             : 0;
   }
   return GST_FLOW_OK;
 }
