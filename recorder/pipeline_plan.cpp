@@ -49,6 +49,12 @@ std::string controlOf(const DeviceTarget& device) {
   return " protocol=" + c.protocol + " host=" + c.host + " port=" + std::to_string(c.port);
 }
 
+// The element that joins the vehicle's Marvelmind positions to its frames.
+std::string positionsOf(const PositionSource& source, const std::string& name) {
+  return "marvelmindpositions name=" + name + " host=" + source.host +
+         " port=" + std::to_string(source.port) + " beacons=" + source.beacons + " ! ";
+}
+
 }  // namespace
 
 PipelinePlan planPipeline(const RecorderOptions& options) {
@@ -79,13 +85,16 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
         controlled = true;  // one controller per vehicle: the first camera's
       }
       if (live) stream.liveSink = "live" + i;
+      if (device.positions) stream.positions = "pos" + i;
       // Only if the recorder could not name a file (it always can).
       auto fallback = (std::filesystem::path(options.outDir) /
                        (stream.name + "-unnamed-%03d" + extensionOf(options.container)))
                           .string();
       // wait-for-device: a recorder started before its vehicle waits for it.
       d += "wircsrc name=" + stream.source + host + port + login +
-           " camera=" + std::to_string(camera) + " wait-for-device=true ! tee name=t" + i + " t" +
+           " camera=" + std::to_string(camera) + " wait-for-device=true ! " +
+           (device.positions ? positionsOf(*device.positions, stream.positions) : "") +
+           "tee name=t" + i + " t" +
            i + ". ! queue max-size-time=3000000000 ! " + encoder(options) +
            "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
            muxerSettings(options.container) + " location=\"" + fallback + "\" ";

@@ -20,6 +20,7 @@ struct StreamPlan {
   std::string detector;         // apriltagdetect, with --detect
   std::string controller;       // wirccontrol, on the first camera of a following device
   std::string liveSink;         // appsink of the frames as they arrive, with --http/--rtsp
+  std::string positions;        // marvelmindpositions, with --marvelmind
 };
 
 struct PipelinePlan {
@@ -28,7 +29,7 @@ struct PipelinePlan {
   bool transcoded = false;  // frames pass an encoder that makes key frames on request
 };
 
-// Per stream: wircsrc → tee → queue → [decode → x264enc →] splitmuxsink,
+// Per stream: wircsrc → [marvelmindpositions →] tee → queue → [decode → x264enc →] splitmuxsink,
 // an appsrc of telemetry text into the same splitmuxsink, and, when asked
 // for, a leaky branch to AprilTag detection (→ wirccontrol) and one to an
 // appsink for the live view and RTSP. splitmuxsink never cuts on its own:

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include "marvelmind/position_client.h"
 #include "wirc/channel_list.h"
 
 namespace wircam::recorder {
@@ -37,6 +38,12 @@ file and exits 0.
   --bitrate KBPS         H.264 bit rate (default 2000)
   --detect FAMILY        find AprilTags (e.g. tag36h11); detections go to telemetry
   --follow               steer the vehicle after the largest tag (needs --detect)
+  --marvelmind HOST[:PORT]
+                         a Marvelmind dashboard (port default 49200) to ask
+                         where the vehicle is; with --beacon
+  --beacon ADDR[,ADDR]   the vehicle's mobile beacon address(es), 1..254:
+                         its positions go to telemetry ("position", metres),
+                         /api/status and the live view's map
   --periods US,...       channel periods the login sets (CCFG): 12 values or
                          one for all, 5000..20000 µs (default 20000)
   --failsafe US,...      what each channel does when the link is lost (FCFG):
@@ -61,9 +68,10 @@ file and exits 0.
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
-min-free, status, http, http-idle-timeout, rtsp, periods, failsafe), and one
-[device NAME] group per vehicle with host, port, cameras (e.g. 0;1), follow
-and control (rcoip://H:P or btemp://H:P, as on the command line):
+min-free, status, http, http-idle-timeout, rtsp, periods, failsafe, marvelmind,
+beacon), and one [device NAME] group per vehicle with host, port, cameras
+(e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as on the command
+line), marvelmind and beacon:
 
   [recorder]
   out=recordings
@@ -72,12 +80,15 @@ and control (rcoip://H:P or btemp://H:P, as on the command line):
   host=192.168.1.1
   cameras=0;1
   follow=true
+  marvelmind=192.168.1.50:49200
+  beacon=5
 
 Files: DIR/<device>-cam<N>-YYYYMMDDTHHMMSSZ.mkv (or .mp4), named by the UTC
 time of their first frame, each starting at 0 on a key frame; a segment also
 ends where the device was lost. Beside each, <same name>.jsonl with one JSON
 object per event: {"pts": ns on the segment's timeline, "utc": "...Z", "type":
-"stats"|"detections"|"control"|"session"|"vehicle", ...}; the same objects are
+"stats"|"detections"|"control"|"session"|"vehicle"|"position"|"position-stale",
+...}; the same objects are
 the file's text track "telemetry". DIR/index.json lists the finished segments
 (camera, file, start_utc, duration_s, frames, bytes).
 
@@ -215,8 +226,14 @@ Expected<std::vector<DeviceTarget>, std::string> loadConfig(const char* path, Re
           auto control = parseControlTarget(text);
           if (!control) return unexpected(where + ": " + control.error());
           device.control = *control;
+        } else if (key == "marvelmind") {
+          device.marvelmind = text;
+        } else if (key == "beacon") {
+          device.beacons = text;
         } else {
-          return unexpected(where + ": unknown key (host, port, cameras, follow, control)");
+          return unexpected(where +
+                            ": unknown key (host, port, cameras, follow, control, marvelmind, "
+                            "beacon)");
         }
       }
       if (device.host.empty()) return unexpected(std::string(path) + " [" + group + "] needs host");
@@ -284,6 +301,10 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
                                    : wirc::validate(wirc::Fcfg{*channels});
     if (valid) return valid->message();
     (name == "periods" ? o.periods : o.failsafe) = value;
+  } else if (name == "marvelmind") {
+    o.marvelmind = value;
+  } else if (name == "beacon") {
+    o.beacons = value;
   } else if (name == "camera") {
     auto camera = number(value);
     if (!camera || *camera < 0 || *camera > 255) return "0..255";
@@ -292,6 +313,30 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     return "unknown option";
   }
   return std::nullopt;
+}
+
+// The dashboard and beacons of a device, both or neither.
+Expected<std::optional<PositionSource>, std::string> positionSource(
+    const std::optional<std::string>& dashboard, const std::optional<std::string>& beacons) {
+  if (!dashboard && !beacons) return std::optional<PositionSource>();
+  if (!dashboard) return unexpected(std::string("beacon= needs marvelmind=HOST[:PORT] (--marvelmind)"));
+  if (!beacons) return unexpected("marvelmind " + *dashboard + " needs the vehicle's beacon (--beacon ADDR)");
+  PositionSource source;
+  auto colon = dashboard->rfind(':');
+  source.host = dashboard->substr(0, colon);
+  if (colon != std::string::npos) {
+    auto port = number(dashboard->substr(colon + 1).c_str());
+    if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
+      return unexpected("marvelmind '" + *dashboard + "': a port is 1..65535");
+    source.port = static_cast<uint16_t>(*port);
+  }
+  if (source.host.empty() || source.host.find_first_of("/ \"'") != std::string::npos)
+    return unexpected("marvelmind '" + *dashboard + "' needs a host, as in 192.168.1.50:49200");
+  auto parsed = marvelmind::parseBeacons(*beacons);
+  if (!parsed) return unexpected(parsed.error());
+  for (uint8_t beacon : *parsed)
+    source.beacons += (source.beacons.empty() ? "" : ",") + std::to_string(beacon);
+  return std::optional<PositionSource>(source);
 }
 
 }  // namespace
@@ -341,6 +386,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"min-free", required_argument, nullptr, kValue},
                                    {"periods", required_argument, nullptr, kValue},
                                    {"failsafe", required_argument, nullptr, kValue},
+                                   {"marvelmind", required_argument, nullptr, kValue},
+                                   {"beacon", required_argument, nullptr, kValue},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};
   RecorderOptions o;
@@ -390,6 +437,10 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                         " has control=, which steers only with follow (--follow or follow=true)");
     if (*device.follow && o.detectFamily.empty())
       return unexpected("device " + device.label + " follows, which needs detect=FAMILY");
+    auto positions = positionSource(device.marvelmind ? device.marvelmind : o.marvelmind,
+                                    device.beacons ? device.beacons : o.beacons);
+    if (!positions) return unexpected("device " + device.label + ": " + positions.error());
+    device.positions = *positions;
   }
   return o;
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "marvelmind/marvelmind_messages.h"
 
 namespace wircam::recorder {
 
@@ -21,6 +22,14 @@ struct ControlTarget {
 };
 Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri);
 
+// A Marvelmind dashboard and the vehicle's beacons on it.
+struct PositionSource {
+  std::string host;
+  uint16_t port = marvelmind::kDefaultDashboardPort;
+  std::string beacons;  // "5" or "5,6"
+  bool operator==(const PositionSource&) const = default;
+};
+
 struct DeviceTarget {
   std::string host;  // empty: discover
   uint16_t port = 1984;
@@ -28,6 +37,10 @@ struct DeviceTarget {
   std::vector<int> cameras;              // empty: the recorder-wide --camera list
   std::optional<bool> follow;            // unset: the recorder-wide --follow
   std::optional<ControlTarget> control;  // unset: steer the WiRC device itself
+  // Unset: the recorder-wide --marvelmind/--beacon, if any.
+  std::optional<std::string> marvelmind;  // HOST[:PORT] of the dashboard
+  std::optional<std::string> beacons;
+  std::optional<PositionSource> positions;  // resolved from the two above
 };
 
 // Where a server listens: "[HOST]:PORT"; no host means this machine only
@@ -66,6 +79,9 @@ struct RecorderOptions {
   // first transmitter's login configures it. Unset: wircsrc's defaults.
   std::optional<std::string> periods;
   std::optional<std::string> failsafe;
+  // Marvelmind positions of every device that names none of its own.
+  std::optional<std::string> marvelmind;  // HOST[:PORT]
+  std::optional<std::string> beacons;
 };
 
 // The file name extension of a container, with its dot.

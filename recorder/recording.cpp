@@ -83,8 +83,8 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
         *stream->planner, [telemetry = stream->telemetry.get()] { telemetry->flushEarly(); });
     if (!streamPlan.liveSink.empty())
       stream->frames = std::make_unique<FrameTap>(elementNamed(streamPlan.liveSink));
-    for (const auto* element :
-         {&streamPlan.source, &streamPlan.muxer, &streamPlan.detector, &streamPlan.controller})
+    for (const auto* element : {&streamPlan.source, &streamPlan.muxer, &streamPlan.detector,
+                                &streamPlan.controller, &streamPlan.positions})
       if (!element->empty()) recording->streamByElement_[*element] = stream.get();
     recording->streams_.push_back(std::move(stream));
   }
@@ -193,6 +193,10 @@ void Recording::handleElementMessage(GstMessage* message) {
   std::string type = gst_structure_get_name(s);
   if (type == "splitmuxsink-fragment-opened") {
     stream->segment = gst_structure_get_string(s, "location");
+    // Frames come, so the device is live, whether or not this camera's
+    // source heard the login (a session shared with wirccontrol may have
+    // logged in before the source listened).
+    followLinkState(*stream, "live");
     stream->telemetry->segmentOpened(stream->segment);
     if (auto failure = stream->telemetry->takeWriteFailure()) log(*failure);
     return;
@@ -247,6 +251,10 @@ void Recording::handleElementMessage(GstMessage* message) {
     writeTelemetry(*stream, line, runningTime());
     return;
   }
+  if (type == "marvelmind-position" || type == "marvelmind-stale") {
+    handlePosition(*stream, s);
+    return;
+  }
   if (type != "apriltag" && type != "wirc-control") return;
   // Detections and commands belong to a frame: its timestamp is their time.
   line["type"] = type == "apriltag" ? "detections" : "control";
@@ -254,6 +262,39 @@ void Recording::handleElementMessage(GstMessage* message) {
   line.erase("timestamp");
   if (http_ && type == "apriltag") http_->publishDetections(stream->plan.name, line["detections"]);
   writeTelemetry(*stream, line, pts);
+}
+
+void Recording::handlePosition(Stream& stream, const GstStructure* s) {
+  guint beacon = 0;
+  gst_structure_get_uint(s, "beacon", &beacon);
+  if (gst_structure_has_name(s, "marvelmind-stale")) {
+    std::string reason = gst_structure_get_string(s, "reason");
+    log(stream.plan.name + ": position of beacon " + std::to_string(beacon) + " stale: " + reason);
+    if (stream.position) stream.position->staleReason = reason;
+    writeTelemetry(stream, {{"type", "position-stale"}, {"beacon", beacon}, {"reason", reason}},
+                   runningTime());
+    return;
+  }
+  Stream::Position position{.beacon = beacon};
+  gst_structure_get_double(s, "x", &position.x);
+  gst_structure_get_double(s, "y", &position.y);
+  gst_structure_get_double(s, "z", &position.z);
+  // When it was measured (a position from before PLAYING has no running time).
+  guint64 measured = GST_CLOCK_TIME_NONE;
+  gst_structure_get_uint64(s, "running-time", &measured);
+  GstClockTime time = GST_CLOCK_TIME_IS_VALID(measured) ? measured : runningTime();
+  position.unixMs = unixMsOf(pipeline_, time);
+  stream.position = position;
+  // Until a frame opens the first file, where the vehicle is belongs to no
+  // recording (and must not crowd the session events out of the early lines).
+  if (!stream.planner->current()) return;
+  writeTelemetry(stream,
+                 {{"type", "position"},
+                  {"beacon", beacon},
+                  {"x", position.x},
+                  {"y", position.y},
+                  {"z", position.z}},
+                 time);
 }
 
 void Recording::handleError(GstMessage* message) {
@@ -402,6 +443,13 @@ void Recording::printStatus() {
   bool terminal = isatty(STDOUT_FILENO);
   // On a terminal the lines are redrawn in place; in a log, appended.
   if (terminal && statusShown_) std::printf("\033[%zuA", streams_.size());
+  auto positionText = [](const Stream& stream) -> std::string {
+    if (!stream.position) return "";
+    char text[64];
+    std::snprintf(text, sizeof text, "  at %.2f, %.2f m%s", stream.position->x,
+                  stream.position->y, stream.position->staleReason.empty() ? "" : " (stale)");
+    return text;
+  };
   for (auto& s : streams_) {
     if (s->state == "waiting for device") {
       std::printf("%s%-20s waiting for device\n", terminal ? "\033[K" : "", s->plan.name.c_str());
@@ -413,10 +461,11 @@ void Recording::printStatus() {
     std::string stale =
         s->statusStale ? " (stale, " + std::to_string(s->statusAgeMs / 1000) + " s old)" : "";
     std::printf(
-        "%s%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V%s  %s\n",
+        "%s%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V%s%s  %s\n",
         terminal ? "\033[K" : "", s->plan.name.c_str(),
         static_cast<unsigned long long>(s->frameCount), s->fps, loss, s->kbps,
-        s->batteryMv / 1000.0, stale.c_str(), std::filesystem::path(s->segment).filename().c_str());
+        s->batteryMv / 1000.0, stale.c_str(), positionText(*s).c_str(),
+        std::filesystem::path(s->segment).filename().c_str());
   }
   std::fflush(stdout);
   statusShown_ = true;
@@ -441,6 +490,18 @@ nlohmann::json Recording::status() const {
         {"status_age_ms", s->statusAgeMs},
         {"segment", std::filesystem::path(s->segment).filename().string()},
         {"live", "/live/" + s->plan.name + ".mjpg"}};
+    if (s->position) {
+      const auto& p = *s->position;
+      stream["position"] = {{"beacon", p.beacon},
+                            {"x", p.x},
+                            {"y", p.y},
+                            {"z", p.z},
+                            {"utc", SegmentPlanner::isoUtc(p.unixMs)},
+                            {"stale", !p.staleReason.empty()}};
+      if (!p.staleReason.empty()) stream["position"]["stale_reason"] = p.staleReason;
+    } else if (!s->plan.positions.empty()) {
+      stream["position"] = nullptr;  // asked for, none yet
+    }
     if (rtsp_)
       stream["rtsp"] =
           rtsp_->url() + "/" + s->plan.device + "/cam" + std::to_string(s->plan.camera);

@@ -56,6 +56,14 @@ class Recording {
     guint batteryMv = 0;
     bool statusStale = false;  // the device stopped reporting; batteryMv is its last word
     guint64 statusAgeMs = 0;
+    // The vehicle's latest Marvelmind position, with --marvelmind.
+    struct Position {
+      guint beacon = 0;
+      double x = 0, y = 0, z = 0;
+      int64_t unixMs = 0;
+      std::string staleReason;  // empty while positions come
+    };
+    std::optional<Position> position;
     // "waiting for device" until the first login, then "live" or "offline".
     std::string state = "waiting for device";
     int64_t stateSinceUnixMs = 0;
@@ -71,6 +79,7 @@ class Recording {
   void stop(const char* why);
   void handleElementMessage(GstMessage* message);
   void handleError(GstMessage* message);
+  void handlePosition(Stream& stream, const GstStructure* s);
   void writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime runningTime);
   void onSegmentClosed(Stream& stream, const std::string& file);
   void followLinkState(Stream& stream, const std::string& linkState);
