@@ -304,7 +304,8 @@ std::string HttpServer::page() const {
                        {"width", feed->width.load()},
                        {"height", feed->height.load()},
                        {"detections", feed->detections}});
-  std::string state = nlohmann::json{{"cameras", cameras}}.dump();
+  nlohmann::json trails = content_.trails ? content_.trails() : nlohmann::json::object();
+  std::string state = nlohmann::json{{"cameras", cameras}, {"trails", trails}}.dump();
   // Inside <script>, "</" could end it early.
   for (size_t at = state.find("</"); at != std::string::npos; at = state.find("</", at))
     state.replace(at, 2, "<\\/");

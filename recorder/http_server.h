@@ -30,6 +30,9 @@ class HttpServer {
     std::vector<Camera> cameras;
     std::string recordingsFolder;
     std::function<nlohmann::json()> status;  // called on the main thread
+    // Each stream's recent Marvelmind positions, for the page's map:
+    // {"<stream>": {"points": [{"x","y","utc"}, ...], "stale": bool}}.
+    std::function<nlohmann::json()> trails;
     std::function<std::vector<std::string>()> openSegments;
   };
 

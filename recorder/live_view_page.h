@@ -1,9 +1,11 @@
 // The page wirc-recorder's web server shows at "/": every camera live as
 // MJPEG (the camera's own frames, not re-encoded), the AprilTags found in
-// them drawn over the picture from the /api/events stream, the status and
-// the recordings. Self-contained: no scripts from elsewhere. The server
-// puts the cameras and their last detections in place of INITIAL_STATE, so
-// the first picture already carries its overlay.
+// them drawn over the picture from the /api/events stream, the status, a
+// map of the vehicles' Marvelmind positions with their trails (when
+// --marvelmind is on) and the recordings. Self-contained: no scripts from
+// elsewhere. The server puts the cameras, their last detections and the
+// position trails in place of INITIAL_STATE, so the first picture already
+// carries its overlay and the map its trails.
 #pragma once
 
 namespace wircam::recorder {
@@ -22,10 +24,16 @@ h1 { font-size: 20px; margin: 0 0 12px; } h2 { font-size: 16px; }
 .label { fill: #00ff00; font: bold 18px sans-serif; }
 .stats { margin-top: 6px; color: #aab; font-family: monospace; }
 a { color: #8cf; } td { padding: 2px 12px 2px 0; }
+#map { width: 100%; max-width: 480px; background: #0d0f12; border: 1px solid #333; }
+#map .grid { stroke: #263040; stroke-width: 1; vector-effect: non-scaling-stroke; }
+#map .trail { fill: none; stroke-width: 2; vector-effect: non-scaling-stroke; }
+#map .stale { stroke-dasharray: 4 3; opacity: 0.5; }
+#map text { font: 11px sans-serif; fill: #ccd; }
 </style></head>
 <body>
 <h1>wirc-recorder</h1>
 <div id="cameras"></div>
+<section id="positions" hidden><h2>Positions</h2><svg id="map" viewBox="0 0 480 360"></svg></section>
 <h2>Recordings</h2>
 <table id="recordings"></table>
 <script>
@@ -69,6 +77,18 @@ function showDetections(event) {
   }
 }
 
+// Each vehicle's trail of Marvelmind positions, newest last.
+const trails = {};
+const kTrailPoints = 600;
+const colours = ["#4fc3f7", "#ffb74d", "#aed581", "#f06292", "#ba68c8", "#fff176"];
+
+function positionText(position) {
+  if (position === undefined) return "";
+  if (position === null) return "  position: none yet";
+  return `  at ${position.x.toFixed(2)}, ${position.y.toFixed(2)} m` +
+         (position.stale ? " (stale)" : "");
+}
+
 function showStatus(status) {
   for (const stream of status.streams) {
     const view = views[stream.name];
@@ -76,13 +96,65 @@ function showStatus(status) {
     view.stats.textContent = `${stream.frames} frames  ${stream.fps.toFixed(1)} fps  ` +
         `loss ${stream.loss_percent.toFixed(1)} %  ${Math.round(stream.kbps)} kbit/s  ` +
         `battery ${stream.battery_v.toFixed(2)} V` +
-        (stream.status_stale ? ` (stale, ${Math.round(stream.status_age_ms / 1000)} s old)` : "");
+        (stream.status_stale ? ` (stale, ${Math.round(stream.status_age_ms / 1000)} s old)` : "") +
+        positionText(stream.position);
+    const p = stream.position;
+    if (!p) continue;
+    const trail = trails[stream.name] || (trails[stream.name] = { points: [] });
+    const last = trail.points[trail.points.length - 1];
+    if (!last || last.utc !== p.utc) trail.points.push({ x: p.x, y: p.y, utc: p.utc });
+    if (trail.points.length > kTrailPoints) trail.points.shift();
+    trail.stale = p.stale;
   }
+  drawMap();
+}
+
+// Metres to the map's 480×360 units: every trail in view, 1 m grid, y up.
+function drawMap() {
+  const names = Object.keys(trails);
+  if (!names.length) return;
+  document.getElementById("positions").hidden = false;
+  const all = names.flatMap(name => trails[name].points);
+  let minX = Math.min(...all.map(p => p.x)), maxX = Math.max(...all.map(p => p.x));
+  let minY = Math.min(...all.map(p => p.y)), maxY = Math.max(...all.map(p => p.y));
+  const span = Math.max(maxX - minX, (maxY - minY) * 4 / 3, 2) + 1;
+  const scale = 480 / span;
+  const centreX = (minX + maxX) / 2, centreY = (minY + maxY) / 2;
+  const toMap = p => [240 + (p.x - centreX) * scale, 180 - (p.y - centreY) * scale];
+  const map = document.getElementById("map");
+  map.replaceChildren();
+  const element = (tag, attributes) => {
+    const e = document.createElementNS(svgNs, tag);
+    for (const [key, value] of Object.entries(attributes)) e.setAttribute(key, value);
+    map.appendChild(e);
+    return e;
+  };
+  if (span < 60) {
+    for (let x = Math.ceil(centreX - span / 2); x <= centreX + span / 2; ++x) {
+      const [mx] = toMap({ x, y: 0 });
+      element("line", { x1: mx, y1: 0, x2: mx, y2: 360, class: "grid" });
+    }
+    for (let y = Math.ceil(centreY - span * 3 / 8); y <= centreY + span * 3 / 8; ++y) {
+      const [, my] = toMap({ x: 0, y });
+      element("line", { x1: 0, y1: my, x2: 480, y2: my, class: "grid" });
+    }
+    element("text", { x: 6, y: 352 }).textContent = "grid: 1 m";
+  }
+  names.forEach((name, i) => {
+    const trail = trails[name], colour = colours[i % colours.length];
+    const points = trail.points.map(p => toMap(p).join(",")).join(" ");
+    element("polyline", { points, stroke: colour, class: "trail" + (trail.stale ? " stale" : "") });
+    const [x, y] = toMap(trail.points[trail.points.length - 1]);
+    element("circle", { cx: x, cy: y, r: 6, fill: trail.stale ? "#777" : colour });
+    element("text", { x: x + 9, y: y + 4 }).textContent = name + (trail.stale ? " (stale)" : "");
+  });
+}
+
+async function refreshStatus() {
+  showStatus(await (await fetch("/api/status")).json());
 }
 
 async function refresh() {
-  const status = await (await fetch("/api/status")).json();
-  showStatus(status);
   const files = await (await fetch("/recordings")).json();
   const table = document.getElementById("recordings");
   table.replaceChildren();
@@ -101,9 +173,14 @@ function start() {
   // Built before the page's load event, so a screenshot at load shows them.
   const initial = INITIAL_STATE;
   initial.cameras.forEach(addCamera);
+  Object.assign(trails, initial.trails);
+  drawMap();
   const events = new EventSource("/api/events");
   events.addEventListener("detections", e => showDetections(JSON.parse(e.data)));
+  refreshStatus();
   refresh();
+  // Twice a second: the trails follow the vehicles.
+  setInterval(refreshStatus, 500);
   setInterval(refresh, 2000);
 }
 start();

@@ -94,9 +94,8 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       d += "wircsrc name=" + stream.source + host + port + login +
            " camera=" + std::to_string(camera) + " wait-for-device=true ! " +
            (device.positions ? positionsOf(*device.positions, stream.positions) : "") +
-           "tee name=t" + i + " t" +
-           i + ". ! queue max-size-time=3000000000 ! " + encoder(options) +
-           "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
+           "tee name=t" + i + " t" + i + ". ! queue max-size-time=3000000000 ! " +
+           encoder(options) + "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
            muxerSettings(options.container) + " location=\"" + fallback + "\" ";
       // The telemetry never blocks the main loop: past 1 MB waiting it
       // drops. Its track is named by a stream tag (in Matroska a

@@ -319,8 +319,10 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
 Expected<std::optional<PositionSource>, std::string> positionSource(
     const std::optional<std::string>& dashboard, const std::optional<std::string>& beacons) {
   if (!dashboard && !beacons) return std::optional<PositionSource>();
-  if (!dashboard) return unexpected(std::string("beacon= needs marvelmind=HOST[:PORT] (--marvelmind)"));
-  if (!beacons) return unexpected("marvelmind " + *dashboard + " needs the vehicle's beacon (--beacon ADDR)");
+  if (!dashboard)
+    return unexpected(std::string("beacon= needs marvelmind=HOST[:PORT] (--marvelmind)"));
+  if (!beacons)
+    return unexpected("marvelmind " + *dashboard + " needs the vehicle's beacon (--beacon ADDR)");
   PositionSource source;
   auto colon = dashboard->rfind(':');
   source.host = dashboard->substr(0, colon);

@@ -19,6 +19,9 @@ namespace wircam::recorder {
 
 namespace {
 
+// A minute of positions at 10 Hz: the trail the live view's map starts with.
+constexpr size_t kTrailPositions = 600;
+
 void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
 
 }  // namespace
@@ -98,6 +101,7 @@ std::optional<std::string> Recording::startServers() {
     for (auto& s : streams_) content.cameras.push_back({s->plan.name, s->frames.get()});
     content.recordingsFolder = options_.outDir;
     content.status = [this] { return status(); };
+    content.trails = [this] { return trails(); };
     content.openSegments = [this] { return openSegments(); };
     auto server = HttpServer::start(
         *options_.http, std::move(content),
@@ -285,6 +289,8 @@ void Recording::handlePosition(Stream& stream, const GstStructure* s) {
   GstClockTime time = GST_CLOCK_TIME_IS_VALID(measured) ? measured : runningTime();
   position.unixMs = unixMsOf(pipeline_, time);
   stream.position = position;
+  stream.trail.push_back(position);
+  if (stream.trail.size() > kTrailPositions) stream.trail.pop_front();
   // Until a frame opens the first file, where the vehicle is belongs to no
   // recording (and must not crowd the session events out of the early lines).
   if (!stream.planner->current()) return;
@@ -446,8 +452,8 @@ void Recording::printStatus() {
   auto positionText = [](const Stream& stream) -> std::string {
     if (!stream.position) return "";
     char text[64];
-    std::snprintf(text, sizeof text, "  at %.2f, %.2f m%s", stream.position->x,
-                  stream.position->y, stream.position->staleReason.empty() ? "" : " (stale)");
+    std::snprintf(text, sizeof text, "  at %.2f, %.2f m%s", stream.position->x, stream.position->y,
+                  stream.position->staleReason.empty() ? "" : " (stale)");
     return text;
   };
   for (auto& s : streams_) {
@@ -511,6 +517,19 @@ nlohmann::json Recording::status() const {
           {"free_bytes", disk_.free()},
           {"stopping", stopping_},
           {"streams", streams}};
+}
+
+nlohmann::json Recording::trails() const {
+  nlohmann::json trails = nlohmann::json::object();
+  for (const auto& s : streams_) {
+    if (s->trail.empty()) continue;
+    nlohmann::json points = nlohmann::json::array();
+    for (const auto& p : s->trail)
+      points.push_back({{"x", p.x}, {"y", p.y}, {"utc", SegmentPlanner::isoUtc(p.unixMs)}});
+    trails[s->plan.name] = {{"points", points},
+                            {"stale", s->position && !s->position->staleReason.empty()}};
+  }
+  return trails;
 }
 
 std::vector<std::string> Recording::openSegments() const {

@@ -5,6 +5,7 @@
 
 #include <gst/gst.h>
 
+#include <deque>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -64,6 +65,7 @@ class Recording {
       std::string staleReason;  // empty while positions come
     };
     std::optional<Position> position;
+    std::deque<Position> trail;  // the recent ones, for the live view's map
     // "waiting for device" until the first login, then "live" or "offline".
     std::string state = "waiting for device";
     int64_t stateSinceUnixMs = 0;
@@ -88,6 +90,7 @@ class Recording {
   void printStatus();
   void guardDisk();
   nlohmann::json status() const;
+  nlohmann::json trails() const;
   std::vector<std::string> openSegments() const;
   Stream* streamOf(GstMessage* message);
 

@@ -12,10 +12,10 @@ G_BEGIN_DECLS
 
 typedef struct {
   GstMeta meta;
-  guint beacon;               /* the beacon's address, 1..254 */
-  gdouble x, y, z;            /* metres, in the Marvelmind system's frame */
-  gdouble dashboard_time;     /* seconds, the dashboard's clock, when it was measured */
-  GstClockTime running_time;  /* the same instant on the pipeline's running time */
+  guint beacon;              /* the beacon's address, 1..254 */
+  gdouble x, y, z;           /* metres, in the Marvelmind system's frame */
+  gdouble dashboard_time;    /* seconds, the dashboard's clock, when it was measured */
+  GstClockTime running_time; /* the same instant on the pipeline's running time */
   /* the frame's running time minus running_time, ns: > 0 when the position
    * is older than the frame, < 0 when it was measured after it */
   gint64 offset;

@@ -15,10 +15,12 @@
  *
  * ## Example launch lines
  * |[
- * gst-launch-1.0 -m wircsrc host=192.168.1.1 ! marvelmindpositions host=192.168.1.50 beacons=5 ! tjpegdec ! tagoverlay ! autovideosink
+ * gst-launch-1.0 -m wircsrc host=192.168.1.1 ! marvelmindpositions host=192.168.1.50 beacons=5 !
+ * tjpegdec ! tagoverlay ! autovideosink
  * ]|
  * |[
- * gst-launch-1.0 -m wircsrc ! marvelmindpositions mode=stream listen-port=49100 host=192.168.1.50 beacons=5,6 ! fakesink
+ * gst-launch-1.0 -m wircsrc ! marvelmindpositions mode=stream listen-port=49100 host=192.168.1.50
+ * beacons=5,6 ! fakesink
  * ]|
  */
 #include "gstmarvelmindpositions.h"
@@ -86,12 +88,11 @@ GType unitsType() {
 
 GType timestampUnitType() {
   static GType type = [] {
-    static const GEnumValue values[] = {
-        {static_cast<gint>(mm::TimestampUnit::kSixtyFourths), "1/64 s (the protocol text)",
-         "sixty-fourths"},
-        {static_cast<gint>(mm::TimestampUnit::kMilliseconds), "Milliseconds (newer dashboards)",
-         "milliseconds"},
-        {0, nullptr, nullptr}};
+    static const GEnumValue values[] = {{static_cast<gint>(mm::TimestampUnit::kSixtyFourths),
+                                         "1/64 s (the protocol text)", "sixty-fourths"},
+                                        {static_cast<gint>(mm::TimestampUnit::kMilliseconds),
+                                         "Milliseconds (newer dashboards)", "milliseconds"},
+                                        {0, nullptr, nullptr}};
     return g_enum_register_static("GstMarvelmindTimestampUnit", values);
   }();
   return type;
@@ -170,8 +171,8 @@ static void on_position_event(GstMarvelmindPositions* self, const mm::PositionEv
       MutexLock lock(state->mutex);
       state->history.erase(stale->beacon);
     }
-    s = gst_structure_new("marvelmind-stale", "beacon", G_TYPE_UINT, guint{stale->beacon},
-                          "reason", G_TYPE_STRING, stale->reason.c_str(), nullptr);
+    s = gst_structure_new("marvelmind-stale", "beacon", G_TYPE_UINT, guint{stale->beacon}, "reason",
+                          G_TYPE_STRING, stale->reason.c_str(), nullptr);
   }
   if (s) gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), s));
 }
@@ -183,8 +184,7 @@ static gboolean gst_marvelmind_positions_start(GstBaseTransform* transform) {
     gst::GLibLocker lock(self);
     config = self->state->config;
   }
-  if (config.mode == mm::Mode::kPoll && config.port == 0)
-    config.port = mm::kDefaultDashboardPort;
+  if (config.mode == mm::Mode::kPoll && config.port == 0) config.port = mm::kDefaultDashboardPort;
   auto client = mm::PositionClient::start(
       config, [self](const mm::PositionEvent& event) { on_position_event(self, event); });
   if (!client) {
@@ -222,7 +222,7 @@ static gboolean gst_marvelmind_positions_stop(GstBaseTransform* transform) {
 
 // The instant on the steady clock of a running time, while PLAYING.
 static std::optional<mm::Clock::time_point> steady_time_of(GstElement* element,
-                                                          GstClockTime runningTime) {
+                                                           GstClockTime runningTime) {
   GstClock* clock = gst_element_get_clock(element);
   if (!clock) return std::nullopt;
   auto steadyNow = mm::Clock::now();
@@ -251,9 +251,9 @@ static GstFlowReturn gst_marvelmind_positions_transform_ip(GstBaseTransform* tra
       if (distance < best) best = distance, nearest = &position;
     }
     if (!nearest) continue;
-    auto offset = std::chrono::duration_cast<std::chrono::nanoseconds>(*frameInstant -
-                                                                       nearest->measured)
-                      .count();
+    auto offset =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(*frameInstant - nearest->measured)
+            .count();
     WircPositionMeta* meta = gst_buffer_add_wirc_position_meta(buffer);
     meta->beacon = beacon;
     meta->x = nearest->x;
@@ -276,11 +276,11 @@ static GstStructure* stats_structure(GstMarvelmindPositions* self) {
     client = self->state->client;
   }
   if (client) stats = client->stats();
-  GstStructure* s = gst_structure_new(
-      "marvelmind-stats", "requests", G_TYPE_UINT64, stats.requests, "replies", G_TYPE_UINT64,
-      stats.replies, "positions", G_TYPE_UINT64, stats.positions, "repeats", G_TYPE_UINT64,
-      stats.repeats, "rejected", G_TYPE_UINT64, stats.rejectedTotal(), "foreign", G_TYPE_UINT64,
-      stats.foreign, nullptr);
+  GstStructure* s =
+      gst_structure_new("marvelmind-stats", "requests", G_TYPE_UINT64, stats.requests, "replies",
+                        G_TYPE_UINT64, stats.replies, "positions", G_TYPE_UINT64, stats.positions,
+                        "repeats", G_TYPE_UINT64, stats.repeats, "rejected", G_TYPE_UINT64,
+                        stats.rejectedTotal(), "foreign", G_TYPE_UINT64, stats.foreign, nullptr);
   for (const auto& [reason, count] : stats.rejected) {
     std::string field = "rejected-" + reason;
     for (char& c : field)

@@ -50,8 +50,8 @@ std::vector<GstStructure*> messagesNamed(GstElement* pipeline, const char* name,
 TEST(MarvelmindPositions, JoinsTheNearestPositionToEachFrameAndPostsEachNewOne) {
   auto dashboard = dashboardAt({2.5, -1.25, 0.3});
   ASSERT_TRUE(dashboard);
-  GstElement* pipeline = testing::launch(pipelineFor(
-      "port=" + std::to_string(dashboard->port()) + " beacons=5 poll-rate=20 units=mm"));
+  GstElement* pipeline = testing::launch(pipelineFor("port=" + std::to_string(dashboard->port()) +
+                                                     " beacons=5 poll-rate=20 units=mm"));
   ASSERT_TRUE(pipeline);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   auto messages = messagesNamed(pipeline, "marvelmind-position", 5, 3s);
@@ -109,8 +109,8 @@ TEST(MarvelmindPositions, JoinsTheNearestPositionToEachFrameAndPostsEachNewOne) 
 TEST(MarvelmindPositions, PostsStaleWhenTheDashboardStopsAndJoinsNothingAfter) {
   auto dashboard = dashboardAt({1, 1, 1});
   ASSERT_TRUE(dashboard);
-  GstElement* pipeline = testing::launch(pipelineFor(
-      "port=" + std::to_string(dashboard->port()) + " beacons=5 stale-timeout=300"));
+  GstElement* pipeline = testing::launch(
+      pipelineFor("port=" + std::to_string(dashboard->port()) + " beacons=5 stale-timeout=300"));
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   ASSERT_EQ(messagesNamed(pipeline, "marvelmind-position", 2, 3s).size(), 2u);
   dashboard.reset();
@@ -143,8 +143,8 @@ TEST(MarvelmindPositions, TakesPushedPositionsInStreamMode) {
   GstElement* pipeline = testing::launch(
       pipelineFor("mode=stream listen-port=" + std::to_string(port) + " beacons=7"));
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  auto dashboard = dashboardAt({0.5, 0.5, 0.5}, {.beacons = {7},
-                                                  .pushTo = SocketAddress::loopback(port)});
+  auto dashboard =
+      dashboardAt({0.5, 0.5, 0.5}, {.beacons = {7}, .pushTo = SocketAddress::loopback(port)});
   ASSERT_TRUE(dashboard);
   EXPECT_EQ(messagesNamed(pipeline, "marvelmind-position", 3, 3s).size(), 3u);
   gst_element_set_state(pipeline, GST_STATE_NULL);

@@ -56,11 +56,9 @@ TEST(MarvelmindClient, PollsTheSimulatedDashboardInBothUnits) {
         startDashboard({.beacons = {5, 6}, .rate = 32, .noise = 0}, {1.234, -2.5, 0.31});
     ASSERT_TRUE(dashboard);
     Reported reported;
-    auto client = mm::PositionClient::start({.port = dashboard->port(),
-                                             .beacons = {5, 6},
-                                             .pollRate = 20,
-                                             .resolution = resolution},
-                                            reported.listener());
+    auto client = mm::PositionClient::start(
+        {.port = dashboard->port(), .beacons = {5, 6}, .pollRate = 20, .resolution = resolution},
+        reported.listener());
     ASSERT_TRUE(client) << client.error();
     ASSERT_TRUE(waitFor([&] { return reported.count() >= 10; }));
     std::lock_guard lock(reported.mutex);
@@ -80,13 +78,12 @@ TEST(MarvelmindClient, PollsTheSimulatedDashboardInBothUnits) {
 
 TEST(MarvelmindClient, TakesWhatAPushingDashboardSends) {
   Reported reported;
-  auto client = mm::PositionClient::start(
-      {.port = 1,
-       .beacons = {9},
-       .mode = mm::Mode::kStream,
-       .listenPort = 0,
-       .timestampUnit = mm::TimestampUnit::kMilliseconds},
-      reported.listener());
+  auto client = mm::PositionClient::start({.port = 1,
+                                           .beacons = {9},
+                                           .mode = mm::Mode::kStream,
+                                           .listenPort = 0,
+                                           .timestampUnit = mm::TimestampUnit::kMilliseconds},
+                                          reported.listener());
   ASSERT_TRUE(client) << client.error();
   auto dashboard = startDashboard({.beacons = {9},
                                    .rate = 40,
@@ -139,9 +136,9 @@ TEST(MarvelmindClient, NoDecoyGetsThrough) {
     auto badCrc = mm::encode(far);
     badCrc.back() ^= 0xFF;
     decoys.push_back(badCrc);
-    decoys.push_back(decoy(far, 1, 0x48));      // type
-    decoys.push_back(decoy(far, 2, 0x02));      // code
-    decoys.push_back(decoy(far, 4, 0x11));      // data size
+    decoys.push_back(decoy(far, 1, 0x48));  // type
+    decoys.push_back(decoy(far, 2, 0x02));  // code
+    decoys.push_back(decoy(far, 4, 0x11));  // data size
     decoys.push_back(mm::encode(mm::Reply{.beacon = 6, .timestamp = round * 10 + 2, .xMm = 99000}));
     auto shortOne = mm::encode(far);
     shortOne.pop_back();
@@ -151,7 +148,8 @@ TEST(MarvelmindClient, NoDecoyGetsThrough) {
     decoys.push_back(longOne);
     decoys.push_back(std::vector<uint8_t>(600, 0x47));  // over any reply's size
     for (const auto& bytes : decoys) sentDecoys += sendDatagram(socket->get(), client_, bytes);
-    mm::Reply good{.beacon = 5, .timestamp = round * 10, .xMm = 10 * (100 + static_cast<int32_t>(round))};
+    mm::Reply good{
+        .beacon = 5, .timestamp = round * 10, .xMm = 10 * (100 + static_cast<int32_t>(round))};
     sentGood += sendDatagram(socket->get(), client_, mm::encode(good));
     sentForeign += sendDatagram(stranger->get(), client_, mm::encode(far));
   }
@@ -159,7 +157,8 @@ TEST(MarvelmindClient, NoDecoyGetsThrough) {
   ASSERT_TRUE(waitFor([&] {
     auto s = (*client)->stats();
     return s.rejectedTotal() == sentDecoys && s.foreign == sentForeign;
-  })) << "rejected " << (*client)->stats().rejectedTotal() << " of " << sentDecoys;
+  })) << "rejected "
+      << (*client)->stats().rejectedTotal() << " of " << sentDecoys;
   auto stats = (*client)->stats();
   EXPECT_EQ(stats.rejected["bad CRC"], 40u);
   EXPECT_EQ(stats.rejected["wrong beacon"], 40u);
@@ -233,7 +232,8 @@ TEST(MarvelmindClient, RefusesBadConfigurations) {
   auto listener = [](const mm::PositionEvent&) {};
   EXPECT_FALSE(mm::PositionClient::start({.beacons = {}}, listener));
   EXPECT_FALSE(mm::PositionClient::start({.beacons = {5}, .pollRate = 0}, listener));
-  EXPECT_FALSE(mm::PositionClient::start({.host = "no.such.host.invalid", .beacons = {5}}, listener));
+  EXPECT_FALSE(
+      mm::PositionClient::start({.host = "no.such.host.invalid", .beacons = {5}}, listener));
   EXPECT_FALSE(mm::parseBeacons("0"));
   EXPECT_FALSE(mm::parseBeacons("255"));
   EXPECT_FALSE(mm::parseBeacons("5,x"));

@@ -128,8 +128,9 @@ TEST(WircCli, SaysWhenNoRcoipReceiverAnswers) {
 
 TEST(WircCli, PrintsMarvelmindPositionsOnePerLineInTheExactForm) {
   auto dashboard = sim::MarvelmindDashboard::start(
-      {.beacons = {5, 6}, .rate = 20, .noise = 0},
-      [](size_t index) { return std::array<double, 3>{1.25, -0.5 - static_cast<double>(index), 0.3}; });
+      {.beacons = {5, 6}, .rate = 20, .noise = 0}, [](size_t index) {
+        return std::array<double, 3>{1.25, -0.5 - static_cast<double>(index), 0.3};
+      });
   ASSERT_TRUE(dashboard) << dashboard.error();
   auto address = "--marvelmind 127.0.0.1:" + std::to_string((*dashboard)->port());
   auto run = wircCli("positions " + address + " --beacon 6 --count 4");

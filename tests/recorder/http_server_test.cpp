@@ -1,7 +1,5 @@
 // wirc-recorder --http: what a browser or a script gets from it, through a
 // real HTTP client (libsoup) and a real browser (headless Chromium).
-#include <gst/app/gstappsink.h>
-#include <gst/video/video.h>
 #include <gtest/gtest.h>
 #include <libsoup/soup.h>
 
@@ -9,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "headless_chromium.h"
 #include "http_fetch.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
@@ -150,55 +149,14 @@ TEST(WircRecorderHttp, EventsCarryTheDetections) {
   EXPECT_EQ(event["detections"][0]["corners"].size(), 8u);
 }
 
-// Pixels of a PNG as RGB, decoded by GStreamer's pngdec.
-struct Picture {
-  int width = 0, height = 0;
-  std::vector<uint8_t> rgb;
-};
-
-Picture readPng(const fs::path& file) {
-  std::string description = "filesrc location=\"" + file.string() +
-                            "\" ! pngdec ! videoconvert ! video/x-raw,format=RGB ! "
-                            "appsink name=sink";
-  GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
-  GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
-  gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  Picture picture;
-  if (GstSample* sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), 10 * GST_SECOND)) {
-    GstVideoInfo info;
-    gst_video_info_from_caps(&info, gst_sample_get_caps(sample));
-    picture.width = GST_VIDEO_INFO_WIDTH(&info);
-    picture.height = GST_VIDEO_INFO_HEIGHT(&info);
-    GstMapInfo map;
-    gst_buffer_map(gst_sample_get_buffer(sample), &map, GST_MAP_READ);
-    int stride = GST_VIDEO_INFO_PLANE_STRIDE(&info, 0);
-    for (int y = 0; y < picture.height; ++y)
-      picture.rgb.insert(picture.rgb.end(), map.data + y * stride,
-                         map.data + y * stride + picture.width * 3);
-    gst_buffer_unmap(gst_sample_get_buffer(sample), &map);
-    gst_sample_unref(sample);
-  }
-  gst_element_set_state(pipeline, GST_STATE_NULL);
-  gst_object_unref(sink);
-  gst_object_unref(pipeline);
-  return picture;
-}
-
 TEST(WircRecorderHttp, LiveViewShowsTheCameraWithTheTagOverlayInChromium) {
-  if (system("command -v chromium > /dev/null") != 0)
+  if (!chromiumInstalled())
     GTEST_SKIP() << "chromium is not installed (tools/install-deps test installs it)";
   LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11"});
   ASSERT_FALSE(live.url.empty()) << live.recorder->log();
   std::this_thread::sleep_for(milliseconds(2000));  // detections have come
   auto shot = live.recorder->out().parent_path() / "live-view.png";
-  auto profile = live.recorder->out().parent_path() / "chromium-profile";
-  std::string command =
-      "timeout 60 chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage "
-      "--disable-quic --no-first-run --disable-background-networking --disable-component-update "
-      "--disable-sync --user-data-dir=" +
-      profile.string() + " --window-size=800,600 --timeout=10000 --screenshot=" + shot.string() +
-      " " + live.url + " > /dev/null 2>&1";
-  ASSERT_EQ(system(command.c_str()), 0) << command;
+  ASSERT_TRUE(screenshot(live.url, shot, 800, 600));
   auto picture = readPng(shot);
   ASSERT_EQ(picture.width, 800);
   // The camera's picture (its sky) and the overlay's green outline.

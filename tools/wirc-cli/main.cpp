@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "cousin_commands.h"
-#include "positions_command.h"
 #include "hex.h"
 #include "message_json.h"
+#include "positions_command.h"
 #include "wirc/channel_list.h"
 #include "wirc/discovery.h"
 #include "wirc/message_stream_parser.h"
@@ -327,9 +327,8 @@ Options parse(int argc, char** argv) {
       case kUnits:
         if (std::string(optarg) != "cm" && std::string(optarg) != "mm")
           usageError("--units is cm or mm");
-        o.positions.resolution = std::string(optarg) == "mm"
-                                     ? marvelmind::Resolution::kMillimetres
-                                     : marvelmind::Resolution::kCentimetres;
+        o.positions.resolution = std::string(optarg) == "mm" ? marvelmind::Resolution::kMillimetres
+                                                             : marvelmind::Resolution::kCentimetres;
         break;
       case kTimestampUnit:
         if (std::string(optarg) != "64" && std::string(optarg) != "ms")

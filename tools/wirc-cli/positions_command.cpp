@@ -20,7 +20,8 @@ void printLine(const marvelmind::Position& p) {
 int printPositions(const PositionsOptions& o) {
   auto colon = o.dashboard.rfind(':');
   char* end = nullptr;
-  long port = colon == std::string::npos ? 0 : std::strtol(o.dashboard.c_str() + colon + 1, &end, 10);
+  long port =
+      colon == std::string::npos ? 0 : std::strtol(o.dashboard.c_str() + colon + 1, &end, 10);
   if (colon == std::string::npos || colon == 0 || *end != '\0' || port < 1 || port > 65535) {
     std::fprintf(stderr, "wirc-cli: --marvelmind wants HOST:PORT, not '%s'\n", o.dashboard.c_str());
     return 2;

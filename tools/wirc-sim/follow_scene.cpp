@@ -345,16 +345,17 @@ void FollowScene::writeTruth() {
   auto unixMs = std::chrono::duration_cast<std::chrono::milliseconds>(
                     std::chrono::system_clock::now().time_since_epoch())
                     .count();
-  std::fprintf(truth_,
-               "{\"tick\":%llu,\"unix_ms\":%lld,\"t\":%.4f,\"car\":{\"x\":%.4f,\"y\":%.4f,\"theta\":%.5f},"
-               "\"target\":{\"x\":%.4f,\"y\":%.4f,\"theta\":%.5f},\"bearing_deg\":%.3f,"
-               "\"distance_m\":%.4f,\"distance_error_m\":%.4f,\"failsafe\":%s,"
-               "\"steering_us\":%u,\"throttle_us\":%u,\"tags\":[",
-               static_cast<unsigned long long>(ticks_), static_cast<long long>(unixMs), time_, car_.x, car_.y, car_.theta,
-               target_.x, target_.y, target_.theta, bearingDeg(), distance(),
-               distance() - config_.followDistance, lastOutputs_.failsafe ? "true" : "false",
-               lastOutputs_.pulses[config_.steeringChannel - 1],
-               lastOutputs_.pulses[config_.throttleChannel - 1]);
+  std::fprintf(
+      truth_,
+      "{\"tick\":%llu,\"unix_ms\":%lld,\"t\":%.4f,\"car\":{\"x\":%.4f,\"y\":%.4f,\"theta\":%.5f},"
+      "\"target\":{\"x\":%.4f,\"y\":%.4f,\"theta\":%.5f},\"bearing_deg\":%.3f,"
+      "\"distance_m\":%.4f,\"distance_error_m\":%.4f,\"failsafe\":%s,"
+      "\"steering_us\":%u,\"throttle_us\":%u,\"tags\":[",
+      static_cast<unsigned long long>(ticks_), static_cast<long long>(unixMs), time_, car_.x,
+      car_.y, car_.theta, target_.x, target_.y, target_.theta, bearingDeg(), distance(),
+      distance() - config_.followDistance, lastOutputs_.failsafe ? "true" : "false",
+      lastOutputs_.pulses[config_.steeringChannel - 1],
+      lastOutputs_.pulses[config_.throttleChannel - 1]);
   auto views = tagViews();
   for (size_t i = 0; i < views.size(); ++i) {
     const auto& c = views[i].corners;

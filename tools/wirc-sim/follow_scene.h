@@ -132,7 +132,7 @@ class FollowScene : public wirc::DeviceScene {
   std::optional<wirc::DeviceClock::time_point> lastAdvance_;
   FILE* truth_ = nullptr;
   mutable std::mutex sharedMutex_;
-  Truth shared_;  // guarded by sharedMutex_
+  Truth shared_;                                   // guarded by sharedMutex_
   std::unique_ptr<void, int (*)(void*)> encoder_;  // TurboJPEG, kept across frames
   uint64_t ticks_ = 0;
   double bearingSum_ = 0;

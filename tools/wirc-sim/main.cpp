@@ -423,8 +423,8 @@ int main(int argc, char** argv) {
       case kMarvelmindPush: {
         std::string text = optarg;
         auto colon = text.rfind(':');
-        auto port = number(colon == std::string::npos ? "" : optarg + colon + 1,
-                           "marvelmind-push", 1, 65535);
+        auto port = number(colon == std::string::npos ? "" : optarg + colon + 1, "marvelmind-push",
+                           1, 65535);
         auto address = SocketAddress::resolve(text.substr(0, colon), static_cast<uint16_t>(port));
         if (!address) usageError("--marvelmind-push: " + address.error());
         dashboardConfig().pushTo = *address;

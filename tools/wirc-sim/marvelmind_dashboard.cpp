@@ -128,7 +128,8 @@ Expected<std::unique_ptr<MarvelmindDashboard>, std::string> MarvelmindDashboard:
   if (!socket) return unexpected("Marvelmind dashboard: " + socket.error());
   setNonBlocking(socket->get());
   std::unique_ptr<MarvelmindDashboard> dashboard(new MarvelmindDashboard());
-  dashboard->impl_ = std::make_unique<Impl>(std::move(config), std::move(truth), std::move(*socket));
+  dashboard->impl_ =
+      std::make_unique<Impl>(std::move(config), std::move(truth), std::move(*socket));
   return dashboard;
 }
 

@@ -24,9 +24,9 @@ struct DashboardConfig {
   std::string bindAddress = "127.0.0.1";
   uint16_t port = 0;  // 0: a free one
   std::vector<uint8_t> beacons = {5};
-  double rate = 16;      // measurements per second
-  double noise = 0.02;   // m, standard deviation per axis
-  double dropout = 0;    // probability a measurement is missed
+  double rate = 16;     // measurements per second
+  double noise = 0.02;  // m, standard deviation per axis
+  double dropout = 0;   // probability a measurement is missed
   marvelmind::TimestampUnit timestampUnit = marvelmind::TimestampUnit::kSixtyFourths;
   std::optional<SocketAddress> pushTo;  // stream mode
   marvelmind::Resolution pushResolution = marvelmind::Resolution::kCentimetres;

@@ -26,8 +26,7 @@ double DashboardClock::seconds(uint32_t timestamp) {
 
 DashboardClock::Clock::time_point DashboardClock::localTime(double dashboardSeconds,
                                                             Clock::time_point received) {
-  while (!samples_.empty() && received - samples_.front().received > kWindow)
-    samples_.pop_front();
+  while (!samples_.empty() && received - samples_.front().received > kWindow) samples_.pop_front();
   samples_.push_back({received, secondsSinceEpoch(received) - dashboardSeconds});
   double offset = std::min_element(samples_.begin(), samples_.end(), [](auto& a, auto& b) {
                     return a.offset < b.offset;

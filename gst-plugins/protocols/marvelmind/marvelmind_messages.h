@@ -44,7 +44,7 @@ struct Request {
 struct Reply {
   uint8_t beacon = 0;
   Resolution resolution = Resolution::kCentimetres;
-  uint32_t timestamp = 0;  // the dashboard's, in its TimestampUnit
+  uint32_t timestamp = 0;             // the dashboard's, in its TimestampUnit
   int32_t xMm = 0, yMm = 0, zMm = 0;  // cm replies carry multiples of 10
   uint8_t flags = 0;                  // mm replies only
   uint16_t angle = 0;                 // mm replies only

@@ -174,8 +174,9 @@ std::string PositionClient::Impl::silenceReason(uint8_t beacon, Clock::time_poin
   const Beacon& state = beacons_.at(beacon);
   bool silent = !lastReply_ || now - *lastReply_ >= config_.staleAfter;
   if (silent && config_.mode == Mode::kStream)
-    return "nothing pushed by the dashboard to port " + std::to_string(localAddress(socket_.get()).port()) +
-           " for " + ms(lastReply_.value_or(state.lastNew));
+    return "nothing pushed by the dashboard to port " +
+           std::to_string(localAddress(socket_.get()).port()) + " for " +
+           ms(lastReply_.value_or(state.lastNew));
   if (silent)
     return "no reply from the dashboard at " + dashboard_.toString() + " for " +
            ms(lastReply_.value_or(state.lastNew));

@@ -61,10 +61,10 @@ using PositionEvent = std::variant<PositionReceived, PositionStale>;
 
 struct ClientStats {
   uint64_t requests = 0;
-  uint64_t replies = 0;    // valid replies for our beacons
-  uint64_t positions = 0;  // of those, new measurements
-  uint64_t repeats = 0;    // the dashboard's latest again (no new measurement)
-  uint64_t foreign = 0;    // datagrams from anyone but the dashboard
+  uint64_t replies = 0;                      // valid replies for our beacons
+  uint64_t positions = 0;                    // of those, new measurements
+  uint64_t repeats = 0;                      // the dashboard's latest again (no new measurement)
+  uint64_t foreign = 0;                      // datagrams from anyone but the dashboard
   std::map<std::string, uint64_t> rejected;  // by reason: "bad CRC", "wrong beacon", ...
   uint64_t rejectedTotal() const;
 };

@@ -12,12 +12,12 @@ using Bytes = std::vector<uint8_t>;
 // A cm reply of beacon 5 at t = 100 (1/64 s), x 1.23 m, y -0.5 m, z 0.25 m,
 // laid out by hand from the protocol text's table.
 Bytes handMadeReply() {
-  Bytes reply = {0x05, 0x47, 0x01, 0x00, 0x10,  // addr, type, code, size
-                 0x64, 0x00, 0x00, 0x00,        // timestamp 100
-                 0x7B, 0x00,                    // x 123 cm
-                 0xCE, 0xFF,                    // y -50 cm
-                 0x19, 0x00,                    // z 25 cm
-                 0,    0,    0,    0,    0, 0};  // reserved
+  Bytes reply = {0x05, 0x47, 0x01, 0x00, 0x10,      // addr, type, code, size
+                 0x64, 0x00, 0x00, 0x00,            // timestamp 100
+                 0x7B, 0x00,                        // x 123 cm
+                 0xCE, 0xFF,                        // y -50 cm
+                 0x19, 0x00,                        // z 25 cm
+                 0,    0,    0,    0,    0,    0};  // reserved
   uint16_t crc = crc16Modbus(reply);
   reply.push_back(static_cast<uint8_t>(crc & 0xFF));
   reply.push_back(static_cast<uint8_t>(crc >> 8));
