@@ -4,7 +4,9 @@
  * Draws what apriltagdetect found (the WircTagMeta of each frame) for viewing
  * and recording: each tag's outline, its id, and, for the control target
  * (`target-id`, or the largest tag when -1), a thicker outline and a line
- * from the image centre to the tag, the error wirccontrol steers away.
+ * from the image centre to the tag, the error wirccontrol steers away; and
+ * each Marvelmind beacon's position (the WircPositionMeta marvelmindpositions
+ * joins to the frame) as a line of text in the bottom left corner.
  * Works in place on RGB, BGRx and I420.
  *
  * ## Example launch line
@@ -18,9 +20,11 @@
 #include <gst/video/video.h>
 
 #include <cmath>
+#include <cstdio>
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "wirc_position_meta.h"
 #include "wirc_tag_meta.h"
 
 GST_DEBUG_CATEGORY_STATIC(tag_overlay_debug);
@@ -52,6 +56,7 @@ struct Colour {
 };
 constexpr Colour kTagColour{40, 220, 60};
 constexpr Colour kTargetColour{255, 60, 40};
+constexpr Colour kPositionColour{255, 230, 80};
 
 // One plane to draw on, with the colour in that plane's terms and the scale
 // from frame to plane coordinates (chroma planes of I420 are half size).
@@ -109,11 +114,38 @@ void drawTag(GstVideoFrame* frame, const WircTag& tag, bool target, bool showId,
   }
 }
 
+// Each beacon's position (marvelmindpositions' WircPositionMeta) as a line
+// of text in the bottom left corner, the first beacon lowest.
+void drawPositions(GstVideoFrame* frame) {
+  int width = GST_VIDEO_FRAME_WIDTH(frame), height = GST_VIDEO_FRAME_HEIGHT(frame);
+  double fontScale = 0.45 * std::max(1.0, width / 640.0);
+  int lineHeight = static_cast<int>(22 * std::max(1.0, width / 640.0));
+  int row = 0;
+  gpointer state = nullptr;
+  while (GstMeta* found =
+             gst_buffer_iterate_meta_filtered(frame->buffer, &state, WIRC_POSITION_META_API_TYPE)) {
+    auto* position = reinterpret_cast<WircPositionMeta*>(found);
+    char text[96];
+    std::snprintf(text, sizeof text, "beacon %u: %.2f, %.2f, %.2f m", position->beacon, position->x,
+                  position->y, position->z);
+    int baseline = height - 8 - lineHeight * row++;
+    if (baseline < lineHeight) break;
+    for (auto& canvas : canvases(frame, kPositionColour)) {
+      auto at =
+          cv::Point(static_cast<int>(8 * canvas.scale), static_cast<int>(baseline * canvas.scale));
+      cv::putText(canvas.plane, text, at, cv::FONT_HERSHEY_SIMPLEX, fontScale * canvas.scale,
+                  canvas.colour, std::max(1, static_cast<int>(std::lround(canvas.scale))),
+                  cv::LINE_AA);
+    }
+  }
+}
+
 }  // namespace
 
 static GstFlowReturn gst_tag_overlay_transform_frame_ip(GstVideoFilter* filter,
                                                         GstVideoFrame* frame) {
   auto* self = GST_TAG_OVERLAY(filter);
+  drawPositions(frame);
   WircTagMeta* meta = gst_buffer_get_wirc_tag_meta(frame->buffer);
   if (!meta || meta->tags->len == 0 || meta->width == 0 || meta->height == 0) return GST_FLOW_OK;
   gint targetId;
@@ -196,7 +228,8 @@ static void gst_tag_overlay_class_init(GstTagOverlayClass* klass) {
   gst_element_class_add_static_pad_template(element, &src_template);
   gst_element_class_set_static_metadata(
       element, "AprilTag overlay", "Filter/Effect/Video",
-      "Draws the AprilTags found by apriltagdetect and the control target", "wircam authors");
+      "Draws the AprilTags found by apriltagdetect, the control target and Marvelmind positions",
+      "wircam authors");
   GST_VIDEO_FILTER_CLASS(klass)->transform_frame_ip = gst_tag_overlay_transform_frame_ip;
   GST_DEBUG_CATEGORY_INIT(tag_overlay_debug, "tagoverlay", 0, "AprilTag overlay");
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "scene_frames.h"
+#include "wirc_position_meta.h"
 #include "wirc_tag_meta.h"
 
 namespace {
@@ -144,6 +145,40 @@ TEST(TagOverlay, OutlinesTheDetectedTag) {
   auto* v = static_cast<const uint8_t*>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 2));
   EXPECT_GT(v[y * GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 2) + x], 180);
   gst_video_frame_unmap(&frame);
+  gst_buffer_unref(out);
+  gst_harness_teardown(h);
+}
+
+TEST(TagOverlay, WritesEachBeaconsPositionInTheBottomLeftCorner) {
+  GstHarness* h = gst_harness_new_parse("tagoverlay");
+  gst_harness_set_src_caps_str(h, "video/x-raw,format=RGB,width=320,height=240,framerate=15/1");
+  auto blackFrame = [] {
+    GstBuffer* buffer = gst_buffer_new_allocate(nullptr, 320 * 240 * 3, nullptr);
+    gst_buffer_memset(buffer, 0, 0, 320 * 240 * 3);
+    return buffer;
+  };
+  // The text's yellow pixels in the bottom left 200×40.
+  auto yellowPixels = [](GstBuffer* buffer) {
+    GstMapInfo map;
+    gst_buffer_map(buffer, &map, GST_MAP_READ);
+    int count = 0;
+    for (int y = 200; y < 240; ++y)
+      for (int x = 0; x < 200; ++x) {
+        const uint8_t* p = map.data + (y * 320 + x) * 3;
+        if (p[0] > 150 && p[1] > 130 && p[2] < 100) ++count;
+      }
+    gst_buffer_unmap(buffer, &map);
+    return count;
+  };
+  GstBuffer* plain = gst_harness_push_and_pull(h, blackFrame());
+  EXPECT_EQ(yellowPixels(plain), 0);
+  gst_buffer_unref(plain);
+  GstBuffer* placed = blackFrame();
+  WircPositionMeta* meta = gst_buffer_add_wirc_position_meta(placed);
+  meta->beacon = 5;
+  meta->x = 1.25;
+  GstBuffer* out = gst_harness_push_and_pull(h, placed);
+  EXPECT_GT(yellowPixels(out), 50);
   gst_buffer_unref(out);
   gst_harness_teardown(h);
 }
