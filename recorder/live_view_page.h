@@ -85,6 +85,7 @@ const colours = ["#4fc3f7", "#ffb74d", "#aed581", "#f06292", "#ba68c8", "#fff176
 function positionText(position) {
   if (position === undefined) return "";
   if (position === null) return "  position: none yet";
+  if (position.x === undefined) return "  position: stale";
   return `  at ${position.x.toFixed(2)}, ${position.y.toFixed(2)} m` +
          (position.stale ? " (stale)" : "");
 }
@@ -99,7 +100,7 @@ function showStatus(status) {
         (stream.status_stale ? ` (stale, ${Math.round(stream.status_age_ms / 1000)} s old)` : "") +
         positionText(stream.position);
     const p = stream.position;
-    if (!p) continue;
+    if (!p || p.x === undefined) continue;
     const trail = trails[stream.name] || (trails[stream.name] = { points: [] });
     const last = trail.points[trail.points.length - 1];
     if (!last || last.utc !== p.utc) trail.points.push({ x: p.x, y: p.y, utc: p.utc });

@@ -274,7 +274,7 @@ void Recording::handlePosition(Stream& stream, const GstStructure* s) {
   if (gst_structure_has_name(s, "marvelmind-stale")) {
     std::string reason = gst_structure_get_string(s, "reason");
     log(stream.plan.name + ": position of beacon " + std::to_string(beacon) + " stale: " + reason);
-    if (stream.position) stream.position->staleReason = reason;
+    stream.positionStale = reason;
     writeTelemetry(stream, {{"type", "position-stale"}, {"beacon", beacon}, {"reason", reason}},
                    runningTime());
     return;
@@ -289,6 +289,7 @@ void Recording::handlePosition(Stream& stream, const GstStructure* s) {
   GstClockTime time = GST_CLOCK_TIME_IS_VALID(measured) ? measured : runningTime();
   position.unixMs = unixMsOf(pipeline_, time);
   stream.position = position;
+  stream.positionStale.clear();
   stream.trail.push_back(position);
   if (stream.trail.size() > kTrailPositions) stream.trail.pop_front();
   // Until a frame opens the first file, where the vehicle is belongs to no
@@ -453,7 +454,7 @@ void Recording::printStatus() {
     if (!stream.position) return "";
     char text[64];
     std::snprintf(text, sizeof text, "  at %.2f, %.2f m%s", stream.position->x, stream.position->y,
-                  stream.position->staleReason.empty() ? "" : " (stale)");
+                  stream.positionStale.empty() ? "" : " (stale)");
     return text;
   };
   for (auto& s : streams_) {
@@ -503,11 +504,13 @@ nlohmann::json Recording::status() const {
                             {"y", p.y},
                             {"z", p.z},
                             {"utc", SegmentPlanner::isoUtc(p.unixMs)},
-                            {"stale", !p.staleReason.empty()}};
-      if (!p.staleReason.empty()) stream["position"]["stale_reason"] = p.staleReason;
+                            {"stale", !s->positionStale.empty()}};
     } else if (!s->plan.positions.empty()) {
-      stream["position"] = nullptr;  // asked for, none yet
+      // Asked for, none yet: null, or why none comes.
+      stream["position"] =
+          s->positionStale.empty() ? nlohmann::json(nullptr) : nlohmann::json{{"stale", true}};
     }
+    if (!s->positionStale.empty()) stream["position"]["stale_reason"] = s->positionStale;
     if (rtsp_)
       stream["rtsp"] =
           rtsp_->url() + "/" + s->plan.device + "/cam" + std::to_string(s->plan.camera);
@@ -526,8 +529,7 @@ nlohmann::json Recording::trails() const {
     nlohmann::json points = nlohmann::json::array();
     for (const auto& p : s->trail)
       points.push_back({{"x", p.x}, {"y", p.y}, {"utc", SegmentPlanner::isoUtc(p.unixMs)}});
-    trails[s->plan.name] = {{"points", points},
-                            {"stale", s->position && !s->position->staleReason.empty()}};
+    trails[s->plan.name] = {{"points", points}, {"stale", !s->positionStale.empty()}};
   }
   return trails;
 }

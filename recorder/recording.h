@@ -62,9 +62,9 @@ class Recording {
       guint beacon = 0;
       double x = 0, y = 0, z = 0;
       int64_t unixMs = 0;
-      std::string staleReason;  // empty while positions come
     };
     std::optional<Position> position;
+    std::string positionStale;   // why, when no position came for a while
     std::deque<Position> trail;  // the recent ones, for the live view's map
     // "waiting for device" until the first login, then "live" or "offline".
     std::string state = "waiting for device";
