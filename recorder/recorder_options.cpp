@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "marvelmind/position_client.h"
+#include "mqtt_url.h"
 #include "wirc/channel_list.h"
 
 namespace wircam::recorder {
@@ -62,6 +63,19 @@ file and exits 0.
                          HOST it listens on 127.0.0.1 only; 0.0.0.0:8080 opens
                          it to the network (it has no authentication yet)
   --http-idle-timeout S  close an HTTP connection silent for S seconds (default 10)
+  --mqtt mqtt://[USER:PASS@]HOST[:PORT]
+                         publish status, detections and events to an MQTT
+                         broker and take follow/target commands (below)
+  --mqtt-prefix P        topic prefix (default wircam)
+  --mqtt-detections-rate HZ
+                         at most HZ detection messages per second and stream
+                         (default 0: every frame with tags)
+  --on-segment-closed CMD
+                         run CMD (split like a shell would, never through
+                         one) with the segment's path and its sidecar's as
+                         two more arguments, for each segment as it closes;
+                         failures are retried with backoff (e.g. rclone copyto)
+  --hook-timeout S       a hook running longer is stopped and retried (default 600)
   --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>; without
                          HOST on 127.0.0.1 only
   -h, --help             this text
@@ -69,7 +83,8 @@ file and exits 0.
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
 min-free, status, http, http-idle-timeout, rtsp, periods, failsafe, marvelmind,
-beacon), and one [device NAME] group per vehicle with host, port, cameras
+beacon, mqtt, mqtt-prefix, mqtt-detections-rate, on-segment-closed,
+hook-timeout), and one [device NAME] group per vehicle with host, port, cameras
 (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as on the command
 line), marvelmind and beacon:
 
@@ -91,6 +106,17 @@ object per event: {"pts": ns on the segment's timeline, "utc": "...Z", "type":
 ...}; the same objects are
 the file's text track "telemetry". DIR/index.json lists the finished segments
 (camera, file, start_utc, duration_s, frames, bytes).
+
+MQTT topics (PREFIX/STREAM, STREAM as in the file names):
+  PREFIX/available          online/offline, retained; offline is the last will
+  PREFIX/STREAM/status      retained JSON: state, fps, loss, battery_v,
+                            has_control, following, position; on change and
+                            at least every 5 s
+  PREFIX/STREAM/detections  JSON per frame with tags (and one when they go)
+  PREFIX/STREAM/events      session events, {"type":"segment-closed",...},
+                            hook failures
+  PREFIX/STREAM/follow/set  ON or OFF (takes effect at once; OFF = neutral)
+  PREFIX/STREAM/target/set  a tag id (-1: the largest)
 
 Exit status: 0 finished cleanly (or stopped by a signal before any frame),
 1 error (or --duration ended with nothing recorded), 2 bad arguments, 3 the
@@ -301,6 +327,34 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
                                    : wirc::validate(wirc::Fcfg{*channels});
     if (valid) return valid->message();
     (name == "periods" ? o.periods : o.failsafe) = value;
+  } else if (name == "mqtt") {
+    auto url = parseMqttUrl(value);
+    if (!url) return url.error();
+    o.mqtt = value;
+  } else if (name == "mqtt-prefix") {
+    std::string prefix = value;
+    if (prefix.empty() || prefix.find_first_of("+#") != std::string::npos ||
+        prefix.front() == '/' || prefix.back() == '/')
+      return "a topic prefix without + # or a leading or trailing /, like wircam or lab/rovers";
+    o.mqttPrefix = prefix;
+  } else if (name == "mqtt-detections-rate") {
+    auto rate = number(value);
+    if (!rate || *rate < 0 || *rate > 1000) return "messages per second, 0..1000 (0: every frame)";
+    o.mqttDetectionsRate = *rate;
+  } else if (name == "on-segment-closed") {
+    gchar** argv = nullptr;
+    GError* error = nullptr;
+    if (!g_shell_parse_argv(value, nullptr, &argv, &error)) {
+      std::string problem = error->message;
+      g_error_free(error);
+      return "cannot split the command: " + problem;
+    }
+    o.onSegmentClosed.assign(argv, argv + g_strv_length(argv));
+    g_strfreev(argv);
+  } else if (name == "hook-timeout") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 1 || *seconds > 86400) return "seconds, 1..86400";
+    o.hookTimeoutSeconds = *seconds;
   } else if (name == "marvelmind") {
     o.marvelmind = value;
   } else if (name == "beacon") {
@@ -389,6 +443,11 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"periods", required_argument, nullptr, kValue},
                                    {"failsafe", required_argument, nullptr, kValue},
                                    {"marvelmind", required_argument, nullptr, kValue},
+                                   {"mqtt", required_argument, nullptr, kValue},
+                                   {"mqtt-prefix", required_argument, nullptr, kValue},
+                                   {"mqtt-detections-rate", required_argument, nullptr, kValue},
+                                   {"on-segment-closed", required_argument, nullptr, kValue},
+                                   {"hook-timeout", required_argument, nullptr, kValue},
                                    {"beacon", required_argument, nullptr, kValue},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};

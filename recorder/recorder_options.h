@@ -79,6 +79,12 @@ struct RecorderOptions {
   // first transmitter's login configures it. Unset: wircsrc's defaults.
   std::optional<std::string> periods;
   std::optional<std::string> failsafe;
+  // Fleets: MQTT (unset: none) and the closed-segment hook (empty: none).
+  std::optional<std::string> mqtt;  // mqtt://[user:pass@]HOST[:PORT]
+  std::string mqttPrefix = "wircam";
+  double mqttDetectionsRate = 0;             // per second and stream at most; 0 = every frame
+  std::vector<std::string> onSegmentClosed;  // the command and its arguments
+  double hookTimeoutSeconds = 600;
   // Marvelmind positions of every device that names none of its own.
   std::optional<std::string> marvelmind;  // HOST[:PORT]
   std::optional<std::string> beacons;

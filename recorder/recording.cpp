@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -110,6 +111,27 @@ std::optional<std::string> Recording::startServers() {
     http_ = std::move(*server);
     log("live view at " + http_->url());
   }
+  if (options_.mqtt) {
+    FleetPublisher::Settings settings{.url = *parseMqttUrl(*options_.mqtt),
+                                      .prefix = options_.mqttPrefix,
+                                      .detectionsRate = options_.mqttDetectionsRate};
+    for (auto& s : streams_) settings.streams.push_back(s->plan.name);
+    auto fleet =
+        FleetPublisher::start(settings, [this](const FleetCommand& c) { applyCommand(c); });
+    if (!fleet) return fleet.error();
+    fleet_ = std::move(*fleet);
+    log("MQTT to " + settings.url.host + ":" + std::to_string(settings.url.port) + " under " +
+        settings.prefix + "/");
+  }
+  if (!options_.onSegmentClosed.empty()) {
+    hook_ = std::make_unique<SegmentHook>(
+        options_.onSegmentClosed,
+        std::chrono::seconds(static_cast<int64_t>(options_.hookTimeoutSeconds)),
+        [this](const std::string& name, const nlohmann::json& event) {
+          for (auto& s : streams_)
+            if (s->plan.name == name) publishEvent(*s, event);
+        });
+  }
   if (options_.rtsp) {
     std::vector<RtspServer::Camera> cameras;
     for (auto& s : streams_)
@@ -127,6 +149,8 @@ Recording::~Recording() {
   // The servers first: they listen to the pipeline's frames.
   http_.reset();
   rtsp_.reset();
+  hook_.reset();
+  fleet_.reset();  // says offline
   if (pipeline_) {
     gst_element_set_state(pipeline_, GST_STATE_NULL);
     streams_.clear();
@@ -170,8 +194,87 @@ void Recording::onSegmentClosed(Stream& stream, const std::string& file) {
               .durationSeconds = planned->durationSeconds(),
               .frames = planned->frames,
               .bytes = std::filesystem::file_size(file, error)});
+  auto sidecar = std::filesystem::path(file).replace_extension(".jsonl").string();
+  publishEvent(stream, {{"type", "segment-closed"},
+                        {"file", std::filesystem::path(file).filename().string()},
+                        {"path", file},
+                        {"sidecar", sidecar},
+                        {"start_utc", SegmentPlanner::isoUtc(planned->startUnixMs)},
+                        {"duration_s", planned->durationSeconds()},
+                        {"frames", planned->frames}});
+  if (hook_) hook_->segmentClosed(stream.plan.name, file, sidecar);
   auto open = openSegments();
   updateIndex(retention_.enforce({open.begin(), open.end()}));
+}
+
+void Recording::publishEvent(const Stream& stream, const nlohmann::json& event) {
+  if (!fleet_) return;
+  nlohmann::json line = event;
+  line["utc"] = SegmentPlanner::isoUtc(g_get_real_time() / 1000);
+  fleet_->event(stream.plan.name, line);
+}
+
+GstElement* Recording::element(const std::string& name) const {
+  if (name.empty()) return nullptr;
+  GstElement* found = gst_bin_get_by_name(GST_BIN(pipeline_), name.c_str());
+  if (found) gst_object_unref(found);  // the pipeline keeps it
+  return found;
+}
+
+nlohmann::json Recording::fleetStatus(const Stream& s) const {
+  double total = static_cast<double>(s.frameCount + s.incomplete);
+  gboolean hasControl = FALSE, following = FALSE;
+  if (GstElement* controller = element(s.plan.controller))
+    g_object_get(controller, "has-control", &hasControl, "enabled", &following, nullptr);
+  nlohmann::json status = {
+      {"state", s.state},
+      {"state_since_utc", SegmentPlanner::isoUtc(s.stateSinceUnixMs)},
+      {"fps", std::round(s.fps * 10) / 10},
+      {"loss",
+       total > 0 ? std::round(1000.0 * static_cast<double>(s.incomplete) / total) / 10 : 0.0},
+      {"battery_v", s.batteryMv / 1000.0},
+      {"has_control", hasControl != FALSE},
+      {"following", following != FALSE},
+      {"position", nullptr}};
+  if (s.position)
+    status["position"] = {{"beacon", s.position->beacon},
+                          {"x", s.position->x},
+                          {"y", s.position->y},
+                          {"z", s.position->z},
+                          {"utc", SegmentPlanner::isoUtc(s.position->unixMs)},
+                          {"stale", !s.positionStale.empty()}};
+  return status;
+}
+
+void Recording::publishFleetStatus(bool force) {
+  if (!fleet_) return;
+  for (const auto& s : streams_) fleet_->status(s->plan.name, fleetStatus(*s), force);
+}
+
+void Recording::applyCommand(const FleetCommand& command) {
+  for (auto& s : streams_) {
+    if (s->plan.name != command.stream) continue;
+    GstElement* controller = element(s->plan.controller);
+    if (!controller) {
+      log("MQTT command for " + command.stream +
+          " ignored: it does not follow (start with --detect FAMILY --follow)");
+      return;
+    }
+    nlohmann::json event = {{"type", "command"}};
+    if (command.kind == FleetCommand::Kind::kFollow) {
+      // Off stops the vehicle at once (wirccontrol sends neutral).
+      g_object_set(controller, "enabled", command.follow ? TRUE : FALSE, nullptr);
+      event["follow"] = command.follow ? "ON" : "OFF";
+    } else {
+      g_object_set(controller, "target-id", command.target, nullptr);
+      event["target"] = command.target;
+    }
+    log(command.stream + ": MQTT " + event.dump());
+    publishEvent(*s, event);
+    writeTelemetry(*s, event, runningTime());
+    publishFleetStatus(true);
+    return;
+  }
 }
 
 void Recording::updateIndex(const std::vector<std::string>& deleted) {
@@ -218,6 +321,7 @@ void Recording::handleElementMessage(GstMessage* message) {
     log(stream->plan.name + ": " + event);
     line["type"] = "session";
     writeTelemetry(*stream, line, runningTime());
+    publishEvent(*stream, line);
     if (const char* state = gst_structure_get_string(s, "state")) followLinkState(*stream, state);
     return;
   }
@@ -253,6 +357,7 @@ void Recording::handleElementMessage(GstMessage* message) {
           ")");
     line["type"] = "vehicle";
     writeTelemetry(*stream, line, runningTime());
+    if (line.contains("state")) publishEvent(*stream, line);  // link changes, not each report
     return;
   }
   if (type == "marvelmind-position" || type == "marvelmind-stale") {
@@ -265,6 +370,12 @@ void Recording::handleElementMessage(GstMessage* message) {
   GstClockTime pts = line["timestamp"].get<GstClockTime>();
   line.erase("timestamp");
   if (http_ && type == "apriltag") http_->publishDetections(stream->plan.name, line["detections"]);
+  if (fleet_ && type == "apriltag")
+    fleet_->detections(stream->plan.name,
+                       {{"utc", SegmentPlanner::isoUtc(unixMsOf(pipeline_, pts))},
+                        {"frame", line.value("frame", 0)},
+                        {"tags", line["detections"]}},
+                       !line["detections"].empty());
   writeTelemetry(*stream, line, pts);
 }
 
@@ -275,8 +386,9 @@ void Recording::handlePosition(Stream& stream, const GstStructure* s) {
     std::string reason = gst_structure_get_string(s, "reason");
     log(stream.plan.name + ": position of beacon " + std::to_string(beacon) + " stale: " + reason);
     stream.positionStale = reason;
-    writeTelemetry(stream, {{"type", "position-stale"}, {"beacon", beacon}, {"reason", reason}},
-                   runningTime());
+    nlohmann::json line = {{"type", "position-stale"}, {"beacon", beacon}, {"reason", reason}};
+    writeTelemetry(stream, line, runningTime());
+    publishEvent(stream, line);
     return;
   }
   Stream::Position position{.beacon = beacon};
@@ -358,6 +470,7 @@ gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
 
 namespace {
 constexpr guint kFinishSeconds = 10;
+constexpr int kHookDrainSeconds = 15;
 }  // namespace
 
 void Recording::stop(const char* why) {
@@ -424,6 +537,7 @@ gboolean Recording::onHeartbeat(gpointer data) {
 gboolean Recording::onTick(gpointer data) {
   auto* self = static_cast<Recording*>(data);
   self->printStatus();
+  self->publishFleetStatus();
   self->guardDisk();
   return G_SOURCE_CONTINUE;
 }
@@ -567,6 +681,11 @@ int Recording::run() {
   gst_object_unref(bus);
   gst_element_set_state(pipeline_, GST_STATE_NULL);
   printStatus();
+  if (hook_) {
+    // The last segments' uploads get a little time; what is left is named.
+    for (const auto& left : hook_->drain(std::chrono::seconds(kHookDrainSeconds)))
+      log("--on-segment-closed did not get to " + left + " before exit");
+  }
   return exitCode_;
 }
 

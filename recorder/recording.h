@@ -15,6 +15,7 @@
 
 #include "common/expected.h"
 #include "disk_guard.h"
+#include "fleet_publisher.h"
 #include "frame_tap.h"
 #include "http_server.h"
 #include "pipeline_plan.h"
@@ -22,6 +23,7 @@
 #include "recording_index.h"
 #include "retention.h"
 #include "rtsp_server.h"
+#include "segment_hook.h"
 #include "segment_planner.h"
 #include "segment_splitter.h"
 #include "telemetry_router.h"
@@ -82,6 +84,12 @@ class Recording {
   void handleElementMessage(GstMessage* message);
   void handleError(GstMessage* message);
   void handlePosition(Stream& stream, const GstStructure* s);
+  // MQTT: a stream's status as the fleet sees it, and a command for it.
+  nlohmann::json fleetStatus(const Stream& stream) const;
+  void publishFleetStatus(bool force = false);
+  void applyCommand(const FleetCommand& command);
+  void publishEvent(const Stream& stream, const nlohmann::json& event);
+  GstElement* element(const std::string& name) const;
   void writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime runningTime);
   void onSegmentClosed(Stream& stream, const std::string& file);
   void followLinkState(Stream& stream, const std::string& linkState);
@@ -104,6 +112,8 @@ class Recording {
   std::map<std::string, Stream*> streamByElement_;  // element name → its stream
   std::unique_ptr<HttpServer> http_;
   std::unique_ptr<RtspServer> rtsp_;
+  std::unique_ptr<FleetPublisher> fleet_;  // with --mqtt
+  std::unique_ptr<SegmentHook> hook_;      // with --on-segment-closed
   bool stopping_ = false;
   bool stoppedBySignal_ = false;
   int exitCode_ = 0;

@@ -418,9 +418,27 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
   return GST_FLOW_OK;
 }
 
+// enabled=false stops the vehicle now, not at the next frame (which may be
+// a frame period away, or never come on a stalled pipeline).
+static void stop_following_now(GstWircControl* self) {
+  std::shared_ptr<link::VehicleLink> session;
+  link::Pulses pulses = link::neutralPulses();
+  {
+    gst::GLibLocker lock(self);
+    auto& s = self->state->settings;
+    s.enabled = FALSE;
+    self->state->settingsChanged = true;
+    session = self->state->session;
+    pulses[s.steeringChannel - 1] = static_cast<uint16_t>(s.neutral);
+    pulses[s.throttleChannel - 1] = static_cast<uint16_t>(s.neutral);
+  }
+  if (session) session->setCommand(pulses);
+}
+
 static void gst_wirc_control_set_property(GObject* object, guint id, const GValue* value,
                                           GParamSpec* pspec) {
   auto* self = GST_WIRC_CONTROL(object);
+  if (id == PROP_ENABLED && !g_value_get_boolean(value)) return stop_following_now(self);
   gst::GLibLocker lock(self);
   auto& s = self->state->settings;
   auto& f = s.follow;

@@ -1,0 +1,165 @@
+#include "fleet_publisher.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+
+namespace wircam::recorder {
+
+namespace {
+
+void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
+
+struct Locked {
+  explicit Locked(GMutex* m) : mutex(m) { g_mutex_lock(mutex); }
+  ~Locked() { g_mutex_unlock(mutex); }
+  GMutex* mutex;
+};
+
+}  // namespace
+
+Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
+                                                      const std::string& command,
+                                                      const std::string& payload) {
+  FleetCommand parsed{.kind = FleetCommand::Kind::kFollow, .stream = stream};
+  std::string upper = payload;
+  std::transform(upper.begin(), upper.end(), upper.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  if (command == "follow/set") {
+    if (upper != "ON" && upper != "OFF")
+      return unexpected("follow/set takes ON or OFF, not '" + payload.substr(0, 40) + "'");
+    parsed.follow = upper == "ON";
+    return parsed;
+  }
+  if (command == "target/set") {
+    char* end = nullptr;
+    long id = std::strtol(payload.c_str(), &end, 10);
+    if (payload.empty() || *end != '\0' || id < -1 || id > 1000000)
+      return unexpected("target/set takes a tag id (or -1: the largest), not '" +
+                        payload.substr(0, 40) + "'");
+    parsed.kind = FleetCommand::Kind::kTarget;
+    parsed.target = static_cast<int>(id);
+    return parsed;
+  }
+  return unexpected("unknown command '" + command + "' (follow/set, target/set)");
+}
+
+FleetPublisher::FleetPublisher(Settings settings, std::function<void(const FleetCommand&)> apply)
+    : settings_(std::move(settings)), apply_(std::move(apply)) {
+  g_mutex_init(&retainedMutex_);
+  for (const auto& stream : settings_.streams) streams_[stream];
+}
+
+Expected<std::unique_ptr<FleetPublisher>, std::string> FleetPublisher::start(
+    const Settings& settings, std::function<void(const FleetCommand&)> apply) {
+  std::unique_ptr<FleetPublisher> publisher(new FleetPublisher(settings, std::move(apply)));
+  auto* self = publisher.get();
+  char host[256] = "host";
+  gethostname(host, sizeof host - 1);
+  std::string clientId = "wirc-recorder-" + std::string(host) + "-" + std::to_string(getpid());
+  MqttWill will{settings.prefix + "/available", "offline"};
+  auto client = MqttClient::start(
+      settings.url, clientId, will,
+      {.connected = [self] { self->republish(); },
+       .message = [self](const std::string& topic, const std::string& payload,
+                         bool retained) { self->onMessage(topic, payload, retained); },
+       .log = [](const std::string& line) { log(line); }});
+  if (!client) return unexpected(client.error());
+  publisher->client_ = std::move(*client);
+  publisher->client_->setFarewell(will);
+  return publisher;
+}
+
+FleetPublisher::~FleetPublisher() {
+  client_.reset();  // says offline first
+  g_mutex_clear(&retainedMutex_);
+}
+
+std::string FleetPublisher::topic(const std::string& stream, const char* leaf) const {
+  return settings_.prefix + "/" + stream + "/" + leaf;
+}
+
+// On the MQTT thread, at each connection: who we are, what we know, and
+// what we listen to.
+void FleetPublisher::republish() {
+  client_->publish(settings_.prefix + "/available", "online", true, 1);
+  {
+    Locked lock(&retainedMutex_);
+    for (const auto& [stream, status] : retained_)
+      client_->publish(topic(stream, "status"), status, true);
+  }
+  client_->subscribe(settings_.prefix + "/+/follow/set");
+  client_->subscribe(settings_.prefix + "/+/target/set");
+}
+
+void FleetPublisher::onMessage(const std::string& topicName, const std::string& payload,
+                               bool retained) {
+  // PREFIX/STREAM/follow/set: the stream is the level after the prefix.
+  std::string rest = topicName.substr(std::min(topicName.size(), settings_.prefix.size() + 1));
+  auto slash = rest.find('/');
+  std::string stream = rest.substr(0, slash);
+  std::string command = slash == std::string::npos ? "" : rest.substr(slash + 1);
+  if (retained) {
+    // A command is an act, not a state: one left retained would replay at
+    // every restart.
+    log("ignoring the retained message on " + topicName +
+        " (commands are not retained; clear it with mosquitto_pub -r -n -t '" + topicName + "')");
+    return;
+  }
+  auto parsed = parseFleetCommand(stream, command, payload);
+  if (parsed && std::find(settings_.streams.begin(), settings_.streams.end(), stream) ==
+                    settings_.streams.end())
+    parsed = unexpected("no stream '" + stream + "' here");
+  if (!parsed) {
+    log("MQTT " + topicName + ": " + parsed.error() + "; ignored");
+    return;
+  }
+  // To the main loop, where the pipeline is driven.
+  auto* handed = new std::pair<FleetPublisher*, FleetCommand>(this, *parsed);
+  g_main_context_invoke_full(
+      nullptr, G_PRIORITY_HIGH,
+      [](gpointer data) {
+        auto* job = static_cast<std::pair<FleetPublisher*, FleetCommand>*>(data);
+        job->first->apply_(job->second);
+        return G_SOURCE_REMOVE;
+      },
+      handed,
+      [](gpointer data) { delete static_cast<std::pair<FleetPublisher*, FleetCommand>*>(data); });
+}
+
+void FleetPublisher::status(const std::string& stream, const nlohmann::json& status, bool force) {
+  auto& state = streams_[stream];
+  std::string text = status.dump();
+  auto now = std::chrono::steady_clock::now();
+  if (!force && text == state.lastStatus && now - state.statusAt < kStatusInterval) return;
+  state.lastStatus = text;
+  state.statusAt = now;
+  {
+    Locked lock(&retainedMutex_);
+    retained_[stream] = text;
+  }
+  client_->publish(topic(stream, "status"), text, true);
+}
+
+void FleetPublisher::detections(const std::string& stream, const nlohmann::json& message,
+                                bool anyTags) {
+  auto& state = streams_[stream];
+  // Frames without tags say nothing, except the first after some had.
+  if (!anyTags && !state.hadTags) return;
+  auto now = std::chrono::steady_clock::now();
+  bool lostThem = !anyTags && state.hadTags;
+  if (!lostThem && settings_.detectionsRate > 0 &&
+      now - state.detectionsAt < std::chrono::duration<double>(1.0 / settings_.detectionsRate))
+    return;
+  state.hadTags = anyTags;
+  state.detectionsAt = now;
+  client_->publish(topic(stream, "detections"), message.dump());
+}
+
+void FleetPublisher::event(const std::string& stream, const nlohmann::json& event) {
+  client_->publish(topic(stream, "events"), event.dump());
+}
+
+}  // namespace wircam::recorder
