@@ -431,9 +431,9 @@ void Recording::handleError(GstMessage* message) {
     log("the disk is full: finishing the other files; earlier segments are untouched");
     stop(nullptr);
     // The failed stream never reaches EOS: give the rest 5 s.
-    g_timeout_add_seconds(
+    timers_.push_back(g_timeout_add_seconds(
         5, [](gpointer loop) { return g_main_loop_quit(static_cast<GMainLoop*>(loop)), FALSE; },
-        loop_);
+        loop_));
     return;
   }
   if (exitCode_ == 0) exitCode_ = kExitError;
@@ -492,7 +492,7 @@ void Recording::stop(const char* why) {
   // A splitmuxsink that never received a frame (the device never streamed)
   // does not pass EOS on, so the pipeline's EOS would never come: finished
   // segments close within a second or two, so after kFinishSeconds stop.
-  g_timeout_add_seconds(
+  timers_.push_back(g_timeout_add_seconds(
       kFinishSeconds,
       [](gpointer data) {
         auto* self = static_cast<Recording*>(data);
@@ -504,7 +504,7 @@ void Recording::stop(const char* why) {
         g_main_loop_quit(self->loop_);
         return G_SOURCE_REMOVE;
       },
-      this);
+      this));
 }
 
 gboolean Recording::onStop(gpointer data) {
@@ -513,6 +513,7 @@ gboolean Recording::onStop(gpointer data) {
     log("stopping now, without finishing the files");
     if (self->exitCode_ == 0) self->exitCode_ = kExitError;
     g_main_loop_quit(self->loop_);
+    if (self->hook_) self->hook_->stopDraining();
     return G_SOURCE_CONTINUE;
   }
   self->stoppedBySignal_ = true;
@@ -662,9 +663,11 @@ int Recording::run() {
   g_unix_signal_add(SIGINT, onStop, this);
   g_unix_signal_add(SIGTERM, onStop, this);
   if (options_.duration)
-    g_timeout_add(static_cast<guint>(*options_.duration * 1000), onDurationOver, this);
-  g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this);
-  g_timeout_add(TelemetryTrack::kHeartbeatInterval / GST_MSECOND, onHeartbeat, this);
+    timers_.push_back(
+        g_timeout_add(static_cast<guint>(*options_.duration * 1000), onDurationOver, this));
+  timers_.push_back(g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this));
+  timers_.push_back(
+      g_timeout_add(TelemetryTrack::kHeartbeatInterval / GST_MSECOND, onHeartbeat, this));
 
   if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE) {
     // The error itself comes on the bus; show it.
@@ -677,6 +680,9 @@ int Recording::run() {
     return kExitError;
   }
   g_main_loop_run(loop_);
+  // The run is over: its timers must not fire while the hooks drain.
+  for (guint id : timers_)
+    if (GSource* timer = g_main_context_find_source_by_id(nullptr, id)) g_source_destroy(timer);
   gst_bus_remove_watch(bus);
   gst_object_unref(bus);
   gst_element_set_state(pipeline_, GST_STATE_NULL);

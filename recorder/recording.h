@@ -114,6 +114,7 @@ class Recording {
   std::unique_ptr<RtspServer> rtsp_;
   std::unique_ptr<FleetPublisher> fleet_;  // with --mqtt
   std::unique_ptr<SegmentHook> hook_;      // with --on-segment-closed
+  std::vector<guint> timers_;              // the run's timeouts, removed when it ends
   bool stopping_ = false;
   bool stoppedBySignal_ = false;
   int exitCode_ = 0;

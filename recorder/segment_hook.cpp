@@ -132,7 +132,7 @@ std::vector<std::string> SegmentHook::drain(std::chrono::seconds limit) {
   // A tick, so a retry waiting longer than the limit does not hold it up.
   guint tick = g_timeout_add(
       200, [](gpointer) -> gboolean { return G_SOURCE_CONTINUE; }, nullptr);
-  while (!queue_.empty() && std::chrono::steady_clock::now() < end)
+  while (!queue_.empty() && !drainStopped_ && std::chrono::steady_clock::now() < end)
     g_main_context_iteration(nullptr, TRUE);
   g_source_remove(tick);
   std::vector<std::string> left;

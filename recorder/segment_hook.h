@@ -37,6 +37,8 @@ class SegmentHook {
   // Lets the queue run for up to `limit` (at exit); the segments it could
   // not hand over, by path.
   std::vector<std::string> drain(std::chrono::seconds limit);
+  // Ends a drain now (a second SIGINT).
+  void stopDraining() { drainStopped_ = true; }
 
  private:
   struct Job {
@@ -57,6 +59,7 @@ class SegmentHook {
   GPid running_ = 0;
   guint timeoutSource_ = 0, retrySource_ = 0, childSource_ = 0;
   bool timedOut_ = false;
+  bool drainStopped_ = false;
 };
 
 }  // namespace wircam::recorder

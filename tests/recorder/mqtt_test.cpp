@@ -1,0 +1,265 @@
+// wirc-recorder --mqtt and --on-segment-closed against a real mosquitto on
+// a loopback port of its own, the simulated car, and real hook commands.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "mqtt_broker.h"
+#include "recorder_process.h"
+#include "simulated_device.h"
+#include "wirc/device.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using namespace wircam::testing;
+using namespace std::chrono_literals;
+using Json = nlohmann::json;
+
+std::string streamOf(const wirc::Device& device) {
+  return "127.0.0.1-" + std::to_string(device.port()) + "-cam0";
+}
+
+Json parsed(const MqttMessage& m) { return Json::parse(m.payload, nullptr, false); }
+
+TEST(RecorderMqtt, StatusRetainedDetectionsAndTheLastWillOnKill) {
+  MosquittoBroker broker;
+  ASSERT_TRUE(broker.running());
+  auto device = startFollowDevice();
+  ASSERT_TRUE(device);
+  std::string stream = streamOf(*device);
+  MqttProbe probe(broker.port(), "wircam/#");
+  RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
+                                            broker.url(), "--duration", "60"});
+  ASSERT_TRUE(probe.waitFor(
+      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s))
+      << recorder.log();
+  // Detections of the simulator's tag, id 0, with centre and corners.
+  ASSERT_TRUE(probe.waitFor(
+      "wircam/" + stream + "/detections",
+      [](auto& m) {
+        auto d = parsed(m);
+        return !d.is_discarded() && !d["tags"].empty() && d["tags"][0]["id"] == 0 &&
+               d["tags"][0]["corners"].size() == 8 && d["tags"][0].contains("cx");
+      },
+      10s));
+  ASSERT_TRUE(probe.waitFor(
+      "wircam/" + stream + "/status",
+      [](auto& m) {
+        auto s = parsed(m);
+        return m.retained == false && s["state"] == "live" && s["fps"].template get<double>() > 0 &&
+               s["has_control"] == true && s["following"] == true && s.contains("loss") &&
+               s.contains("battery_v") && s.contains("position");
+      },
+      10s));
+  // Retained: a client that comes later gets the status and "online" at once.
+  MqttProbe late(broker.port(), "wircam/#");
+  EXPECT_TRUE(late.waitFor(
+      "wircam/" + stream + "/status",
+      [](auto& m) { return m.retained && parsed(m)["state"] == "live"; }, 5s));
+  EXPECT_TRUE(late.waitFor(
+      "wircam/available", [](auto& m) { return m.retained && m.payload == "online"; }, 5s));
+  // kill -9: the broker says offline for it (the last will).
+  recorder.signal(SIGKILL);
+  recorder.wait();
+  EXPECT_TRUE(late.waitFor(
+      "wircam/available", [](auto& m) { return m.payload == "offline"; }, 5s));
+}
+
+TEST(RecorderMqtt, SegmentClosedForEveryFileAndTheHookGetsEachWhole) {
+  MosquittoBroker broker;
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  MqttProbe probe(broker.port(), "fleet/one/#");
+  auto folder = fs::temp_directory_path() / ("wirc-hook-" + std::to_string(getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder / "uploaded");
+  // An uploader as a user would write one: copy the segment and its sidecar.
+  auto hook = folder / "upload.sh";
+  std::ofstream(hook) << "#!/bin/sh\nset -e\ncp \"$1\" \"$2\" '" << (folder / "uploaded").string()
+                      << "/'\n";
+  fs::permissions(hook, fs::perms::owner_all);
+  RecorderProcess recorder(device->port(),
+                           {"--mqtt", broker.url(), "--mqtt-prefix", "fleet/one", "--segment", "2",
+                            "--duration", "7", "--on-segment-closed", hook.string()});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto files = recorder.files(".mkv");
+  ASSERT_GE(files.size(), 3u);
+  std::string stream = streamOf(*device);
+  ASSERT_TRUE(probe.waitFor(
+      "fleet/one/" + stream + "/events",
+      [&](auto&) {
+        size_t closed = 0;
+        for (const auto& m : probe.messages("fleet/one/" + stream + "/events"))
+          closed += parsed(m)["type"] == "segment-closed";
+        return closed == files.size();
+      },
+      5s));
+  for (const auto& m : probe.messages("fleet/one/" + stream + "/events")) {
+    auto event = parsed(m);
+    if (event["type"] != "segment-closed") continue;
+    EXPECT_TRUE(fs::exists(recorder.out() / event["file"].get<std::string>())) << m.payload;
+    EXPECT_GT(event["duration_s"].get<double>(), 0.5);
+    EXPECT_EQ(event["start_utc"].get<std::string>().back(), 'Z');
+  }
+  for (const auto& file : files) {
+    auto copy = folder / "uploaded" / file.filename();
+    ASSERT_TRUE(fs::exists(copy)) << file;
+    EXPECT_EQ(fs::file_size(copy), fs::file_size(file)) << file;
+    std::string compare = "cmp -s '" + file.string() + "' '" + copy.string() + "'";
+    EXPECT_EQ(std::system(compare.c_str()), 0) << file << " arrived changed";
+    auto sidecar = fs::path(file).replace_extension(".jsonl");
+    EXPECT_TRUE(fs::exists(folder / "uploaded" / sidecar.filename()));
+  }
+  fs::remove_all(folder);
+}
+
+TEST(RecorderMqtt, FollowOffSendsTheCarToNeutralWithinOneCommandPeriod) {
+  MosquittoBroker broker;
+  auto device = startFollowDevice();
+  ASSERT_TRUE(device);
+  std::string stream = streamOf(*device);
+  MqttProbe probe(broker.port(), "wircam/#");
+  RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
+                                            broker.url(), "--duration", "60"});
+  ASSERT_TRUE(probe.waitFor(
+      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s));
+  // Driving after the target.
+  auto moving = [&] { return device->outputs().pulses[1] != wirc::kPulseNeutral; };
+  for (int i = 0; i < 500 && !moving(); ++i) std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(moving()) << "the car never drove";
+  auto sent = std::chrono::steady_clock::now();
+  probe.publish("wircam/" + stream + "/follow/set", "OFF");
+  while (moving() && std::chrono::steady_clock::now() - sent < 2s) std::this_thread::sleep_for(1ms);
+  auto took = std::chrono::steady_clock::now() - sent;
+  EXPECT_FALSE(moving());
+  // One command period: a frame at the simulator's 15 fps.
+  EXPECT_LT(took, 67ms) << std::chrono::duration_cast<std::chrono::milliseconds>(took).count();
+  EXPECT_EQ(device->outputs().pulses[0], wirc::kPulseNeutral);  // steering too
+  EXPECT_TRUE(probe.waitFor(
+      "wircam/" + stream + "/status", [](auto& m) { return parsed(m)["following"] == false; }, 3s));
+  // It stays stopped while the target is in view, and ON resumes.
+  std::this_thread::sleep_for(500ms);
+  EXPECT_FALSE(moving());
+  probe.publish("wircam/" + stream + "/follow/set", "ON");
+  bool resumed = false;
+  for (int i = 0; i < 300 && !resumed; ++i, std::this_thread::sleep_for(10ms)) resumed = moving();
+  EXPECT_TRUE(resumed);
+}
+
+TEST(RecorderMqtt, RejoinsABrokerRestartedMidRun) {
+  MosquittoBroker broker;
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess recorder(device->port(), {"--mqtt", broker.url(), "--duration", "60"});
+  {
+    MqttProbe probe(broker.port(), "wircam/#");
+    ASSERT_TRUE(probe.waitFor(
+        "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s));
+  }
+  broker.kill();
+  std::this_thread::sleep_for(1500ms);  // the recorder notices and backs off
+  ASSERT_TRUE(broker.start());
+  MqttProbe probe(broker.port(), "wircam/#");
+  // Back within its backoff (a few seconds), with its retained status again.
+  EXPECT_TRUE(probe.waitFor(
+      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s))
+      << recorder.log();
+  EXPECT_TRUE(probe.waitFor(
+      "wircam/" + streamOf(*device) + "/status",
+      [](auto& m) { return parsed(m)["state"] == "live"; }, 10s));
+  EXPECT_NE(recorder.log().find("lost the MQTT broker"), std::string::npos) << recorder.log();
+  recorder.signal(SIGTERM);
+  EXPECT_EQ(recorder.wait(), 0);
+}
+
+TEST(RecorderMqtt, RecordsOnWhateverTheBrokerDoes) {
+  // Down at the start, then refusing the credentials: clear lines, and the
+  // recording goes on.
+  MosquittoBroker strict("rover", "secret");
+  ASSERT_TRUE(strict.running());
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess wrongPassword(device->port(),
+                                {"--mqtt", strict.url("rover:wrong"), "--duration", "4"});
+  RecorderProcess nobody(device->port(), {"--mqtt", "mqtt://127.0.0.1:1", "--duration", "4"});
+  EXPECT_EQ(wrongPassword.wait(), 0) << wrongPassword.log();
+  EXPECT_EQ(nobody.wait(), 0) << nobody.log();
+  EXPECT_NE(wrongPassword.log().find("refused the connection: Connection Refused: not authorised"),
+            std::string::npos)
+      << wrongPassword.log();
+  EXPECT_NE(nobody.log().find("cannot be reached"), std::string::npos) << nobody.log();
+  EXPECT_FALSE(wrongPassword.files(".mkv").empty());
+  EXPECT_FALSE(nobody.files(".mkv").empty());
+  // The right password works.
+  MqttProbe watcher(strict.port(), "#");  // anonymous: refused, sees nothing
+  RecorderProcess right(device->port(), {"--mqtt", strict.url("rover:secret"), "--duration", "3"});
+  EXPECT_EQ(right.wait(), 0);
+  EXPECT_NE(right.log().find("connected to the MQTT broker"), std::string::npos) << right.log();
+}
+
+TEST(RecorderMqtt, IgnoresRetainedJunkAndBadCommands) {
+  MosquittoBroker broker;
+  auto device = startFollowDevice();
+  ASSERT_TRUE(device);
+  std::string stream = streamOf(*device);
+  MqttProbe probe(broker.port(), "wircam/#");
+  // Left behind by some other tool: replayed to every new subscriber.
+  probe.publish("wircam/" + stream + "/follow/set", "OFF", true);
+  probe.publish("wircam/" + stream + "/target/set", "\x01\xff junk", true);
+  std::this_thread::sleep_for(200ms);
+  RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
+                                            broker.url(), "--duration", "60"});
+  ASSERT_TRUE(probe.waitFor(
+      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s));
+  probe.publish("wircam/" + stream + "/follow/set", "SIDEWAYS");
+  probe.publish("wircam/" + stream + "/target/set", "7x");
+  probe.publish("wircam/no-such-stream/follow/set", "OFF");
+  std::this_thread::sleep_for(1500ms);
+  // Still following: no junk turned it off.
+  EXPECT_TRUE(probe.waitFor(
+      "wircam/" + stream + "/status", [](auto& m) { return parsed(m)["following"] == true; }, 5s));
+  for (const auto& m : probe.messages("wircam/" + stream + "/status"))
+    EXPECT_EQ(parsed(m)["following"], true) << m.payload;
+  auto log = recorder.log();
+  EXPECT_NE(log.find("ignoring the retained message on wircam/" + stream + "/follow/set"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("follow/set takes ON or OFF, not 'SIDEWAYS'"), std::string::npos) << log;
+  EXPECT_NE(log.find("not '7x'"), std::string::npos) << log;
+  EXPECT_NE(log.find("no stream 'no-such-stream'"), std::string::npos) << log;
+  probe.publish("wircam/" + stream + "/follow/set", "", true);  // clean up the retained ones
+}
+
+TEST(RecorderMqtt, AHangingHookIsStoppedRetriedAndReportedWhileRecordingGoesOn) {
+  MosquittoBroker broker;
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  MqttProbe probe(broker.port(), "wircam/#");
+  auto hang = fs::temp_directory_path() / ("wirc-hang-" + std::to_string(getpid()) + ".sh");
+  std::ofstream(hang) << "#!/bin/sh\nsleep 1000\n";
+  fs::permissions(hang, fs::perms::owner_all);
+  auto start = std::chrono::steady_clock::now();
+  RecorderProcess recorder(device->port(),
+                           {"--mqtt", broker.url(), "--segment", "2", "--duration", "5",
+                            "--on-segment-closed", hang.string(), "--hook-timeout", "1"});
+  EXPECT_EQ(recorder.wait(), 0) << recorder.log();
+  // Recording was not held up: the segments are all there and whole, and
+  // the exit came after at most the hooks' drain time.
+  EXPECT_GE(recorder.files(".mkv").size(), 2u);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 30s);
+  EXPECT_NE(recorder.log().find("ran longer than 1 s"), std::string::npos) << recorder.log();
+  EXPECT_NE(recorder.log().find("did not get to"), std::string::npos) << recorder.log();
+  EXPECT_EQ(recorder.log().find("gave up waiting for the pipeline"), std::string::npos)
+      << recorder.log();
+  fs::remove(hang);
+  EXPECT_TRUE(probe.waitFor(
+      "wircam/" + streamOf(*device) + "/events",
+      [](auto& m) { return parsed(m)["type"] == "hook-failed"; }, 3s));
+}
+
+}  // namespace
