@@ -20,32 +20,6 @@ struct Locked {
 
 }  // namespace
 
-Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
-                                                      const std::string& command,
-                                                      const std::string& payload) {
-  FleetCommand parsed{.kind = FleetCommand::Kind::kFollow, .stream = stream};
-  std::string upper = payload;
-  std::transform(upper.begin(), upper.end(), upper.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-  if (command == "follow/set") {
-    if (upper != "ON" && upper != "OFF")
-      return unexpected("follow/set takes ON or OFF, not '" + payload.substr(0, 40) + "'");
-    parsed.follow = upper == "ON";
-    return parsed;
-  }
-  if (command == "target/set") {
-    char* end = nullptr;
-    long id = std::strtol(payload.c_str(), &end, 10);
-    if (payload.empty() || *end != '\0' || id < -1 || id > 1000000)
-      return unexpected("target/set takes a tag id (or -1: the largest), not '" +
-                        payload.substr(0, 40) + "'");
-    parsed.kind = FleetCommand::Kind::kTarget;
-    parsed.target = static_cast<int>(id);
-    return parsed;
-  }
-  return unexpected("unknown command '" + command + "' (follow/set, target/set)");
-}
-
 FleetPublisher::FleetPublisher(Settings settings, std::function<void(const FleetCommand&)> apply)
     : settings_(std::move(settings)), apply_(std::move(apply)) {
   g_mutex_init(&retainedMutex_);

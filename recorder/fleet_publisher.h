@@ -17,20 +17,10 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "fleet_command.h"
 #include "mqtt_client.h"
 
 namespace wircam::recorder {
-
-struct FleetCommand {
-  enum class Kind { kFollow, kTarget } kind;
-  std::string stream;
-  bool follow = false;  // kFollow
-  int target = -1;      // kTarget
-};
-// A command's topic (after the prefix) and payload, or why it is refused.
-Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
-                                                      const std::string& command,
-                                                      const std::string& payload);
 
 class FleetPublisher {
  public:

@@ -45,7 +45,8 @@ Usage waitFor(pid_t pid) {
 size_t linesIn(const fs::path& file, const std::string& containing) {
   std::ifstream in(file);
   size_t count = 0;
-  for (std::string line; std::getline(in, line);) count += line.find(containing) != std::string::npos;
+  for (std::string line; std::getline(in, line);)
+    count += line.find(containing) != std::string::npos;
   return count;
 }
 
