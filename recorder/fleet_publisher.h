@@ -43,6 +43,7 @@ class FleetPublisher {
   void detections(const std::string& stream, const nlohmann::json& message, bool anyTags);
   void event(const std::string& stream, const nlohmann::json& event);
   MqttClient::Stats stats() const { return client_->stats(); }
+  bool connected() const { return client_->connected(); }
 
  private:
   struct StreamState {

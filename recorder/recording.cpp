@@ -538,7 +538,6 @@ gboolean Recording::onHeartbeat(gpointer data) {
 gboolean Recording::onTick(gpointer data) {
   auto* self = static_cast<Recording*>(data);
   self->printStatus();
-  self->publishFleetStatus();
   self->guardDisk();
   return G_SOURCE_CONTINUE;
 }
@@ -631,10 +630,18 @@ nlohmann::json Recording::status() const {
           rtsp_->url() + "/" + s->plan.device + "/cam" + std::to_string(s->plan.camera);
     streams.push_back(stream);
   }
-  return {{"out", options_.outDir},
-          {"free_bytes", disk_.free()},
-          {"stopping", stopping_},
-          {"streams", streams}};
+  nlohmann::json result = {{"out", options_.outDir},
+                           {"free_bytes", disk_.free()},
+                           {"stopping", stopping_},
+                           {"streams", streams}};
+  if (fleet_) {
+    auto mqtt = fleet_->stats();
+    result["mqtt"] = {{"connected", fleet_->connected()},
+                      {"published", mqtt.published},
+                      {"dropped", mqtt.dropped},
+                      {"connects", mqtt.connects}};
+  }
+  return result;
 }
 
 nlohmann::json Recording::trails() const {
@@ -668,6 +675,16 @@ int Recording::run() {
   timers_.push_back(g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this));
   timers_.push_back(
       g_timeout_add(TelemetryTrack::kHeartbeatInterval / GST_MSECOND, onHeartbeat, this));
+  // Once a second, whatever --status says: the fleet's status is published
+  // on change and at least every FleetPublisher::kStatusInterval.
+  if (fleet_)
+    timers_.push_back(g_timeout_add_seconds(
+        1,
+        [](gpointer self) -> gboolean {
+          static_cast<Recording*>(self)->publishFleetStatus();
+          return G_SOURCE_CONTINUE;
+        },
+        this));
 
   if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE) {
     // The error itself comes on the bus; show it.
