@@ -7,7 +7,6 @@
 // the messages are counted at the subscriber.
 // Usage: bench_recorder_mqtt [SECONDS] [N]   (default 15 s, 16 streams)
 #include <signal.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -27,20 +26,8 @@ namespace {
 namespace fs = std::filesystem;
 using wircam::bench::spawn;
 using wircam::bench::stopGroup;
-
-struct Usage {
-  double cpuSeconds = 0;
-  long maxRssKb = 0;
-};
-
-Usage waitFor(pid_t pid) {
-  int status = 0;
-  rusage usage{};
-  wait4(pid, &status, 0, &usage);
-  return {static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-              static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6,
-          usage.ru_maxrss};
-}
+using wircam::bench::Usage;
+using wircam::bench::waitForUsage;
 
 size_t linesIn(const fs::path& file, const std::string& containing) {
   std::ifstream in(file);
@@ -99,7 +86,7 @@ int main(int argc, char** argv) {
                           (work / "rec").string() + " --detect tag36h11 --segment 600 --duration " +
                           std::to_string(seconds);
     if (mqtt) command += " --mqtt mqtt://127.0.0.1:" + std::to_string(brokerPort);
-    Usage usage = waitFor(spawn(command));
+    Usage usage = waitForUsage(spawn(command));
     double cpuPerStream = 100.0 * usage.cpuSeconds / seconds / streams;
     std::string messages = "-";
     if (mqtt) {

@@ -8,7 +8,6 @@
 // Usage: bench_recorder_streams [SECONDS] [N...]   (default 10 s; 1 2 4 8)
 #include <gst/gst.h>
 #include <signal.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -29,20 +28,8 @@ namespace {
 namespace fs = std::filesystem;
 
 using wircam::bench::spawn;
-
-struct Usage {
-  double cpuSeconds = 0;
-  long maxRssKb = 0;
-};
-
-Usage waitFor(pid_t pid) {
-  int status = 0;
-  rusage usage{};
-  wait4(pid, &status, 0, &usage);
-  return {usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
-              (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6,
-          usage.ru_maxrss};
-}
+using wircam::bench::Usage;
+using wircam::bench::waitForUsage;
 
 int framesIn(const fs::path& file) {
   std::string description =
@@ -158,7 +145,7 @@ int main(int argc, char** argv) {
               " --segment 600 --duration " + std::to_string(seconds));
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
     int ourThreads = threadsOf(recorder);
-    Usage ours = waitFor(recorder);
+    Usage ours = waitForUsage(recorder);
     for (pid_t sim : sims) wircam::bench::stopGroup(sim, SIGINT);
     int sent = 0;
     for (int i = 0; i < n; ++i) sent += framesSent(work / ("sim" + std::to_string(i) + ".txt"));
@@ -192,7 +179,7 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
     int theirThreads = threadsOf(receiver);
     for (pid_t s : senders) waitpid(s, nullptr, 0);
-    Usage theirs = waitFor(receiver);
+    Usage theirs = waitForUsage(receiver);
     int rtpRecorded = framesInFolder(work / "rtp");
     int rtpSent = rtpFrames * n;
 

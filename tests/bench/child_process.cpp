@@ -1,6 +1,7 @@
 #include "child_process.h"
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +21,15 @@ pid_t spawn(const std::string& command, const std::string& output) {
 void stopGroup(pid_t pid, int signal) {
   kill(-pid, signal);
   waitpid(pid, nullptr, 0);
+}
+
+Usage waitForUsage(pid_t pid) {
+  int status = 0;
+  rusage usage{};
+  wait4(pid, &status, 0, &usage);
+  return {static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+              static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6,
+          usage.ru_maxrss};
 }
 
 }  // namespace wircam::bench

@@ -14,4 +14,11 @@ pid_t spawn(const std::string& command, const std::string& output = "/dev/null")
 // Signals the whole group and waits for its leader.
 void stopGroup(pid_t pid, int signal);
 
+// Waits for a child and says what it used: CPU (user + system) and peak memory.
+struct Usage {
+  double cpuSeconds = 0;
+  long maxRssKb = 0;
+};
+Usage waitForUsage(pid_t pid);
+
 }  // namespace wircam::bench

@@ -26,6 +26,12 @@ std::string streamOf(const wirc::Device& device) {
 
 Json parsed(const MqttMessage& m) { return Json::parse(m.payload, nullptr, false); }
 
+// The recorder said it is online (under the default prefix).
+bool cameOnline(MqttProbe& probe) {
+  return probe.waitFor(
+      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s);
+}
+
 TEST(RecorderMqtt, StatusRetainedDetectionsAndTheLastWillOnKill) {
   MosquittoBroker broker;
   ASSERT_TRUE(broker.running());
@@ -35,9 +41,7 @@ TEST(RecorderMqtt, StatusRetainedDetectionsAndTheLastWillOnKill) {
   MqttProbe probe(broker.port(), "wircam/#");
   RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
                                             broker.url(), "--duration", "60"});
-  ASSERT_TRUE(probe.waitFor(
-      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s))
-      << recorder.log();
+  ASSERT_TRUE(cameOnline(probe)) << recorder.log();
   // Detections of the simulator's tag, id 0, with centre and corners.
   ASSERT_TRUE(probe.waitFor(
       "wircam/" + stream + "/detections",
@@ -126,8 +130,7 @@ TEST(RecorderMqtt, FollowOffSendsTheCarToNeutralWithinOneCommandPeriod) {
   MqttProbe probe(broker.port(), "wircam/#");
   RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
                                             broker.url(), "--duration", "60"});
-  ASSERT_TRUE(probe.waitFor(
-      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s));
+  ASSERT_TRUE(cameOnline(probe));
   // Driving after the target.
   auto moving = [&] { return device->outputs().pulses[1] != wirc::kPulseNeutral; };
   for (int i = 0; i < 500 && !moving(); ++i) std::this_thread::sleep_for(10ms);
@@ -158,17 +161,14 @@ TEST(RecorderMqtt, RejoinsABrokerRestartedMidRun) {
   RecorderProcess recorder(device->port(), {"--mqtt", broker.url(), "--duration", "60"});
   {
     MqttProbe probe(broker.port(), "wircam/#");
-    ASSERT_TRUE(probe.waitFor(
-        "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s));
+    ASSERT_TRUE(cameOnline(probe));
   }
   broker.kill();
   std::this_thread::sleep_for(1500ms);  // the recorder notices and backs off
   ASSERT_TRUE(broker.start());
   MqttProbe probe(broker.port(), "wircam/#");
   // Back within its backoff (a few seconds), with its retained status again.
-  EXPECT_TRUE(probe.waitFor(
-      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s))
-      << recorder.log();
+  EXPECT_TRUE(cameOnline(probe)) << recorder.log();
   EXPECT_TRUE(probe.waitFor(
       "wircam/" + streamOf(*device) + "/status",
       [](auto& m) { return parsed(m)["state"] == "live"; }, 10s));
@@ -214,8 +214,7 @@ TEST(RecorderMqtt, IgnoresRetainedJunkAndBadCommands) {
   std::this_thread::sleep_for(200ms);
   RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
                                             broker.url(), "--duration", "60"});
-  ASSERT_TRUE(probe.waitFor(
-      "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s));
+  ASSERT_TRUE(cameOnline(probe));
   probe.publish("wircam/" + stream + "/follow/set", "SIDEWAYS");
   probe.publish("wircam/" + stream + "/target/set", "7x");
   probe.publish("wircam/no-such-stream/follow/set", "OFF");
