@@ -36,13 +36,12 @@ Expected<std::unique_ptr<FleetPublisher>, std::string> FleetPublisher::start(
   MqttWill will{settings.prefix + "/available", "offline"};
   auto client = MqttClient::start(
       settings.url, clientId, will,
-      {.connected = [self] { self->republish(); },
+      {.connected = [self](MqttClient& connected) { self->republish(connected); },
        .message = [self](const std::string& topic, const std::string& payload,
                          bool retained) { self->onMessage(topic, payload, retained); },
        .log = [](const std::string& line) { log(line); }});
   if (!client) return unexpected(client.error());
   publisher->client_ = std::move(*client);
-  publisher->client_->setFarewell(will);
   return publisher;
 }
 
@@ -57,15 +56,15 @@ std::string FleetPublisher::topic(const std::string& stream, const char* leaf) c
 
 // On the MQTT thread, at each connection: who we are, what we know, and
 // what we listen to.
-void FleetPublisher::republish() {
-  client_->publish(settings_.prefix + "/available", "online", true, 1);
+void FleetPublisher::republish(MqttClient& client) {
+  client.publish(settings_.prefix + "/available", "online", true, 1);
   {
     Locked lock(&retainedMutex_);
     for (const auto& [stream, status] : retained_)
-      client_->publish(topic(stream, "status"), status, true);
+      client.publish(topic(stream, "status"), status, true);
   }
-  client_->subscribe(settings_.prefix + "/+/follow/set");
-  client_->subscribe(settings_.prefix + "/+/target/set");
+  client.subscribe(settings_.prefix + "/+/follow/set");
+  client.subscribe(settings_.prefix + "/+/target/set");
 }
 
 void FleetPublisher::onMessage(const std::string& topicName, const std::string& payload,

@@ -55,7 +55,7 @@ class FleetPublisher {
   FleetPublisher(Settings settings, std::function<void(const FleetCommand&)> apply);
   std::string topic(const std::string& stream, const char* leaf) const;
   void onMessage(const std::string& topic, const std::string& payload, bool retained);
-  void republish();
+  void republish(MqttClient& client);
 
   const Settings settings_;
   const std::function<void(const FleetCommand&)> apply_;

@@ -18,8 +18,11 @@ constexpr int kReachTimeoutMs = 2000;
 
 }  // namespace
 
-MqttClient::MqttClient(MqttUrl url, mosquitto* handle, Handlers handlers)
-    : url_(std::move(url)), handle_(handle), handlers_(std::move(handlers)) {}
+MqttClient::MqttClient(MqttUrl url, MqttWill will, mosquitto* handle, Handlers handlers)
+    : url_(std::move(url)),
+      handle_(handle),
+      handlers_(std::move(handlers)),
+      will_(std::move(will)) {}
 
 Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttUrl& url,
                                                                      const std::string& clientId,
@@ -29,7 +32,7 @@ Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttU
   (void)initialised;
   mosquitto* handle = mosquitto_new(clientId.c_str(), true, nullptr);
   if (!handle) return unexpected(std::string("cannot create an MQTT client"));
-  std::unique_ptr<MqttClient> client(new MqttClient(url, handle, std::move(handlers)));
+  std::unique_ptr<MqttClient> client(new MqttClient(url, will, handle, std::move(handlers)));
   mosquitto_user_data_set(handle, client.get());
   mosquitto_threaded_set(handle, true);
   if (!url.user.empty() &&
@@ -111,10 +114,8 @@ void MqttClient::run() {
   }
   if (connected_) {
     // The last word, as the will would say it; then a clean goodbye.
-    if (farewell_)
-      mosquitto_publish(handle_, nullptr, farewell_->topic.c_str(),
-                        static_cast<int>(farewell_->payload.size()), farewell_->payload.data(), 1,
-                        true);
+    mosquitto_publish(handle_, nullptr, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
+                      will_.payload.data(), 1, true);
     for (int turn = 0; turn < 5 && mosquitto_want_write(handle_); ++turn)
       mosquitto_loop(handle_, 100, 1);
     mosquitto_disconnect(handle_);
@@ -138,7 +139,7 @@ void MqttClient::onConnect(mosquitto*, void* self, int rc) {
   ++client->connects_;
   client->report("connected to the MQTT broker " + client->url_.host + ":" +
                  std::to_string(client->url_.port));
-  if (client->handlers_.connected) client->handlers_.connected();
+  if (client->handlers_.connected) client->handlers_.connected(*client);
 }
 
 void MqttClient::onMessage(mosquitto*, void* self, const mosquitto_message* message) {

@@ -11,7 +11,6 @@
 #include <cstdint>
 #include <functional>
 #include <mutex>
-#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -33,7 +32,9 @@ class MqttClient {
  public:
   struct Handlers {
     // Each runs on the client's thread and must not block.
-    std::function<void()> connected;  // subscribe and publish what a new session needs
+    // Subscribe and publish what a new session needs (the client is passed:
+    // this may run before start() has returned).
+    std::function<void(MqttClient&)> connected;
     std::function<void(const std::string& topic, const std::string& payload, bool retained)>
         message;
     std::function<void(const std::string& line)> log;  // connection changes, once each
@@ -50,8 +51,9 @@ class MqttClient {
                                                                   const std::string& clientId,
                                                                   const MqttWill& will,
                                                                   Handlers handlers);
-  // Publishes `farewell` (retained) if connected, disconnects, joins the
-  // thread: within about a second whatever the broker does.
+  // Says the will itself (a clean stop is an end like any other) if
+  // connected, disconnects, joins the thread: within about a second
+  // whatever the broker does.
   ~MqttClient();
   MqttClient(const MqttClient&) = delete;
   MqttClient& operator=(const MqttClient&) = delete;
@@ -61,12 +63,11 @@ class MqttClient {
                int qos = 0);
   // Thread-safe; the client's thread only subscribes after it is connected.
   void subscribe(const std::string& pattern);
-  void setFarewell(const MqttWill& farewell) { farewell_ = farewell; }
   bool connected() const { return connected_; }
   Stats stats() const;
 
  private:
-  MqttClient(MqttUrl url, mosquitto* handle, Handlers handlers);
+  MqttClient(MqttUrl url, MqttWill will, mosquitto* handle, Handlers handlers);
   void run();
   bool reachable();
   void waitBackoff();
@@ -78,7 +79,7 @@ class MqttClient {
   const MqttUrl url_;
   mosquitto* handle_;
   const Handlers handlers_;
-  std::optional<MqttWill> farewell_;
+  const MqttWill will_;
   std::atomic<bool> connected_{false};
   std::atomic<bool> stopping_{false};
   std::atomic<uint64_t> published_{0}, written_{0}, dropped_{0}, connects_{0};
