@@ -23,6 +23,25 @@ namespace {
 // A minute of positions at 10 Hz: the trail the live view's map starts with.
 constexpr size_t kTrailPositions = 600;
 
+// --detect FAMILY against the families apriltagdetect knows (its GEnum).
+std::optional<std::string> checkFamily(const std::string& family) {
+  if (family.empty()) return std::nullopt;
+  GstElement* detector = gst_element_factory_make("apriltagdetect", nullptr);
+  if (!detector) return "--detect needs apriltagdetect: are the wircam plugins on GST_PLUGIN_PATH?";
+  auto* spec =
+      G_PARAM_SPEC_ENUM(g_object_class_find_property(G_OBJECT_GET_CLASS(detector), "family"));
+  std::string known;
+  bool found = false;
+  for (guint i = 0; i < spec->enum_class->n_values; ++i) {
+    std::string nick = spec->enum_class->values[i].value_nick;
+    found |= nick == family;
+    known += (known.empty() ? "" : ", ") + nick;
+  }
+  gst_object_unref(detector);
+  if (found) return std::nullopt;
+  return "--detect " + family + ": not an AprilTag family (" + known + ")";
+}
+
 void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
 
 }  // namespace
@@ -45,6 +64,8 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     return unexpected(
         "--codec h264 needs x264enc, from Debian's gstreamer1.0-plugins-ugly "
         "(tools/install-deps installs it)");
+
+  if (auto problem = checkFamily(options.detectFamily)) return unexpected(*problem);
 
   std::unique_ptr<Recording> recording(new Recording(options));
   // Segments the index lacks (a crash's last one, or a lost index).

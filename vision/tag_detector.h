@@ -47,9 +47,13 @@ struct PoseConfig {
   double fx = 0, fy = 0, cx = 0, cy = 0;
 };
 
+// The most bit errors a detector corrects: 3 would need a decoding table of
+// gigabytes (apriltag.h's own warning; 2.4 GB measured).
+inline constexpr int kMaxHamming = 2;
+
 struct DetectorOptions {
   std::string family = "tag36h11";
-  float quadDecimate = 2.0f;
+  float quadDecimate = 2.0f;  // the library's; the element defaults to 1 (see its blurb)
   float quadSigma = 0.0f;
   int threads = 1;
   bool refineEdges = true;

@@ -43,14 +43,18 @@ Expected<TagTracker, std::string> TagTracker::create(const DetectorOptions& opti
     return unexpected(std::string("the full-frame interval must be >= 1"));
   auto full = TagDetector::create(options);
   if (!full) return unexpected(full.error());
-  DetectorOptions windowOptions = options;
-  windowOptions.quadDecimate = 1;
-  auto window = TagDetector::create(windowOptions);
-  if (!window) return unexpected(window.error());
-  return TagTracker(std::move(*full), std::move(*window), tracking);
+  std::optional<TagDetector> window;
+  if (tracking.fullFrameInterval > 1) {
+    DetectorOptions windowOptions = options;
+    windowOptions.quadDecimate = 1;
+    auto created = TagDetector::create(windowOptions);
+    if (!created) return unexpected(created.error());
+    window.emplace(std::move(*created));
+  }
+  return TagTracker(std::move(*full), std::move(window), tracking);
 }
 
-TagTracker::TagTracker(TagDetector full, TagDetector window, TrackerOptions tracking)
+TagTracker::TagTracker(TagDetector full, std::optional<TagDetector> window, TrackerOptions tracking)
     : full_(std::move(full)), window_(std::move(window)), tracking_(tracking) {}
 
 std::vector<TagDetection> TagTracker::searchWindows(const GrayView& image) {
@@ -64,7 +68,7 @@ std::vector<TagDetection> TagTracker::searchWindows(const GrayView& image) {
     GrayView crop{image.data + static_cast<ptrdiff_t>(w.y0) * image.stride + w.x0, w.x1 - w.x0,
                   w.y1 - w.y0, image.stride};
     bool seen = false;
-    for (auto& d : window_.detect(crop, {static_cast<double>(w.x0), static_cast<double>(w.y0)})) {
+    for (auto& d : window_->detect(crop, {static_cast<double>(w.x0), static_cast<double>(w.y0)})) {
       bool duplicate = std::any_of(found.begin(), found.end(),
                                    [&](const TagDetection& f) { return f.id == d.id; });
       seen = seen || d.id == last.id;
@@ -78,7 +82,7 @@ std::vector<TagDetection> TagTracker::searchWindows(const GrayView& image) {
 std::vector<TagDetection> TagTracker::detect(const GrayView& image) {
   ++stats_.frames;
   std::vector<TagDetection> found;
-  bool full = previous_.empty() || ++sinceFullSearch_ >= tracking_.fullFrameInterval;
+  bool full = !window_ || previous_.empty() || ++sinceFullSearch_ >= tracking_.fullFrameInterval;
   if (!full) {
     ++stats_.windowSearches;
     found = searchWindows(image);

@@ -5,6 +5,7 @@
 // frame; new tags are found at the next full search.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "tag_detector.h"
@@ -33,11 +34,13 @@ class TagTracker {
   const TrackerStats& stats() const { return stats_; }
 
  private:
-  TagTracker(TagDetector full, TagDetector window, TrackerOptions tracking);
+  TagTracker(TagDetector full, std::optional<TagDetector> window, TrackerOptions tracking);
   std::vector<TagDetection> searchWindows(const GrayView& image);
 
   TagDetector full_;
-  TagDetector window_;  // no decimation: windows are small
+  // No decimation (windows are small); only with tracking on
+  // (fullFrameInterval > 1), or every frame is a full search anyway.
+  std::optional<TagDetector> window_;
   TrackerOptions tracking_;
   std::vector<TagDetection> previous_;
   std::vector<TagDetection> beforePrevious_;

@@ -11,8 +11,7 @@
  *
  * ## Example launch line
  * |[
- * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=I420 ! apriltagdetect !
- * tagoverlay ! videoconvert ! autovideosink
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=I420 ! apriltagdetect ! tagoverlay ! videoconvert ! autovideosink
  * ]|
  */
 #include "gsttagoverlay.h"

@@ -10,9 +10,10 @@
  *
  * ## Example launch lines
  * |[
- * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=GRAY8 ! apriltagdetect !
- * fakesink gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec scale=1/2 ! videoconvert !
- * autovideosink
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec ! video/x-raw,format=GRAY8 ! apriltagdetect ! fakesink
+ * ]|
+ * |[
+ * gst-launch-1.0 wircsrc host=127.0.0.1 ! tjpegdec scale=1/2 ! videoconvert ! autovideosink
  * ]|
  */
 #include "gsttjpegdec.h"

@@ -15,12 +15,10 @@
  *
  * ## Example launch lines
  * |[
- * gst-launch-1.0 -m wircsrc host=192.168.1.1 ! marvelmindpositions host=192.168.1.50 beacons=5 !
- * tjpegdec ! tagoverlay ! autovideosink
+ * gst-launch-1.0 -m wircsrc host=192.168.1.1 ! marvelmindpositions host=192.168.1.50 beacons=5 ! tjpegdec ! tagoverlay ! autovideosink
  * ]|
  * |[
- * gst-launch-1.0 -m wircsrc ! marvelmindpositions mode=stream listen-port=49100 host=192.168.1.50
- * beacons=5,6 ! fakesink
+ * gst-launch-1.0 -m wircsrc ! marvelmindpositions mode=stream listen-port=49100 host=192.168.1.50 beacons=5,6 ! fakesink
  * ]|
  */
 #include "gstmarvelmindpositions.h"

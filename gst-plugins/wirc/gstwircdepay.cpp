@@ -9,8 +9,7 @@
  *
  * ## Example launch line
  * |[
- * gst-launch-1.0 udpsrc port=5000 buffer-size=8388608 mtu=65536 caps=application/x-wirc-mjpeg !
- * wircdepay ! jpegdec ! videoconvert ! autovideosink
+ * gst-launch-1.0 udpsrc port=5000 buffer-size=8388608 mtu=65536 caps=application/x-wirc-mjpeg ! wircdepay ! jpegdec ! videoconvert ! autovideosink
  * ]|
  */
 #include "gstwircdepay.h"

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <regex>
 
 #include "scene_frames.h"
 #include "wirc_position_meta.h"
@@ -181,6 +182,35 @@ TEST(TagOverlay, WritesEachBeaconsPositionInTheBottomLeftCorner) {
   EXPECT_GT(yellowPixels(out), 50);
   gst_buffer_unref(out);
   gst_harness_teardown(h);
+}
+
+TEST(ApriltagDetect, GstInspectListsTheFamiliesAndTheSafeLimits) {
+  // As a user sees it: the families are an enum, quad-decimate defaults to
+  // what the README recommends, max-hamming stops at 2.
+  std::string command =
+      std::string("GST_PLUGIN_PATH=") + WIRCAM_PLUGIN_DIR + " gst-inspect-1.0 apriltagdetect 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string text;
+  char chunk[4096];
+  while (size_t n = fread(chunk, 1, sizeof chunk, pipe)) text.append(chunk, n);
+  pclose(pipe);
+  for (const char* family :
+       {"tag36h11", "tag25h9", "tag16h5", "tagCircle21h7", "tagStandard41h12", "tagStandard52h13"})
+    EXPECT_NE(text.find(std::string(": ") + family), std::string::npos) << family << "\n" << text;
+  EXPECT_NE(text.find("Enum \"GstApriltagFamily\" Default: 0, \"tag36h11\""), std::string::npos);
+  // quad-decimate: "Float. Range: 1 - 8 Default: 1", gst-inspect pads the numbers.
+  EXPECT_TRUE(std::regex_search(text, std::regex("Float\\. Range: +1 - +8 Default: +1 "))) << text;
+  EXPECT_NE(text.find("Range: 0 - 2 Default: 1"), std::string::npos) << text;
+}
+
+TEST(ApriltagDetect, RefusesAFamilyItDoesNotKnowWhereItIsSet) {
+  GError* error = nullptr;
+  GstElement* pipeline =
+      gst_parse_launch("videotestsrc ! apriltagdetect family=tag99h1 ! fakesink", &error);
+  EXPECT_NE(error, nullptr);
+  if (error) g_error_free(error);
+  if (pipeline) gst_object_unref(pipeline);
 }
 
 }  // namespace

@@ -73,5 +73,25 @@ TEST(TagTracker, SearchesTheWholeFrameWhenATagIsLost) {
   EXPECT_FALSE(tracker->detect(view).empty());
 }
 
+TEST(TagDetector, RefusesAHammingDistanceThatWouldTakeGigabytes) {
+  EXPECT_TRUE(TagDetector::create({.maxHamming = kMaxHamming}));
+  auto refused = TagDetector::create({.maxHamming = 3});
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().find("0..2"), std::string::npos) << refused.error();
+}
+
+TEST(TagTracker, WithoutTrackingEveryFrameIsAFullSearch) {
+  // fullFrameInterval 1 is apriltagdetect without roi-tracking: no window
+  // detector is built, and no window is ever searched.
+  auto tracker = TagTracker::create({.quadDecimate = 1}, {.fullFrameInterval = 1});
+  ASSERT_TRUE(tracker);
+  for (const auto& frame : followSequence(352, 288, 5)) {
+    GrayView view{frame.gray.data(), frame.width, frame.height, frame.width};
+    EXPECT_FALSE(tracker->detect(view).empty());
+  }
+  EXPECT_EQ(tracker->stats().fullSearches, 5u);
+  EXPECT_EQ(tracker->stats().windowSearches, 0u);
+}
+
 }  // namespace
 }  // namespace wircam::vision
