@@ -22,9 +22,15 @@
  * reconnect, login-timeout, link-timeout, max-bad-messages, periods,
  * failsafe); a conflict is an error naming both elements.
  *
- * ## Example launch line
+ * As a URI handler it takes wirc://HOST[:PORT]/CAMERA?device=NAME (an empty
+ * HOST discovers the device named), so playbin and gst-play-1.0 play it.
+ *
+ * ## Example launch lines
  * |[
  * gst-launch-1.0 -e wircsrc host=127.0.0.1 ! jpegdec ! videoconvert ! autovideosink
+ * ]|
+ * |[
+ * gst-play-1.0 wirc://192.168.1.1/0
  * ]|
  */
 #include "gstwircsrc.h"
@@ -48,6 +54,7 @@
 #include "login_properties.h"
 #include "wirc/stream_receiver.h"
 #include "wirc/transmitter_session.h"
+#include "wirc_uri.h"
 
 GST_DEBUG_CATEGORY_STATIC(wirc_src_debug);
 #define GST_CAT_DEFAULT wirc_src_debug
@@ -158,7 +165,10 @@ struct _GstWircSrc {
   WircSrcState* state;
 };
 
-G_DEFINE_TYPE(GstWircSrc, gst_wirc_src, GST_TYPE_PUSH_SRC)
+static void gst_wirc_src_uri_handler_init(gpointer iface, gpointer);
+
+G_DEFINE_TYPE_WITH_CODE(GstWircSrc, gst_wirc_src, GST_TYPE_PUSH_SRC,
+                        G_IMPLEMENT_INTERFACE(GST_TYPE_URI_HANDLER, gst_wirc_src_uri_handler_init))
 
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("image/jpeg"));
@@ -795,4 +805,51 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
   pushsrc->create = gst_wirc_src_create;
 
   GST_DEBUG_CATEGORY_INIT(wirc_src_debug, "wircsrc", 0, "WiRC camera source");
+}
+
+static GstURIType gst_wirc_src_uri_get_type(GType) { return GST_URI_SRC; }
+
+static const gchar* const* gst_wirc_src_uri_get_protocols(GType) {
+  static const gchar* const protocols[] = {"wirc", nullptr};
+  return protocols;
+}
+
+static gchar* gst_wirc_src_uri_get_uri(GstURIHandler* handler) {
+  auto* self = GST_WIRC_SRC(handler);
+  gst::GLibLocker lock(self);
+  const auto& s = self->state->settings;
+  gst::WircUri uri{.host = s.host,
+                   .port = static_cast<uint16_t>(s.port),
+                   .camera = s.camera,
+                   .device = s.device};
+  return g_strdup(uri.toString().c_str());
+}
+
+static gboolean gst_wirc_src_uri_set_uri(GstURIHandler* handler, const gchar* text,
+                                         GError** error) {
+  auto* self = GST_WIRC_SRC(handler);
+  auto uri = gst::parseWircUri(text ? text : "");
+  if (!uri) {
+    g_set_error(error, GST_URI_ERROR, GST_URI_ERROR_BAD_URI, "%s", uri.error().c_str());
+    return FALSE;
+  }
+  {
+    gst::GLibLocker lock(self);
+    if (GST_STATE(self) > GST_STATE_READY) {
+      g_set_error(error, GST_URI_ERROR, GST_URI_ERROR_BAD_STATE,
+                  "the URI cannot change while wircsrc is PAUSED or PLAYING");
+      return FALSE;
+    }
+  }
+  g_object_set(self, "host", uri->host.c_str(), "port", guint{uri->port}, "camera", uri->camera,
+               "device", uri->device.c_str(), nullptr);
+  return TRUE;
+}
+
+static void gst_wirc_src_uri_handler_init(gpointer g_iface, gpointer) {
+  auto* iface = static_cast<GstURIHandlerInterface*>(g_iface);
+  iface->get_type = gst_wirc_src_uri_get_type;
+  iface->get_protocols = gst_wirc_src_uri_get_protocols;
+  iface->get_uri = gst_wirc_src_uri_get_uri;
+  iface->set_uri = gst_wirc_src_uri_set_uri;
 }

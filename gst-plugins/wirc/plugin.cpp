@@ -6,8 +6,10 @@
 #include "gstwircdepay.h"
 #include "gstwircsrc.h"
 
+// wircsrc has a rank so that playbin picks it for wirc:// URIs (it is the
+// only handler of that scheme, and autoplugs nothing else).
 static gboolean plugin_init(GstPlugin* plugin) {
-  return gst_element_register(plugin, "wircsrc", GST_RANK_NONE, GST_TYPE_WIRC_SRC) &&
+  return gst_element_register(plugin, "wircsrc", GST_RANK_PRIMARY, GST_TYPE_WIRC_SRC) &&
          gst_element_register(plugin, "wircdepay", GST_RANK_NONE, GST_TYPE_WIRC_DEPAY) &&
          gst_element_register(plugin, "wirccontrol", GST_RANK_NONE, GST_TYPE_WIRC_CONTROL) &&
          gst_element_register(plugin, "marvelmindpositions", GST_RANK_NONE,
