@@ -7,12 +7,15 @@
 
 namespace wircam::gst {
 
+// Holds a reference while mapped: the buffer may be released by its owner
+// (a decoder's finished frame) before the scope ends.
 class ScopedBufferMap {
  public:
   ScopedBufferMap(GstBuffer* buffer, GstMapFlags flags)
-      : buffer_(buffer), mapped_(gst_buffer_map(buffer, &info_, flags)) {}
+      : buffer_(gst_buffer_ref(buffer)), mapped_(gst_buffer_map(buffer, &info_, flags)) {}
   ~ScopedBufferMap() {
     if (mapped_) gst_buffer_unmap(buffer_, &info_);
+    gst_buffer_unref(buffer_);
   }
   ScopedBufferMap(const ScopedBufferMap&) = delete;
   ScopedBufferMap& operator=(const ScopedBufferMap&) = delete;
