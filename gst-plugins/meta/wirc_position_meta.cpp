@@ -62,9 +62,9 @@ guint wirc_buffer_get_n_position_metas(GstBuffer* buffer) {
 WircPositionMeta* wirc_buffer_get_position_meta(GstBuffer* buffer, guint index) {
   gpointer state = nullptr;
   guint seen = 0;
-  while (GstMeta* meta = buffer ? gst_buffer_iterate_meta_filtered(buffer, &state,
-                                                                   WIRC_POSITION_META_API_TYPE)
-                                : nullptr)
+  while (GstMeta* meta =
+             buffer ? gst_buffer_iterate_meta_filtered(buffer, &state, WIRC_POSITION_META_API_TYPE)
+                    : nullptr)
     if (seen++ == index) return reinterpret_cast<WircPositionMeta*>(meta);
   return nullptr;
 }
