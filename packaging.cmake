@@ -12,9 +12,11 @@ set(CPACK_PACKAGE_DESCRIPTION
  apriltagdetect, tagoverlay), the wirc-recorder service with its systemd unit,
  wirc-cli, wirc-sim, and libwircam-gst with its typelib for Python.")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_INSTALL_PREFIX /usr)
 # The unit's paths are written at install time: the staging must keep /usr.
 set(CPACK_SET_DESTDIR ON)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_STRIP_FILES ON)  # the debug info stays in the build tree
 set(CPACK_DEBIAN_PACKAGE_SECTION video)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS ON)
