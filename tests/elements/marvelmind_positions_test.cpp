@@ -71,8 +71,11 @@ TEST(MarvelmindPositions, JoinsTheNearestPositionToEachFrameAndPostsEachNewOne) 
     }
     gst_structure_free(s);
   }
-  // Frames after the first positions carry one meta each.
+  // Frames after the first positions carry one meta each (those queued in
+  // the appsink from before are skipped).
   GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
+  while (GstSample* queued = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), 0))
+    gst_sample_unref(queued);
   int withMeta = 0;
   for (int i = 0; i < 15; ++i) {
     GstSample* sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), GST_SECOND);
