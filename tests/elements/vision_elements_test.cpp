@@ -7,6 +7,7 @@
 #include <cmath>
 #include <regex>
 
+#include "pipelines.h"
 #include "scene_frames.h"
 #include "wirc_position_meta.h"
 #include "wirc_tag_meta.h"
@@ -187,14 +188,8 @@ TEST(TagOverlay, WritesEachBeaconsPositionInTheBottomLeftCorner) {
 TEST(ApriltagDetect, GstInspectListsTheFamiliesAndTheSafeLimits) {
   // As a user sees it: the families are an enum, quad-decimate defaults to
   // what the README recommends, max-hamming stops at 2.
-  std::string command =
-      std::string("GST_PLUGIN_PATH=") + WIRCAM_PLUGIN_DIR + " gst-inspect-1.0 apriltagdetect 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string text;
-  char chunk[4096];
-  while (size_t n = fread(chunk, 1, sizeof chunk, pipe)) text.append(chunk, n);
-  pclose(pipe);
+  std::string text = wircam::testing::commandOutput(
+      std::string("GST_PLUGIN_PATH=") + WIRCAM_PLUGIN_DIR + " gst-inspect-1.0 apriltagdetect");
   for (const char* family :
        {"tag36h11", "tag25h9", "tag16h5", "tagCircle21h7", "tagStandard41h12", "tagStandard52h13"})
     EXPECT_NE(text.find(std::string(": ") + family), std::string::npos) << family << "\n" << text;

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "jpeg_sequence_scene.h"
+#include "pipelines.h"
 #include "scene_frames.h"
 #include "wirc/device.h"
 
@@ -92,15 +93,10 @@ TEST(WircUri, PlaybinPlaysTheCamera) {
 TEST(WircUri, GstPlayPlaysItWithAFakeVideoSink) {
   auto device = startDevice();
   ASSERT_TRUE(device);
-  std::string command = std::string("GST_PLUGIN_PATH=") + WIRCAM_PLUGIN_DIR +
-                        " timeout -s INT 3 gst-play-1.0 --videosink=fakesink wirc://127.0.0.1:" +
-                        std::to_string(device->port()) + "/0 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string output;
-  char chunk[4096];
-  while (size_t n = fread(chunk, 1, sizeof chunk, pipe)) output.append(chunk, n);
-  pclose(pipe);
+  std::string output = testing::commandOutput(
+      std::string("GST_PLUGIN_PATH=") + WIRCAM_PLUGIN_DIR +
+      " timeout -s INT 3 gst-play-1.0 --videosink=fakesink wirc://127.0.0.1:" +
+      std::to_string(device->port()) + "/0");
   EXPECT_NE(output.find("Now playing wirc://127.0.0.1:"), std::string::npos) << output;
   EXPECT_NE(output.find("Prerolled"), std::string::npos) << output;
   EXPECT_NE(output.find("0:00:01.0"), std::string::npos) << "the position never reached 1 s\n"
