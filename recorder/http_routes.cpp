@@ -7,6 +7,8 @@ namespace {
 constexpr std::string_view kLive = "/live/";
 constexpr std::string_view kMjpeg = ".mjpg";
 constexpr std::string_view kRecordings = "/recordings/";
+constexpr std::string_view kCameras = "/api/cameras/";
+constexpr std::string_view kSnapshot = "/snapshot.jpg";
 
 }  // namespace
 
@@ -15,6 +17,14 @@ Route routeOf(std::string_view path) {
   if (path == "/" || path == "/index.html") return {Kind::Page, ""};
   if (path == "/api/status") return {Kind::Status, ""};
   if (path == "/api/events") return {Kind::Events, ""};
+  if (path == "/api/cameras") return {Kind::Cameras, ""};
+  if (path == "/api/recordings") return {Kind::RecordingIndex, ""};
+  if (path.starts_with(kCameras) && path.ends_with(kSnapshot) &&
+      path.size() > kCameras.size() + kSnapshot.size()) {
+    auto camera = path.substr(kCameras.size(), path.size() - kCameras.size() - kSnapshot.size());
+    if (camera.find('/') == std::string_view::npos) return {Kind::Snapshot, std::string(camera)};
+  }
+  if (path.starts_with("/api/")) return {Kind::ApiNotFound, ""};
   if (path.starts_with(kLive) && path.ends_with(kMjpeg) &&
       path.size() > kLive.size() + kMjpeg.size())
     return {Kind::Live,

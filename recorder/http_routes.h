@@ -8,9 +8,21 @@
 namespace wircam::recorder {
 
 struct Route {
-  enum class Kind { Page, Status, Events, Live, RecordingList, Recording, NotFound };
+  enum class Kind {
+    Page,
+    Status,
+    Events,
+    Live,
+    RecordingList,
+    Recording,
+    Cameras,         // GET /api/cameras
+    Snapshot,        // GET /api/cameras/NAME/snapshot.jpg
+    RecordingIndex,  // GET /api/recordings
+    ApiNotFound,     // any other /api/ path: 404 with JSON
+    NotFound
+  };
   Kind kind = Kind::NotFound;
-  std::string name;  // the camera (Live) or the file (Recording)
+  std::string name;  // the camera (Live, Snapshot) or the file (Recording)
 };
 
 // `path` as libsoup hands it over (percent-decoded).

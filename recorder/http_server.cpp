@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <mutex>
 #include <set>
 
 #include "http_routes.h"
@@ -27,6 +28,11 @@ void respondError(SoupServerMessage* message, guint status, const std::string& t
   respond(message, status, "text/plain; charset=utf-8", text + "\n");
 }
 
+// The API answers errors in JSON too, so scripts can read them.
+void respondJsonError(SoupServerMessage* message, guint status, const std::string& text) {
+  respond(message, status, "application/json", nlohmann::json{{"error", text}}.dump());
+}
+
 }  // namespace
 
 // One open streaming response: an MJPEG viewer or an event listener.
@@ -41,8 +47,12 @@ struct HttpServer::CameraFeed {
   FrameTap* frames;
   int listener = 0;
   std::vector<std::unique_ptr<Client>> clients;
-  std::atomic<int> clientCount{0};                      // read on the streaming thread
-  std::atomic<int> width{0}, height{0};                 // of the last frame, for the overlay
+  std::atomic<int> clientCount{0};       // read on the streaming thread
+  std::atomic<int> width{0}, height{0};  // of the last frame, for the overlay
+  // The newest frame as the camera sent it, for snapshots (the streaming
+  // thread swaps it, the main loop reads it).
+  std::mutex latestMutex;
+  GstBuffer* latest = nullptr;
   nlohmann::json detections = nlohmann::json::array();  // the last ones
 };
 
@@ -93,8 +103,12 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
         raw->width = width;
         raw->height = height;
       }
-      if (raw->clientCount.load() == 0) return;
       GstBuffer* jpeg = gst_sample_get_buffer(sample);
+      {
+        std::lock_guard lock(raw->latestMutex);
+        gst_buffer_replace(&raw->latest, jpeg);
+      }
+      if (raw->clientCount.load() == 0) return;
       struct Delivery {
         HttpServer* server;
         size_t camera;
@@ -122,7 +136,10 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
 }
 
 HttpServer::~HttpServer() {
-  for (auto& feed : feeds_) feed->frames->forget(feed->listener);
+  for (auto& feed : feeds_) {
+    feed->frames->forget(feed->listener);
+    gst_buffer_replace(&feed->latest, nullptr);
+  }
   alive_.reset();
   auto release = [](std::vector<std::unique_ptr<Client>>& clients) {
     for (auto& client : clients) {
@@ -201,10 +218,22 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       return self->serveRecordings(message, "");
     case Route::Kind::Recording:
       return self->serveRecordings(message, route.name);
+    case Route::Kind::Cameras:
+      return respond(message, SOUP_STATUS_OK, "application/json",
+                     self->content_.cameraStates().dump());
+    case Route::Kind::Snapshot:
+      return self->serveSnapshot(message, route.name);
+    case Route::Kind::RecordingIndex:
+      return self->serveRecordingIndex(message);
+    case Route::Kind::ApiNotFound:
+      return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
+                              "no such endpoint; /api/status, /api/events, /api/cameras, "
+                              "/api/cameras/NAME/snapshot.jpg, /api/recordings");
     case Route::Kind::NotFound:
       return respondError(
           message, SOUP_STATUS_NOT_FOUND,
-          "not found; try /, /api/status, /api/events, /live/CAMERA.mjpg or /recordings");
+          "not found; try /, /api/status, /api/events, /api/cameras, /api/recordings, "
+          "/live/CAMERA.mjpg or /recordings");
   }
 }
 
@@ -323,6 +352,41 @@ void HttpServer::publishDetections(const std::string& camera, const nlohmann::js
   GBytes* chunk = g_bytes_new(text.data(), text.size());
   send(eventClients_, chunk);
   g_bytes_unref(chunk);
+}
+
+void HttpServer::serveSnapshot(SoupServerMessage* message, const std::string& camera) {
+  auto feed =
+      std::find_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f->name == camera; });
+  if (feed == feeds_.end())
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+  GstBuffer* jpeg = nullptr;
+  {
+    std::lock_guard lock((*feed)->latestMutex);
+    gst_buffer_replace(&jpeg, (*feed)->latest);
+  }
+  if (!jpeg)
+    return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE,
+                            "camera '" + camera + "' has sent no frame yet");
+  // The frame untouched: the camera's own JPEG bytes.
+  GstMapInfo map;
+  if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
+    respond(message, SOUP_STATUS_OK, "image/jpeg",
+            std::string(reinterpret_cast<const char*>(map.data), map.size));
+    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Cache-Control",
+                                 "no-cache, no-store");
+    gst_buffer_unmap(jpeg, &map);
+  }
+  gst_buffer_unref(jpeg);
+}
+
+void HttpServer::serveRecordingIndex(SoupServerMessage* message) {
+  nlohmann::json list = content_.recordings();
+  for (auto& entry : list) {
+    gchar* escaped = g_uri_escape_string(entry["file"].get<std::string>().c_str(), nullptr, FALSE);
+    entry["url"] = std::string("/recordings/") + escaped;
+    g_free(escaped);
+  }
+  respond(message, SOUP_STATUS_OK, "application/json", list.dump());
 }
 
 void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& name) {

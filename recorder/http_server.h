@@ -30,6 +30,10 @@ class HttpServer {
     std::vector<Camera> cameras;
     std::string recordingsFolder;
     std::function<nlohmann::json()> status;  // called on the main thread
+    // /api/cameras: [{name, state, fps, has_control, following}, ...]
+    std::function<nlohmann::json()> cameraStates;
+    // /api/recordings: the recording index's entries (url added here)
+    std::function<nlohmann::json()> recordings;
     // Each stream's recent Marvelmind positions, for the page's map:
     // {"<stream>": {"points": [{"x","y","utc"}, ...], "stale": bool}}.
     std::function<nlohmann::json()> trails;
@@ -66,6 +70,8 @@ class HttpServer {
   std::string page() const;  // the live view page with the current state
   void serveLive(SoupServerMessage* message, const std::string& camera);
   void serveEvents(SoupServerMessage* message);
+  void serveSnapshot(SoupServerMessage* message, const std::string& camera);
+  void serveRecordingIndex(SoupServerMessage* message);
   void serveRecordings(SoupServerMessage* message, const std::string& name);
   // Keeps `message` open as a stream of chunks in `clients`.
   void openStream(SoupServerMessage* message, const char* contentType,

@@ -23,6 +23,13 @@ namespace {
 // A minute of positions at 10 Hz: the trail the live view's map starts with.
 constexpr size_t kTrailPositions = 600;
 
+// /api/cameras' state: live, offline or connecting (the device not seen yet).
+const char* apiState(const std::string& state) {
+  if (state == "live") return "live";
+  if (state == "offline") return "offline";
+  return "connecting";
+}
+
 // --detect FAMILY against the families apriltagdetect knows (its GEnum).
 std::optional<std::string> checkFamily(const std::string& family) {
   if (family.empty()) return std::nullopt;
@@ -124,6 +131,23 @@ std::optional<std::string> Recording::startServers() {
     content.recordingsFolder = options_.outDir;
     content.status = [this] { return status(); };
     content.trails = [this] { return trails(); };
+    content.cameraStates = [this] {
+      nlohmann::json cameras = nlohmann::json::array();
+      for (const auto& s : streams_) {
+        auto status = fleetStatus(*s);
+        cameras.push_back({{"name", s->plan.name},
+                           {"state", apiState(s->state)},
+                           {"fps", status["fps"]},
+                           {"has_control", status["has_control"]},
+                           {"following", status["following"]}});
+      }
+      return cameras;
+    };
+    content.recordings = [this] {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& entry : index_.entries()) list.push_back(toJson(entry));
+      return list;
+    };
     content.openSegments = [this] { return openSegments(); };
     auto server = HttpServer::start(
         *options_.http, std::move(content),

@@ -170,4 +170,45 @@ TEST(WircRecorderHttp, LiveViewShowsTheCameraWithTheTagOverlayInChromium) {
   EXPECT_GT(overlay, 100) << "no tag overlay in " << shot;
 }
 
+TEST(WircRecorderHttp, CameraSnapshotAndRecordingApi) {
+  LiveRecorder live(startSequenceDevice(), {"--segment", "1"});
+  ASSERT_FALSE(live.url.empty()) << live.recorder->log();
+  // Exact fields: name, state (live|offline|connecting), fps, has_control, following.
+  nlohmann::json cameras;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    std::this_thread::sleep_for(milliseconds(100));
+    cameras = nlohmann::json::parse(fetch(live.url + "api/cameras").body);
+    if (cameras[0]["state"] == "live" && cameras[0]["fps"].get<double>() > 0) break;
+  }
+  ASSERT_EQ(cameras.size(), 1u);
+  EXPECT_EQ(cameras[0]["name"], live.camera());
+  EXPECT_EQ(cameras[0]["state"], "live");
+  EXPECT_GT(cameras[0]["fps"].get<double>(), 0);
+  EXPECT_EQ(cameras[0]["has_control"], false);  // no --follow: nothing steers
+  EXPECT_EQ(cameras[0]["following"], false);
+  // The newest frame, byte for byte as the camera sent it.
+  auto snapshot = fetch(live.url + "api/cameras/" + live.camera() + "/snapshot.jpg");
+  EXPECT_EQ(snapshot.status, 200u);
+  EXPECT_EQ(snapshot.contentType, "image/jpeg");
+  EXPECT_TRUE(isSceneFrame({snapshot.body.begin(), snapshot.body.end()}));
+  auto missing = fetch(live.url + "api/cameras/nobody-cam0/snapshot.jpg");
+  EXPECT_EQ(missing.status, 404u);
+  EXPECT_EQ(nlohmann::json::parse(missing.body)["error"], "no camera named 'nobody-cam0'");
+  EXPECT_EQ(fetch(live.url + "api/nothing").status, 404u);
+  // The recording index, each with a URL that downloads it.
+  nlohmann::json recordings;
+  for (int attempt = 0; attempt < 50 && recordings.empty(); ++attempt) {
+    std::this_thread::sleep_for(milliseconds(100));
+    recordings = nlohmann::json::parse(fetch(live.url + "api/recordings").body);
+  }
+  ASSERT_FALSE(recordings.empty());
+  auto first = recordings[0];
+  for (const char* field : {"camera", "file", "start_utc", "duration_s", "frames", "bytes", "url"})
+    EXPECT_TRUE(first.contains(field)) << field << " in " << first.dump();
+  EXPECT_EQ(first["camera"], live.camera());
+  auto download = fetch(live.url + first["url"].get<std::string>().substr(1));
+  EXPECT_EQ(download.status, 200u);
+  EXPECT_EQ(download.body.size(), first["bytes"].get<size_t>());
+}
+
 }  // namespace

@@ -25,6 +25,18 @@ TEST(HttpRoutes, NamesEveryResource) {
   EXPECT_EQ(routeOf("/etc/passwd").kind, Kind::NotFound);
 }
 
+TEST(HttpRoutes, NamesTheCameraAndRecordingApi) {
+  EXPECT_EQ(routeOf("/api/cameras").kind, Kind::Cameras);
+  EXPECT_EQ(routeOf("/api/recordings").kind, Kind::RecordingIndex);
+  auto snapshot = routeOf("/api/cameras/rover-cam0/snapshot.jpg");
+  EXPECT_EQ(snapshot.kind, Kind::Snapshot);
+  EXPECT_EQ(snapshot.name, "rover-cam0");
+  // Other /api/ paths are answered in JSON, not as the page's 404.
+  for (const char* other : {"/api/cameras/snapshot.jpg", "/api/cameras/a/b/snapshot.jpg",
+                            "/api/cameras/rover-cam0", "/api/nothing"})
+    EXPECT_EQ(routeOf(other).kind, Kind::ApiNotFound) << other;
+}
+
 TEST(HttpRoutes, ServesOnlyPlainNamesOfRecordings) {
   EXPECT_TRUE(isRecordingName("rover-cam0-000.mkv"));
   EXPECT_TRUE(isRecordingName("rover-cam0-000.jsonl"));
