@@ -15,6 +15,7 @@ constexpr std::string_view kSnapshot = "/snapshot.jpg";
 Route routeOf(std::string_view path) {
   using Kind = Route::Kind;
   if (path == "/" || path == "/index.html") return {Kind::Page, ""};
+  if (path == "/login") return {Kind::Login, ""};
   if (path == "/api/status") return {Kind::Status, ""};
   if (path == "/api/events") return {Kind::Events, ""};
   if (path == "/api/cameras") return {Kind::Cameras, ""};
@@ -33,6 +34,39 @@ Route routeOf(std::string_view path) {
   if (path.starts_with(kRecordings))
     return {Kind::Recording, std::string(path.substr(kRecordings.size()))};
   return {Kind::NotFound, ""};
+}
+
+namespace {
+
+bool sameSecret(std::string_view given, std::string_view token) {
+  // Every byte is looked at whatever differs, so timing says nothing.
+  unsigned char difference = given.size() == token.size() ? 0 : 1;
+  for (size_t i = 0; i < given.size(); ++i)
+    difference |= static_cast<unsigned char>(given[i] ^ token[i % token.size()]);
+  return difference == 0;
+}
+
+}  // namespace
+
+bool carriesToken(const char* authorization, const char* cookie, std::string_view token) {
+  if (token.empty()) return true;
+  constexpr std::string_view kBearer = "Bearer ";
+  if (authorization && std::string_view(authorization).starts_with(kBearer) &&
+      sameSecret(std::string_view(authorization).substr(kBearer.size()), token))
+    return true;
+  if (!cookie) return false;
+  // "a=1; wircam_token=T; b=2"
+  std::string_view cookies = cookie;
+  while (!cookies.empty()) {
+    auto end = cookies.find(';');
+    auto pair = cookies.substr(0, end);
+    while (!pair.empty() && pair.front() == ' ') pair.remove_prefix(1);
+    constexpr std::string_view kName = "wircam_token=";
+    if (pair.starts_with(kName) && sameSecret(pair.substr(kName.size()), token)) return true;
+    if (end == std::string_view::npos) break;
+    cookies.remove_prefix(end + 1);
+  }
+  return false;
 }
 
 const char* recordingContentType(std::string_view name) {

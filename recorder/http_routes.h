@@ -10,6 +10,7 @@ namespace wircam::recorder {
 struct Route {
   enum class Kind {
     Page,
+    Login,  // GET /login: the sign-in page, served without the token
     Status,
     Events,
     Live,
@@ -27,6 +28,11 @@ struct Route {
 
 // `path` as libsoup hands it over (percent-decoded).
 Route routeOf(std::string_view path);
+
+// Whether a request carries the access token, as "Authorization: Bearer T"
+// or the "wircam_token" cookie (either header may be null). Compared in
+// constant time.
+bool carriesToken(const char* authorization, const char* cookie, std::string_view token);
 
 // A recording may be served by this name: a plain file name (no folder, not
 // hidden) of a video or sidecar. Whether it is a regular file in the folder

@@ -7,6 +7,7 @@
 
 #include "http_routes.h"
 #include "live_view_page.h"
+#include "login_page.h"
 
 namespace wircam::recorder {
 
@@ -205,7 +206,19 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                            gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
   auto route = routeOf(path);
+  if (route.kind != Route::Kind::Login && !self->authorised(message)) {
+    // Pages get the sign-in form; the API, streams and files a 401 in JSON.
+    if (route.kind == Route::Kind::Page)
+      return respond(message, SOUP_STATUS_UNAUTHORIZED, "text/html; charset=utf-8", kLoginPage);
+    soup_message_headers_replace(soup_server_message_get_response_headers(message),
+                                 "WWW-Authenticate", "Bearer realm=\"wirc-recorder\"");
+    return respondJsonError(message, SOUP_STATUS_UNAUTHORIZED,
+                            "needs the access token: Authorization: Bearer T, or sign in at "
+                            "/login");
+  }
   switch (route.kind) {
+    case Route::Kind::Login:
+      return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", kLoginPage);
     case Route::Kind::Page:
       return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", self->page());
     case Route::Kind::Status:
@@ -235,6 +248,12 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
           "not found; try /, /api/status, /api/events, /api/cameras, /api/recordings, "
           "/live/CAMERA.mjpg or /recordings");
   }
+}
+
+bool HttpServer::authorised(SoupServerMessage* message) const {
+  auto* headers = soup_server_message_get_request_headers(message);
+  return carriesToken(soup_message_headers_get_one(headers, "Authorization"),
+                      soup_message_headers_get_one(headers, "Cookie"), content_.token);
 }
 
 void HttpServer::openStream(SoupServerMessage* message, const char* contentType,

@@ -34,6 +34,7 @@ class HttpServer {
     std::function<nlohmann::json()> cameraStates;
     // /api/recordings: the recording index's entries (url added here)
     std::function<nlohmann::json()> recordings;
+    std::string token;  // empty: no authentication (this machine only)
     // Each stream's recent Marvelmind positions, for the page's map:
     // {"<stream>": {"points": [{"x","y","utc"}, ...], "stale": bool}}.
     std::function<nlohmann::json()> trails;
@@ -68,6 +69,7 @@ class HttpServer {
   static void onRequestStarted(SoupServer*, SoupServerMessage* message, gpointer self);
   static void onRequestEnded(SoupServer*, SoupServerMessage* message, gpointer self);
   std::string page() const;  // the live view page with the current state
+  bool authorised(SoupServerMessage* message) const;
   void serveLive(SoupServerMessage* message, const std::string& camera);
   void serveEvents(SoupServerMessage* message);
   void serveSnapshot(SoupServerMessage* message, const std::string& camera);

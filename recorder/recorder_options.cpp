@@ -60,8 +60,10 @@ file and exits 0.
                          has less than SIZE free
   --http [HOST]:PORT     web server: live view at /, status at /api/status,
                          recordings at /recordings (e.g. --http :8080). Without
-                         HOST it listens on 127.0.0.1 only; 0.0.0.0:8080 opens
-                         it to the network (it has no authentication yet)
+                         HOST it listens on 127.0.0.1 only; another HOST (e.g.
+                         0.0.0.0 for the network) needs --http-token
+  --http-token T         every request needs "Authorization: Bearer T" or the
+                         cookie the page's /login sets (16 characters at least)
   --http-idle-timeout S  close an HTTP connection silent for S seconds (default 10)
   --mqtt mqtt://[USER:PASS@]HOST[:PORT]
                          publish status, detections and events to an MQTT
@@ -82,7 +84,7 @@ file and exits 0.
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
-min-free, status, http, http-idle-timeout, rtsp, periods, failsafe, marvelmind,
+min-free, status, http, http-token, http-idle-timeout, rtsp, periods, failsafe, marvelmind,
 beacon, mqtt, mqtt-prefix, mqtt-detections-rate, on-segment-closed,
 hook-timeout), and one [device NAME] group per vehicle with host, port, cameras
 (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as on the command
@@ -300,6 +302,12 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto address = parseServerAddress(value);
     if (!address) return "[HOST]:PORT, as in :8080 or 127.0.0.1:8080";
     (name == "http" ? o.http : o.rtsp) = *address;
+  } else if (name == "http-token") {
+    std::string token = value;
+    if (token.size() < 16 || token.find_first_of(" ;,\"\\") != std::string::npos)
+      return "at least 16 characters, no spaces, quotes, commas or semicolons (e.g. from "
+             "openssl rand -hex 16)";
+    o.httpToken = token;
   } else if (name == "http-idle-timeout") {
     auto seconds = number(value);
     if (!seconds || *seconds < 0.1 || *seconds > 3600) return "seconds, 0.1..3600";
@@ -434,6 +442,7 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"http", required_argument, nullptr, kValue},
                                    {"rtsp", required_argument, nullptr, kValue},
                                    {"http-idle-timeout", required_argument, nullptr, kValue},
+                                   {"http-token", required_argument, nullptr, kValue},
                                    {"detect", required_argument, nullptr, kValue},
                                    {"follow", no_argument, nullptr, kValue},
                                    {"duration", required_argument, nullptr, kValue},
@@ -488,6 +497,11 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
     return unexpected(
         "--format mp4 needs --codec h264: GStreamer's mp4mux cannot carry the camera's JPEG "
         "frames as they are (use mkv to keep them untouched)");
+  if (o.http && o.httpToken.empty() && !o.http->host.empty() && o.http->host != "127.0.0.1" &&
+      o.http->host != "localhost")
+    return unexpected("--http " + o.http->host + ":" + std::to_string(o.http->port) +
+                      " would open the recorder beyond this machine without authentication: "
+                      "give --http-token T (or leave HOST out for 127.0.0.1 only)");
   if (o.devices.empty()) o.devices.push_back({"", 1984, "discovered"});
   if (o.cameras.empty()) o.cameras.push_back(0);
   for (auto& device : o.devices) {

@@ -129,6 +129,7 @@ std::optional<std::string> Recording::startServers() {
     HttpServer::Content content;
     for (auto& s : streams_) content.cameras.push_back({s->plan.name, s->frames.get()});
     content.recordingsFolder = options_.outDir;
+    content.token = options_.httpToken;
     content.status = [this] { return status(); };
     content.trails = [this] { return trails(); };
     content.cameraStates = [this] {

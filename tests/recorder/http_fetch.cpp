@@ -4,15 +4,21 @@
 
 namespace wircam::testing {
 
-Response fetch(const std::string& url, const char* method) {
+Response fetch(const std::string& url, const char* method, const Headers& headers) {
   SoupSession* session = soup_session_new();
   SoupMessage* message = soup_message_new(method, url.c_str());
+  for (const auto& [name, value] : headers)
+    soup_message_headers_replace(soup_message_get_request_headers(message), name.c_str(),
+                                 value.c_str());
   Response response;
   GBytes* body = soup_session_send_and_read(session, message, nullptr, nullptr);
   response.status = soup_message_get_status(message);
   const char* type =
       soup_message_headers_get_content_type(soup_message_get_response_headers(message), nullptr);
   response.contentType = type ? type : "";
+  const char* authenticate =
+      soup_message_headers_get_one(soup_message_get_response_headers(message), "WWW-Authenticate");
+  response.authenticate = authenticate ? authenticate : "";
   if (body) {
     gsize size = 0;
     auto* data = static_cast<const char*>(g_bytes_get_data(body, &size));

@@ -4,6 +4,8 @@
 #include <glib.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace wircam::testing {
 
@@ -11,8 +13,11 @@ struct Response {
   guint status = 0;
   std::string contentType;
   std::string body;
+  std::string authenticate;  // the WWW-Authenticate header
 };
 
-Response fetch(const std::string& url, const char* method = "GET");
+using Headers = std::vector<std::pair<std::string, std::string>>;
+
+Response fetch(const std::string& url, const char* method = "GET", const Headers& headers = {});
 
 }  // namespace wircam::testing

@@ -25,6 +25,21 @@ TEST(HttpRoutes, NamesEveryResource) {
   EXPECT_EQ(routeOf("/etc/passwd").kind, Kind::NotFound);
 }
 
+TEST(HttpRoutes, TheTokenComesAsBearerOrCookie) {
+  std::string token = "0123456789abcdef";
+  EXPECT_TRUE(carriesToken(nullptr, nullptr, ""));  // no token set: everyone
+  EXPECT_FALSE(carriesToken(nullptr, nullptr, token));
+  EXPECT_TRUE(carriesToken("Bearer 0123456789abcdef", nullptr, token));
+  EXPECT_FALSE(carriesToken("Bearer 0123456789abcde", nullptr, token));
+  EXPECT_FALSE(carriesToken("Bearer 0123456789abcdef0", nullptr, token));
+  EXPECT_FALSE(carriesToken("Basic 0123456789abcdef", nullptr, token));
+  EXPECT_TRUE(carriesToken(nullptr, "a=1; wircam_token=0123456789abcdef; b=2", token));
+  EXPECT_TRUE(carriesToken(nullptr, "wircam_token=0123456789abcdef", token));
+  EXPECT_FALSE(carriesToken(nullptr, "xwircam_token=0123456789abcdef", token));
+  EXPECT_FALSE(carriesToken(nullptr, "wircam_token=", token));
+  EXPECT_EQ(routeOf("/login").kind, Kind::Login);
+}
+
 TEST(HttpRoutes, NamesTheCameraAndRecordingApi) {
   EXPECT_EQ(routeOf("/api/cameras").kind, Kind::Cameras);
   EXPECT_EQ(routeOf("/api/recordings").kind, Kind::RecordingIndex);
