@@ -347,11 +347,18 @@ void HttpServer::serveEvents(SoupServerMessage* message) {
 
 std::string HttpServer::page() const {
   nlohmann::json cameras = nlohmann::json::array();
-  for (const auto& feed : feeds_)
-    cameras.push_back({{"name", feed->name},
-                       {"width", feed->width.load()},
-                       {"height", feed->height.load()},
-                       {"detections", feed->detections}});
+  // Each card starts in its camera's state (live, offline, ...), with the
+  // status figures, so the first picture is already right.
+  nlohmann::json status = content_.status ? content_.status() : nlohmann::json::object();
+  for (const auto& feed : feeds_) {
+    nlohmann::json camera = {{"name", feed->name},
+                             {"width", feed->width.load()},
+                             {"height", feed->height.load()},
+                             {"detections", feed->detections}};
+    for (const auto& stream : status.value("streams", nlohmann::json::array()))
+      if (stream.value("name", "") == feed->name) camera["status"] = stream;
+    cameras.push_back(camera);
+  }
   nlohmann::json trails = content_.trails ? content_.trails() : nlohmann::json::object();
   std::string state = nlohmann::json{{"cameras", cameras}, {"trails", trails}}.dump();
   // Inside <script>, "</" could end it early.

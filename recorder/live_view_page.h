@@ -16,10 +16,22 @@ inline constexpr const char kLiveViewPage[] = R"html(<!doctype html>
 <style>
 body { background: #15171a; color: #e8e8e8; font: 14px sans-serif; margin: 16px; }
 h1 { font-size: 20px; margin: 0 0 12px; } h2 { font-size: 16px; }
-.camera { display: inline-block; margin: 0 16px 16px 0; vertical-align: top; }
-.view { position: relative; display: inline-block; line-height: 0; background: #000; }
-.view img { display: block; max-width: 100%; min-width: 160px; min-height: 120px; }
+.camera { display: inline-block; margin: 0 16px 16px 0; vertical-align: top; background: #202328;
+          border-radius: 8px; padding: 10px; width: min(640px, calc(100vw - 52px)); }
+.head { display: flex; align-items: center; gap: 8px; margin-bottom: 8px; flex-wrap: wrap; }
+.badge { border-radius: 4px; padding: 2px 8px; font-size: 12px; font-weight: bold; color: #fff; }
+.badge.live { background: #1b873f; } .badge.offline { background: #c53030; }
+.badge.waiting, .badge.connecting { background: #8a6d1d; }
+.since { color: #aab; font-size: 12px; }
+.view { position: relative; line-height: 0; background: #000; }
+.view img { display: block; width: 100%; height: auto; }
 .view svg { position: absolute; left: 0; top: 0; width: 100%; height: 100%; }
+.placeholder { display: none; aspect-ratio: 4 / 3; align-items: center; justify-content: center;
+               line-height: 1.4; color: #889; background: repeating-linear-gradient(45deg, #111,
+               #111 12px, #171717 12px, #171717 24px); font-size: 16px; text-align: center; }
+.camera:not([data-state="live"]) .view img, .camera:not([data-state="live"]) .view svg
+  { display: none; }
+.camera:not([data-state="live"]) .placeholder { display: flex; }
 .tag { fill: none; stroke: #00ff00; stroke-width: 3; }
 .label { fill: #00ff00; font: bold 18px sans-serif; }
 .stats { margin-top: 6px; color: #aab; font-family: monospace; }
@@ -44,20 +56,49 @@ const views = {};
 function addCamera(camera) {
   const box = document.createElement("div");
   box.className = "camera";
-  box.innerHTML = `<div><b></b></div><div class="view"><img alt="live"><svg></svg></div>` +
-                  `<div class="stats"></div>`;
+  box.innerHTML = `<div class="head"><b></b><span class="badge"></span><span class="since">` +
+                  `</span></div><div class="view"><img alt="live"><svg></svg>` +
+                  `<div class="placeholder"></div></div><div class="stats"></div>`;
   box.querySelector("b").textContent = camera.name;
-  box.querySelector("img").src = "/live/" + encodeURIComponent(camera.name) + ".mjpg";
   document.getElementById("cameras").appendChild(box);
-  views[camera.name] = { img: box.querySelector("img"), svg: box.querySelector("svg"),
+  views[camera.name] = { box, img: box.querySelector("img"), svg: box.querySelector("svg"),
+                         badge: box.querySelector(".badge"), since: box.querySelector(".since"),
+                         placeholder: box.querySelector(".placeholder"),
                          stats: box.querySelector(".stats"),
-                         width: camera.width, height: camera.height };
+                         width: camera.width, height: camera.height, state: "" };
+  if (camera.status) showStream(camera.status);
+  else setState(views[camera.name], "live", null);
   showDetections({ stream: camera.name, detections: camera.detections });
+}
+
+// live, offline, or waiting for device (with since when). Not live: a
+// placeholder saying so, never a broken image or a stale tag box; live
+// again: the picture reconnects.
+function setState(view, state, sinceUtc) {
+  const kind = state === "live" ? "live" : state === "offline" ? "offline" : "waiting";
+  const since = sinceUtc ? new Date(sinceUtc) : null;
+  const sinceText = since ? "since " + since.toLocaleTimeString() : "";
+  view.badge.className = "badge " + kind;
+  view.badge.textContent = state;
+  view.since.textContent = sinceText;
+  view.placeholder.textContent = state === "offline" ? `offline ${sinceText}: the device is ` +
+      "off, out of range or gone; it is reconnected to when it is back" : "waiting for device";
+  if (view.state !== kind) {
+    view.box.dataset.state = kind;
+    if (kind === "live") {
+      const name = view.box.querySelector("b").textContent;
+      view.img.src = "/live/" + encodeURIComponent(name) + ".mjpg?t=" + Date.now();
+    } else {
+      view.img.removeAttribute("src");
+      view.svg.replaceChildren();
+    }
+    view.state = kind;
+  }
 }
 
 function showDetections(event) {
   const view = views[event.stream];
-  if (!view) return;
+  if (!view || view.state !== "live") return;
   const width = view.img.naturalWidth || view.width, height = view.img.naturalHeight || view.height;
   if (!width || !height) return;
   view.svg.setAttribute("viewBox", `0 0 ${width} ${height}`);
@@ -90,15 +131,27 @@ function positionText(position) {
          (position.stale ? " (stale)" : "");
 }
 
+function controlText(stream) {
+  if (stream.following === undefined) return "";
+  const target = stream.target >= 0 ? `tag ${stream.target}` : "largest tag";
+  return `  control ${stream.has_control ? "yes" : "no"}  following ` +
+         (stream.following ? `on (${target})` : "off");
+}
+
+function showStream(stream) {
+  const view = views[stream.name];
+  if (!view) return;
+  setState(view, stream.state, stream.state_since_utc);
+  view.stats.textContent = `${stream.fps.toFixed(1)} fps  ` +
+      `loss ${stream.loss_percent.toFixed(1)} %  ${Math.round(stream.kbps)} kbit/s  ` +
+      `battery ${stream.battery_v.toFixed(2)} V` +
+      (stream.status_stale ? ` (stale, ${Math.round(stream.status_age_ms / 1000)} s old)` : "") +
+      controlText(stream) + positionText(stream.position);
+}
+
 function showStatus(status) {
   for (const stream of status.streams) {
-    const view = views[stream.name];
-    if (!view) continue;
-    view.stats.textContent = `${stream.frames} frames  ${stream.fps.toFixed(1)} fps  ` +
-        `loss ${stream.loss_percent.toFixed(1)} %  ${Math.round(stream.kbps)} kbit/s  ` +
-        `battery ${stream.battery_v.toFixed(2)} V` +
-        (stream.status_stale ? ` (stale, ${Math.round(stream.status_age_ms / 1000)} s old)` : "") +
-        positionText(stream.position);
+    showStream(stream);
     const p = stream.position;
     if (!p || p.x === undefined) continue;
     const trail = trails[stream.name] || (trails[stream.name] = { points: [] });

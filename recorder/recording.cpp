@@ -657,6 +657,14 @@ nlohmann::json Recording::status() const {
         {"status_age_ms", s->statusAgeMs},
         {"segment", std::filesystem::path(s->segment).filename().string()},
         {"live", "/live/" + s->plan.name + ".mjpg"}};
+    if (!s->plan.controller.empty()) {
+      auto fleet = fleetStatus(*s);
+      stream["has_control"] = fleet["has_control"];
+      stream["following"] = fleet["following"];
+      gint target = -1;
+      g_object_get(element(s->plan.controller), "target-id", &target, nullptr);
+      stream["target"] = target;
+    }
     if (s->position) {
       const auto& p = *s->position;
       stream["position"] = {{"beacon", p.beacon},

@@ -59,7 +59,9 @@ MarvelmindDashboard::Impl::~Impl() {
 
 void MarvelmindDashboard::Impl::measure() {
   auto now = Clock::now();
-  double seconds = std::chrono::duration<double>(now - started_).count();
+  // Stamped at the measurement's scheduled instant: a late wake of this
+  // process is not a late measurement.
+  double seconds = std::chrono::duration<double>(nextMeasurement_ - started_).count();
   std::vector<std::vector<uint8_t>> pushes;
   {
     std::lock_guard lock(mutex_);
