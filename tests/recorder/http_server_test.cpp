@@ -211,4 +211,31 @@ TEST(WircRecorderHttp, CameraSnapshotAndRecordingApi) {
   EXPECT_EQ(download.body.size(), first["bytes"].get<size_t>());
 }
 
+TEST(WircRecorderHttp, TheCameraCardSaysLiveThenOfflineWhenTheDeviceStops) {
+  if (!chromiumInstalled())
+    GTEST_SKIP() << "chromium is not installed (tools/install-deps test installs it)";
+  LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11", "--follow"});
+  ASSERT_FALSE(live.url.empty()) << live.recorder->log();
+  std::this_thread::sleep_for(milliseconds(2000));
+  // Kept beside the build for people to look at.
+  auto liveShot = fs::path(WIRCAM_SCREENSHOT_DIR) / "card-live.png";
+  ASSERT_TRUE(screenshot(live.url, liveShot, 800, 700));
+  auto picture = readPng(liveShot);
+  // The green "live" badge and the camera's sky; no red "offline" badge.
+  EXPECT_GT(picture.count(0x1b, 0x87, 0x3f, 10), 100) << "no live badge in " << liveShot;
+  EXPECT_GT(picture.count(0x9f, 0xcb, 0xec, 20), 20000) << "no camera picture in " << liveShot;
+  EXPECT_LT(picture.count(0xc5, 0x30, 0x30, 10), 20) << liveShot;
+
+  live.device.reset();                              // the car is switched off
+  std::this_thread::sleep_for(milliseconds(3500));  // the link timeout (2 s) and a status
+  auto offlineShot = fs::path(WIRCAM_SCREENSHOT_DIR) / "card-offline.png";
+  ASSERT_TRUE(screenshot(live.url, offlineShot, 800, 700));
+  picture = readPng(offlineShot);
+  // The red badge and the placeholder: no picture, no broken-image icon.
+  EXPECT_GT(picture.count(0xc5, 0x30, 0x30, 10), 100) << "no offline badge in " << offlineShot;
+  EXPECT_LT(picture.count(0x9f, 0xcb, 0xec, 20), 500) << "a picture still shows in " << offlineShot;
+  auto page = fetch(live.url);
+  EXPECT_NE(page.body.find("\"state\":\"offline\""), std::string::npos);
+}
+
 }  // namespace
