@@ -20,6 +20,9 @@ Route routeOf(std::string_view path) {
   if (path == "/api/events") return {Kind::Events, ""};
   if (path == "/api/cameras") return {Kind::Cameras, ""};
   if (path == "/api/recordings") return {Kind::RecordingIndex, ""};
+  constexpr std::string_view kRecordingEntry = "/api/recordings/";
+  if (path.starts_with(kRecordingEntry) && path.size() > kRecordingEntry.size())
+    return {Kind::RecordingEntry, std::string(path.substr(kRecordingEntry.size()))};
   if (path.starts_with(kCameras) && path.ends_with(kSnapshot) &&
       path.size() > kCameras.size() + kSnapshot.size()) {
     auto camera = path.substr(kCameras.size(), path.size() - kCameras.size() - kSnapshot.size());

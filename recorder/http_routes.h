@@ -19,11 +19,12 @@ struct Route {
     Cameras,         // GET /api/cameras
     Snapshot,        // GET /api/cameras/NAME/snapshot.jpg
     RecordingIndex,  // GET /api/recordings
+    RecordingEntry,  // /api/recordings/FILE (DELETE only)
     ApiNotFound,     // any other /api/ path: 404 with JSON
     NotFound
   };
   Kind kind = Kind::NotFound;
-  std::string name;  // the camera (Live, Snapshot) or the file (Recording)
+  std::string name;  // the camera (Live, Snapshot) or the file (Recording, RecordingEntry)
 };
 
 // `path` as libsoup hands it over (percent-decoded).

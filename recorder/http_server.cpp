@@ -185,14 +185,12 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*,
   auto* headers = soup_server_message_get_request_headers(message);
   bool hasBody = soup_message_headers_get_content_length(headers) > 0 ||
                  soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CHUNKED;
-  if (method == "GET" || method == "HEAD") {
-    if (!hasBody) return;
-  }
+  bool known = method == "GET" || method == "HEAD" || method == "DELETE";
+  if (known && !hasBody) return;
   // libsoup would read the whole body before answering: answer on the
   // socket now, and close it. Nothing of this request was written yet.
-  std::string answer = method != "GET" && method != "HEAD"
-                           ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD\r\n"
-                           : "HTTP/1.1 413 Content Too Large\r\n";
+  std::string answer = !known ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE\r\n"
+                              : "HTTP/1.1 413 Content Too Large\r\n";
   answer += "Content-Length: 0\r\nConnection: close\r\n\r\n";
   soup_message_body_set_accumulate(soup_server_message_get_request_body(message), FALSE);
   if (GSocket* socket = soup_server_message_get_socket(message)) {
@@ -216,7 +214,18 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                             "needs the access token: Authorization: Bearer T, or sign in at "
                             "/login");
   }
+  std::string method = soup_server_message_get_method(message);
+  if (method == "DELETE") {
+    if (route.kind != Route::Kind::Recording && route.kind != Route::Kind::RecordingEntry)
+      return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                              "only recordings can be deleted: DELETE /api/recordings/FILE");
+    return self->deleteRecording(message, route.name);
+  }
   switch (route.kind) {
+    case Route::Kind::RecordingEntry:
+      return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                              "GET /recordings/FILE downloads it; DELETE /api/recordings/FILE "
+                              "deletes it");
     case Route::Kind::Login:
       return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", kLoginPage);
     case Route::Kind::Page:
@@ -403,6 +412,21 @@ void HttpServer::serveSnapshot(SoupServerMessage* message, const std::string& ca
     gst_buffer_unmap(jpeg, &map);
   }
   gst_buffer_unref(jpeg);
+}
+
+void HttpServer::deleteRecording(SoupServerMessage* message, const std::string& name) {
+  // Always behind the token: without one set, nobody may delete.
+  if (content_.token.empty())
+    return respondJsonError(message, SOUP_STATUS_FORBIDDEN,
+                            "deleting recordings needs the server started with --http-token");
+  if (!isRecordingName(name) || name.ends_with(".jsonl"))
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
+  auto refused = content_.deleteRecording(name);
+  if (!refused) {
+    respond(message, SOUP_STATUS_OK, "application/json", nlohmann::json{{"deleted", name}}.dump());
+    return;
+  }
+  respondJsonError(message, refused->first, refused->second);
 }
 
 void HttpServer::serveRecordingIndex(SoupServerMessage* message) {

@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ class HttpServer {
     // /api/recordings: the recording index's entries (url added here)
     std::function<nlohmann::json()> recordings;
     std::string token;  // empty: no authentication (this machine only)
+    // Deletes a finished segment (video and sidecar) and its index entry;
+    // the HTTP status and reason when it cannot.
+    std::function<std::optional<std::pair<guint, std::string>>(const std::string& file)>
+        deleteRecording;
     // Each stream's recent Marvelmind positions, for the page's map:
     // {"<stream>": {"points": [{"x","y","utc"}, ...], "stale": bool}}.
     std::function<nlohmann::json()> trails;
@@ -74,6 +79,7 @@ class HttpServer {
   void serveEvents(SoupServerMessage* message);
   void serveSnapshot(SoupServerMessage* message, const std::string& camera);
   void serveRecordingIndex(SoupServerMessage* message);
+  void deleteRecording(SoupServerMessage* message, const std::string& name);
   void serveRecordings(SoupServerMessage* message, const std::string& name);
   // Keeps `message` open as a stream of chunks in `clients`.
   void openStream(SoupServerMessage* message, const char* contentType,

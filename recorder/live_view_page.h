@@ -36,6 +36,10 @@ h1 { font-size: 20px; margin: 0 0 12px; } h2 { font-size: 16px; }
 .label { fill: #00ff00; font: bold 18px sans-serif; }
 .stats { margin-top: 6px; color: #aab; font-family: monospace; }
 a { color: #8cf; } td { padding: 2px 12px 2px 0; }
+h3 { font-size: 14px; margin: 12px 0 4px; color: #ccd; }
+td.number { text-align: right; font-family: monospace; }
+button.delete { background: none; color: #e88; border: 1px solid #744; border-radius: 4px;
+                font: inherit; font-size: 12px; padding: 1px 8px; cursor: pointer; }
 #map { width: 100%; max-width: 480px; background: #0d0f12; border: 1px solid #333; }
 #map .grid { stroke: #263040; stroke-width: 1; vector-effect: non-scaling-stroke; }
 #map .trail { fill: none; stroke-width: 2; vector-effect: non-scaling-stroke; }
@@ -47,7 +51,8 @@ a { color: #8cf; } td { padding: 2px 12px 2px 0; }
 <div id="cameras"></div>
 <section id="positions" hidden><h2>Positions</h2><svg id="map" viewBox="0 0 480 360"></svg></section>
 <h2>Recordings</h2>
-<table id="recordings"></table>
+<div id="recordings"></div>
+<p id="recording-message" class="since"></p>
 <script>
 "use strict";
 const svgNs = "http://www.w3.org/2000/svg";
@@ -208,19 +213,56 @@ async function refreshStatus() {
   showStatus(await (await fetch("/api/status")).json());
 }
 
+// The finished segments from the recording index, by camera and by day
+// (local time), newest first: start, duration, size, frames, download,
+// delete (which the server allows only with the access token).
 async function refresh() {
-  const files = await (await fetch("/recordings")).json();
-  const table = document.getElementById("recordings");
-  table.replaceChildren();
-  for (const file of files) {
-    const row = table.insertRow();
-    const link = document.createElement("a");
-    link.href = "/recordings/" + encodeURIComponent(file.name);
-    link.textContent = file.name;
-    row.insertCell().appendChild(link);
-    row.insertCell().textContent = (file.bytes / 1e6).toFixed(1) + " MB";
-    row.insertCell().textContent = file.recording ? "recording" : "";
+  const segments = await (await fetch("/api/recordings")).json();
+  const groups = new Map();
+  for (const segment of segments.reverse()) {
+    const start = new Date(segment.start_utc);
+    const key = `${segment.camera} · ${start.toLocaleDateString()}`;
+    if (!groups.has(key)) groups.set(key, []);
+    groups.get(key).push({ ...segment, start });
   }
+  const box = document.getElementById("recordings");
+  box.replaceChildren();
+  for (const [title, list] of groups) {
+    const heading = document.createElement("h3");
+    heading.textContent = title;
+    const table = document.createElement("table");
+    for (const segment of list) {
+      const row = table.insertRow();
+      row.insertCell().textContent = segment.start.toLocaleTimeString();
+      const cells = [`${segment.duration_s.toFixed(1)} s`,
+                     `${(segment.bytes / 1e6).toFixed(1)} MB`, `${segment.frames} frames`];
+      for (const text of cells) {
+        const cell = row.insertCell();
+        cell.className = "number";
+        cell.textContent = text;
+      }
+      const link = document.createElement("a");
+      link.href = segment.url;
+      link.textContent = "download";
+      row.insertCell().appendChild(link);
+      const remove = document.createElement("button");
+      remove.className = "delete";
+      remove.textContent = "delete";
+      remove.addEventListener("click", () => deleteSegment(segment.file));
+      row.insertCell().appendChild(remove);
+    }
+    box.append(heading, table);
+  }
+}
+
+async function deleteSegment(file) {
+  if (!confirm(`Delete ${file} and its telemetry?`)) return;
+  const response = await fetch("/api/recordings/" + encodeURIComponent(file),
+                               { method: "DELETE" });
+  const answer = await response.json();
+  document.getElementById("recording-message").textContent =
+      response.ok ? `deleted ${file}` : answer.error;
+  refresh();
 }
 
 function start() {

@@ -1,6 +1,7 @@
 #include "recording.h"
 
 #include <glib-unix.h>
+#include <libsoup/soup.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -143,6 +144,29 @@ std::optional<std::string> Recording::startServers() {
                            {"following", status["following"]}});
       }
       return cameras;
+    };
+    content.deleteRecording =
+        [this](const std::string& file) -> std::optional<std::pair<guint, std::string>> {
+      auto open = openSegments();
+      for (const auto& path : open)
+        if (std::filesystem::path(path).filename() == file)
+          return std::pair<guint, std::string>(
+              SOUP_STATUS_CONFLICT, "'" + file + "' is being recorded; it can go once closed");
+      const auto& entries = index_.entries();
+      if (std::none_of(entries.begin(), entries.end(),
+                       [&](const auto& e) { return e.file == file; }))
+        return std::pair<guint, std::string>(SOUP_STATUS_NOT_FOUND,
+                                             "no recording named '" + file + "'");
+      auto video = std::filesystem::path(options_.outDir) / file;
+      std::error_code error;
+      std::filesystem::remove(video, error);
+      if (error)
+        return std::pair<guint, std::string>(SOUP_STATUS_INTERNAL_SERVER_ERROR,
+                                             "cannot delete '" + file + "': " + error.message());
+      std::filesystem::remove(std::filesystem::path(video).replace_extension(".jsonl"), error);
+      log("deleted " + file + " (asked over HTTP)");
+      updateIndex({video.string()});
+      return std::nullopt;
     };
     content.recordings = [this] {
       nlohmann::json list = nlohmann::json::array();

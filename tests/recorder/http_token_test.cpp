@@ -3,7 +3,9 @@
 // this machine.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "http_fetch.h"
 #include "recorder_process.h"
@@ -59,6 +61,55 @@ TEST(WircRecorderHttpToken, WithoutATokenTheServerStaysOnThisMachine) {
   RecorderProcess shortToken(0, {"--device", "127.0.0.1:9", "--out", "/tmp/unused", "--http", ":0",
                                  "--http-token", "short"});
   EXPECT_EQ(shortToken.wait(), 2);
+}
+
+TEST(WircRecorderHttpToken, DeletingARecordingNeedsTheTokenAndAFinishedSegment) {
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess recorder(device->port(), {"--http", "127.0.0.1:0", "--http-token", kToken,
+                                            "--segment", "1", "--duration", "30"});
+  auto url = recorder.waitForLog("http://", milliseconds(10000));
+  ASSERT_TRUE(url) << recorder.log();
+  Headers token = {{"Authorization", std::string("Bearer ") + kToken}};
+  nlohmann::json segments;
+  for (int attempt = 0; attempt < 60 && segments.size() < 1; ++attempt) {
+    std::this_thread::sleep_for(milliseconds(100));
+    segments = nlohmann::json::parse(fetch(*url + "api/recordings", "GET", token).body);
+  }
+  ASSERT_FALSE(segments.empty());
+  std::string file = segments[0]["file"];
+  auto path = recorder.out() / file;
+  ASSERT_TRUE(std::filesystem::exists(path));
+  EXPECT_EQ(fetch(*url + "api/recordings/" + file, "DELETE").status, 401u);
+  EXPECT_TRUE(std::filesystem::exists(path));
+  auto deleted = fetch(*url + "api/recordings/" + file, "DELETE", token);
+  EXPECT_EQ(deleted.status, 200u) << deleted.body;
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(path).replace_extension(".jsonl")));
+  auto after = nlohmann::json::parse(fetch(*url + "api/recordings", "GET", token).body);
+  for (const auto& entry : after) EXPECT_NE(entry["file"], file);
+  // Not twice, not outside the folder, not the segment being written.
+  EXPECT_EQ(fetch(*url + "api/recordings/" + file, "DELETE", token).status, 404u);
+  // (libsoup itself refuses a path that climbs out with 400; either way, refused.)
+  auto climbing = fetch(*url + "api/recordings/..%2F..%2Fetc%2Fpasswd", "DELETE", token).status;
+  EXPECT_TRUE(climbing == 400u || climbing == 404u) << climbing;
+  EXPECT_TRUE(std::filesystem::exists("/etc/passwd"));
+  auto status = nlohmann::json::parse(fetch(*url + "api/status", "GET", token).body);
+  std::string open = status["streams"][0]["segment"];
+  auto busy = fetch(*url + "api/recordings/" + open, "DELETE", token);
+  EXPECT_EQ(busy.status, 409u) << busy.body;
+  EXPECT_TRUE(std::filesystem::exists(recorder.out() / open));
+}
+
+TEST(WircRecorderHttpToken, WithoutATokenNothingCanBeDeleted) {
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess recorder(device->port(), {"--http", "127.0.0.1:0", "--duration", "30"});
+  auto url = recorder.waitForLog("http://", milliseconds(10000));
+  ASSERT_TRUE(url) << recorder.log();
+  auto refused = fetch(*url + "api/recordings/anything.mkv", "DELETE");
+  EXPECT_EQ(refused.status, 403u);
+  EXPECT_NE(refused.body.find("--http-token"), std::string::npos) << refused.body;
 }
 
 }  // namespace
