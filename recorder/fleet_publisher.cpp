@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cstdio>
 
 namespace wircam::recorder {
@@ -12,17 +11,10 @@ namespace {
 
 void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
 
-struct Locked {
-  explicit Locked(GMutex* m) : mutex(m) { g_mutex_lock(mutex); }
-  ~Locked() { g_mutex_unlock(mutex); }
-  GMutex* mutex;
-};
-
 }  // namespace
 
 FleetPublisher::FleetPublisher(Settings settings, std::function<void(const FleetCommand&)> apply)
     : settings_(std::move(settings)), apply_(std::move(apply)) {
-  g_mutex_init(&retainedMutex_);
   for (const auto& stream : settings_.streams) streams_[stream];
 }
 
@@ -46,8 +38,7 @@ Expected<std::unique_ptr<FleetPublisher>, std::string> FleetPublisher::start(
 }
 
 FleetPublisher::~FleetPublisher() {
-  client_.reset();  // says offline first
-  g_mutex_clear(&retainedMutex_);
+  client_.reset();  // says offline
 }
 
 std::string FleetPublisher::topic(const std::string& stream, const char* leaf) const {
@@ -59,7 +50,7 @@ std::string FleetPublisher::topic(const std::string& stream, const char* leaf) c
 void FleetPublisher::republish(MqttClient& client) {
   client.publish(settings_.prefix + "/available", "online", true, 1);
   {
-    Locked lock(&retainedMutex_);
+    std::lock_guard lock(retainedMutex_);
     for (const auto& [stream, status] : retained_)
       client.publish(topic(stream, "status"), status, true);
   }
@@ -110,7 +101,7 @@ void FleetPublisher::status(const std::string& stream, const nlohmann::json& sta
   state.lastStatus = text;
   state.statusAt = now;
   {
-    Locked lock(&retainedMutex_);
+    std::lock_guard lock(retainedMutex_);
     retained_[stream] = text;
   }
   client_->publish(topic(stream, "status"), text, true);

@@ -11,6 +11,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -62,7 +63,7 @@ class FleetPublisher {
   std::unique_ptr<MqttClient> client_;
   std::map<std::string, StreamState> streams_;  // main loop only (the MQTT thread reads settings_)
   // The retained statuses, for a new connection (guarded: the MQTT thread reads it).
-  GMutex retainedMutex_;
+  std::mutex retainedMutex_;
   std::map<std::string, std::string> retained_;
 };
 

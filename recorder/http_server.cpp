@@ -8,6 +8,7 @@
 #include "http_routes.h"
 #include "live_view_page.h"
 #include "login_page.h"
+#include "telemetry_log.h"
 
 namespace wircam::recorder {
 
@@ -446,7 +447,7 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
     std::set<std::string> openNames;
     for (const auto& path : open) {
       openNames.insert(fs::path(path).filename().string());
-      openNames.insert(fs::path(path).replace_extension(".jsonl").filename().string());
+      openNames.insert(fs::path(TelemetryLog::pathFor(path)).filename().string());
     }
     nlohmann::json files = nlohmann::json::array();
     std::error_code error;

@@ -76,7 +76,8 @@ file and exits 0.
                          run CMD (split like a shell would, never through
                          one) with the segment's path and its sidecar's as
                          two more arguments, for each segment as it closes;
-                         failures are retried with backoff (e.g. rclone copyto)
+                         failures are retried with backoff (e.g. a script
+                         that runs rclone: README.md, "Fleets")
   --hook-timeout S       a hook running longer is stopped and retried (default 600)
   --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>; without
                          HOST on 127.0.0.1 only

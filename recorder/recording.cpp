@@ -136,38 +136,16 @@ std::optional<std::string> Recording::startServers() {
     content.cameraStates = [this] {
       nlohmann::json cameras = nlohmann::json::array();
       for (const auto& s : streams_) {
-        auto status = fleetStatus(*s);
+        auto control = controlOf(*s);
         cameras.push_back({{"name", s->plan.name},
                            {"state", apiState(s->state)},
-                           {"fps", status["fps"]},
-                           {"has_control", status["has_control"]},
-                           {"following", status["following"]}});
+                           {"fps", std::round(s->fps * 10) / 10},
+                           {"has_control", control.hasControl},
+                           {"following", control.following}});
       }
       return cameras;
     };
-    content.deleteRecording =
-        [this](const std::string& file) -> std::optional<std::pair<guint, std::string>> {
-      auto open = openSegments();
-      for (const auto& path : open)
-        if (std::filesystem::path(path).filename() == file)
-          return std::pair<guint, std::string>(
-              SOUP_STATUS_CONFLICT, "'" + file + "' is being recorded; it can go once closed");
-      const auto& entries = index_.entries();
-      if (std::none_of(entries.begin(), entries.end(),
-                       [&](const auto& e) { return e.file == file; }))
-        return std::pair<guint, std::string>(SOUP_STATUS_NOT_FOUND,
-                                             "no recording named '" + file + "'");
-      auto video = std::filesystem::path(options_.outDir) / file;
-      std::error_code error;
-      std::filesystem::remove(video, error);
-      if (error)
-        return std::pair<guint, std::string>(SOUP_STATUS_INTERNAL_SERVER_ERROR,
-                                             "cannot delete '" + file + "': " + error.message());
-      std::filesystem::remove(std::filesystem::path(video).replace_extension(".jsonl"), error);
-      log("deleted " + file + " (asked over HTTP)");
-      updateIndex({video.string()});
-      return std::nullopt;
-    };
+    content.deleteRecording = [this](const std::string& file) { return deleteSegment(file); };
     content.recordings = [this] {
       nlohmann::json list = nlohmann::json::array();
       for (const auto& entry : index_.entries()) list.push_back(toJson(entry));
@@ -264,7 +242,7 @@ void Recording::onSegmentClosed(Stream& stream, const std::string& file) {
               .durationSeconds = planned->durationSeconds(),
               .frames = planned->frames,
               .bytes = std::filesystem::file_size(file, error)});
-  auto sidecar = std::filesystem::path(file).replace_extension(".jsonl").string();
+  auto sidecar = TelemetryLog::pathFor(file);
   publishEvent(stream, {{"type", "segment-closed"},
                         {"file", std::filesystem::path(file).filename().string()},
                         {"path", file},
@@ -291,11 +269,52 @@ GstElement* Recording::element(const std::string& name) const {
   return found;
 }
 
+Recording::Control Recording::controlOf(const Stream& s) const {
+  GstElement* controller = element(s.plan.controller);
+  if (!controller) return {};
+  gboolean hasControl = FALSE, following = FALSE;
+  gint target = -1;
+  g_object_get(controller, "has-control", &hasControl, "enabled", &following, "target-id", &target,
+               nullptr);
+  return {.hasControl = hasControl != FALSE, .following = following != FALSE, .target = target};
+}
+
+nlohmann::json Recording::positionJson(const Stream& s) const {
+  nlohmann::json position = nullptr;
+  if (s.position)
+    position = {{"beacon", s.position->beacon},
+                {"x", s.position->x},
+                {"y", s.position->y},
+                {"z", s.position->z},
+                {"utc", SegmentPlanner::isoUtc(s.position->unixMs)},
+                {"stale", !s.positionStale.empty()}};
+  else if (!s.positionStale.empty())
+    position = {{"stale", true}};  // none came: say why
+  if (!s.positionStale.empty()) position["stale_reason"] = s.positionStale;
+  return position;
+}
+
+std::optional<std::pair<guint, std::string>> Recording::deleteSegment(const std::string& file) {
+  using Refusal = std::pair<guint, std::string>;
+  for (const auto& path : openSegments())
+    if (std::filesystem::path(path).filename() == file)
+      return Refusal(SOUP_STATUS_CONFLICT,
+                     "'" + file + "' is being recorded; it can go once closed");
+  const auto& entries = index_.entries();
+  if (std::none_of(entries.begin(), entries.end(), [&](const auto& e) { return e.file == file; }))
+    return Refusal(SOUP_STATUS_NOT_FOUND, "no recording named '" + file + "'");
+  auto video = std::filesystem::path(options_.outDir) / file;
+  if (auto error = removeSegment(video))
+    return Refusal(SOUP_STATUS_INTERNAL_SERVER_ERROR,
+                   "cannot delete '" + file + "': " + error.message());
+  log("deleted " + file + " (asked over HTTP)");
+  updateIndex({video.string()});
+  return std::nullopt;
+}
+
 nlohmann::json Recording::fleetStatus(const Stream& s) const {
   double total = static_cast<double>(s.frameCount + s.incomplete);
-  gboolean hasControl = FALSE, following = FALSE;
-  if (GstElement* controller = element(s.plan.controller))
-    g_object_get(controller, "has-control", &hasControl, "enabled", &following, nullptr);
+  auto control = controlOf(s);
   nlohmann::json status = {
       {"state", s.state},
       {"state_since_utc", SegmentPlanner::isoUtc(s.stateSinceUnixMs)},
@@ -303,16 +322,9 @@ nlohmann::json Recording::fleetStatus(const Stream& s) const {
       {"loss",
        total > 0 ? std::round(1000.0 * static_cast<double>(s.incomplete) / total) / 10 : 0.0},
       {"battery_v", s.batteryMv / 1000.0},
-      {"has_control", hasControl != FALSE},
-      {"following", following != FALSE},
-      {"position", nullptr}};
-  if (s.position)
-    status["position"] = {{"beacon", s.position->beacon},
-                          {"x", s.position->x},
-                          {"y", s.position->y},
-                          {"z", s.position->z},
-                          {"utc", SegmentPlanner::isoUtc(s.position->unixMs)},
-                          {"stale", !s.positionStale.empty()}};
+      {"has_control", control.hasControl},
+      {"following", control.following},
+      {"position", positionJson(s)}};
   return status;
 }
 
@@ -682,27 +694,12 @@ nlohmann::json Recording::status() const {
         {"segment", std::filesystem::path(s->segment).filename().string()},
         {"live", "/live/" + s->plan.name + ".mjpg"}};
     if (!s->plan.controller.empty()) {
-      auto fleet = fleetStatus(*s);
-      stream["has_control"] = fleet["has_control"];
-      stream["following"] = fleet["following"];
-      gint target = -1;
-      g_object_get(element(s->plan.controller), "target-id", &target, nullptr);
-      stream["target"] = target;
+      auto control = controlOf(*s);
+      stream["has_control"] = control.hasControl;
+      stream["following"] = control.following;
+      stream["target"] = control.target;
     }
-    if (s->position) {
-      const auto& p = *s->position;
-      stream["position"] = {{"beacon", p.beacon},
-                            {"x", p.x},
-                            {"y", p.y},
-                            {"z", p.z},
-                            {"utc", SegmentPlanner::isoUtc(p.unixMs)},
-                            {"stale", !s->positionStale.empty()}};
-    } else if (!s->plan.positions.empty()) {
-      // Asked for, none yet: null, or why none comes.
-      stream["position"] =
-          s->positionStale.empty() ? nlohmann::json(nullptr) : nlohmann::json{{"stale", true}};
-    }
-    if (!s->positionStale.empty()) stream["position"]["stale_reason"] = s->positionStale;
+    if (!s->plan.positions.empty()) stream["position"] = positionJson(*s);
     if (rtsp_)
       stream["rtsp"] =
           rtsp_->url() + "/" + s->plan.device + "/cam" + std::to_string(s->plan.camera);

@@ -86,6 +86,16 @@ class Recording {
   void handlePosition(Stream& stream, const GstStructure* s);
   // MQTT: a stream's status as the fleet sees it, and a command for it.
   nlohmann::json fleetStatus(const Stream& stream) const;
+  // What the stream's wirccontrol says (all off without --follow).
+  struct Control {
+    bool hasControl = false, following = false;
+    int target = -1;
+  };
+  Control controlOf(const Stream& stream) const;
+  // The latest Marvelmind position (null until one came), for status and MQTT.
+  nlohmann::json positionJson(const Stream& stream) const;
+  // DELETE /api/recordings/FILE: the HTTP status and reason when it cannot.
+  std::optional<std::pair<guint, std::string>> deleteSegment(const std::string& file);
   void publishFleetStatus(bool force = false);
   void applyCommand(const FleetCommand& command);
   void publishEvent(const Stream& stream, const nlohmann::json& event);

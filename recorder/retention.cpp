@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "disk_guard.h"
+#include "telemetry_log.h"
 
 namespace wircam::recorder {
 
@@ -23,6 +24,14 @@ struct Segment {
 
 }  // namespace
 
+std::error_code removeSegment(const fs::path& video) {
+  std::error_code error, sidecarError;
+  fs::remove(video, error);
+  // A segment may have no sidecar (a crash before its first line).
+  fs::remove(TelemetryLog::pathFor(video.string()), sidecarError);
+  return error;
+}
+
 std::vector<std::string> Retention::enforce(const std::set<std::string>& open) {
   std::vector<std::string> deleted;
   if (!active()) return deleted;
@@ -32,7 +41,7 @@ std::vector<std::string> Retention::enforce(const std::set<std::string>& open) {
   for (const auto& entry : fs::directory_iterator(folder_, error)) {
     auto extension = entry.path().extension();
     if (extension != ".mkv" && extension != ".mp4") continue;
-    auto sidecar = fs::path(entry.path()).replace_extension(".jsonl");
+    fs::path sidecar = TelemetryLog::pathFor(entry.path().string());
     uint64_t bytes =
         entry.file_size(error) + (fs::exists(sidecar) ? fs::file_size(sidecar, error) : 0);
     total += bytes;
@@ -45,8 +54,7 @@ std::vector<std::string> Retention::enforce(const std::set<std::string>& open) {
     bool overSize = limits_.maxBytes > 0 && total > limits_.maxBytes;
     bool underFree = limits_.minFree > 0 && freeBytes(folder_) < limits_.minFree;
     if (!overSize && !underFree) break;
-    fs::remove(segment.video, error);
-    fs::remove(fs::path(segment.video).replace_extension(".jsonl"), error);
+    removeSegment(segment.video);
     total -= segment.bytes;
     deleted.push_back(segment.video.string());
     logger_("deleted " + segment.video.filename().string() +

@@ -3,12 +3,18 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <set>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace wircam::recorder {
+
+// Deletes a segment's video and its sidecar (what retention and the web
+// server's delete do); the video's error, if it could not go.
+std::error_code removeSegment(const std::filesystem::path& video);
 
 struct RetentionLimits {
   uint64_t maxBytes = 0;  // 0 = no cap on what the recordings take

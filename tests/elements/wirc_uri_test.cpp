@@ -3,7 +3,6 @@
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <memory>
 #include <thread>
 

@@ -32,27 +32,39 @@ bool cameOnline(MqttProbe& probe) {
       "wircam/available", [](auto& m) { return m.payload == "online"; }, 10s);
 }
 
-TEST(RecorderMqtt, StatusRetainedDetectionsAndTheLastWillOnKill) {
+// A broker, the follow scene's car and a subscriber to everything under
+// wircam/; follow() starts a recorder that follows the car and publishes
+// there, and says whether it came online.
+struct FollowedOverMqtt {
   MosquittoBroker broker;
-  ASSERT_TRUE(broker.running());
-  auto device = startFollowDevice();
-  ASSERT_TRUE(device);
-  std::string stream = streamOf(*device);
-  MqttProbe probe(broker.port(), "wircam/#");
-  RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
-                                            broker.url(), "--duration", "60"});
-  ASSERT_TRUE(cameOnline(probe)) << recorder.log();
+  std::unique_ptr<wirc::Device> device = startFollowDevice();
+  std::string stream = device ? streamOf(*device) : "";
+  MqttProbe probe{broker.port(), "wircam/#"};
+  std::unique_ptr<RecorderProcess> recorder;
+
+  bool follow() {
+    recorder = std::make_unique<RecorderProcess>(
+        device->port(), std::vector<std::string>{"--detect", "tag36h11", "--follow", "--mqtt",
+                                                 broker.url(), "--duration", "60"});
+    return cameOnline(probe);
+  }
+};
+
+TEST(RecorderMqtt, StatusRetainedDetectionsAndTheLastWillOnKill) {
+  FollowedOverMqtt car;
+  ASSERT_TRUE(car.broker.running() && car.device);
+  ASSERT_TRUE(car.follow()) << car.recorder->log();
   // Detections of the simulator's tag, id 0, with centre and corners.
-  ASSERT_TRUE(probe.waitFor(
-      "wircam/" + stream + "/detections",
+  ASSERT_TRUE(car.probe.waitFor(
+      "wircam/" + car.stream + "/detections",
       [](auto& m) {
         auto d = parsed(m);
         return !d.is_discarded() && !d["tags"].empty() && d["tags"][0]["id"] == 0 &&
                d["tags"][0]["corners"].size() == 8 && d["tags"][0].contains("cx");
       },
       10s));
-  ASSERT_TRUE(probe.waitFor(
-      "wircam/" + stream + "/status",
+  ASSERT_TRUE(car.probe.waitFor(
+      "wircam/" + car.stream + "/status",
       [](auto& m) {
         auto s = parsed(m);
         return m.retained == false && s["state"] == "live" && s["fps"].template get<double>() > 0 &&
@@ -61,15 +73,15 @@ TEST(RecorderMqtt, StatusRetainedDetectionsAndTheLastWillOnKill) {
       },
       10s));
   // Retained: a client that comes later gets the status and "online" at once.
-  MqttProbe late(broker.port(), "wircam/#");
+  MqttProbe late(car.broker.port(), "wircam/#");
   EXPECT_TRUE(late.waitFor(
-      "wircam/" + stream + "/status",
+      "wircam/" + car.stream + "/status",
       [](auto& m) { return m.retained && parsed(m)["state"] == "live"; }, 5s));
   EXPECT_TRUE(late.waitFor(
       "wircam/available", [](auto& m) { return m.retained && m.payload == "online"; }, 5s));
   // kill -9: the broker says offline for it (the last will).
-  recorder.signal(SIGKILL);
-  recorder.wait();
+  car.recorder->signal(SIGKILL);
+  car.recorder->wait();
   EXPECT_TRUE(late.waitFor(
       "wircam/available", [](auto& m) { return m.payload == "offline"; }, 5s));
 }
@@ -123,32 +135,28 @@ TEST(RecorderMqtt, SegmentClosedForEveryFileAndTheHookGetsEachWhole) {
 }
 
 TEST(RecorderMqtt, FollowOffSendsTheCarToNeutralWithinOneCommandPeriod) {
-  MosquittoBroker broker;
-  auto device = startFollowDevice();
-  ASSERT_TRUE(device);
-  std::string stream = streamOf(*device);
-  MqttProbe probe(broker.port(), "wircam/#");
-  RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
-                                            broker.url(), "--duration", "60"});
-  ASSERT_TRUE(cameOnline(probe));
+  FollowedOverMqtt car;
+  ASSERT_TRUE(car.device);
+  ASSERT_TRUE(car.follow()) << car.recorder->log();
   // Driving after the target.
-  auto moving = [&] { return device->outputs().pulses[1] != wirc::kPulseNeutral; };
+  auto moving = [&] { return car.device->outputs().pulses[1] != wirc::kPulseNeutral; };
   for (int i = 0; i < 500 && !moving(); ++i) std::this_thread::sleep_for(10ms);
   ASSERT_TRUE(moving()) << "the car never drove";
   auto sent = std::chrono::steady_clock::now();
-  probe.publish("wircam/" + stream + "/follow/set", "OFF");
+  car.probe.publish("wircam/" + car.stream + "/follow/set", "OFF");
   while (moving() && std::chrono::steady_clock::now() - sent < 2s) std::this_thread::sleep_for(1ms);
   auto took = std::chrono::steady_clock::now() - sent;
   EXPECT_FALSE(moving());
   // One command period: a frame at the simulator's 15 fps.
   EXPECT_LT(took, 67ms) << std::chrono::duration_cast<std::chrono::milliseconds>(took).count();
-  EXPECT_EQ(device->outputs().pulses[0], wirc::kPulseNeutral);  // steering too
-  EXPECT_TRUE(probe.waitFor(
-      "wircam/" + stream + "/status", [](auto& m) { return parsed(m)["following"] == false; }, 3s));
+  EXPECT_EQ(car.device->outputs().pulses[0], wirc::kPulseNeutral);  // steering too
+  EXPECT_TRUE(car.probe.waitFor(
+      "wircam/" + car.stream + "/status", [](auto& m) { return parsed(m)["following"] == false; },
+      3s));
   // It stays stopped while the target is in view, and ON resumes.
   std::this_thread::sleep_for(500ms);
   EXPECT_FALSE(moving());
-  probe.publish("wircam/" + stream + "/follow/set", "ON");
+  car.probe.publish("wircam/" + car.stream + "/follow/set", "ON");
   bool resumed = false;
   for (int i = 0; i < 300 && !resumed; ++i, std::this_thread::sleep_for(10ms)) resumed = moving();
   EXPECT_TRUE(resumed);
@@ -203,35 +211,32 @@ TEST(RecorderMqtt, RecordsOnWhateverTheBrokerDoes) {
 }
 
 TEST(RecorderMqtt, IgnoresRetainedJunkAndBadCommands) {
-  MosquittoBroker broker;
-  auto device = startFollowDevice();
-  ASSERT_TRUE(device);
-  std::string stream = streamOf(*device);
-  MqttProbe probe(broker.port(), "wircam/#");
+  FollowedOverMqtt car;
+  ASSERT_TRUE(car.device);
   // Left behind by some other tool: replayed to every new subscriber.
-  probe.publish("wircam/" + stream + "/follow/set", "OFF", true);
-  probe.publish("wircam/" + stream + "/target/set", "\x01\xff junk", true);
+  car.probe.publish("wircam/" + car.stream + "/follow/set", "OFF", true);
+  car.probe.publish("wircam/" + car.stream + "/target/set", "\x01\xff junk", true);
   std::this_thread::sleep_for(200ms);
-  RecorderProcess recorder(device->port(), {"--detect", "tag36h11", "--follow", "--mqtt",
-                                            broker.url(), "--duration", "60"});
-  ASSERT_TRUE(cameOnline(probe));
-  probe.publish("wircam/" + stream + "/follow/set", "SIDEWAYS");
-  probe.publish("wircam/" + stream + "/target/set", "7x");
-  probe.publish("wircam/no-such-stream/follow/set", "OFF");
+  ASSERT_TRUE(car.follow()) << car.recorder->log();
+  car.probe.publish("wircam/" + car.stream + "/follow/set", "SIDEWAYS");
+  car.probe.publish("wircam/" + car.stream + "/target/set", "7x");
+  car.probe.publish("wircam/no-such-stream/follow/set", "OFF");
   std::this_thread::sleep_for(1500ms);
   // Still following: no junk turned it off.
-  EXPECT_TRUE(probe.waitFor(
-      "wircam/" + stream + "/status", [](auto& m) { return parsed(m)["following"] == true; }, 5s));
-  for (const auto& m : probe.messages("wircam/" + stream + "/status"))
+  EXPECT_TRUE(car.probe.waitFor(
+      "wircam/" + car.stream + "/status", [](auto& m) { return parsed(m)["following"] == true; },
+      5s));
+  for (const auto& m : car.probe.messages("wircam/" + car.stream + "/status"))
     EXPECT_EQ(parsed(m)["following"], true) << m.payload;
-  auto log = recorder.log();
-  EXPECT_NE(log.find("ignoring the retained message on wircam/" + stream + "/follow/set"),
+  auto log = car.recorder->log();
+  EXPECT_NE(log.find("ignoring the retained message on wircam/" + car.stream + "/follow/set"),
             std::string::npos)
       << log;
   EXPECT_NE(log.find("follow/set takes ON or OFF, not 'SIDEWAYS'"), std::string::npos) << log;
   EXPECT_NE(log.find("not '7x'"), std::string::npos) << log;
   EXPECT_NE(log.find("no stream 'no-such-stream'"), std::string::npos) << log;
-  probe.publish("wircam/" + stream + "/follow/set", "", true);  // clean up the retained ones
+  // Clean up the retained ones.
+  car.probe.publish("wircam/" + car.stream + "/follow/set", "", true);
 }
 
 TEST(RecorderMqtt, AHangingHookIsStoppedRetriedAndReportedWhileRecordingGoesOn) {
