@@ -21,8 +21,6 @@ uint16_t freePort() {
   return socket ? localAddress(socket->get()).port() : 0;
 }
 
-bool accepts(uint16_t port) { return connectTcp(SocketAddress::loopback(port)).has_value(); }
-
 }  // namespace
 
 MosquittoBroker::MosquittoBroker(const std::string& user, const std::string& password) {
@@ -31,20 +29,23 @@ MosquittoBroker::MosquittoBroker(const std::string& user, const std::string& pas
             ("wirc-mosquitto-" + std::to_string(getpid()) + "-" + std::to_string(++count));
   fs::remove_all(folder_);
   fs::create_directories(folder_);
-  port_ = freePort();
-  std::ofstream config(folder_ / "mosquitto.conf");
-  config << "listener " << port_ << " 127.0.0.1\npersistence false\n";
-  if (user.empty()) {
-    config << "allow_anonymous true\n";
-  } else {
+  std::string access = "allow_anonymous true\n";
+  if (!user.empty()) {
     auto passwords = folder_ / "passwords";
     std::string command = "mosquitto_passwd -b -c " + passwords.string() + " '" + user + "' '" +
                           password + "' > /dev/null 2>&1";
     if (std::system(command.c_str()) != 0) return;
-    config << "allow_anonymous false\npassword_file " << passwords.string() << "\n";
+    access = "allow_anonymous false\npassword_file " + passwords.string() + "\n";
   }
-  config.close();
-  start();
+  // The free port may be taken by a test running beside this one before
+  // mosquitto binds it: then it exits, and another port is tried.
+  for (int attempt = 0; attempt < 5 && !running(); ++attempt) {
+    port_ = freePort();
+    std::ofstream(folder_ / "mosquitto.conf")
+        << "listener " << port_ << " 127.0.0.1\npersistence false\n"
+        << access;
+    start();
+  }
 }
 
 MosquittoBroker::~MosquittoBroker() {
@@ -66,15 +67,25 @@ void MosquittoBroker::kill() {
 
 bool MosquittoBroker::start() {
   std::string config = (folder_ / "mosquitto.conf").string();
-  std::string log = (folder_ / "mosquitto.log").string();
+  fs::path log = folder_ / "mosquitto.log";
+  std::error_code error;
+  auto logged = fs::exists(log) ? fs::file_size(log, error) : 0;  // earlier runs' lines
   pid_ = fork();
   if (pid_ == 0) {
     if (!freopen(log.c_str(), "a", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(126);
     execlp("mosquitto", "mosquitto", "-c", config.c_str(), nullptr);
     _exit(127);
   }
+  // Its own word that it listens: something else may answer on the port.
   for (int i = 0; i < 250; ++i) {
-    if (accepts(port_)) return true;
+    if (waitpid(pid_, nullptr, WNOHANG) == pid_) {
+      pid_ = -1;  // exited: the port was taken
+      return false;
+    }
+    std::ifstream in(log);
+    in.seekg(static_cast<std::streamoff>(logged));
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    if (text.find(" running") != std::string::npos) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return false;
