@@ -23,6 +23,12 @@
  * once. The `request-control` action signal (or `take-control=true`, at each
  * login) asks the device for it with AREQ.
  *
+ * Driving by hand: the `drive` action signal (steering, throttle in -1..1)
+ * sends a command at once, within the same limits, and holds it for
+ * `drive-timeout` ms (250 by default) while the follower keeps off; without
+ * a newer one by then the vehicle goes to neutral, frames or not. Each is
+ * posted as a `wirc-drive` element message (`reason`: command, dead-man).
+ *
  * The vehicle may speak WiRC, RCOIP or BTEMP (`protocol`), whatever the
  * video comes from: the same follower, limits and failsafe steer all three.
  * RCOIP sends channels 1..8 as bytes (800..2200 µs → 0..255) to a receiver
@@ -56,6 +62,7 @@
 #include "control_link.h"
 #include "glib_locker.h"
 #include "login_properties.h"
+#include "manual_drive.h"
 #include "target_follower.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_tag_meta.h"
@@ -87,6 +94,7 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_KEEPALIVE 100
 #define DEFAULT_ENABLED TRUE
 #define DEFAULT_TAKE_CONTROL FALSE
+#define DEFAULT_DRIVE_TIMEOUT 250
 
 enum {
   PROP_0,
@@ -118,12 +126,13 @@ enum {
   PROP_KEEPALIVE,
   PROP_ENABLED,
   PROP_TAKE_CONTROL,
+  PROP_DRIVE_TIMEOUT,
   PROP_HAS_CONTROL,
   PROP_PERIODS,
   PROP_FAILSAFE,
 };
 
-enum { SIGNAL_REQUEST_CONTROL, SIGNAL_COUNT };
+enum { SIGNAL_REQUEST_CONTROL, SIGNAL_DRIVE, SIGNAL_COUNT };
 guint signals[SIGNAL_COUNT];
 GParamSpec* hasControlSpec;
 
@@ -148,6 +157,7 @@ struct Settings {
   bool keepaliveSet = false;
   gboolean enabled = DEFAULT_ENABLED;
   gboolean takeControl = DEFAULT_TAKE_CONTROL;
+  guint driveTimeoutMs = DEFAULT_DRIVE_TIMEOUT;
   wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
   wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
   // The shared link's settings given: the pacing ones always (the element
@@ -169,6 +179,8 @@ struct WircControlState {
   std::shared_ptr<link::VehicleLink> session;
   int sessionListener = 0;
   std::atomic<bool> hasControl{false};
+  // Commands by hand (the `drive` action); created in init().
+  std::unique_ptr<gst::ManualDrive> manual;
 };
 
 vision::FollowConfig followConfig(const Settings& s) {
@@ -188,6 +200,14 @@ vision::FollowerSettings followerSettings(const Settings& s) {
   return {.targetId = s.targetId,
           .lostTimeout = std::chrono::milliseconds(s.lostTimeoutMs),
           .enabled = s.enabled != FALSE};
+}
+
+// Neutral on the element's two channels (the others are at 1500 anyway).
+link::Pulses neutralOf(const Settings& s) {
+  link::Pulses pulses = link::neutralPulses();
+  pulses[s.steeringChannel - 1] = static_cast<uint16_t>(s.neutral);
+  pulses[s.throttleChannel - 1] = static_cast<uint16_t>(s.neutral);
+  return pulses;
 }
 
 double meanEdge(const WircTag& tag) {
@@ -281,6 +301,50 @@ static void gst_wirc_control_request_control(GstWircControl* self) {
   session->requestControl();
 }
 
+static void post_drive(GstWircControl* self, const char* reason, const link::Pulses& pulses,
+                       guint steeringChannel, guint throttleChannel) {
+  gst_element_post_message(
+      GST_ELEMENT(self),
+      gst_message_new_element(
+          GST_OBJECT(self),
+          gst_structure_new("wirc-drive", "reason", G_TYPE_STRING, reason, "steering-pulse",
+                            G_TYPE_UINT, static_cast<guint>(pulses[steeringChannel - 1]),
+                            "throttle-pulse", G_TYPE_UINT,
+                            static_cast<guint>(pulses[throttleChannel - 1]), "has-control",
+                            G_TYPE_BOOLEAN, self->state->hasControl.load(), nullptr)));
+}
+
+static gboolean gst_wirc_control_drive(GstWircControl* self, gdouble steering, gdouble throttle) {
+  auto* state = self->state;
+  std::shared_ptr<link::VehicleLink> session;
+  Settings settings;
+  {
+    gst::GLibLocker lock(self);
+    session = state->session;
+    settings = state->settings;
+  }
+  if (!session) {
+    GST_WARNING_OBJECT(self, "drive before the element started: no vehicle to drive");
+    return FALSE;
+  }
+  link::Pulses neutral = neutralOf(settings);
+  link::Pulses pulses = neutral;
+  const char* reason = "command";
+  if (std::isfinite(steering) && std::isfinite(throttle)) {
+    auto config = followConfig(settings);
+    pulses[settings.steeringChannel - 1] = config.steeringMap.toPulse(steering);
+    pulses[settings.throttleChannel - 1] =
+        config.throttleMap.toPulse(std::clamp(throttle, -1.0, 1.0) * settings.maxThrottle);
+  } else {
+    GST_WARNING_OBJECT(self, "drive: steering and throttle must be numbers; neutral sent");
+    reason = "not a number: neutral";
+  }
+  state->manual->drive(session, pulses, neutral,
+                       std::chrono::milliseconds(settings.driveTimeoutMs));
+  post_drive(self, reason, pulses, settings.steeringChannel, settings.throttleChannel);
+  return state->hasControl.load();
+}
+
 static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
   auto* self = GST_WIRC_CONTROL(transform);
   auto* state = self->state;
@@ -352,6 +416,7 @@ static gboolean gst_wirc_control_stop(GstBaseTransform* transform) {
     gst::GLibLocker lock(self);
     session = std::move(state->session);
   }
+  state->manual->release();
   if (session) {
     session->removeListener(state->sessionListener);
     session->setCommand(link::neutralPulses());
@@ -388,7 +453,9 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
   link::Pulses pulses = link::neutralPulses();
   pulses[settings.steeringChannel - 1] = command.steeringPulse;
   pulses[settings.throttleChannel - 1] = command.throttlePulse;
-  state->session->setCommand(pulses);
+  // A command by hand holds the vehicle until its dead-man lapses.
+  bool manual = state->manual->active();
+  if (!manual) state->session->setCommand(pulses);
 
   bool steering =
       command.steeringPulse != settings.neutral || command.throttlePulse != settings.neutral;
@@ -414,7 +481,8 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
               command.bearingRad, "distance", G_TYPE_DOUBLE, command.distance, "steering",
               G_TYPE_DOUBLE, command.steering, "throttle", G_TYPE_DOUBLE, command.throttle,
               "steering-pulse", G_TYPE_UINT, static_cast<guint>(command.steeringPulse),
-              "throttle-pulse", G_TYPE_UINT, static_cast<guint>(command.throttlePulse), nullptr)));
+              "throttle-pulse", G_TYPE_UINT, static_cast<guint>(command.throttlePulse), "manual",
+              G_TYPE_BOOLEAN, manual, nullptr)));
   return GST_FLOW_OK;
 }
 
@@ -422,17 +490,17 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
 // a frame period away, or never come on a stalled pipeline).
 static void stop_following_now(GstWircControl* self) {
   std::shared_ptr<link::VehicleLink> session;
-  link::Pulses pulses = link::neutralPulses();
+  link::Pulses pulses;
   {
     gst::GLibLocker lock(self);
     auto& s = self->state->settings;
     s.enabled = FALSE;
     self->state->settingsChanged = true;
     session = self->state->session;
-    pulses[s.steeringChannel - 1] = static_cast<uint16_t>(s.neutral);
-    pulses[s.throttleChannel - 1] = static_cast<uint16_t>(s.neutral);
+    pulses = neutralOf(s);
   }
-  if (session) session->setCommand(pulses);
+  // Not over a driver's command by hand: that one ends by its own dead-man.
+  if (session && !self->state->manual->active()) session->setCommand(pulses);
 }
 
 static void gst_wirc_control_set_property(GObject* object, guint id, const GValue* value,
@@ -524,6 +592,9 @@ static void gst_wirc_control_set_property(GObject* object, guint id, const GValu
       break;
     case PROP_ENABLED:
       s.enabled = g_value_get_boolean(value);
+      break;
+    case PROP_DRIVE_TIMEOUT:
+      s.driveTimeoutMs = g_value_get_uint(value);
       break;
     case PROP_TAKE_CONTROL:
       s.takeControl = g_value_get_boolean(value);
@@ -629,6 +700,9 @@ static void gst_wirc_control_get_property(GObject* object, guint id, GValue* val
     case PROP_ENABLED:
       g_value_set_boolean(value, s.enabled);
       break;
+    case PROP_DRIVE_TIMEOUT:
+      g_value_set_uint(value, s.driveTimeoutMs);
+      break;
     case PROP_TAKE_CONTROL:
       g_value_set_boolean(value, s.takeControl);
       break;
@@ -654,6 +728,14 @@ static void gst_wirc_control_finalize(GObject* object) {
 
 static void gst_wirc_control_init(GstWircControl* self) {
   self->state = new WircControlState();
+  self->state->manual = std::make_unique<gst::ManualDrive>([self] {
+    Settings settings;
+    {
+      gst::GLibLocker lock(self);
+      settings = self->state->settings;
+    }
+    post_drive(self, "dead-man", neutralOf(settings), settings.steeringChannel, settings.throttleChannel);
+  });
   gst_base_transform_set_passthrough(GST_BASE_TRANSFORM(self), TRUE);
 }
 
@@ -782,6 +864,10 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
                            "Ask the device for the control right (AREQ) at each login that "
                            "does not bring it; the answer comes as a wirc-control-right message",
                            DEFAULT_TAKE_CONTROL, ready));
+  install_uint(gobject, PROP_DRIVE_TIMEOUT, "drive-timeout",
+               "Milliseconds a command by hand (the drive action) holds; without a newer one "
+               "by then the vehicle goes to neutral (a dead-man)",
+               20, 5000, DEFAULT_DRIVE_TIMEOUT, live);
   hasControlSpec = g_param_spec_boolean(
       "has-control", "Has control",
       "Whether this transmitter holds the control right (only then do commands reach the "
@@ -799,6 +885,25 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
       "request-control", G_TYPE_FROM_CLASS(klass),
       static_cast<GSignalFlags>(G_SIGNAL_RUN_LAST | G_SIGNAL_ACTION),
       G_CALLBACK(gst_wirc_control_request_control), nullptr, nullptr, nullptr, G_TYPE_NONE, 0);
+
+  /**
+   * GstWircControl::drive:
+   * @steering: -1 (full right) .. 1 (full left)
+   * @throttle: -1 (full reverse) .. 1 (full ahead), scaled by max-throttle
+   *
+   * Drives by hand: the command goes to the vehicle at once, through the
+   * same pulse limits as the follower's, and holds for `drive-timeout` ms;
+   * the follower keeps off meanwhile. Without a newer command by then the
+   * vehicle goes to neutral. Send commands more often than that (every 100
+   * ms, say) for as long as the driver drives. A value that is not a number
+   * sends neutral. Each command is posted as a `wirc-drive` element message.
+   * Returns whether the vehicle obeys (this transmitter holds the right).
+   */
+  signals[SIGNAL_DRIVE] = g_signal_new_class_handler(
+      "drive", G_TYPE_FROM_CLASS(klass),
+      static_cast<GSignalFlags>(G_SIGNAL_RUN_LAST | G_SIGNAL_ACTION),
+      G_CALLBACK(gst_wirc_control_drive), nullptr, nullptr, nullptr, G_TYPE_BOOLEAN, 2,
+      G_TYPE_DOUBLE, G_TYPE_DOUBLE);
 
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);
