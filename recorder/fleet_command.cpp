@@ -29,7 +29,12 @@ Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
     parsed.target = static_cast<int>(id);
     return parsed;
   }
-  return unexpected("unknown command '" + command + "' (follow/set, target/set)");
+  if (command == "request-control") {
+    parsed.kind = FleetCommand::Kind::kRequestControl;
+    return parsed;
+  }
+  return unexpected("unknown command '" + command +
+                    "' (follow/set, target/set, request-control)");
 }
 
 }  // namespace wircam::recorder

@@ -1,5 +1,7 @@
-// The commands the recorder takes over MQTT: PREFIX/STREAM/follow/set (ON,
-// OFF) and PREFIX/STREAM/target/set (a tag id, -1 = the largest).
+// The commands the recorder takes over MQTT (and from its web page):
+// PREFIX/STREAM/follow/set (ON, OFF), PREFIX/STREAM/target/set (a tag id,
+// -1 = the largest) and PREFIX/STREAM/request-control (asks the vehicle for
+// the control right; any payload).
 #pragma once
 
 #include <string>
@@ -9,7 +11,7 @@
 namespace wircam::recorder {
 
 struct FleetCommand {
-  enum class Kind { kFollow, kTarget } kind;
+  enum class Kind { kFollow, kTarget, kRequestControl } kind;
   std::string stream;
   bool follow = false;  // kFollow
   int target = -1;      // kTarget

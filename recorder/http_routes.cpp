@@ -23,11 +23,24 @@ Route routeOf(std::string_view path) {
   constexpr std::string_view kRecordingEntry = "/api/recordings/";
   if (path.starts_with(kRecordingEntry) && path.size() > kRecordingEntry.size())
     return {Kind::RecordingEntry, std::string(path.substr(kRecordingEntry.size()))};
-  if (path.starts_with(kCameras) && path.ends_with(kSnapshot) &&
-      path.size() > kCameras.size() + kSnapshot.size()) {
-    auto camera = path.substr(kCameras.size(), path.size() - kCameras.size() - kSnapshot.size());
-    if (camera.find('/') == std::string_view::npos) return {Kind::Snapshot, std::string(camera)};
+  if (path.starts_with(kCameras)) {
+    // NAME/ACTION, NAME without a slash
+    auto rest = path.substr(kCameras.size());
+    auto slash = rest.find('/');
+    if (slash != std::string_view::npos && slash > 0) {
+      std::string camera(rest.substr(0, slash));
+      auto action = rest.substr(slash + 1);
+      if (action == kSnapshot.substr(1)) return {Kind::Snapshot, camera};
+      if (action == "drive") return {Kind::Drive, camera};
+      if (action == "follow" || action == "target" || action == "request-control")
+        return {Kind::CameraCommand, camera, std::string(action)};
+    }
   }
+  constexpr std::string_view kPlay = "/play/";
+  if (path.starts_with(kPlay) && path.ends_with(kMjpeg) &&
+      path.size() > kPlay.size() + kMjpeg.size())
+    return {Kind::Playback,
+            std::string(path.substr(kPlay.size(), path.size() - kPlay.size() - kMjpeg.size()))};
   if (path.starts_with("/api/")) return {Kind::ApiNotFound, ""};
   if (path.starts_with(kLive) && path.ends_with(kMjpeg) &&
       path.size() > kLive.size() + kMjpeg.size())

@@ -20,11 +20,15 @@ struct Route {
     Snapshot,        // GET /api/cameras/NAME/snapshot.jpg
     RecordingIndex,  // GET /api/recordings
     RecordingEntry,  // /api/recordings/FILE (DELETE only)
+    CameraCommand,   // POST /api/cameras/NAME/{follow,target,request-control}
+    Drive,           // GET /api/cameras/NAME/drive: the drive mode's WebSocket
+    Playback,        // GET /play/FILE.mjpg?from=SECONDS: a recording replayed as MJPEG
     ApiNotFound,     // any other /api/ path: 404 with JSON
     NotFound
   };
   Kind kind = Kind::NotFound;
-  std::string name;  // the camera (Live, Snapshot) or the file (Recording, RecordingEntry)
+  std::string name;    // the camera (Live, Snapshot, CameraCommand, Drive) or the file
+  std::string action;  // CameraCommand: follow, target or request-control
 };
 
 // `path` as libsoup hands it over (percent-decoded).

@@ -8,6 +8,7 @@
 #include "http_routes.h"
 #include "live_view_page.h"
 #include "login_page.h"
+#include "playback_stream.h"
 #include "telemetry_log.h"
 
 namespace wircam::recorder {
@@ -37,12 +38,35 @@ void respondJsonError(SoupServerMessage* message, guint status, const std::strin
 
 }  // namespace
 
-// One open streaming response: an MJPEG viewer or an event listener.
+// One open streaming response: an MJPEG viewer, an event listener, or a
+// recording being replayed (which goes when the viewer does).
 struct HttpServer::Client {
   SoupServerMessage* message;
   int inFlight = 0;  // chunks appended but not yet written to the socket
   gulong wroteHandler = 0, finishedHandler = 0;
+  std::unique_ptr<PlaybackStream> playback;
 };
+
+namespace {
+
+// One part of a multipart/x-mixed-replace stream, built in one piece: a
+// single copy of the frame per delivery. `extraHeaders` end in CRLF.
+GBytes* multipartFrame(GstBuffer* jpeg, const std::string& extraHeaders) {
+  GstMapInfo map;
+  if (!gst_buffer_map(jpeg, &map, GST_MAP_READ)) return nullptr;
+  std::string header = std::string("--") + kBoundary +
+                       "\r\nContent-Type: image/jpeg\r\nContent-Length: " +
+                       std::to_string(map.size) + "\r\n" + extraHeaders + "\r\n";
+  GByteArray* part = g_byte_array_sized_new(static_cast<guint>(header.size() + map.size + 2));
+  g_byte_array_append(part, reinterpret_cast<const guint8*>(header.data()),
+                      static_cast<guint>(header.size()));
+  g_byte_array_append(part, map.data, static_cast<guint>(map.size));
+  g_byte_array_append(part, reinterpret_cast<const guint8*>("\r\n"), 2);
+  gst_buffer_unmap(jpeg, &map);
+  return g_byte_array_free_to_bytes(part);
+}
+
+}  // namespace
 
 struct HttpServer::CameraFeed {
   std::string name;
@@ -86,6 +110,9 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
 
   soup_server_add_early_handler(self->server_, nullptr, onHeaders, self.get(), nullptr);
   soup_server_add_handler(self->server_, nullptr, onRequest, self.get(), nullptr);
+  // Upgrades only the requests onRequest leaves unanswered (the drive mode's).
+  soup_server_add_websocket_handler(self->server_, nullptr, nullptr, nullptr, onWebSocket,
+                                    self.get(), nullptr);
   g_signal_connect(self->server_, "request-started", G_CALLBACK(onRequestStarted), self.get());
   g_signal_connect(self->server_, "request-finished", G_CALLBACK(onRequestEnded), self.get());
   g_signal_connect(self->server_, "request-aborted", G_CALLBACK(onRequestEnded), self.get());
@@ -152,6 +179,8 @@ HttpServer::~HttpServer() {
   };
   for (auto& feed : feeds_) release(feed->clients);
   release(eventClients_);
+  release(playbackClients_);
+  driveSockets_.clear();  // each sends neutral and closes
   if (server_) {
     soup_server_disconnect(server_);
     g_object_unref(server_);
@@ -186,11 +215,11 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*,
   auto* headers = soup_server_message_get_request_headers(message);
   bool hasBody = soup_message_headers_get_content_length(headers) > 0 ||
                  soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CHUNKED;
-  bool known = method == "GET" || method == "HEAD" || method == "DELETE";
+  bool known = method == "GET" || method == "HEAD" || method == "DELETE" || method == "POST";
   if (known && !hasBody) return;
   // libsoup would read the whole body before answering: answer on the
   // socket now, and close it. Nothing of this request was written yet.
-  std::string answer = !known ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE\r\n"
+  std::string answer = !known ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE, POST\r\n"
                               : "HTTP/1.1 413 Content Too Large\r\n";
   answer += "Content-Length: 0\r\nConnection: close\r\n\r\n";
   soup_message_body_set_accumulate(soup_server_message_get_request_body(message), FALSE);
@@ -201,8 +230,8 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*,
   soup_server_message_set_status(message, SOUP_STATUS_BAD_REQUEST, nullptr);
 }
 
-void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
-                           gpointer data) {
+void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* path,
+                           GHashTable* query, gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
   auto route = routeOf(path);
   if (route.kind != Route::Kind::Login && !self->authorised(message)) {
@@ -222,6 +251,10 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                               "only recordings can be deleted: DELETE /api/recordings/FILE");
     return self->deleteRecording(message, route.name);
   }
+  if (route.kind == Route::Kind::CameraCommand) return self->serveCommand(message, route, query);
+  if (method == "POST")
+    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                            "POST is for /api/cameras/NAME/follow, /target and /request-control");
   switch (route.kind) {
     case Route::Kind::RecordingEntry:
       return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
@@ -248,10 +281,20 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       return self->serveSnapshot(message, route.name);
     case Route::Kind::RecordingIndex:
       return self->serveRecordingIndex(message);
+    case Route::Kind::Playback:
+      return self->servePlayback(message, route.name, query);
+    case Route::Kind::Drive:
+      // Left unanswered when allowed: libsoup then upgrades it (onWebSocket).
+      self->mayDrive(message, route.name);
+      return;
+    case Route::Kind::CameraCommand:
+      return;  // answered above
     case Route::Kind::ApiNotFound:
       return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
                               "no such endpoint; /api/status, /api/events, /api/cameras, "
-                              "/api/cameras/NAME/snapshot.jpg, /api/recordings");
+                              "/api/cameras/NAME/snapshot.jpg, /api/cameras/NAME/follow, "
+                              "/api/cameras/NAME/target, /api/cameras/NAME/request-control, "
+                              "/api/cameras/NAME/drive, /api/recordings");
     case Route::Kind::NotFound:
       return respondError(
           message, SOUP_STATUS_NOT_FOUND,
@@ -307,12 +350,14 @@ void HttpServer::openStream(SoupServerMessage* message, const char* contentType,
 }
 
 void HttpServer::send(std::vector<std::unique_ptr<Client>>& clients, GBytes* chunk) {
-  for (auto& client : clients) {
-    if (client->inFlight >= kMaxFramesInFlight) continue;
-    ++client->inFlight;
-    soup_message_body_append_bytes(soup_server_message_get_response_body(client->message), chunk);
-    soup_server_message_unpause(client->message);
-  }
+  for (auto& client : clients) sendTo(*client, chunk);
+}
+
+void HttpServer::sendTo(Client& client, GBytes* chunk) {
+  if (client.inFlight >= kMaxFramesInFlight) return;
+  ++client.inFlight;
+  soup_message_body_append_bytes(soup_server_message_get_response_body(client.message), chunk);
+  soup_server_message_unpause(client.message);
 }
 
 void HttpServer::serveLive(SoupServerMessage* message, const std::string& camera) {
@@ -331,19 +376,8 @@ void HttpServer::sendFrame(size_t camera, GstBuffer* jpeg) {
   auto& feed = *feeds_[camera];
   feed.clientCount = static_cast<int>(feed.clients.size());
   if (feed.clients.empty()) return;
-  GstMapInfo map;
-  if (!gst_buffer_map(jpeg, &map, GST_MAP_READ)) return;
-  // One part, built in place: a single copy of the frame per delivery.
-  std::string header =
-      std::string("--") + kBoundary +
-      "\r\nContent-Type: image/jpeg\r\nContent-Length: " + std::to_string(map.size) + "\r\n\r\n";
-  GByteArray* part = g_byte_array_sized_new(static_cast<guint>(header.size() + map.size + 2));
-  g_byte_array_append(part, reinterpret_cast<const guint8*>(header.data()),
-                      static_cast<guint>(header.size()));
-  g_byte_array_append(part, map.data, static_cast<guint>(map.size));
-  g_byte_array_append(part, reinterpret_cast<const guint8*>("\r\n"), 2);
-  gst_buffer_unmap(jpeg, &map);
-  GBytes* chunk = g_byte_array_free_to_bytes(part);
+  GBytes* chunk = multipartFrame(jpeg, "");
+  if (!chunk) return;
   send(feed.clients, chunk);
   g_bytes_unref(chunk);
 }
@@ -416,10 +450,7 @@ void HttpServer::serveSnapshot(SoupServerMessage* message, const std::string& ca
 }
 
 void HttpServer::deleteRecording(SoupServerMessage* message, const std::string& name) {
-  // Always behind the token: without one set, nobody may delete.
-  if (content_.token.empty())
-    return respondJsonError(message, SOUP_STATUS_FORBIDDEN,
-                            "deleting recordings needs the server started with --http-token");
+  if (refusedWithoutToken(message, "deleting recordings")) return;
   if (!isRecordingName(name) || name.ends_with(".jsonl"))
     return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
   auto refused = content_.deleteRecording(name);
@@ -485,10 +516,134 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
   GBytes* bytes = g_mapped_file_get_bytes(mapped);
   g_mapped_file_unref(mapped);
   soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
-  soup_message_headers_set_content_type(soup_server_message_get_response_headers(message),
-                                        recordingContentType(name), nullptr);
+  SoupMessageHeaders* headers = soup_server_message_get_response_headers(message);
+  soup_message_headers_set_content_type(headers, recordingContentType(name), nullptr);
+  // libsoup answers a Range request from the whole body: a <video> seeks.
+  soup_message_headers_replace(headers, "Accept-Ranges", "bytes");
   soup_message_body_append_bytes(soup_server_message_get_response_body(message), bytes);
   g_bytes_unref(bytes);
+}
+
+// Control and deletion are always behind the token: without one set, nobody
+// may (the page is then open to anyone who can reach this machine's port).
+bool HttpServer::refusedWithoutToken(SoupServerMessage* message, const char* what) {
+  if (!content_.token.empty()) return false;
+  respondJsonError(message, SOUP_STATUS_FORBIDDEN,
+                   std::string(what) + " needs the server started with --http-token");
+  return true;
+}
+
+void HttpServer::servePlayback(SoupServerMessage* message, const std::string& name,
+                               GHashTable* query) {
+  fs::path file = fs::path(content_.recordingsFolder) / name;
+  std::error_code error;
+  if (!isRecordingName(name) || !name.ends_with(".mkv") ||
+      fs::is_symlink(fs::symlink_status(file, error)) || !fs::is_regular_file(file, error))
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
+                            "no Matroska recording named '" + name +
+                                "' (MP4 recordings play from /recordings/FILE)");
+  double from = 0;
+  if (const char* text = query ? static_cast<const char*>(g_hash_table_lookup(query, "from"))
+                               : nullptr) {
+    char* end = nullptr;
+    from = g_ascii_strtod(text, &end);
+    if (end == text || *end != '\0' || !std::isfinite(from) || from < 0)
+      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
+                              "from= takes seconds into the recording, not '" +
+                                  std::string(text).substr(0, 40) + "'");
+  }
+  if (playbackClients_.size() >= kMaxPlaybacks)
+    return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE,
+                            "already replaying " + std::to_string(kMaxPlaybacks) +
+                                " recordings; try again later");
+  PlaybackStream::Callbacks callbacks;
+  callbacks.frame = [this, message](GstBuffer* jpeg, double position) {
+    char header[48];
+    g_snprintf(header, sizeof header, "X-Position: %.3f\r\n", position);
+    GBytes* chunk = multipartFrame(jpeg, header);
+    if (!chunk) return;
+    for (auto& client : playbackClients_)
+      if (client->message == message) sendTo(*client, chunk);
+    g_bytes_unref(chunk);
+  };
+  callbacks.ended = [message](const std::string&) {
+    // The end of the response: the viewer's stream closes, its replay goes.
+    soup_message_body_complete(soup_server_message_get_response_body(message));
+    soup_server_message_unpause(message);
+  };
+  auto playback = PlaybackStream::start(file.string(), from, std::move(callbacks));
+  if (!playback)
+    return respondJsonError(message, SOUP_STATUS_UNSUPPORTED_MEDIA_TYPE, playback.error());
+  std::string type = std::string("multipart/x-mixed-replace; boundary=") + kBoundary;
+  openStream(message, type.c_str(), playbackClients_);
+  playbackClients_.back()->playback = std::move(*playback);
+}
+
+void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query) {
+  if (std::string(soup_server_message_get_method(message)) != "POST")
+    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                            "POST /api/cameras/NAME/" + route.action);
+  if (refusedWithoutToken(message, "controlling the vehicle")) return;
+  auto lookup = [&](const char* key) -> std::string {
+    const char* value = query ? static_cast<const char*>(g_hash_table_lookup(query, key)) : nullptr;
+    return value ? value : "";
+  };
+  // The same commands as over MQTT, with their checks.
+  std::string command = "request-control", payload;
+  if (route.action == "follow") {
+    std::string on = lookup("on");
+    if (on != "true" && on != "false")
+      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
+                              "follow takes on=true or on=false");
+    command = "follow/set";
+    payload = on == "true" ? "ON" : "OFF";
+  } else if (route.action == "target") {
+    command = "target/set";
+    payload = lookup("id");
+  }
+  auto parsed = parseFleetCommand(route.name, command, payload);
+  if (!parsed) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, parsed.error());
+  if (auto refused = content_.command(*parsed)) {
+    bool unknown = std::none_of(feeds_.begin(), feeds_.end(),
+                                [&](const auto& feed) { return feed->name == route.name; });
+    return respondJsonError(message, unknown ? SOUP_STATUS_NOT_FOUND : SOUP_STATUS_CONFLICT,
+                            *refused);
+  }
+  for (const auto& camera : content_.cameraStates())
+    if (camera.value("name", "") == route.name)
+      return respond(message, SOUP_STATUS_OK, "application/json", camera.dump());
+  respond(message, SOUP_STATUS_OK, "application/json", "{}");
+}
+
+bool HttpServer::mayDrive(SoupServerMessage* message, const std::string& camera) {
+  if (refusedWithoutToken(message, "driving")) return false;
+  if (std::none_of(feeds_.begin(), feeds_.end(),
+                   [&](const auto& feed) { return feed->name == camera; })) {
+    respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+    return false;
+  }
+  return true;  // not a WebSocket handshake: libsoup answers 400
+}
+
+void HttpServer::onWebSocket(SoupServer*, SoupServerMessage*, const char* path,
+                             SoupWebsocketConnection* connection, gpointer data) {
+  auto* self = static_cast<HttpServer*>(data);
+  // The upgraded request never "finishes": it no longer counts as open,
+  // and it is not idle between a driver's commands.
+  --self->openRequests_;
+  if (GIOStream* stream = soup_websocket_connection_get_io_stream(connection);
+      G_IS_SOCKET_CONNECTION(stream))
+    g_socket_set_timeout(g_socket_connection_get_socket(G_SOCKET_CONNECTION(stream)), 0);
+  std::string camera = routeOf(path).name;
+  auto socket = std::make_unique<DriveSocket>(
+      connection,
+      [self, camera](double steering, double throttle) {
+        return self->content_.drive(camera, steering, throttle);
+      },
+      [self](DriveSocket* closed) {
+        std::erase_if(self->driveSockets_, [&](const auto& s) { return s.get() == closed; });
+      });
+  self->driveSockets_.push_back(std::move(socket));
 }
 
 }  // namespace wircam::recorder

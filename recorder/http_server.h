@@ -1,7 +1,9 @@
 // wirc-recorder's web server (libsoup): the live view page, each camera as
 // MJPEG over HTTP (multipart/x-mixed-replace, the camera's frames as they
-// are), detections as server-sent events, the status as JSON, and the
-// recordings to list and download. Runs on the main loop's context.
+// are), detections as server-sent events, the status as JSON, the
+// recordings to list, download, replay and delete, and the vehicle's
+// control (follow, target, control right, drive mode over a WebSocket).
+// Runs on the main loop's context.
 #pragma once
 
 #include <libsoup/soup.h>
@@ -16,7 +18,10 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "drive_socket.h"
+#include "fleet_command.h"
 #include "frame_tap.h"
+#include "http_routes.h"
 #include "recorder_options.h"
 
 namespace wircam::recorder {
@@ -44,6 +49,12 @@ class HttpServer {
     // {"<stream>": {"points": [{"x","y","utc"}, ...], "stale": bool}}.
     std::function<nlohmann::json()> trails;
     std::function<std::vector<std::string>()> openSegments;
+    // Follow, target, request-control from the page: why not, if refused.
+    std::function<std::optional<std::string>(const FleetCommand&)> command;
+    // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
+    std::function<std::optional<bool>(const std::string& camera, double steering,
+                                      double throttle)>
+        drive;
   };
 
   // Limits that keep hostile clients from holding the recorder's memory or
@@ -51,6 +62,8 @@ class HttpServer {
   // served), a connection silent for `idleTimeout` is closed, and at most
   // kMaxRequests are open at once (the rest are closed at once).
   static constexpr int kMaxRequests = 128;
+  // Recordings replayed at once (each a small pipeline); more get a 503.
+  static constexpr size_t kMaxPlaybacks = 16;
   static Expected<std::unique_ptr<HttpServer>, std::string> start(
       const ServerAddress& address, Content content,
       std::chrono::milliseconds idleTimeout = std::chrono::seconds(10));
@@ -67,8 +80,10 @@ class HttpServer {
   struct CameraFeed;
   HttpServer(Content content, std::chrono::milliseconds idleTimeout);
 
-  static void onRequest(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
-                        gpointer self);
+  static void onRequest(SoupServer*, SoupServerMessage* message, const char* path,
+                        GHashTable* query, gpointer self);
+  static void onWebSocket(SoupServer*, SoupServerMessage* message, const char* path,
+                          SoupWebsocketConnection* connection, gpointer self);
   static void onHeaders(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
                         gpointer self);
   static void onRequestStarted(SoupServer*, SoupServerMessage* message, gpointer self);
@@ -81,10 +96,17 @@ class HttpServer {
   void serveRecordingIndex(SoupServerMessage* message);
   void deleteRecording(SoupServerMessage* message, const std::string& name);
   void serveRecordings(SoupServerMessage* message, const std::string& name);
+  void servePlayback(SoupServerMessage* message, const std::string& name, GHashTable* query);
+  void serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query);
+  // Whether a drive-mode WebSocket may open (else answered with the reason).
+  bool mayDrive(SoupServerMessage* message, const std::string& camera);
+  bool refusedWithoutToken(SoupServerMessage* message, const char* what);
   // Keeps `message` open as a stream of chunks in `clients`.
   void openStream(SoupServerMessage* message, const char* contentType,
                   std::vector<std::unique_ptr<Client>>& clients);
   void send(std::vector<std::unique_ptr<Client>>& clients, GBytes* chunk);
+  // Skipped for a client kMaxFramesInFlight chunks behind.
+  void sendTo(Client& client, GBytes* chunk);
   void sendFrame(size_t camera, GstBuffer* jpeg);
 
   Content content_;
@@ -92,6 +114,8 @@ class HttpServer {
   std::string url_;
   std::vector<std::unique_ptr<CameraFeed>> feeds_;
   std::vector<std::unique_ptr<Client>> eventClients_;
+  std::vector<std::unique_ptr<Client>> playbackClients_;  // each with its replay
+  std::vector<std::unique_ptr<DriveSocket>> driveSockets_;
   std::chrono::milliseconds idleTimeout_;
   int openRequests_ = 0;  // main loop only
   // Frames queued for the main loop check it: the server may be gone.

@@ -152,6 +152,10 @@ std::optional<std::string> Recording::startServers() {
       return list;
     };
     content.openSegments = [this] { return openSegments(); };
+    content.command = [this](const FleetCommand& c) { return applyCommand(c, "web"); };
+    content.drive = [this](const std::string& camera, double steering, double throttle) {
+      return drive(camera, steering, throttle);
+    };
     auto server = HttpServer::start(
         *options_.http, std::move(content),
         std::chrono::milliseconds(static_cast<int64_t>(options_.httpIdleSeconds * 1000)));
@@ -165,7 +169,7 @@ std::optional<std::string> Recording::startServers() {
                                       .detectionsRate = options_.mqttDetectionsRate};
     for (auto& s : streams_) settings.streams.push_back(s->plan.name);
     auto fleet =
-        FleetPublisher::start(settings, [this](const FleetCommand& c) { applyCommand(c); });
+        FleetPublisher::start(settings, [this](const FleetCommand& c) { applyCommand(c, "MQTT"); });
     if (!fleet) return fleet.error();
     fleet_ = std::move(*fleet);
     log("MQTT to " + settings.url.host + ":" + std::to_string(settings.url.port) + " under " +
@@ -333,30 +337,50 @@ void Recording::publishFleetStatus(bool force) {
   for (const auto& s : streams_) fleet_->status(s->plan.name, fleetStatus(*s), force);
 }
 
-void Recording::applyCommand(const FleetCommand& command) {
+std::optional<std::string> Recording::applyCommand(const FleetCommand& command,
+                                                   const char* from) {
   for (auto& s : streams_) {
     if (s->plan.name != command.stream) continue;
     GstElement* controller = element(s->plan.controller);
     if (!controller) {
-      log("MQTT command for " + command.stream +
-          " ignored: it does not follow (start with --detect FAMILY --follow)");
-      return;
+      std::string why = command.stream + " does not follow (start with --detect FAMILY --follow)";
+      log(std::string(from) + " command ignored: " + why);
+      return why;
     }
     nlohmann::json event = {{"type", "command"}};
     if (command.kind == FleetCommand::Kind::kFollow) {
       // Off stops the vehicle at once (wirccontrol sends neutral).
       g_object_set(controller, "enabled", command.follow ? TRUE : FALSE, nullptr);
       event["follow"] = command.follow ? "ON" : "OFF";
-    } else {
+    } else if (command.kind == FleetCommand::Kind::kTarget) {
       g_object_set(controller, "target-id", command.target, nullptr);
       event["target"] = command.target;
+    } else {
+      // The answer comes as a wirc-control-right message, into telemetry.
+      g_signal_emit_by_name(controller, "request-control");
+      event["request_control"] = true;
     }
-    log(command.stream + ": MQTT " + event.dump());
+    event["from"] = from;
+    log(command.stream + ": " + from + " " + event.dump());
     publishEvent(*s, event);
     writeTelemetry(*s, event, runningTime());
     publishFleetStatus(true);
-    return;
+    return std::nullopt;
   }
+  return "no camera named '" + command.stream + "'";
+}
+
+std::optional<bool> Recording::drive(const std::string& stream, double steering,
+                                     double throttle) {
+  for (auto& s : streams_) {
+    if (s->plan.name != stream) continue;
+    GstElement* controller = element(s->plan.controller);
+    if (!controller) return std::nullopt;
+    gboolean obeyed = FALSE;
+    g_signal_emit_by_name(controller, "drive", steering, throttle, &obeyed);
+    return obeyed != FALSE;
+  }
+  return std::nullopt;
 }
 
 void Recording::updateIndex(const std::vector<std::string>& deleted) {
@@ -444,6 +468,12 @@ void Recording::handleElementMessage(GstMessage* message) {
   }
   if (type == "marvelmind-position" || type == "marvelmind-stale") {
     handlePosition(*stream, s);
+    return;
+  }
+  if (type == "wirc-drive") {
+    // Driving by hand from the page: each command, and the dead-man's neutral.
+    line["type"] = "drive";
+    writeTelemetry(*stream, line, runningTime());
     return;
   }
   if (type != "apriltag" && type != "wirc-control") return;

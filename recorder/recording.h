@@ -97,7 +97,12 @@ class Recording {
   // DELETE /api/recordings/FILE: the HTTP status and reason when it cannot.
   std::optional<std::pair<guint, std::string>> deleteSegment(const std::string& file);
   void publishFleetStatus(bool force = false);
-  void applyCommand(const FleetCommand& command);
+  // Why it cannot be carried out (the stream does not follow), if so.
+  // `from` says where it came from in the log: "MQTT", "web".
+  std::optional<std::string> applyCommand(const FleetCommand& command, const char* from);
+  // Drive mode from the web page: whether the vehicle obeys, or nullopt
+  // when the stream has no wirccontrol.
+  std::optional<bool> drive(const std::string& stream, double steering, double throttle);
   void publishEvent(const Stream& stream, const nlohmann::json& event);
   GstElement* element(const std::string& name) const;
   void writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime runningTime);

@@ -52,6 +52,24 @@ TEST(HttpRoutes, NamesTheCameraAndRecordingApi) {
     EXPECT_EQ(routeOf(other).kind, Kind::ApiNotFound) << other;
 }
 
+TEST(HttpRoutes, NamesTheControlDriveAndPlaybackResources) {
+  for (const char* action : {"follow", "target", "request-control"}) {
+    auto command = routeOf(std::string("/api/cameras/rover-cam0/") + action);
+    EXPECT_EQ(command.kind, Kind::CameraCommand) << action;
+    EXPECT_EQ(command.name, "rover-cam0");
+    EXPECT_EQ(command.action, action);
+  }
+  auto drive = routeOf("/api/cameras/rover-cam0/drive");
+  EXPECT_EQ(drive.kind, Kind::Drive);
+  EXPECT_EQ(drive.name, "rover-cam0");
+  auto play = routeOf("/play/rover-cam0-20261122T101500Z.mkv.mjpg");
+  EXPECT_EQ(play.kind, Kind::Playback);
+  EXPECT_EQ(play.name, "rover-cam0-20261122T101500Z.mkv");
+  for (const char* other : {"/api/cameras//drive", "/api/cameras/a/steer", "/api/cameras/a/drive/x"})
+    EXPECT_EQ(routeOf(other).kind, Kind::ApiNotFound) << other;
+  EXPECT_EQ(routeOf("/play/.mjpg").kind, Kind::NotFound);
+}
+
 TEST(HttpRoutes, ServesOnlyPlainNamesOfRecordings) {
   EXPECT_TRUE(isRecordingName("rover-cam0-000.mkv"));
   EXPECT_TRUE(isRecordingName("rover-cam0-000.jsonl"));
