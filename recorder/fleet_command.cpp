@@ -33,8 +33,7 @@ Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
     parsed.kind = FleetCommand::Kind::kRequestControl;
     return parsed;
   }
-  return unexpected("unknown command '" + command +
-                    "' (follow/set, target/set, request-control)");
+  return unexpected("unknown command '" + command + "' (follow/set, target/set, request-control)");
 }
 
 }  // namespace wircam::recorder

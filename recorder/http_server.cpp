@@ -8,6 +8,8 @@
 #include "http_routes.h"
 #include "live_view_page.h"
 #include "login_page.h"
+#include "page_control_script.h"
+#include "page_player_script.h"
 #include "playback_stream.h"
 #include "telemetry_log.h"
 
@@ -54,9 +56,10 @@ namespace {
 GBytes* multipartFrame(GstBuffer* jpeg, const std::string& extraHeaders) {
   GstMapInfo map;
   if (!gst_buffer_map(jpeg, &map, GST_MAP_READ)) return nullptr;
-  std::string header = std::string("--") + kBoundary +
-                       "\r\nContent-Type: image/jpeg\r\nContent-Length: " +
-                       std::to_string(map.size) + "\r\n" + extraHeaders + "\r\n";
+  std::string header =
+      std::string("--") + kBoundary +
+      "\r\nContent-Type: image/jpeg\r\nContent-Length: " + std::to_string(map.size) + "\r\n" +
+      extraHeaders + "\r\n";
   GByteArray* part = g_byte_array_sized_new(static_cast<guint>(header.size() + map.size + 2));
   g_byte_array_append(part, reinterpret_cast<const guint8*>(header.data()),
                       static_cast<guint>(header.size()));
@@ -219,8 +222,9 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*,
   if (known && !hasBody) return;
   // libsoup would read the whole body before answering: answer on the
   // socket now, and close it. Nothing of this request was written yet.
-  std::string answer = !known ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE, POST\r\n"
-                              : "HTTP/1.1 413 Content Too Large\r\n";
+  std::string answer = !known
+                           ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE, POST\r\n"
+                           : "HTTP/1.1 413 Content Too Large\r\n";
   answer += "Content-Length: 0\r\nConnection: close\r\n\r\n";
   soup_message_body_set_accumulate(soup_server_message_get_request_body(message), FALSE);
   if (GSocket* socket = soup_server_message_get_socket(message)) {
@@ -409,7 +413,12 @@ std::string HttpServer::page() const {
   for (size_t at = state.find("</"); at != std::string::npos; at = state.find("</", at))
     state.replace(at, 2, "<\\/");
   std::string html = kLiveViewPage;
-  html.replace(html.find("INITIAL_STATE"), 13, state);
+  auto put = [&html](std::string_view placeholder, std::string_view text) {
+    html.replace(html.find(placeholder), placeholder.size(), text);
+  };
+  put("PLAYER_SCRIPT", kPlayerScript);
+  put("CONTROL_SCRIPT", kControlScript);
+  put("INITIAL_STATE", state);
   return html;
 }
 
@@ -539,23 +548,23 @@ void HttpServer::servePlayback(SoupServerMessage* message, const std::string& na
   std::error_code error;
   if (!isRecordingName(name) || !name.ends_with(".mkv") ||
       fs::is_symlink(fs::symlink_status(file, error)) || !fs::is_regular_file(file, error))
-    return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
-                            "no Matroska recording named '" + name +
-                                "' (MP4 recordings play from /recordings/FILE)");
+    return respondJsonError(
+        message, SOUP_STATUS_NOT_FOUND,
+        "no Matroska recording named '" + name + "' (MP4 recordings play from /recordings/FILE)");
   double from = 0;
-  if (const char* text = query ? static_cast<const char*>(g_hash_table_lookup(query, "from"))
-                               : nullptr) {
+  if (const char* text =
+          query ? static_cast<const char*>(g_hash_table_lookup(query, "from")) : nullptr) {
     char* end = nullptr;
     from = g_ascii_strtod(text, &end);
     if (end == text || *end != '\0' || !std::isfinite(from) || from < 0)
-      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
-                              "from= takes seconds into the recording, not '" +
-                                  std::string(text).substr(0, 40) + "'");
+      return respondJsonError(
+          message, SOUP_STATUS_BAD_REQUEST,
+          "from= takes seconds into the recording, not '" + std::string(text).substr(0, 40) + "'");
   }
   if (playbackClients_.size() >= kMaxPlaybacks)
-    return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE,
-                            "already replaying " + std::to_string(kMaxPlaybacks) +
-                                " recordings; try again later");
+    return respondJsonError(
+        message, SOUP_STATUS_SERVICE_UNAVAILABLE,
+        "already replaying " + std::to_string(kMaxPlaybacks) + " recordings; try again later");
   PlaybackStream::Callbacks callbacks;
   callbacks.frame = [this, message](GstBuffer* jpeg, double position) {
     char header[48];
@@ -593,8 +602,7 @@ void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GH
   if (route.action == "follow") {
     std::string on = lookup("on");
     if (on != "true" && on != "false")
-      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
-                              "follow takes on=true or on=false");
+      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "follow takes on=true or on=false");
     command = "follow/set";
     payload = on == "true" ? "ON" : "OFF";
   } else if (route.action == "target") {

@@ -52,8 +52,7 @@ class HttpServer {
     // Follow, target, request-control from the page: why not, if refused.
     std::function<std::optional<std::string>(const FleetCommand&)> command;
     // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
-    std::function<std::optional<bool>(const std::string& camera, double steering,
-                                      double throttle)>
+    std::function<std::optional<bool>(const std::string& camera, double steering, double throttle)>
         drive;
   };
 

@@ -5,7 +5,9 @@
 // --marvelmind is on) and the recordings. Self-contained: no scripts from
 // elsewhere. The server puts the cameras, their last detections and the
 // position trails in place of INITIAL_STATE, so the first picture already
-// carries its overlay and the map its trails.
+// carries its overlay and the map its trails, and the player
+// (page_player_script.h) and control (page_control_script.h) scripts in
+// place of PLAYER_SCRIPT and CONTROL_SCRIPT.
 #pragma once
 
 namespace wircam::recorder {
@@ -45,11 +47,29 @@ button.delete { background: none; color: #e88; border: 1px solid #744; border-ra
 #map .trail { fill: none; stroke-width: 2; vector-effect: non-scaling-stroke; }
 #map .stale { stroke-dasharray: 4 3; opacity: 0.5; }
 #map text { font: 11px sans-serif; fill: #ccd; }
+[hidden] { display: none !important; }
+button { background: #2b3038; color: #e8e8e8; border: 1px solid #445; border-radius: 4px;
+         font: inherit; font-size: 13px; padding: 3px 10px; cursor: pointer; }
+button.on { background: #1b6f3f; border-color: #2a9d5c; }
+.controls { margin-top: 8px; display: flex; flex-wrap: wrap; gap: 6px; align-items: center; }
+.controls input { width: 4em; background: #15171a; color: #e8e8e8; border: 1px solid #445; }
+.drive-info { color: #8cf; font-family: monospace; }
+.control-message { flex-basis: 100%; color: #e88; }
+.camera[data-driving="true"] { outline: 2px solid #4fc3f7; }
+#player { max-width: 680px; background: #202328; border-radius: 8px; padding: 10px; }
+#player h2 { display: flex; gap: 8px; align-items: center; margin-top: 0; font-size: 15px; }
+#player-title { font-weight: normal; color: #aab; overflow-wrap: anywhere; flex: 1; }
+#player img, #player video { display: block; width: 100%; background: #000; }
+#timeline { display: block; width: 100%; height: 104px; margin-top: 8px; cursor: pointer; }
 </style></head>
 <body>
 <h1>wirc-recorder</h1>
 <div id="cameras"></div>
 <section id="positions" hidden><h2>Positions</h2><svg id="map" viewBox="0 0 480 360"></svg></section>
+<section id="player" hidden><h2>Playback <span id="player-title"></span>
+<button id="player-close">close</button></h2><img id="playback-image" alt="playback">
+<video id="playback-video" controls hidden></video>
+<div class="stats" id="playback-time"></div><canvas id="timeline"></canvas></section>
 <h2>Recordings</h2>
 <div id="recordings"></div>
 <p id="recording-message" class="since"></p>
@@ -71,6 +91,8 @@ function addCamera(camera) {
                          placeholder: box.querySelector(".placeholder"),
                          stats: box.querySelector(".stats"),
                          width: camera.width, height: camera.height, state: "" };
+  if (camera.status && camera.status.following !== undefined)
+    addControls(views[camera.name], camera.name);
   if (camera.status) showStream(camera.status);
   else setState(views[camera.name], "live", null);
   showDetections({ stream: camera.name, detections: camera.detections });
@@ -147,6 +169,7 @@ function showStream(stream) {
   const view = views[stream.name];
   if (!view) return;
   setState(view, stream.state, stream.state_since_utc);
+  showControls(view, stream);
   view.stats.textContent = `${stream.fps.toFixed(1)} fps  ` +
       `loss ${stream.loss_percent.toFixed(1)} %  ${Math.round(stream.kbps)} kbit/s  ` +
       `battery ${stream.battery_v.toFixed(2)} V` +
@@ -241,6 +264,11 @@ async function refresh() {
         cell.className = "number";
         cell.textContent = text;
       }
+      const play = document.createElement("button");
+      play.className = "play";
+      play.textContent = "play";
+      play.addEventListener("click", () => openPlayer(segment));
+      row.insertCell().appendChild(play);
       const link = document.createElement("a");
       link.href = segment.url;
       link.textContent = "download";
@@ -264,6 +292,9 @@ async function deleteSegment(file) {
       response.ok ? `deleted ${file}` : answer.error;
   refresh();
 }
+
+PLAYER_SCRIPT
+CONTROL_SCRIPT
 
 function start() {
   // Built before the page's load event, so a screenshot at load shows them.

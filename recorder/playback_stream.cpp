@@ -66,8 +66,7 @@ GstFlowReturn PlaybackStream::onSample(GstElement* sink, gpointer data) {
     std::weak_ptr<bool> alive;
     GstBuffer* jpeg;
   };
-  auto* delivery =
-      new Delivery{self, self->alive_, gst_buffer_ref(gst_sample_get_buffer(sample))};
+  auto* delivery = new Delivery{self, self->alive_, gst_buffer_ref(gst_sample_get_buffer(sample))};
   gst_sample_unref(sample);
   g_main_context_invoke_full(
       nullptr, G_PRIORITY_DEFAULT,
@@ -75,8 +74,8 @@ GstFlowReturn PlaybackStream::onSample(GstElement* sink, gpointer data) {
         auto* frame = static_cast<Delivery*>(d);
         if (!frame->alive.expired()) {
           GstClockTime pts = GST_BUFFER_PTS(frame->jpeg);
-          double position = GST_CLOCK_TIME_IS_VALID(pts) ? static_cast<double>(pts) / GST_SECOND
-                                                         : 0.0;
+          double position =
+              GST_CLOCK_TIME_IS_VALID(pts) ? static_cast<double>(pts) / GST_SECOND : 0.0;
           frame->stream->callbacks_.frame(frame->jpeg, position);
         }
         return G_SOURCE_REMOVE;

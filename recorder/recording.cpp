@@ -337,8 +337,7 @@ void Recording::publishFleetStatus(bool force) {
   for (const auto& s : streams_) fleet_->status(s->plan.name, fleetStatus(*s), force);
 }
 
-std::optional<std::string> Recording::applyCommand(const FleetCommand& command,
-                                                   const char* from) {
+std::optional<std::string> Recording::applyCommand(const FleetCommand& command, const char* from) {
   for (auto& s : streams_) {
     if (s->plan.name != command.stream) continue;
     GstElement* controller = element(s->plan.controller);
@@ -370,8 +369,7 @@ std::optional<std::string> Recording::applyCommand(const FleetCommand& command,
   return "no camera named '" + command.stream + "'";
 }
 
-std::optional<bool> Recording::drive(const std::string& stream, double steering,
-                                     double throttle) {
+std::optional<bool> Recording::drive(const std::string& stream, double steering, double throttle) {
   for (auto& s : streams_) {
     if (s->plan.name != stream) continue;
     GstElement* controller = element(s->plan.controller);

@@ -734,7 +734,8 @@ static void gst_wirc_control_init(GstWircControl* self) {
       gst::GLibLocker lock(self);
       settings = self->state->settings;
     }
-    post_drive(self, "dead-man", neutralOf(settings), settings.steeringChannel, settings.throttleChannel);
+    post_drive(self, "dead-man", neutralOf(settings), settings.steeringChannel,
+               settings.throttleChannel);
   });
   gst_base_transform_set_passthrough(GST_BASE_TRANSFORM(self), TRUE);
 }
@@ -899,11 +900,11 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
    * sends neutral. Each command is posted as a `wirc-drive` element message.
    * Returns whether the vehicle obeys (this transmitter holds the right).
    */
-  signals[SIGNAL_DRIVE] = g_signal_new_class_handler(
-      "drive", G_TYPE_FROM_CLASS(klass),
-      static_cast<GSignalFlags>(G_SIGNAL_RUN_LAST | G_SIGNAL_ACTION),
-      G_CALLBACK(gst_wirc_control_drive), nullptr, nullptr, nullptr, G_TYPE_BOOLEAN, 2,
-      G_TYPE_DOUBLE, G_TYPE_DOUBLE);
+  signals[SIGNAL_DRIVE] =
+      g_signal_new_class_handler("drive", G_TYPE_FROM_CLASS(klass),
+                                 static_cast<GSignalFlags>(G_SIGNAL_RUN_LAST | G_SIGNAL_ACTION),
+                                 G_CALLBACK(gst_wirc_control_drive), nullptr, nullptr, nullptr,
+                                 G_TYPE_BOOLEAN, 2, G_TYPE_DOUBLE, G_TYPE_DOUBLE);
 
   gst_element_class_add_static_pad_template(element, &sink_template);
   gst_element_class_add_static_pad_template(element, &src_template);

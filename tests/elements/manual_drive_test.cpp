@@ -33,8 +33,8 @@ struct DrivenControl {
     auto started = wirc::Device::start({.port = 0}, nullptr);
     EXPECT_TRUE(started.has_value()) << started.error();
     device = std::move(*started);
-    auto description = "wirccontrol host=127.0.0.1 port=" + std::to_string(device->port()) + " " +
-                       properties;
+    auto description =
+        "wirccontrol host=127.0.0.1 port=" + std::to_string(device->port()) + " " + properties;
     harness = gst_harness_new_parse(description.c_str());
     control = gst_harness_find_element(harness, "wirccontrol");
     gst_element_set_bus(harness->element, bus);

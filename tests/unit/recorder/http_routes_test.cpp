@@ -65,7 +65,8 @@ TEST(HttpRoutes, NamesTheControlDriveAndPlaybackResources) {
   auto play = routeOf("/play/rover-cam0-20261122T101500Z.mkv.mjpg");
   EXPECT_EQ(play.kind, Kind::Playback);
   EXPECT_EQ(play.name, "rover-cam0-20261122T101500Z.mkv");
-  for (const char* other : {"/api/cameras//drive", "/api/cameras/a/steer", "/api/cameras/a/drive/x"})
+  for (const char* other :
+       {"/api/cameras//drive", "/api/cameras/a/steer", "/api/cameras/a/drive/x"})
     EXPECT_EQ(routeOf(other).kind, Kind::ApiNotFound) << other;
   EXPECT_EQ(routeOf("/play/.mjpg").kind, Kind::NotFound);
 }

@@ -1,0 +1,260 @@
+#include "devtools_page.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <iostream>
+#include <thread>
+#include <vector>
+
+namespace wircam::testing {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// libsoup works on the thread-default context it was created under.
+class ContextScope {
+ public:
+  explicit ContextScope(GMainContext* context) : context_(context) {
+    g_main_context_push_thread_default(context_);
+  }
+  ~ContextScope() { g_main_context_pop_thread_default(context_); }
+
+ private:
+  GMainContext* context_;
+};
+
+std::string httpGet(SoupSession* session, const std::string& url, const char* method = "GET") {
+  SoupMessage* message = soup_message_new(method, url.c_str());
+  if (!message) return "";
+  GBytes* body = soup_session_send_and_read(session, message, nullptr, nullptr);
+  std::string text;
+  if (body) {
+    gsize size = 0;
+    const char* data = static_cast<const char*>(g_bytes_get_data(body, &size));
+    text.assign(data, size);
+    g_bytes_unref(body);
+  }
+  g_object_unref(message);
+  return text;
+}
+
+}  // namespace
+
+std::unique_ptr<DevToolsPage> DevToolsPage::launch(const std::filesystem::path& profile,
+                                                   int width, int height) {
+  std::unique_ptr<DevToolsPage> page(new DevToolsPage());
+  page->profile_ = profile;
+  std::error_code ignored;
+  std::filesystem::remove_all(profile, ignored);
+  std::filesystem::create_directories(profile);
+  std::vector<std::string> args = {"chromium",
+                                   "--headless",
+                                   "--no-sandbox",
+                                   "--disable-gpu",
+                                   "--disable-dev-shm-usage",
+                                   "--no-first-run",
+                                   "--disable-background-networking",
+                                   "--disable-component-update",
+                                   "--disable-sync",
+                                   // A hidden or idle tab must keep its timers at speed.
+                                   "--disable-background-timer-throttling",
+                                   "--disable-renderer-backgrounding",
+                                   "--remote-debugging-address=127.0.0.1",
+                                   "--remote-debugging-port=0",
+                                   "--user-data-dir=" + profile.string(),
+                                   "--window-size=" + std::to_string(width) + "," +
+                                       std::to_string(height),
+                                   "about:blank"};
+  page->chromium_ = fork();
+  if (page->chromium_ == 0) {
+    std::vector<char*> argv;
+    for (auto& arg : args) argv.push_back(arg.data());
+    argv.push_back(nullptr);
+    int null = open("/dev/null", O_WRONLY);
+    dup2(null, STDOUT_FILENO);
+    dup2(null, STDERR_FILENO);
+    execvp("chromium", argv.data());
+    _exit(127);
+  }
+  // Chromium writes its port and the browser's path here once listening.
+  auto portFile = profile / "DevToolsActivePort";
+  std::string port;
+  for (auto until = Clock::now() + std::chrono::seconds(20); Clock::now() < until;) {
+    std::ifstream in(portFile);
+    if (in && std::getline(in, port) && !port.empty()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (port.empty()) {
+    std::cerr << "chromium wrote no DevToolsActivePort\n";
+    return nullptr;
+  }
+  ContextScope scope(page->context_);
+  page->session_ = soup_session_new();
+  auto base = "http://127.0.0.1:" + port;
+  // The first tab: the page to drive.
+  nlohmann::json targets;
+  for (auto until = Clock::now() + std::chrono::seconds(10); Clock::now() < until;) {
+    targets = nlohmann::json::parse(httpGet(page->session_, base + "/json/list"), nullptr, false);
+    if (targets.is_array() &&
+        std::any_of(targets.begin(), targets.end(), [](auto& t) { return t["type"] == "page"; }))
+      break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  for (const auto& target : targets.is_array() ? targets : nlohmann::json::array())
+    if (target["type"] == "page") {
+      page->targetId_ = target["id"];
+      if (page->attach(target["webSocketDebuggerUrl"])) return page;
+    }
+  std::cerr << "cannot attach to a chromium tab at " << base << "\n";
+  return nullptr;
+}
+
+bool DevToolsPage::attach(const std::string& webSocketUrl) {
+  SoupMessage* message = soup_message_new("GET", webSocketUrl.c_str());
+  struct Result {
+    SoupWebsocketConnection* socket = nullptr;
+    bool done = false;
+  } result;
+  soup_session_websocket_connect_async(
+      session_, message, nullptr, nullptr, G_PRIORITY_DEFAULT, nullptr,
+      [](GObject* session, GAsyncResult* async, gpointer data) {
+        auto* r = static_cast<Result*>(data);
+        r->socket = soup_session_websocket_connect_finish(SOUP_SESSION(session), async, nullptr);
+        r->done = true;
+      },
+      &result);
+  auto until = Clock::now() + std::chrono::seconds(10);
+  while (!result.done && Clock::now() < until) g_main_context_iteration(context_, TRUE);
+  g_object_unref(message);
+  if (!result.socket) return false;
+  socket_ = result.socket;
+  // Screenshots are a few hundred kB.
+  soup_websocket_connection_set_max_incoming_payload_size(socket_, 64 << 20);
+  g_signal_connect(socket_, "message",
+                   G_CALLBACK(+[](SoupWebsocketConnection*, gint, GBytes* bytes, gpointer data) {
+                     auto* self = static_cast<DevToolsPage*>(data);
+                     gsize size = 0;
+                     const char* text = static_cast<const char*>(g_bytes_get_data(bytes, &size));
+                     auto reply = nlohmann::json::parse(std::string_view(text, size), nullptr,
+                                                        false);
+                     if (reply.is_object() && reply.contains("id"))
+                       self->replies_[std::to_string(reply["id"].get<int>())] = reply;
+                   }),
+                   this);
+  return true;
+}
+
+DevToolsPage::~DevToolsPage() {
+  {
+    ContextScope scope(context_);
+    if (socket_) {
+      soup_websocket_connection_close(socket_, SOUP_WEBSOCKET_CLOSE_NORMAL, nullptr);
+      g_object_unref(socket_);
+    }
+    if (session_) g_object_unref(session_);
+    while (g_main_context_iteration(context_, FALSE)) {
+    }
+  }
+  g_main_context_unref(context_);
+  if (chromium_ > 0) {
+    kill(chromium_, SIGKILL);
+    waitpid(chromium_, nullptr, 0);
+  }
+  std::error_code ignored;
+  std::filesystem::remove_all(profile_, ignored);
+}
+
+void DevToolsPage::iterate() { g_main_context_iteration(context_, FALSE); }
+
+nlohmann::json DevToolsPage::call(const std::string& method, nlohmann::json params,
+                                  std::chrono::milliseconds timeout) {
+  if (!socket_ || soup_websocket_connection_get_state(socket_) != SOUP_WEBSOCKET_STATE_OPEN)
+    return {{"error", "not connected"}};
+  ContextScope scope(context_);
+  int id = nextId_++;
+  soup_websocket_connection_send_text(
+      socket_, nlohmann::json{{"id", id}, {"method", method}, {"params", params}}.dump().c_str());
+  auto key = std::to_string(id);
+  for (auto until = Clock::now() + timeout; Clock::now() < until;) {
+    if (replies_.contains(key)) {
+      auto reply = replies_[key];
+      replies_.erase(key);
+      if (reply.contains("error")) return {{"error", reply["error"]}};
+      return reply.value("result", nlohmann::json::object());
+    }
+    if (!g_main_context_iteration(context_, FALSE))
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return {{"error", "no answer to " + method}};
+}
+
+bool DevToolsPage::navigate(const std::string& url) {
+  auto result = call("Page.navigate", {{"url", url}});
+  if (result.contains("error") || result.contains("errorText")) return false;
+  return waitUntil("document.readyState === 'complete'");
+}
+
+nlohmann::json DevToolsPage::evaluate(const std::string& expression) {
+  auto result = call("Runtime.evaluate",
+                     {{"expression", expression}, {"returnByValue", true}, {"awaitPromise", true}});
+  if (result.contains("exceptionDetails") || !result.contains("result")) return nullptr;
+  return result["result"].value("value", nlohmann::json());
+}
+
+bool DevToolsPage::waitUntil(const std::string& expression, std::chrono::milliseconds timeout) {
+  for (auto until = Clock::now() + timeout; Clock::now() < until;) {
+    if (evaluate("Boolean(" + expression + ")") == true) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+bool DevToolsPage::setCookie(const std::string& name, const std::string& value,
+                             const std::string& url) {
+  auto result = call("Network.setCookie", {{"name", name}, {"value", value}, {"url", url}});
+  return result.value("success", false);
+}
+
+void DevToolsPage::key(const char* type, const std::string& key) {
+  // Arrow keys' Windows key codes, which the page's keydown handler reads as event.key.
+  static const std::map<std::string, int> codes = {
+      {"ArrowLeft", 37}, {"ArrowUp", 38}, {"ArrowRight", 39}, {"ArrowDown", 40}};
+  call("Input.dispatchKeyEvent", {{"type", type},
+                                  {"key", key},
+                                  {"code", key},
+                                  {"windowsVirtualKeyCode", codes.count(key) ? codes.at(key) : 0}});
+}
+
+void DevToolsPage::click(double x, double y) {
+  for (const char* type : {"mousePressed", "mouseReleased"})
+    call("Input.dispatchMouseEvent",
+         {{"type", type}, {"x", x}, {"y", y}, {"button", "left"}, {"clickCount", 1}});
+}
+
+bool DevToolsPage::screenshot(const std::filesystem::path& png) {
+  auto result = call("Page.captureScreenshot", {{"format", "png"}});
+  if (!result.contains("data")) return false;
+  std::string encoded = result["data"];
+  gsize size = 0;
+  guchar* bytes = g_base64_decode(encoded.c_str(), &size);
+  std::ofstream out(png, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes), static_cast<std::streamsize>(size));
+  g_free(bytes);
+  return static_cast<bool>(out);
+}
+
+void DevToolsPage::pauseScripts() {
+  call("Debugger.enable");
+  call("Debugger.pause");
+}
+
+void DevToolsPage::closeTab() {
+  call("Page.close", nlohmann::json::object(), std::chrono::milliseconds(2000));
+}
+
+}  // namespace wircam::testing

@@ -1,0 +1,66 @@
+// Debian's chromium, headless, driven through the DevTools protocol over
+// its WebSocket (libsoup as the client): load a page, run script in it and
+// read the answer, press keys, click, take screenshots, pause its scripts
+// (a page that hangs) or close it (a page that goes away). For the tests
+// that check the live view as a user would use it.
+#pragma once
+
+#include <glib.h>
+#include <libsoup/soup.h>
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace wircam::testing {
+
+class DevToolsPage {
+ public:
+  // Starts chromium with a fresh profile in `profile` (removed at the end)
+  // and attaches to its first tab; nullptr (with the reason on stderr) if
+  // it cannot.
+  static std::unique_ptr<DevToolsPage> launch(const std::filesystem::path& profile, int width,
+                                              int height);
+  ~DevToolsPage();
+  DevToolsPage(const DevToolsPage&) = delete;
+  DevToolsPage& operator=(const DevToolsPage&) = delete;
+
+  // A DevTools command and its result (an {"error": ...} object on failure
+  // or after `timeout`).
+  nlohmann::json call(const std::string& method, nlohmann::json params = nlohmann::json::object(),
+                      std::chrono::milliseconds timeout = std::chrono::seconds(10));
+  // Loads `url` and waits for its load event.
+  bool navigate(const std::string& url);
+  // The value of a JavaScript expression (promises awaited), or null.
+  nlohmann::json evaluate(const std::string& expression);
+  // Polls `expression` until it is true.
+  bool waitUntil(const std::string& expression,
+                 std::chrono::milliseconds timeout = std::chrono::seconds(10));
+  bool setCookie(const std::string& name, const std::string& value, const std::string& url);
+  void key(const char* type, const std::string& key);  // type: keyDown or keyUp
+  void click(double x, double y);
+  bool screenshot(const std::filesystem::path& png);
+  // Stops the page's scripts where they are; the socket stays open.
+  void pauseScripts();
+  // Closes the tab, as a user closing it would.
+  void closeTab();
+
+ private:
+  DevToolsPage() = default;
+  bool attach(const std::string& webSocketUrl);
+  void iterate();
+
+  std::filesystem::path profile_;
+  pid_t chromium_ = -1;
+  GMainContext* context_ = g_main_context_new();
+  SoupSession* session_ = nullptr;
+  SoupWebsocketConnection* socket_ = nullptr;
+  std::string targetId_;
+  int nextId_ = 1;
+  nlohmann::json replies_ = nlohmann::json::object();  // id → message
+};
+
+}  // namespace wircam::testing

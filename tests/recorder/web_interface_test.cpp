@@ -1,0 +1,263 @@
+// The live view page in a real browser (Debian's chromium over the
+// DevTools protocol) as its users use it: a recording plays and its time
+// advances, its telemetry timeline is drawn and a click on it seeks; drive
+// mode moves the simulated car with the arrow keys and a page that hangs
+// or goes away stops it; without the token, control is refused. The
+// screenshots stay under the build tree (build/tests/recorder/web-*.png).
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "devtools_page.h"
+#include "follow_scene.h"
+#include "headless_chromium.h"
+#include "http_fetch.h"
+#include "recorder_process.h"
+#include "simulated_device.h"
+#include "wait_for.h"
+
+namespace {
+
+using namespace wircam;
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kToken = "0123456789abcdef0123456789abcdef";
+constexpr size_t kSteering = 0, kThrottle = 1;
+
+std::filesystem::path shotPath(const std::string& name) {
+  return std::filesystem::path(WIRCAM_SCREENSHOT_DIR) / name;
+}
+
+// The follow scene, kept here so the test can see where the car is.
+struct FollowedCar {
+  std::shared_ptr<sim::FollowScene> scene;
+  std::unique_ptr<wirc::Device> device;
+  FollowedCar() {
+    auto created = sim::FollowScene::create({});
+    EXPECT_TRUE(created.has_value());
+    scene = std::shared_ptr<sim::FollowScene>(std::move(*created));
+    auto started = wirc::Device::start({.port = 0, .fragmentSize = 8000}, scene);
+    EXPECT_TRUE(started.has_value());
+    device = std::move(*started);
+  }
+};
+
+// A recorder with the web server and the token, and a browser signed in.
+struct SignedInPage {
+  RecorderProcess recorder;
+  std::string url;
+  std::unique_ptr<DevToolsPage> page;
+  SignedInPage(uint16_t port, std::vector<std::string> extra, const std::string& profile,
+               bool withToken = true)
+      : recorder(port, withArgs(extra, withToken)) {
+    auto found = recorder.waitForLog("http://", milliseconds(10000));
+    EXPECT_TRUE(found) << recorder.log();
+    url = found.value_or("");
+    page = DevToolsPage::launch(shotPath(profile), 900, 1400);
+    EXPECT_TRUE(page);
+    if (!page) return;
+    if (withToken) {
+      EXPECT_TRUE(page->setCookie("wircam_token", kToken, url));
+    }
+    EXPECT_TRUE(page->navigate(url));
+  }
+  static std::vector<std::string> withArgs(std::vector<std::string> extra, bool withToken) {
+    extra.insert(extra.end(), {"--http", "127.0.0.1:0", "--duration", "120"});
+    if (withToken) extra.insert(extra.end(), {"--http-token", kToken});
+    return extra;
+  }
+  // The centre of the first element `selector` names, in page pixels.
+  std::pair<double, double> centreOf(const std::string& selector) {
+    auto box = page->evaluate("(() => { const r = document.querySelector('" + selector +
+                              "').getBoundingClientRect(); return [r.x + r.width / 2, "
+                              "r.y + r.height / 2]; })()");
+    if (!box.is_array()) return {0, 0};
+    return {box[0].get<double>(), box[1].get<double>()};
+  }
+  void clickOn(const std::string& selector) {
+    page->evaluate("document.querySelector('" + selector + "').scrollIntoView({block: 'center'})");
+    auto [x, y] = centreOf(selector);
+    page->click(x, y);
+  }
+};
+
+double shownPosition(DevToolsPage& page) {
+  auto text = page.evaluate("document.getElementById('playback-time').textContent");
+  return text.is_string() ? std::atof(text.get<std::string>().c_str()) : -1;
+}
+
+TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
+  if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  SignedInPage signedIn(car.device->port(),
+                        {"--detect", "tag36h11", "--follow", "--segment", "6"}, "web-playback");
+  ASSERT_TRUE(signedIn.page);
+  auto& page = *signedIn.page;
+  // A finished segment in the list, then play it.
+  ASSERT_TRUE(page.waitUntil("document.querySelector('button.play')", milliseconds(20000)));
+  signedIn.clickOn("button.play");
+  ASSERT_TRUE(page.waitUntil("!document.getElementById('player').hidden"));
+
+  // It plays at real speed: the shown time advances with the clock.
+  ASSERT_TRUE(page.waitUntil("parseFloat(document.getElementById('playback-time').textContent) "
+                             "> 0.3"));
+  double first = shownPosition(page);
+  std::this_thread::sleep_for(milliseconds(1500));
+  double second = shownPosition(page);
+  EXPECT_GT(second - first, 0.9) << first << " → " << second;
+  EXPECT_LT(second - first, 2.2) << first << " → " << second;
+  EXPECT_TRUE(page.evaluate("document.getElementById('playback-image').naturalWidth") == 352);
+
+  // The timeline is drawn from the sidecar: detections (green) and the
+  // cursor; the screenshot shows them.
+  page.evaluate("document.getElementById('timeline').scrollIntoView({block: 'center'})");
+  auto shot = shotPath("web-playback.png");
+  ASSERT_TRUE(page.screenshot(shot));
+  auto picture = readPng(shot);
+  EXPECT_GT(picture.count(0x00, 0xc8, 0x53, 12), 40) << "detection ticks";
+  EXPECT_GT(picture.count(0x0d, 0x0f, 0x12, 2), 5000) << "the timeline's background";
+
+  // A click at 80 % of the timeline seeks there.
+  auto box = page.evaluate(
+      "(() => { const r = document.getElementById('timeline').getBoundingClientRect(); "
+      "return [r.x, r.y, r.width, r.height, player.duration]; })()");
+  ASSERT_TRUE(box.is_array());
+  double left = box[0], top = box[1], width = box[2], height = box[3], duration = box[4];
+  page.click(left + 70 + 0.8 * (width - 78), top + height / 2);
+  ASSERT_TRUE(page.waitUntil("player.position >= " + std::to_string(0.8 * duration - 0.3)));
+  // ...and plays on from there.
+  double afterSeek = shownPosition(page);
+  EXPECT_GE(afterSeek, 0.8 * duration - 0.3);
+  EXPECT_TRUE(page.waitUntil("player.position > " + std::to_string(afterSeek + 0.2)));
+  page.screenshot(shotPath("web-playback-seeked.png"));
+}
+
+// Both channels at neutral on the simulated device.
+bool atNeutral(const wirc::Device& device) {
+  auto pulses = device.outputs().pulses;
+  return pulses[kSteering] == 1500 && pulses[kThrottle] == 1500;
+}
+
+milliseconds untilNeutral(const wirc::Device& device) {
+  auto start = Clock::now();
+  while (!atNeutral(device) && Clock::now() - start < std::chrono::seconds(3))
+    std::this_thread::sleep_for(milliseconds(2));
+  return std::chrono::duration_cast<milliseconds>(Clock::now() - start);
+}
+
+TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
+  if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  SignedInPage signedIn(car.device->port(), {"--detect", "tag36h11", "--follow"}, "web-drive");
+  ASSERT_TRUE(signedIn.page);
+  auto& page = *signedIn.page;
+  ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-state=live] button.drive')"));
+  signedIn.clickOn("button.drive");
+  ASSERT_TRUE(page.waitUntil(
+      "document.querySelector('.drive-info').textContent.startsWith('round trip')"))
+      << page.evaluate("document.querySelector('.control-message').textContent");
+  // Following went off when drive mode began.
+  EXPECT_EQ(page.evaluate("document.querySelector('button.follow').textContent"),
+            "following: off");
+
+  auto before = car.scene->truthNow().car;
+  page.key("keyDown", "ArrowUp");
+  page.key("keyDown", "ArrowLeft");
+  ASSERT_TRUE(waitFor([&] {
+    auto pulses = car.device->outputs().pulses;
+    return pulses[kThrottle] > 1500 && pulses[kSteering] > 1500;
+  }));
+  std::this_thread::sleep_for(milliseconds(800));
+  auto after = car.scene->truthNow().car;
+  EXPECT_GT(std::hypot(after.x - before.x, after.y - before.y), 0.1) << "the car moved";
+  EXPECT_GT(after.theta, before.theta) << "and turned left";
+  // The round trip shows, in milliseconds.
+  auto roundTrip = page.evaluate("Number(document.querySelector('.drive-info').dataset.roundTripMs)");
+  ASSERT_TRUE(roundTrip.is_number());
+  EXPECT_LT(roundTrip.get<double>(), 250);
+  page.screenshot(shotPath("web-drive.png"));
+
+  // The page hangs (its scripts stop, the socket stays open): the dead-man
+  // stops the car within 250 ms of the last command, and a command period
+  // (100 ms) is the most that can pass between them.
+  page.pauseScripts();
+  auto hung = untilNeutral(*car.device);
+  EXPECT_LE(hung.count(), 250 + 100 + 100) << "neutral " << hung.count() << " ms after the page hung";
+  std::cerr << "[ measured ] hung page → neutral in " << hung.count() << " ms\n";
+
+  // It comes back, drives again, and its tab is closed: neutral at once.
+  page.call("Debugger.resume");
+  ASSERT_TRUE(waitFor([&] { return car.device->outputs().pulses[kThrottle] > 1500; }));
+  page.closeTab();
+  auto closed = untilNeutral(*car.device);
+  EXPECT_LE(closed.count(), 250 + 100) << "neutral " << closed.count() << " ms after the tab closed";
+  std::cerr << "[ measured ] closed tab → neutral in " << closed.count() << " ms\n";
+}
+
+TEST(WebInterface, WithoutTheTokenControlIsRefused) {
+  if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  // No token: the page is open (on this machine only), control is not.
+  SignedInPage open(car.device->port(), {"--detect", "tag36h11", "--follow"}, "web-refused",
+                    false);
+  ASSERT_TRUE(open.page);
+  auto& page = *open.page;
+  ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-state=live] button.drive')"));
+  open.clickOn("button.drive");
+  ASSERT_TRUE(page.waitUntil("document.querySelector('.control-message').textContent"));
+  EXPECT_EQ(page.evaluate("document.querySelector('.control-message').textContent"),
+            "control needs the recorder started with --http-token (and you signed in)");
+  EXPECT_EQ(page.evaluate("document.querySelector('.camera').dataset.driving || 'false'"), "false");
+  page.screenshot(shotPath("web-refused.png"));
+  // The API says so too, and the drive socket is not opened.
+  std::string camera = "127.0.0.1-" + std::to_string(car.device->port()) + "-cam0";
+  auto follow = fetch(open.url + "api/cameras/" + camera + "/follow?on=true", "POST");
+  EXPECT_EQ(follow.status, 403u);
+  EXPECT_EQ(follow.contentType, "application/json");
+  auto opened = page.evaluate(
+      "new Promise(done => { const s = new WebSocket(`ws://${location.host}/api/cameras/" +
+      camera + "/drive`); s.onopen = () => done('open'); s.onclose = () => done('refused'); })");
+  EXPECT_EQ(opened, "refused");
+  auto drive = fetch(open.url + "api/cameras/" + camera + "/drive");
+  EXPECT_EQ(drive.status, 403u);
+  EXPECT_TRUE(atNeutral(*car.device) || car.device->outputs().failsafe ||
+              car.device->stats().pcdReceived > 0);
+}
+
+TEST(WebInterface, WithATokenSetControlNeedsIt) {
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  RecorderProcess recorder(car.device->port(), {"--detect", "tag36h11", "--follow", "--http",
+                                                "127.0.0.1:0", "--http-token", kToken,
+                                                "--duration", "30"});
+  auto url = recorder.waitForLog("http://", milliseconds(10000));
+  ASSERT_TRUE(url) << recorder.log();
+  std::string camera = "127.0.0.1-" + std::to_string(car.device->port()) + "-cam0";
+  Headers token = {{"Authorization", std::string("Bearer ") + kToken}};
+  EXPECT_EQ(fetch(*url + "api/cameras/" + camera + "/follow?on=false", "POST").status, 401u);
+  EXPECT_EQ(fetch(*url + "api/cameras/" + camera + "/drive").status, 401u);
+  // With it: following goes off, and /api/cameras says so.
+  ASSERT_TRUE(waitFor([&] {
+    return fetch(*url + "api/cameras/" + camera + "/follow?on=false", "POST", token).status ==
+           200u;
+  }));
+  auto cameras = nlohmann::json::parse(fetch(*url + "api/cameras", "GET", token).body);
+  EXPECT_EQ(cameras[0]["following"], false);
+  auto target = fetch(*url + "api/cameras/" + camera + "/target?id=x", "POST", token);
+  EXPECT_EQ(target.status, 400u);
+  EXPECT_NE(target.body.find("target/set takes a tag id"), std::string::npos) << target.body;
+  EXPECT_EQ(fetch(*url + "api/cameras/nope/follow?on=true", "POST", token).status, 404u);
+  EXPECT_EQ(fetch(*url + "api/cameras/" + camera + "/follow?on=true", "GET", token).status, 405u);
+  // Drive over the socket without a handshake: not a WebSocket request.
+  EXPECT_EQ(fetch(*url + "api/cameras/" + camera + "/drive", "GET", token).status, 400u);
+}
+
+}  // namespace
