@@ -127,19 +127,21 @@ void FollowScene::step(double seconds, const wirc::ChannelOutputs& outputs) {
     if (!config_.carFixed) drive(dt, outputs);
     time_ += dt;
   }
-  ++ticks_;
+  double bearing = std::abs(bearingDeg());
+  double error = std::abs(distance() - config_.followDistance);
+  // The truth and the summary are read from other threads (summary(),
+  // truthNow()): written under the lock they read them under.
   {
     std::lock_guard lock(sharedMutex_);
+    ++ticks_;
     shared_ = {car_, target_};
-  }
-  if (time_ >= kSettleSeconds) {
-    double bearing = std::abs(bearingDeg());
-    double error = std::abs(distance() - config_.followDistance);
-    ++summary_.measuredTicks;
-    bearingSum_ += bearing;
-    distanceErrorSum_ += error;
-    summary_.maxBearingDeg = std::max(summary_.maxBearingDeg, bearing);
-    summary_.maxDistanceError = std::max(summary_.maxDistanceError, error);
+    if (time_ >= kSettleSeconds) {
+      ++summary_.measuredTicks;
+      bearingSum_ += bearing;
+      distanceErrorSum_ += error;
+      summary_.maxBearingDeg = std::max(summary_.maxBearingDeg, bearing);
+      summary_.maxDistanceError = std::max(summary_.maxDistanceError, error);
+    }
   }
   writeTruth();
 }
@@ -189,6 +191,7 @@ double FollowScene::bearingDeg() const {
 double FollowScene::distance() const { return std::hypot(target_.x - car_.x, target_.y - car_.y); }
 
 FollowSummary FollowScene::summary() const {
+  std::lock_guard lock(sharedMutex_);
   FollowSummary s = summary_;
   s.ticks = ticks_;
   if (s.measuredTicks > 0) {

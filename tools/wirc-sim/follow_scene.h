@@ -132,8 +132,9 @@ class FollowScene : public wirc::DeviceScene {
   std::optional<wirc::DeviceClock::time_point> lastAdvance_;
   FILE* truth_ = nullptr;
   mutable std::mutex sharedMutex_;
-  Truth shared_;                                   // guarded by sharedMutex_
   std::unique_ptr<void, int (*)(void*)> encoder_;  // TurboJPEG, kept across frames
+  // Written on the device's thread under sharedMutex_, read under it elsewhere.
+  Truth shared_;
   uint64_t ticks_ = 0;
   double bearingSum_ = 0;
   double distanceErrorSum_ = 0;

@@ -1,0 +1,198 @@
+// 50 people watching one camera live, half of them on a link so slow that
+// they read nothing: what it costs the recorder and whether the recording
+// waits for them. Side by side, the stock GStreamer way to serve MJPEG to
+// many viewers (multipartmux ! tcpserversink) with the same viewers.
+//   wirc-sim (the follow scene) → wirc-recorder --http → N viewers
+//   wirc-sim → gst-launch-1.0 wircsrc ! multipartmux ! tcpserversink → N viewers
+// Each server's peak memory and CPU come from wait4(); its memory is also
+// sampled each second (VmRSS) to show whether it keeps growing; the frames
+// each fast viewer got are counted at the viewer, the recorded frames read
+// from the recording index.
+// Usage: bench_live_viewers [SECONDS] [VIEWERS]   (default 20 s, 50 viewers)
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "child_process.h"
+#include "common/socket.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using wircam::bench::spawn;
+using wircam::bench::stopGroup;
+
+uint16_t freePort() {
+  auto socket = wircam::listenTcp(wircam::SocketAddress::loopback(0));
+  return socket ? wircam::localAddress(socket->get()).port() : uint16_t{0};
+}
+
+// A /proc/PID/status field in kB: VmRSS (now) or VmHWM (the peak).
+long statusKb(pid_t pid, const std::string& field) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.starts_with(field + ":")) return std::atol(line.c_str() + field.size() + 1);
+  return 0;
+}
+long rssKb(pid_t pid) { return statusKb(pid, "VmRSS"); }
+
+// User + system CPU seconds so far, from /proc/PID/stat.
+double cpuSeconds(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(stat)), {});
+  auto fields = text.substr(text.rfind(')') + 2);
+  std::istringstream in(fields);
+  std::string skip;
+  for (int i = 3; i < 14; ++i) in >> skip;
+  long user = 0, system = 0;
+  in >> user >> system;
+  return static_cast<double>(user + system) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+struct Viewers {
+  double fastFps = 0;    // frames per second each reading viewer got
+  long rssMiddleKb = 0;  // the server's memory half-way
+  long rssEndKb = 0;     // and at the end
+  long peakKb = 0;       // its peak (VmHWM), at the end
+  double cpuSeconds = 0;  // what the server used while watched
+};
+
+// Opens `count` connections to port, asks for `path` and, for the first
+// half, reads everything (counting the parts by their boundary); the other
+// half never read. Runs for `seconds`.
+Viewers watch(pid_t server, uint16_t port, const std::string& path, int count, double seconds) {
+  std::vector<wircam::UniqueFd> sockets;
+  auto connecting = Clock::now();  // frames come from the first connection on
+  for (auto until = Clock::now() + std::chrono::seconds(10);
+       static_cast<int>(sockets.size()) < count && Clock::now() < until;) {
+    auto socket = wircam::connectTcp(wircam::SocketAddress::loopback(port));
+    if (!socket) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      continue;
+    }
+    std::string request = "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+    ::send(socket->get(), request.data(), request.size(), MSG_NOSIGNAL);
+    sockets.push_back(std::move(*socket));
+  }
+  int readers = count / 2;
+  std::vector<long> parts(sockets.size(), 0);
+  std::vector<std::string> tails(sockets.size());
+  Viewers result;
+  double cpuBefore = cpuSeconds(server);
+  auto start = Clock::now();
+  auto end = start + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(seconds));
+  bool sampledMiddle = false;
+  char buffer[65536];
+  while (Clock::now() < end) {
+    std::vector<pollfd> fds;
+    for (int i = 0; i < readers && i < static_cast<int>(sockets.size()); ++i)
+      fds.push_back({sockets[i].get(), POLLIN, 0});
+    poll(fds.data(), fds.size(), 100);
+    for (size_t i = 0; i < fds.size(); ++i) {
+      if (!(fds[i].revents & POLLIN)) continue;
+      ssize_t n = ::recv(fds[i].fd, buffer, sizeof buffer, MSG_DONTWAIT);
+      if (n <= 0) continue;
+      // Boundaries may straddle reads: keep the last few bytes.
+      std::string text = tails[i] + std::string(buffer, static_cast<size_t>(n));
+      for (size_t at = text.find("--wircframe"); at != std::string::npos;
+           at = text.find("--wircframe", at + 1))
+        ++parts[i];
+      tails[i] = text.substr(text.size() > 10 ? text.size() - 10 : 0);
+    }
+    if (!sampledMiddle && Clock::now() - start > std::chrono::duration<double>(seconds / 2)) {
+      result.rssMiddleKb = rssKb(server);
+      sampledMiddle = true;
+    }
+  }
+  result.rssEndKb = rssKb(server);
+  result.peakKb = statusKb(server, "VmHWM");
+  result.cpuSeconds = cpuSeconds(server) - cpuBefore;
+  long total = 0;
+  for (int i = 0; i < readers; ++i) total += parts[i];
+  double watched = std::chrono::duration<double>(Clock::now() - connecting).count();
+  result.fastFps = readers ? static_cast<double>(total) / readers / watched : 0;
+  return result;
+}
+
+long recordedFrames(const fs::path& folder) {
+  std::ifstream in(folder / "index.json");
+  auto index = nlohmann::json::parse(in, nullptr, false);
+  long frames = 0;
+  if (index.is_object())
+    for (const auto& entry : index.value("segments", nlohmann::json::array()))
+      frames += entry.value("frames", 0L);
+  return frames;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double seconds = argc > 1 ? std::atof(argv[1]) : 20;
+  int viewers = argc > 2 ? std::atoi(argv[2]) : 50;
+  fs::path bin = fs::canonical("/proc/self/exe").parent_path();
+  fs::path work = fs::temp_directory_path() / ("wircam-bench-viewers-" + std::to_string(getpid()));
+  fs::create_directories(work);
+  uint16_t devicePort = freePort();
+  pid_t sim = spawn((bin / "wirc-sim").string() + " --port " + std::to_string(devicePort));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const double warmUp = 3;  // login and the first frames before the viewers come
+
+  std::printf("%d viewers (%d reading, %d never reading), %.0f s, one 352x288 camera at 15 fps\n",
+              viewers, viewers / 2, viewers - viewers / 2, seconds);
+  std::printf("%-37s | %-7s | %-6s | %-14s | %-7s | %s\n", "server", "viewers", "CPU %",
+              "MB mid → end", "peak MB", "reader fps · recorded frames");
+  auto row = [seconds](const char* name, int count, const Viewers& seen,
+                       const std::string& recorded) {
+    std::printf("%-37s | %-7d | %5.1f  | %5.1f → %-5.1f  | %6.1f  | %5.1f · %s\n", name, count,
+                100.0 * seen.cpuSeconds / seconds, static_cast<double>(seen.rssMiddleKb) / 1024,
+                static_cast<double>(seen.rssEndKb) / 1024, static_cast<double>(seen.peakKb) / 1024,
+                seen.fastFps, recorded.c_str());
+  };
+  // The plugin registry is brought up to date before anything is measured.
+  std::system("gst-inspect-1.0 wircsrc > /dev/null 2>&1");
+  for (int count : {0, viewers}) {
+    fs::remove_all(work / "rec");
+    uint16_t httpPort = freePort();
+    pid_t recorder = spawn((bin / "wirc-recorder").string() + " --device 127.0.0.1:" +
+                           std::to_string(devicePort) + " --out " + (work / "rec").string() +
+                           " --segment 600 --http 127.0.0.1:" + std::to_string(httpPort));
+    std::this_thread::sleep_for(std::chrono::duration<double>(warmUp));
+    std::string camera = "127.0.0.1-" + std::to_string(devicePort) + "-cam0";
+    auto recordingStart = Clock::now();
+    Viewers seen = watch(recorder, httpPort, "/live/" + camera + ".mjpg", count, seconds);
+    double recorded = std::chrono::duration<double>(Clock::now() - recordingStart).count() + warmUp;
+    stopGroup(recorder, SIGINT);  // it closes its segment and index
+    char text[64];
+    std::snprintf(text, sizeof text, "%ld in %.1f s", recordedFrames(work / "rec"), recorded);
+    row("wirc-recorder --http", count, seen, text);
+  }
+  for (int count : {0, viewers}) {
+    uint16_t tcpPort = freePort();
+    pid_t launch = spawn("gst-launch-1.0 -q wircsrc host=127.0.0.1 port=" +
+                         std::to_string(devicePort) +
+                         " ! multipartmux boundary=wircframe ! tcpserversink host=127.0.0.1 port=" +
+                         std::to_string(tcpPort));
+    std::this_thread::sleep_for(std::chrono::duration<double>(warmUp));
+    Viewers seen = watch(launch, tcpPort, "/", count, seconds);
+    stopGroup(launch, SIGINT);
+    row("stock: multipartmux ! tcpserversink", count, seen, "(does not record)");
+  }
+  stopGroup(sim, SIGINT);
+  fs::remove_all(work);
+  return 0;
+}
