@@ -64,10 +64,10 @@ double cpuSeconds(pid_t pid) {
 }
 
 struct Viewers {
-  double fastFps = 0;    // frames per second each reading viewer got
-  long rssMiddleKb = 0;  // the server's memory half-way
-  long rssEndKb = 0;     // and at the end
-  long peakKb = 0;       // its peak (VmHWM), at the end
+  double fastFps = 0;     // frames per second each reading viewer got
+  long rssMiddleKb = 0;   // the server's memory half-way
+  long rssEndKb = 0;      // and at the end
+  long peakKb = 0;        // its peak (VmHWM), at the end
   double cpuSeconds = 0;  // what the server used while watched
 };
 
@@ -94,8 +94,8 @@ Viewers watch(pid_t server, uint16_t port, const std::string& path, int count, d
   Viewers result;
   double cpuBefore = cpuSeconds(server);
   auto start = Clock::now();
-  auto end = start + std::chrono::duration_cast<Clock::duration>(
-                         std::chrono::duration<double>(seconds));
+  auto end =
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   bool sampledMiddle = false;
   char buffer[65536];
   while (Clock::now() < end) {
@@ -183,10 +183,10 @@ int main(int argc, char** argv) {
   }
   for (int count : {0, viewers}) {
     uint16_t tcpPort = freePort();
-    pid_t launch = spawn("gst-launch-1.0 -q wircsrc host=127.0.0.1 port=" +
-                         std::to_string(devicePort) +
-                         " ! multipartmux boundary=wircframe ! tcpserversink host=127.0.0.1 port=" +
-                         std::to_string(tcpPort));
+    pid_t launch =
+        spawn("gst-launch-1.0 -q wircsrc host=127.0.0.1 port=" + std::to_string(devicePort) +
+              " ! multipartmux boundary=wircframe ! tcpserversink host=127.0.0.1 port=" +
+              std::to_string(tcpPort));
     std::this_thread::sleep_for(std::chrono::duration<double>(warmUp));
     Viewers seen = watch(launch, tcpPort, "/", count, seconds);
     stopGroup(launch, SIGINT);

@@ -45,31 +45,22 @@ std::string httpGet(SoupSession* session, const std::string& url, const char* me
 
 }  // namespace
 
-std::unique_ptr<DevToolsPage> DevToolsPage::launch(const std::filesystem::path& profile,
-                                                   int width, int height) {
+std::unique_ptr<DevToolsPage> DevToolsPage::launch(const std::filesystem::path& profile, int width,
+                                                   int height) {
   std::unique_ptr<DevToolsPage> page(new DevToolsPage());
   page->profile_ = profile;
   std::error_code ignored;
   std::filesystem::remove_all(profile, ignored);
   std::filesystem::create_directories(profile);
-  std::vector<std::string> args = {"chromium",
-                                   "--headless",
-                                   "--no-sandbox",
-                                   "--disable-gpu",
-                                   "--disable-dev-shm-usage",
-                                   "--no-first-run",
-                                   "--disable-background-networking",
-                                   "--disable-component-update",
-                                   "--disable-sync",
-                                   // A hidden or idle tab must keep its timers at speed.
-                                   "--disable-background-timer-throttling",
-                                   "--disable-renderer-backgrounding",
-                                   "--remote-debugging-address=127.0.0.1",
-                                   "--remote-debugging-port=0",
-                                   "--user-data-dir=" + profile.string(),
-                                   "--window-size=" + std::to_string(width) + "," +
-                                       std::to_string(height),
-                                   "about:blank"};
+  std::vector<std::string> args = {
+      "chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+      "--no-first-run", "--disable-background-networking", "--disable-component-update",
+      "--disable-sync",
+      // A hidden or idle tab must keep its timers at speed.
+      "--disable-background-timer-throttling", "--disable-renderer-backgrounding",
+      "--remote-debugging-address=127.0.0.1", "--remote-debugging-port=0",
+      "--user-data-dir=" + profile.string(),
+      "--window-size=" + std::to_string(width) + "," + std::to_string(height), "about:blank"};
   page->chromium_ = fork();
   if (page->chromium_ == 0) {
     std::vector<char*> argv;
@@ -140,8 +131,8 @@ bool DevToolsPage::attach(const std::string& webSocketUrl) {
                      auto* self = static_cast<DevToolsPage*>(data);
                      gsize size = 0;
                      const char* text = static_cast<const char*>(g_bytes_get_data(bytes, &size));
-                     auto reply = nlohmann::json::parse(std::string_view(text, size), nullptr,
-                                                        false);
+                     auto reply =
+                         nlohmann::json::parse(std::string_view(text, size), nullptr, false);
                      if (reply.is_object() && reply.contains("id"))
                        self->replies_[std::to_string(reply["id"].get<int>())] = reply;
                    }),

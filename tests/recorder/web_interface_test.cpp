@@ -95,8 +95,8 @@ TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
   if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
   FollowedCar car;
   ASSERT_TRUE(car.device);
-  SignedInPage signedIn(car.device->port(),
-                        {"--detect", "tag36h11", "--follow", "--segment", "6"}, "web-playback");
+  SignedInPage signedIn(car.device->port(), {"--detect", "tag36h11", "--follow", "--segment", "6"},
+                        "web-playback");
   ASSERT_TRUE(signedIn.page);
   auto& page = *signedIn.page;
   // A finished segment in the list, then play it.
@@ -105,8 +105,9 @@ TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
   ASSERT_TRUE(page.waitUntil("!document.getElementById('player').hidden"));
 
   // It plays at real speed: the shown time advances with the clock.
-  ASSERT_TRUE(page.waitUntil("parseFloat(document.getElementById('playback-time').textContent) "
-                             "> 0.3"));
+  ASSERT_TRUE(
+      page.waitUntil("parseFloat(document.getElementById('playback-time').textContent) "
+                     "> 0.3"));
   double first = shownPosition(page);
   std::this_thread::sleep_for(milliseconds(1500));
   double second = shownPosition(page);
@@ -160,12 +161,11 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
   auto& page = *signedIn.page;
   ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-state=live] button.drive')"));
   signedIn.clickOn("button.drive");
-  ASSERT_TRUE(page.waitUntil(
-      "document.querySelector('.drive-info').textContent.startsWith('round trip')"))
+  ASSERT_TRUE(
+      page.waitUntil("document.querySelector('.drive-info').textContent.startsWith('round trip')"))
       << page.evaluate("document.querySelector('.control-message').textContent");
   // Following went off when drive mode began.
-  EXPECT_EQ(page.evaluate("document.querySelector('button.follow').textContent"),
-            "following: off");
+  EXPECT_EQ(page.evaluate("document.querySelector('button.follow').textContent"), "following: off");
 
   auto before = car.scene->truthNow().car;
   page.key("keyDown", "ArrowUp");
@@ -179,7 +179,8 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
   EXPECT_GT(std::hypot(after.x - before.x, after.y - before.y), 0.1) << "the car moved";
   EXPECT_GT(after.theta, before.theta) << "and turned left";
   // The round trip shows, in milliseconds.
-  auto roundTrip = page.evaluate("Number(document.querySelector('.drive-info').dataset.roundTripMs)");
+  auto roundTrip =
+      page.evaluate("Number(document.querySelector('.drive-info').dataset.roundTripMs)");
   ASSERT_TRUE(roundTrip.is_number());
   EXPECT_LT(roundTrip.get<double>(), 250);
   page.screenshot(shotPath("web-drive.png"));
@@ -189,7 +190,8 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
   // (100 ms) is the most that can pass between them.
   page.pauseScripts();
   auto hung = untilNeutral(*car.device);
-  EXPECT_LE(hung.count(), 250 + 100 + 100) << "neutral " << hung.count() << " ms after the page hung";
+  EXPECT_LE(hung.count(), 250 + 100 + 100)
+      << "neutral " << hung.count() << " ms after the page hung";
   std::cerr << "[ measured ] hung page → neutral in " << hung.count() << " ms\n";
 
   // It comes back, drives again, and its tab is closed: neutral at once.
@@ -197,7 +199,8 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
   ASSERT_TRUE(waitFor([&] { return car.device->outputs().pulses[kThrottle] > 1500; }));
   page.closeTab();
   auto closed = untilNeutral(*car.device);
-  EXPECT_LE(closed.count(), 250 + 100) << "neutral " << closed.count() << " ms after the tab closed";
+  EXPECT_LE(closed.count(), 250 + 100)
+      << "neutral " << closed.count() << " ms after the tab closed";
   std::cerr << "[ measured ] closed tab → neutral in " << closed.count() << " ms\n";
 }
 
@@ -206,8 +209,7 @@ TEST(WebInterface, WithoutTheTokenControlIsRefused) {
   FollowedCar car;
   ASSERT_TRUE(car.device);
   // No token: the page is open (on this machine only), control is not.
-  SignedInPage open(car.device->port(), {"--detect", "tag36h11", "--follow"}, "web-refused",
-                    false);
+  SignedInPage open(car.device->port(), {"--detect", "tag36h11", "--follow"}, "web-refused", false);
   ASSERT_TRUE(open.page);
   auto& page = *open.page;
   ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-state=live] button.drive')"));
@@ -223,8 +225,8 @@ TEST(WebInterface, WithoutTheTokenControlIsRefused) {
   EXPECT_EQ(follow.status, 403u);
   EXPECT_EQ(follow.contentType, "application/json");
   auto opened = page.evaluate(
-      "new Promise(done => { const s = new WebSocket(`ws://${location.host}/api/cameras/" +
-      camera + "/drive`); s.onopen = () => done('open'); s.onclose = () => done('refused'); })");
+      "new Promise(done => { const s = new WebSocket(`ws://${location.host}/api/cameras/" + camera +
+      "/drive`); s.onopen = () => done('open'); s.onclose = () => done('refused'); })");
   EXPECT_EQ(opened, "refused");
   auto drive = fetch(open.url + "api/cameras/" + camera + "/drive");
   EXPECT_EQ(drive.status, 403u);
@@ -235,9 +237,9 @@ TEST(WebInterface, WithoutTheTokenControlIsRefused) {
 TEST(WebInterface, WithATokenSetControlNeedsIt) {
   FollowedCar car;
   ASSERT_TRUE(car.device);
-  RecorderProcess recorder(car.device->port(), {"--detect", "tag36h11", "--follow", "--http",
-                                                "127.0.0.1:0", "--http-token", kToken,
-                                                "--duration", "30"});
+  RecorderProcess recorder(car.device->port(),
+                           {"--detect", "tag36h11", "--follow", "--http", "127.0.0.1:0",
+                            "--http-token", kToken, "--duration", "30"});
   auto url = recorder.waitForLog("http://", milliseconds(10000));
   ASSERT_TRUE(url) << recorder.log();
   std::string camera = "127.0.0.1-" + std::to_string(car.device->port()) + "-cam0";
@@ -246,8 +248,7 @@ TEST(WebInterface, WithATokenSetControlNeedsIt) {
   EXPECT_EQ(fetch(*url + "api/cameras/" + camera + "/drive").status, 401u);
   // With it: following goes off, and /api/cameras says so.
   ASSERT_TRUE(waitFor([&] {
-    return fetch(*url + "api/cameras/" + camera + "/follow?on=false", "POST", token).status ==
-           200u;
+    return fetch(*url + "api/cameras/" + camera + "/follow?on=false", "POST", token).status == 200u;
   }));
   auto cameras = nlohmann::json::parse(fetch(*url + "api/cameras", "GET", token).body);
   EXPECT_EQ(cameras[0]["following"], false);
