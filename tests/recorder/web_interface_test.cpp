@@ -204,6 +204,39 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
   std::cerr << "[ measured ] closed tab → neutral in " << closed.count() << " ms\n";
 }
 
+TEST(WebInterface, AMalformedDriveMessageIsAnsweredAndStopsTheCar) {
+  if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  SignedInPage signedIn(car.device->port(), {"--detect", "tag36h11", "--follow"}, "web-malformed");
+  ASSERT_TRUE(signedIn.page);
+  auto& page = *signedIn.page;
+  ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-state=live]')"));
+  std::string camera = "127.0.0.1-" + std::to_string(car.device->port()) + "-cam0";
+  // A socket of the page's own (the cookie signs it in), full ahead...
+  auto opened = page.evaluate(
+      "new Promise(done => { window.probe = new WebSocket(`ws://${location.host}/api/cameras/" +
+      camera + "/drive`); probe.onmessage = e => { window.answer = JSON.parse(e.data); }; " +
+      "probe.onopen = () => done('open'); probe.onclose = () => done('closed'); })");
+  ASSERT_EQ(opened, "open");
+  // (held by sending it every 100 ms until the malformed one)
+  page.evaluate(
+      "window.keep = setInterval(() => probe.send(JSON.stringify({seq: 1, "
+      "steering: 0, throttle: 1})), 100)");
+  ASSERT_TRUE(waitFor([&] { return car.device->outputs().pulses[kThrottle] > 1500; }));
+  ASSERT_TRUE(page.waitUntil("window.answer && window.answer.ack === 1"));
+  // ...then junk: answered with the reason, and the car is at neutral at
+  // once, not only when the dead-man would have lapsed.
+  page.evaluate("clearInterval(keep); probe.send('{\"steering\": \"hard left\"}')");
+  // The last good command left at most 100 ms before: the dead-man would
+  // take 150 ms more at least.
+  auto neutral = untilNeutral(*car.device);
+  EXPECT_LT(neutral.count(), 120) << "neutral " << neutral.count() << " ms after the junk";
+  ASSERT_TRUE(page.waitUntil("window.answer.error"));
+  EXPECT_EQ(page.evaluate("window.answer.error"), "'steering' is not a number");
+  EXPECT_EQ(page.evaluate("window.answer.neutral"), true);
+}
+
 TEST(WebInterface, WithoutTheTokenControlIsRefused) {
   if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
   FollowedCar car;
