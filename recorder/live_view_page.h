@@ -60,6 +60,11 @@ button.on { background: #1b6f3f; border-color: #2a9d5c; }
 #player h2 { display: flex; gap: 8px; align-items: center; margin-top: 0; font-size: 15px; }
 #player-title { font-weight: normal; color: #aab; overflow-wrap: anywhere; flex: 1; }
 #player img, #player video { display: block; width: 100%; background: #000; }
+/* A phone: each recording's cells wrap instead of running off the side. */
+@media (max-width: 560px) {
+  #recordings tr { display: flex; flex-wrap: wrap; align-items: center; margin-bottom: 6px; }
+  body { margin: 8px; } .camera { width: calc(100vw - 36px); margin-right: 0; }
+}
 #timeline { display: block; width: 100%; height: 104px; margin-top: 8px; cursor: pointer; }
 </style></head>
 <body>

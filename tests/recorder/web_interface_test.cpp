@@ -113,7 +113,7 @@ TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
   double second = shownPosition(page);
   EXPECT_GT(second - first, 0.9) << first << " → " << second;
   EXPECT_LT(second - first, 2.2) << first << " → " << second;
-  EXPECT_TRUE(page.evaluate("document.getElementById('playback-image').naturalWidth") == 352);
+  EXPECT_TRUE(page.waitUntil("document.getElementById('playback-image').naturalWidth === 352"));
 
   // The timeline is drawn from the sidecar: detections (green) and the
   // cursor; the screenshot shows them.
@@ -137,6 +137,20 @@ TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
   EXPECT_GE(afterSeek, 0.8 * duration - 0.3);
   EXPECT_TRUE(page.waitUntil("player.position > " + std::to_string(afterSeek + 0.2)));
   page.screenshot(shotPath("web-playback-seeked.png"));
+
+  // The files themselves answer Range requests, so an MP4 seeks in <video>.
+  std::string file = page.evaluate("player.file");
+  auto part = fetch(signedIn.url + "recordings/" + file, "GET",
+                    {{"Authorization", std::string("Bearer ") + kToken}, {"Range", "bytes=0-99"}});
+  EXPECT_EQ(part.status, 206u);
+  EXPECT_EQ(part.body.size(), 100u);
+
+  // At a phone's width nothing runs off the side.
+  page.call("Emulation.setDeviceMetricsOverride",
+            {{"width", 390}, {"height", 844}, {"deviceScaleFactor", 2}, {"mobile", true}});
+  EXPECT_TRUE(page.waitUntil("document.documentElement.scrollWidth <= 390"))
+      << page.evaluate("document.documentElement.scrollWidth");
+  page.screenshot(shotPath("web-phone.png"));
 }
 
 // Both channels at neutral on the simulated device.
