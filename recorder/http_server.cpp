@@ -289,8 +289,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       return self->servePlayback(message, route.name, query);
     case Route::Kind::Drive:
       // Left unanswered when allowed: libsoup then upgrades it (onWebSocket).
-      self->mayDrive(message, route.name);
-      return;
+      return self->refuseDriveUnlessAllowed(message, route.name);
     case Route::Kind::CameraCommand:
       return;  // answered above
     case Route::Kind::ApiNotFound:
@@ -623,14 +622,12 @@ void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GH
   respond(message, SOUP_STATUS_OK, "application/json", "{}");
 }
 
-bool HttpServer::mayDrive(SoupServerMessage* message, const std::string& camera) {
-  if (refusedWithoutToken(message, "driving")) return false;
+void HttpServer::refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera) {
+  if (refusedWithoutToken(message, "driving")) return;
   if (std::none_of(feeds_.begin(), feeds_.end(),
-                   [&](const auto& feed) { return feed->name == camera; })) {
+                   [&](const auto& feed) { return feed->name == camera; }))
     respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
-    return false;
-  }
-  return true;  // not a WebSocket handshake: libsoup answers 400
+  // Allowed but not a WebSocket handshake: libsoup answers 400.
 }
 
 void HttpServer::onWebSocket(SoupServer*, SoupServerMessage*, const char* path,

@@ -97,8 +97,9 @@ class HttpServer {
   void serveRecordings(SoupServerMessage* message, const std::string& name);
   void servePlayback(SoupServerMessage* message, const std::string& name, GHashTable* query);
   void serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query);
-  // Whether a drive-mode WebSocket may open (else answered with the reason).
-  bool mayDrive(SoupServerMessage* message, const std::string& camera);
+  // Answers with the reason when a drive-mode WebSocket may not open;
+  // otherwise leaves the request to libsoup's upgrade.
+  void refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera);
   bool refusedWithoutToken(SoupServerMessage* message, const char* what);
   // Keeps `message` open as a stream of chunks in `clients`.
   void openStream(SoupServerMessage* message, const char* contentType,

@@ -122,8 +122,11 @@ function closePlayer() {
   player.file = "";
 }
 
-const timelineRows = [["battery", 4, 30], ["tags", 38, 10], ["commands", 54, 10],
-                      ["positions", 70, 10], ["events", 86, 10]];
+// The timeline's rows (top, height) and its margins, in CSS pixels.
+const timelineRows = { battery: [4, 30], tags: [38, 10], commands: [54, 10],
+                       positions: [70, 10], events: [86, 10] };
+const timelineLeft = 70, timelineRight = 8;
+const timelineSpan = canvas => canvas.clientWidth - timelineLeft - timelineRight;
 
 // Each telemetry line at its time in the segment (pts, ns).
 function drawTimeline() {
@@ -136,13 +139,15 @@ function drawTimeline() {
   g.scale(scale, scale);
   g.fillStyle = "#0d0f12";
   g.fillRect(0, 0, width, height);
-  const left = 70, span = width - left - 8;
-  const x = seconds => left + Math.min(1, seconds / (player.duration || 1)) * span;
+  const span = timelineSpan(canvas);
+  const x = seconds => timelineLeft + Math.min(1, seconds / (player.duration || 1)) * span;
   g.font = "11px sans-serif";
   g.fillStyle = "#889";
-  for (const [name, top, rowHeight] of timelineRows) g.fillText(name, 4, top + rowHeight / 2 + 4);
+  for (const [name, [top, rowHeight]] of Object.entries(timelineRows))
+    g.fillText(name, 4, top + rowHeight / 2 + 4);
   const at = line => (line.pts || 0) / 1e9;
-  const tick = (line, top, rowHeight, colour) => {
+  const tick = (line, row, colour) => {
+    const [top, rowHeight] = timelineRows[row];
     g.fillStyle = colour;
     g.fillRect(Math.round(x(at(line))), top, 2, rowHeight);
   };
@@ -150,10 +155,11 @@ function drawTimeline() {
   if (battery.length) {
     const volts = battery.map(l => l["battery-v"]);
     const low = Math.min(...volts) - 0.05, high = Math.max(...volts) + 0.05;
+    const [top, rowHeight] = timelineRows.battery;
     g.strokeStyle = "#ffb74d";
     g.beginPath();
     battery.forEach((l, i) => {
-      const y = 4 + 30 - (l["battery-v"] - low) / (high - low) * 30;
+      const y = top + rowHeight - (l["battery-v"] - low) / (high - low) * rowHeight;
       i ? g.lineTo(x(at(l)), y) : g.moveTo(x(at(l)), y);
     });
     g.stroke();
@@ -161,14 +167,14 @@ function drawTimeline() {
     g.fillText(`${volts[volts.length - 1].toFixed(2)} V`, width - 48, 14);
   }
   for (const line of player.lines) {
-    if (line.type === "detections" && line.detections.length) tick(line, 38, 10, "#00c853");
+    if (line.type === "detections" && line.detections.length) tick(line, "tags", "#00c853");
     const steering = line["steering-pulse"], throttle = line["throttle-pulse"];
     if (line.type === "control" && (steering !== 1500 || throttle !== 1500))
-      tick(line, 54, 10, "#ffd54f");
-    if (line.type === "drive") tick(line, 54, 10, "#4fc3f7");
-    if (line.type === "position") tick(line, 70, 10, "#ba68c8");
-    if (line.type === "position-stale") tick(line, 70, 10, "#777");
-    if (line.type === "session" || line.type === "command") tick(line, 86, 10, "#ef5350");
+      tick(line, "commands", "#ffd54f");
+    if (line.type === "drive") tick(line, "commands", "#4fc3f7");
+    if (line.type === "position") tick(line, "positions", "#ba68c8");
+    if (line.type === "position-stale") tick(line, "positions", "#777");
+    if (line.type === "session" || line.type === "command") tick(line, "events", "#ef5350");
   }
   g.fillStyle = "#fff";
   g.fillRect(Math.round(x(player.position)) - 1, 0, 2, height);
@@ -176,8 +182,7 @@ function drawTimeline() {
 
 function seekOnTimeline(event) {
   const canvas = document.getElementById("timeline");
-  const left = 70, span = canvas.clientWidth - left - 8;
-  const fraction = (event.offsetX - left) / span;
+  const fraction = (event.offsetX - timelineLeft) / timelineSpan(canvas);
   if (fraction < 0 || fraction > 1 || !player.file) return;
   const seconds = Math.max(0, Math.min(player.duration - 0.1, fraction * player.duration));
   showPosition(seconds);

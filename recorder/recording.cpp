@@ -180,8 +180,7 @@ std::optional<std::string> Recording::startServers() {
         options_.onSegmentClosed,
         std::chrono::seconds(static_cast<int64_t>(options_.hookTimeoutSeconds)),
         [this](const std::string& name, const nlohmann::json& event) {
-          for (auto& s : streams_)
-            if (s->plan.name == name) publishEvent(*s, event);
+          if (Stream* s = streamNamed(name)) publishEvent(*s, event);
         });
   }
   if (options_.rtsp) {
@@ -337,48 +336,49 @@ void Recording::publishFleetStatus(bool force) {
   for (const auto& s : streams_) fleet_->status(s->plan.name, fleetStatus(*s), force);
 }
 
+Recording::Stream* Recording::streamNamed(const std::string& name) {
+  for (auto& s : streams_)
+    if (s->plan.name == name) return s.get();
+  return nullptr;
+}
+
 std::optional<std::string> Recording::applyCommand(const FleetCommand& command, const char* from) {
-  for (auto& s : streams_) {
-    if (s->plan.name != command.stream) continue;
-    GstElement* controller = element(s->plan.controller);
-    if (!controller) {
-      std::string why = command.stream + " does not follow (start with --detect FAMILY --follow)";
-      log(std::string(from) + " command ignored: " + why);
-      return why;
-    }
-    nlohmann::json event = {{"type", "command"}};
-    if (command.kind == FleetCommand::Kind::kFollow) {
-      // Off stops the vehicle at once (wirccontrol sends neutral).
-      g_object_set(controller, "enabled", command.follow ? TRUE : FALSE, nullptr);
-      event["follow"] = command.follow ? "ON" : "OFF";
-    } else if (command.kind == FleetCommand::Kind::kTarget) {
-      g_object_set(controller, "target-id", command.target, nullptr);
-      event["target"] = command.target;
-    } else {
-      // The answer comes as a wirc-control-right message, into telemetry.
-      g_signal_emit_by_name(controller, "request-control");
-      event["request_control"] = true;
-    }
-    event["from"] = from;
-    log(command.stream + ": " + from + " " + event.dump());
-    publishEvent(*s, event);
-    writeTelemetry(*s, event, runningTime());
-    publishFleetStatus(true);
-    return std::nullopt;
+  Stream* s = streamNamed(command.stream);
+  if (!s) return "no camera named '" + command.stream + "'";
+  GstElement* controller = element(s->plan.controller);
+  if (!controller) {
+    std::string why = command.stream + " does not follow (start with --detect FAMILY --follow)";
+    log(std::string(from) + " command ignored: " + why);
+    return why;
   }
-  return "no camera named '" + command.stream + "'";
+  nlohmann::json event = {{"type", "command"}};
+  if (command.kind == FleetCommand::Kind::kFollow) {
+    // Off stops the vehicle at once (wirccontrol sends neutral).
+    g_object_set(controller, "enabled", command.follow ? TRUE : FALSE, nullptr);
+    event["follow"] = command.follow ? "ON" : "OFF";
+  } else if (command.kind == FleetCommand::Kind::kTarget) {
+    g_object_set(controller, "target-id", command.target, nullptr);
+    event["target"] = command.target;
+  } else {
+    // The answer comes as a wirc-control-right message, into telemetry.
+    g_signal_emit_by_name(controller, "request-control");
+    event["request_control"] = true;
+  }
+  event["from"] = from;
+  log(command.stream + ": " + from + " " + event.dump());
+  publishEvent(*s, event);
+  writeTelemetry(*s, event, runningTime());
+  publishFleetStatus(true);
+  return std::nullopt;
 }
 
 std::optional<bool> Recording::drive(const std::string& stream, double steering, double throttle) {
-  for (auto& s : streams_) {
-    if (s->plan.name != stream) continue;
-    GstElement* controller = element(s->plan.controller);
-    if (!controller) return std::nullopt;
-    gboolean obeyed = FALSE;
-    g_signal_emit_by_name(controller, "drive", steering, throttle, &obeyed);
-    return obeyed != FALSE;
-  }
-  return std::nullopt;
+  Stream* s = streamNamed(stream);
+  GstElement* controller = s ? element(s->plan.controller) : nullptr;
+  if (!controller) return std::nullopt;
+  gboolean obeyed = FALSE;
+  g_signal_emit_by_name(controller, "drive", steering, throttle, &obeyed);
+  return obeyed != FALSE;
 }
 
 void Recording::updateIndex(const std::vector<std::string>& deleted) {

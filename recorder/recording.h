@@ -116,6 +116,7 @@ class Recording {
   nlohmann::json trails() const;
   std::vector<std::string> openSegments() const;
   Stream* streamOf(GstMessage* message);
+  Stream* streamNamed(const std::string& name);
 
   RecorderOptions options_;
   Retention retention_;

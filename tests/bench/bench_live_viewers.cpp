@@ -4,8 +4,8 @@
 // many viewers (multipartmux ! tcpserversink) with the same viewers.
 //   wirc-sim (the follow scene) → wirc-recorder --http → N viewers
 //   wirc-sim → gst-launch-1.0 wircsrc ! multipartmux ! tcpserversink → N viewers
-// Each server's peak memory and CPU come from wait4(); its memory is also
-// sampled each second (VmRSS) to show whether it keeps growing; the frames
+// Each server's memory (VmRSS half-way and at the end, to show whether it
+// keeps growing; VmHWM, its peak) and CPU come from /proc; the frames
 // each fast viewer got are counted at the viewer, the recorded frames read
 // from the recording index.
 // Usage: bench_live_viewers [SECONDS] [VIEWERS]   (default 20 s, 50 viewers)

@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include "headless_chromium.h"
+
 namespace wircam::testing {
 
 namespace {
@@ -52,15 +54,12 @@ std::unique_ptr<DevToolsPage> DevToolsPage::launch(const std::filesystem::path& 
   std::error_code ignored;
   std::filesystem::remove_all(profile, ignored);
   std::filesystem::create_directories(profile);
-  std::vector<std::string> args = {
-      "chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-      "--no-first-run", "--disable-background-networking", "--disable-component-update",
-      "--disable-sync",
-      // A hidden or idle tab must keep its timers at speed.
-      "--disable-background-timer-throttling", "--disable-renderer-backgrounding",
-      "--remote-debugging-address=127.0.0.1", "--remote-debugging-port=0",
-      "--user-data-dir=" + profile.string(),
-      "--window-size=" + std::to_string(width) + "," + std::to_string(height), "about:blank"};
+  std::vector<std::string> args = {"chromium"};
+  for (auto& flag : chromiumFlags(profile, width, height)) args.push_back(flag);
+  // A hidden or idle tab must keep its timers at speed.
+  args.insert(args.end(),
+              {"--disable-background-timer-throttling", "--disable-renderer-backgrounding",
+               "--remote-debugging-address=127.0.0.1", "--remote-debugging-port=0", "about:blank"});
   page->chromium_ = fork();
   if (page->chromium_ == 0) {
     std::vector<char*> argv;
@@ -159,8 +158,6 @@ DevToolsPage::~DevToolsPage() {
   std::error_code ignored;
   std::filesystem::remove_all(profile_, ignored);
 }
-
-void DevToolsPage::iterate() { g_main_context_iteration(context_, FALSE); }
 
 nlohmann::json DevToolsPage::call(const std::string& method, nlohmann::json params,
                                   std::chrono::milliseconds timeout) {

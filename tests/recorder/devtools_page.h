@@ -51,7 +51,6 @@ class DevToolsPage {
  private:
   DevToolsPage() = default;
   bool attach(const std::string& webSocketUrl);
-  void iterate();
 
   std::filesystem::path profile_;
   pid_t chromium_ = -1;

@@ -9,16 +9,28 @@ namespace wircam::testing {
 
 bool chromiumInstalled() { return std::system("command -v chromium > /dev/null") == 0; }
 
+std::vector<std::string> chromiumFlags(const std::filesystem::path& profile, int width,
+                                       int height) {
+  return {"--headless",
+          "--no-sandbox",
+          "--disable-gpu",
+          "--disable-dev-shm-usage",
+          "--disable-quic",
+          "--no-first-run",
+          "--disable-background-networking",
+          "--disable-component-update",
+          "--disable-sync",
+          "--user-data-dir=" + profile.string(),
+          "--window-size=" + std::to_string(width) + "," + std::to_string(height)};
+}
+
 bool screenshot(const std::string& url, const std::filesystem::path& shot, int width, int height,
                 int budgetMs) {
   auto profile = shot.parent_path() / (shot.stem().string() + "-chromium-profile");
-  std::string command =
-      "timeout 60 chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage "
-      "--disable-quic --no-first-run --disable-background-networking --disable-component-update "
-      "--disable-sync --user-data-dir=" +
-      profile.string() + " --window-size=" + std::to_string(width) + "," + std::to_string(height) +
-      (budgetMs > 0 ? " --virtual-time-budget=" + std::to_string(budgetMs) : "") +
-      " --timeout=10000 --screenshot=" + shot.string() + " " + url + " > /dev/null 2>&1";
+  std::string command = "timeout 60 chromium";
+  for (const auto& flag : chromiumFlags(profile, width, height)) command += " " + flag;
+  command += (budgetMs > 0 ? " --virtual-time-budget=" + std::to_string(budgetMs) : "") +
+             " --timeout=10000 --screenshot=" + shot.string() + " " + url + " > /dev/null 2>&1";
   bool taken = std::system(command.c_str()) == 0;
   std::error_code ignored;
   std::filesystem::remove_all(profile, ignored);

@@ -11,6 +11,10 @@ namespace wircam::testing {
 
 bool chromiumInstalled();
 
+// The flags every test run of chromium gets: headless, a fresh profile
+// in `profile`, nothing fetched from the network, the window's size.
+std::vector<std::string> chromiumFlags(const std::filesystem::path& profile, int width, int height);
+
 // Loads `url` in a window of width×height and saves a PNG to `shot` once
 // it has loaded, or (budgetMs > 0) after its scripts had that much virtual
 // time; false if it failed.
