@@ -58,12 +58,14 @@ file and exits 0.
                          deleting the oldest finished segments
   --min-free SIZE        delete the oldest finished segments while the disk
                          has less than SIZE free
-  --http [HOST]:PORT     web server: live view at /, status at /api/status,
-                         recordings at /recordings (e.g. --http :8080). Without
-                         HOST it listens on 127.0.0.1 only; another HOST (e.g.
-                         0.0.0.0 for the network) needs --http-token
+  --http [HOST]:PORT     web server: live view, playback, control and drive
+                         mode at /, status at /api/status, cameras at
+                         /api/cameras, recordings at /api/recordings (e.g.
+                         --http :8080). Without HOST it listens on 127.0.0.1
+                         only; another HOST (e.g. 0.0.0.0) needs --http-token
   --http-token T         every request needs "Authorization: Bearer T" or the
-                         cookie the page's /login sets (16 characters at least)
+                         cookie the page's /login sets (16 characters at least);
+                         control, driving and deleting need it always
   --http-idle-timeout S  close an HTTP connection silent for S seconds (default 10)
   --mqtt mqtt://[USER:PASS@]HOST[:PORT]
                          publish status, detections and events to an MQTT
