@@ -325,11 +325,13 @@ void HttpServer::openStream(SoupServerMessage* message, const char* contentType,
   auto client = std::make_unique<Client>();
   client->message = message;
   Client* raw = client.get();
-  client->wroteHandler = g_signal_connect(message, "wrote-chunk",
-                                          G_CALLBACK(+[](SoupServerMessage*, guint, gpointer c) {
-                                            --static_cast<Client*>(c)->inFlight;
-                                          }),
-                                          raw);
+  // libsoup 3's wrote-chunk carries no argument: the handler is (message,
+  // data). A chunk-size parameter here would read the client from a stray
+  // register (found by the TSan build, which crashed on it).
+  client->wroteHandler = g_signal_connect(
+      message, "wrote-chunk",
+      G_CALLBACK(+[](SoupServerMessage*, gpointer c) { --static_cast<Client*>(c)->inFlight; }),
+      raw);
   struct Finished {
     std::vector<std::unique_ptr<Client>>* clients;
     Client* client;

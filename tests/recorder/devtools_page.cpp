@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "headless_chromium.h"
+#include "wait_for.h"
 
 namespace wircam::testing {
 
@@ -168,7 +169,7 @@ nlohmann::json DevToolsPage::call(const std::string& method, nlohmann::json para
   soup_websocket_connection_send_text(
       socket_, nlohmann::json{{"id", id}, {"method", method}, {"params", params}}.dump().c_str());
   auto key = std::to_string(id);
-  for (auto until = Clock::now() + timeout; Clock::now() < until;) {
+  for (auto until = Clock::now() + patience(timeout); Clock::now() < until;) {
     if (replies_.contains(key)) {
       auto reply = replies_[key];
       replies_.erase(key);
@@ -195,7 +196,7 @@ nlohmann::json DevToolsPage::evaluate(const std::string& expression) {
 }
 
 bool DevToolsPage::waitUntil(const std::string& expression, std::chrono::milliseconds timeout) {
-  for (auto until = Clock::now() + timeout; Clock::now() < until;) {
+  for (auto until = Clock::now() + patience(timeout); Clock::now() < until;) {
     if (evaluate("Boolean(" + expression + ")") == true) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

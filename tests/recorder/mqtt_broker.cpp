@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "common/socket.h"
+#include "wait_for.h"
 
 namespace wircam::testing {
 
@@ -132,7 +133,7 @@ std::vector<MqttMessage> MqttProbe::messages(const std::string& topic) const {
 bool MqttProbe::waitFor(const std::string& topic,
                         const std::function<bool(const MqttMessage&)>& match,
                         std::chrono::milliseconds timeout) {
-  auto end = std::chrono::steady_clock::now() + timeout;
+  auto end = std::chrono::steady_clock::now() + patience(timeout);
   do {
     for (const auto& m : messages(topic))
       if (match(m)) return true;

@@ -1,14 +1,18 @@
 #include "recorder_process.h"
 
 #include <gst/pbutils/pbutils.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <thread>
+
+#include "wait_for.h"
 
 namespace wircam::testing {
 
@@ -45,6 +49,15 @@ RecorderProcess::~RecorderProcess() {
     kill(pid_, SIGKILL);
     wait();
   }
+  // The folder goes away with the test: a failing test shows why the
+  // recorder did what it did (its errors, a sanitizer's report) first.
+  if (::testing::Test::HasFailure()) {
+    std::string text = log();
+    constexpr size_t kTail = 64 * 1024;
+    if (text.size() > kTail) text = "...\n" + text.substr(text.size() - kTail);
+    std::fprintf(stderr, "--- wirc-recorder's log (%s) ---\n%s--- end of its log ---\n",
+                 folder_.c_str(), text.c_str());
+  }
   fs::remove_all(folder_);
 }
 
@@ -77,7 +90,7 @@ std::string RecorderProcess::log() const {
 
 std::optional<std::string> RecorderProcess::waitForLog(const std::string& prefix,
                                                        std::chrono::milliseconds timeout) {
-  auto deadline = std::chrono::steady_clock::now() + timeout;
+  auto deadline = std::chrono::steady_clock::now() + patience(timeout);
   while (std::chrono::steady_clock::now() < deadline) {
     std::istringstream words(log());
     std::string word;

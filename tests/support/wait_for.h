@@ -1,5 +1,5 @@
 // Waits for a condition instead of sleeping a fixed time: returns as soon as
-// `done()` holds, or false after `timeout`.
+// `done()` holds, or false after `timeout` (stretched under a sanitizer).
 #pragma once
 
 #include <chrono>
@@ -7,9 +7,22 @@
 
 namespace wircam::testing {
 
+// Under ThreadSanitizer everything runs several times slower (each memory
+// access is checked), so the waits that only bound a failure stretch by this.
+#if defined(__SANITIZE_THREAD__)
+inline constexpr int kSanitizerSlowdown = 4;
+#else
+inline constexpr int kSanitizerSlowdown = 1;
+#endif
+
+// `timeout`, stretched under a sanitizer.
+inline std::chrono::milliseconds patience(std::chrono::milliseconds timeout) {
+  return timeout * kSanitizerSlowdown;
+}
+
 template <typename Condition>
 bool waitFor(Condition done, std::chrono::milliseconds timeout = std::chrono::seconds(5)) {
-  auto end = std::chrono::steady_clock::now() + timeout;
+  auto end = std::chrono::steady_clock::now() + patience(timeout);
   while (!done()) {
     if (std::chrono::steady_clock::now() >= end) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
