@@ -7,8 +7,13 @@ namespace wircam::marvelmind {
 namespace {
 constexpr uint32_t kHalfRange = 0x80000000u;
 
-double secondsSinceEpoch(DashboardClock::Clock::time_point t) {
-  return std::chrono::duration<double>(t.time_since_epoch()).count();
+// Longer than any dashboard runs (≈ 31 years): clamped to it, a corrupt
+// timestamp cannot overflow the clock's 64-bit ticks.
+constexpr double kLongestRunSeconds = 1e9;
+
+DashboardClock::Clock::duration ticksOf(double seconds) {
+  return std::chrono::round<DashboardClock::Clock::duration>(
+      std::chrono::duration<double>(std::clamp(seconds, 0.0, kLongestRunSeconds)));
 }
 }  // namespace
 
@@ -27,13 +32,12 @@ double DashboardClock::seconds(uint32_t timestamp) {
 DashboardClock::Clock::time_point DashboardClock::localTime(double dashboardSeconds,
                                                             Clock::time_point received) {
   while (!samples_.empty() && received - samples_.front().received > kWindow) samples_.pop_front();
-  samples_.push_back({received, secondsSinceEpoch(received) - dashboardSeconds});
-  double offset = std::min_element(samples_.begin(), samples_.end(), [](auto& a, auto& b) {
-                    return a.offset < b.offset;
-                  })->offset;
-  auto local = Clock::time_point(std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(dashboardSeconds + offset)));
-  return std::min(local, received);
+  Clock::duration dashboard = ticksOf(dashboardSeconds);
+  samples_.push_back({received, received.time_since_epoch() - dashboard});
+  Clock::duration offset = std::min_element(samples_.begin(), samples_.end(), [](auto& a, auto& b) {
+                             return a.offset < b.offset;
+                           })->offset;
+  return std::min(Clock::time_point(dashboard + offset), received);
 }
 
 }  // namespace wircam::marvelmind

@@ -33,7 +33,9 @@ class DashboardClock {
  private:
   struct Sample {
     Clock::time_point received;
-    double offset;  // received − dashboard time, seconds
+    // received − dashboard time, in the clock's own ticks: a measurement
+    // whose own offset is the smallest lands exactly on its arrival.
+    Clock::duration offset;
   };
   TimestampUnit unit_;
   std::optional<uint32_t> last_;
