@@ -122,15 +122,22 @@ TEST(ManualDrive, WithoutANewerCommandTheVehicleIsAtNeutralAfterTheDriveTimeout)
 
 TEST(ManualDrive, CommandsKeepItGoingAndNotANumberMeansNeutral) {
   DrivenControl c("drive-timeout=200");
-  // Every 100 ms for 600 ms: three times the timeout, never neutral between.
+  // A command every 100 ms for 600 ms, three times the timeout. Between a
+  // command's arrival (50 ms on) and the earliest the dead-man may act
+  // (150 ms, a margin under 200) the car must be driving. Timed from the
+  // last command sent, so a stall of this thread cannot fail the test.
   auto until = Clock::now() + milliseconds(600);
+  auto lastCommand = Clock::now();
+  c.drive(0, 1.0);
   bool everNeutral = false;
   while (Clock::now() < until) {
-    c.drive(0, 1.0);
-    for (int i = 0; i < 10; ++i) {
-      std::this_thread::sleep_for(milliseconds(10));
-      if (c.device->outputs().pulses[kThrottle] == 1500 && Clock::now() > until - milliseconds(550))
-        everNeutral = true;
+    std::this_thread::sleep_for(milliseconds(10));
+    auto since = Clock::now() - lastCommand;
+    if (since > milliseconds(50) && since < milliseconds(150) && c.pulse(kThrottle) == 1500)
+      everNeutral = true;
+    if (since >= milliseconds(100)) {
+      lastCommand = Clock::now();
+      c.drive(0, 1.0);
     }
   }
   EXPECT_FALSE(everNeutral);
