@@ -327,7 +327,7 @@ void HttpServer::openStream(SoupServerMessage* message, const char* contentType,
   Client* raw = client.get();
   // libsoup 3's wrote-chunk carries no argument: the handler is (message,
   // data). A chunk-size parameter here would read the client from a stray
-  // register (found by the TSan build, which crashed on it).
+  // register.
   client->wroteHandler = g_signal_connect(
       message, "wrote-chunk",
       G_CALLBACK(+[](SoupServerMessage*, gpointer c) { --static_cast<Client*>(c)->inFlight; }),

@@ -29,7 +29,8 @@ class DevToolsPage {
   DevToolsPage& operator=(const DevToolsPage&) = delete;
 
   // A DevTools command and its result (an {"error": ...} object on failure
-  // or after `timeout`).
+  // or after `timeout`; timeouts here stretch under a sanitizer, see
+  // patience() in wait_for.h).
   nlohmann::json call(const std::string& method, nlohmann::json params = nlohmann::json::object(),
                       std::chrono::milliseconds timeout = std::chrono::seconds(10));
   // Loads `url` and waits for its load event.

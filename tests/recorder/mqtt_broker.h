@@ -52,7 +52,8 @@ class MqttProbe {
   void publish(const std::string& topic, const std::string& payload, bool retain = false);
   // The messages so far on `topic` (all with an empty topic).
   std::vector<MqttMessage> messages(const std::string& topic = "") const;
-  // Waits for a message on `topic` that `match` accepts.
+  // Waits for a message on `topic` that `match` accepts (`timeout` stretched
+  // under a sanitizer).
   bool waitFor(const std::string& topic, const std::function<bool(const MqttMessage&)>& match,
                std::chrono::milliseconds timeout);
 

@@ -36,7 +36,7 @@ class RecorderProcess {
   // Its status display (stdout) so far.
   std::string statusLines() const;
   // The first word starting with `prefix` in the log (e.g. "http://"), or
-  // nullopt after `timeout`.
+  // nullopt after `timeout` (stretched under a sanitizer).
   std::optional<std::string> waitForLog(const std::string& prefix,
                                         std::chrono::milliseconds timeout);
 
