@@ -35,7 +35,8 @@
  * that has no control right to give; BTEMP registers with the robot (the
  * control right) and sends channels 1..4 as Throt1..4 in CTRL every
  * `keepalive` ms. Status reports (battery, RSSI, pins) and link changes are
- * posted as `wirc-vehicle` element messages.
+ * posted as `wirc-vehicle` element messages; a link already live when the
+ * element starts is posted then.
  *
  * ## Example launch lines
  * |[
@@ -396,6 +397,8 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
   state->hasControl = (*session)->status().hasControl;
   state->warnedWithoutControl = false;
   state->follower.reset();
+  // A link already live (another element's, or quick) is heard from
+  // addListener() itself, so the application sees its state either way.
   state->sessionListener =
       (*session)->addListener([self](const link::LinkEvent& event) { on_link_event(self, event); });
   {

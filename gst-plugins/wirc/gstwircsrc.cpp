@@ -136,10 +136,6 @@ struct WircSrcState {
   Settings active;  // what start() used: properties may change meanwhile
   std::shared_ptr<wirc::TransmitterSession> session;
   int sessionListener = 0;
-  // Whether this login's "live" was posted: a session shared with another
-  // element may have logged in before this one listened (start() then
-  // posts it), and the event must not come twice.
-  std::atomic<bool> liveAnnounced{false};
   std::optional<wirc::StreamReceiver> receiver;
   UniqueFd socket;
   UniqueFd wake;         // unlock() writes here to end a blocking receive
@@ -235,11 +231,6 @@ void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
       gst_structure_new("wirc-session", "event", G_TYPE_STRING, text.c_str(), nullptr);
   if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
     signal(state->linkChanged);
-    bool live = changed->state == link::LinkState::Live;
-    if (state->liveAnnounced.exchange(live) && live) {
-      gst_structure_free(s);  // start() posted it already
-      return;
-    }
     gst_structure_set(s, "state", G_TYPE_STRING, link::linkStateName(changed->state), "reason",
                       G_TYPE_STRING, changed->reason.c_str(), nullptr);
   }
@@ -326,14 +317,10 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   state->loginDeadline = Clock::now() + std::chrono::milliseconds(settings.loginTimeoutMs + 500);
   state->nextStats = Clock::now() + std::chrono::milliseconds(settings.statsIntervalMs);
   publishStats(self);
-  state->liveAnnounced = false;
+  // A login made before this element listened (its own, done quickly, or
+  // another element's it joined) is heard from addListener() itself.
   state->sessionListener = state->session->addListener(
       [self](const link::LinkEvent& event) { onLinkEvent(self, event); });
-  // A login made before this element listened (its own, done quickly, or
-  // another element's it joined): its event was not heard, so say it here.
-  if (auto status = state->session->status(); status.state == link::LinkState::Live)
-    onLinkEvent(self,
-                link::StateChanged{link::LinkState::Live, "logged in to " + status.vehicleAddress});
   // The session sends STST once logged in, and again after each reconnect.
   uint16_t port = localAddress(state->socket.get()).port();
   state->session->startStream(static_cast<uint8_t>(settings.camera), port);

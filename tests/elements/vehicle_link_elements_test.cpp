@@ -7,6 +7,7 @@
 
 #include "misbehaving_peers.h"
 #include "pipelines.h"
+#include "vehicle_control.h"
 #include "wait_for.h"
 #include "wirc/device.h"
 #include "wirc/transmitter_session.h"
@@ -208,6 +209,42 @@ TEST(VehicleLinkElements, WirccontrolShowsTheControlRightAndTheAnswerToARequest)
   gst_object_unref(control);
   gst_harness_teardown(h);
   gst_object_unref(bus);
+}
+
+// The first `wirc-vehicle` link state `pipeline` posts within 3 s.
+std::string firstVehicleState(GstElement* pipeline) {
+  GstBus* bus = gst_element_get_bus(pipeline);
+  std::string state;
+  auto deadline = std::chrono::steady_clock::now() + milliseconds(3000);
+  while (state.empty() && std::chrono::steady_clock::now() < deadline) {
+    GstMessage* m = gst_bus_timed_pop_filtered(bus, 100 * GST_MSECOND, GST_MESSAGE_ELEMENT);
+    if (!m) continue;
+    const GstStructure* s = gst_message_get_structure(m);
+    if (gst_structure_has_name(s, "wirc-vehicle") && gst_structure_has_field(s, "state"))
+      state = gst_structure_get_string(s, "state");
+    gst_message_unref(m);
+  }
+  gst_object_unref(bus);
+  return state;
+}
+
+// A link that logged in before the element listened (another element's, or
+// an RCOIP receiver that answered within microseconds) is still announced.
+TEST(VehicleLinkElements, WirccontrolJoiningALiveLinkPostsThatItIsLive) {
+  auto receiver = sim::startVehicleControl("rcoip", "127.0.0.1", 0, {});
+  ASSERT_TRUE(receiver.has_value());
+  auto description = "videotestsrc is-live=true ! wirccontrol protocol=rcoip host=127.0.0.1 port=" +
+                     std::to_string((*receiver)->port()) + " ! fakesink";
+  GstElement* first = launch(description);
+  gst_element_set_state(first, GST_STATE_PLAYING);
+  ASSERT_EQ(firstVehicleState(first), "live");
+  GstElement* second = launch(description);
+  gst_element_set_state(second, GST_STATE_PLAYING);
+  EXPECT_EQ(firstVehicleState(second), "live");
+  for (GstElement* pipeline : {first, second}) {
+    gst_element_set_state(pipeline, GST_STATE_NULL);
+    gst_object_unref(pipeline);
+  }
 }
 
 }  // namespace

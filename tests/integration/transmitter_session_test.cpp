@@ -53,6 +53,13 @@ class EventLog {
       if (const auto* found = std::get_if<T>(&event)) return *found;
     return std::nullopt;
   }
+  template <typename T>
+  std::optional<T> last() {
+    std::lock_guard lock(mutex_);
+    for (auto event = events_.rbegin(); event != events_.rend(); ++event)
+      if (const auto* found = std::get_if<T>(&*event)) return *found;
+    return std::nullopt;
+  }
 
  private:
   TransmitterSession& session_;
@@ -254,7 +261,7 @@ TEST(TransmitterSession, ReportsTheAnswerToAControlRequest) {
   boss->requestControlFor(minion->sessionStatus().connectionId);
   EXPECT_TRUE(waitFor([&] { return minion->status().hasControl; }));
   EXPECT_TRUE(waitFor([&] { return !boss->status().hasControl; }));
-  auto change = minionEvents.first<link::ControlRightChanged>();
+  auto change = minionEvents.last<link::ControlRightChanged>();
   ASSERT_TRUE(change.has_value());
   EXPECT_TRUE(change->hasControl);
 }

@@ -44,9 +44,22 @@ std::string describe(const LinkEvent& event) {
 }
 
 int LinkListeners::add(Listener listener) {
-  MutexLock lock(mutex_);
-  int id = next_++;
-  listeners_[id] = std::make_shared<const Listener>(std::move(listener));
+  // No event is emitted while this runs, so the sticky ones heard here and
+  // the ones emitted after it neither overlap nor leave a gap.
+  std::lock_guard emitting(emitting_);
+  auto shared = std::make_shared<const Listener>(std::move(listener));
+  std::optional<StateChanged> state;
+  std::optional<ControlRightChanged> controlRight;
+  int id;
+  {
+    MutexLock lock(mutex_);
+    id = next_++;
+    listeners_[id] = shared;
+    state = lastState_;
+    controlRight = lastControlRight_;
+  }
+  if (state) (*shared)(*state);
+  if (controlRight) (*shared)(*controlRight);
   return id;
 }
 
@@ -62,6 +75,8 @@ void LinkListeners::emit(const LinkEvent& event) {
   std::vector<std::shared_ptr<const Listener>> current;
   {
     MutexLock lock(mutex_);
+    if (const auto* state = std::get_if<StateChanged>(&event)) lastState_ = *state;
+    if (const auto* right = std::get_if<ControlRightChanged>(&event)) lastControlRight_ = *right;
     current.reserve(listeners_.size());
     for (const auto& [id, listener] : listeners_) current.push_back(listener);
   }

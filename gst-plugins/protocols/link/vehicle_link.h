@@ -103,6 +103,12 @@ struct LinkStatus {
 // loop thread: they must not block, and must not drop the last reference to
 // their link (as a GStreamer application must not set a pipeline to NULL
 // from a streaming thread).
+//
+// The link's state and control right are sticky, as GStreamer's sticky
+// events are for a pad linked late: a listener added after the link logged
+// in first hears the last StateChanged and ControlRightChanged, from add()
+// on the caller's thread, then every later event. None is missed or heard
+// twice, however the login and add() interleave.
 class LinkListeners {
  public:
   using Listener = std::function<void(const LinkEvent&)>;
@@ -114,6 +120,8 @@ class LinkListeners {
   Mutex mutex_;  // not held while a listener runs
   std::map<int, std::shared_ptr<const Listener>> listeners_ WIRCAM_GUARDED_BY(mutex_);
   int next_ WIRCAM_GUARDED_BY(mutex_) = 1;
+  std::optional<StateChanged> lastState_ WIRCAM_GUARDED_BY(mutex_);
+  std::optional<ControlRightChanged> lastControlRight_ WIRCAM_GUARDED_BY(mutex_);
   std::recursive_mutex emitting_;  // held while listeners run (emit may nest)
 };
 
