@@ -72,14 +72,16 @@ void expectDroppedAsMisbehavingWithFlatMemory(std::vector<uint8_t> flood) {
   auto start = Clock::now();
   // Dropped and tried again, more than once: the peer sees the new logins.
   EXPECT_TRUE(waitFor([&] { return peer.connections() >= 3; }, milliseconds(10000)));
-  auto seconds = std::chrono::duration<double>(Clock::now() - start).count();
   EXPECT_LT(residentKb() - before, 20 * 1024) << "memory grew with the garbage";
   EXPECT_NE(session->status().reason.find("dropped as misbehaving"), std::string::npos)
       << session->status().reason;
   EXPECT_GT(session->status().inputRejected, 100u);
+  // The first summary may have left before the listener was added (it is
+  // not sticky); the next comes a second later, from the next connection.
+  EXPECT_TRUE(waitFor([&] { return !summaries.events().empty(); }, milliseconds(3000)));
+  auto seconds = std::chrono::duration<double>(Clock::now() - start).count();
   // Summed up, not one event per bad byte: at most one summary a second.
   EXPECT_LE(summaries.events().size(), static_cast<size_t>(seconds) + 1);
-  EXPECT_GE(summaries.events().size(), 1u);
 }
 
 TEST(HostileDevice, GarbageOnTheControlConnectionIsCountedAndTheDeviceDropped) {
