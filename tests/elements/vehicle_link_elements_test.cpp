@@ -233,7 +233,7 @@ std::string firstVehicleState(GstElement* pipeline) {
 TEST(VehicleLinkElements, WirccontrolJoiningALiveLinkPostsThatItIsLive) {
   auto receiver = sim::startVehicleControl("rcoip", "127.0.0.1", 0, {});
   ASSERT_TRUE(receiver.has_value());
-  auto description = "videotestsrc is-live=true ! wirccontrol protocol=rcoip host=127.0.0.1 port=" +
+  auto description = "fakesrc is-live=true ! wirccontrol protocol=rcoip host=127.0.0.1 port=" +
                      std::to_string((*receiver)->port()) + " ! fakesink";
   GstElement* first = launch(description);
   gst_element_set_state(first, GST_STATE_PLAYING);
