@@ -397,8 +397,9 @@ static gboolean gst_wirc_control_start(GstBaseTransform* transform) {
   state->hasControl = (*session)->status().hasControl;
   state->warnedWithoutControl = false;
   state->follower.reset();
-  // A link already live (another element's, or quick) is heard from
-  // addListener() itself, so the application sees its state either way.
+  // A link already live (another element's, or a receiver that answered
+  // at once) is heard from addListener() itself: the application sees its
+  // state either way.
   state->sessionListener =
       (*session)->addListener([self](const link::LinkEvent& event) { on_link_event(self, event); });
   {
