@@ -84,7 +84,9 @@ GstBuffer* bufferWithATagOnTheRight() {
 }
 
 TEST(ManualDrive, ACommandLeavesAtOnceWithinTheLimitsAndHoldsOffTheFollower) {
-  DrivenControl c;
+  // The dead-man is another test's: here it must not act while a stalled
+  // test thread (a sanitizer's, a loaded machine's) waits.
+  DrivenControl c("drive-timeout=5000");
   // Half left, full ahead: throttle is scaled by max-throttle (0.8) and
   // starts past the deadband (50 µs): 1500 + 50 + 0.8 × 450 = 1910.
   EXPECT_TRUE(c.drive(0.5, 1.0));

@@ -5,6 +5,7 @@
 
 #include "recorder_process.h"
 #include "simulated_device.h"
+#include "wait_for.h"
 
 namespace {
 
@@ -18,7 +19,11 @@ TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
   ASSERT_TRUE(url) << recorder.log();
   EXPECT_NE(url->find("/127.0.0.1-" + std::to_string(device->port()) + "/cam0"), std::string::npos);
   for (const char* protocols : {"udp", "tcp"}) {
+    // rtspsrc gives up on UDP after `timeout` µs without a packet (5 s by
+    // default); a sanitizer's slower server gets the longer patience.
+    auto udpTimeoutUs = patience(milliseconds(5000)).count() * 1000;
     std::string description = "rtspsrc location=" + *url + " protocols=" + protocols +
+                              " timeout=" + std::to_string(udpTimeoutUs) +
                               " ! rtpjpegdepay ! jpegdec ! appsink name=sink";
     GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
     GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
@@ -26,7 +31,8 @@ TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
     int frames = 0;
     int width = 0;
     while (frames < 15) {
-      GstSample* sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), 10 * GST_SECOND);
+      GstSample* sample = gst_app_sink_try_pull_sample(
+          GST_APP_SINK(sink), patience(milliseconds(10000)).count() * GST_MSECOND);
       if (!sample) break;
       GstVideoInfo info;
       gst_video_info_from_caps(&info, gst_sample_get_caps(sample));
