@@ -211,11 +211,12 @@ TEST(VehicleLinkElements, WirccontrolShowsTheControlRightAndTheAnswerToARequest)
   gst_object_unref(bus);
 }
 
-// The first `wirc-vehicle` link state `pipeline` posts within 3 s.
+// The first `wirc-vehicle` link state `pipeline` posts within 3 s (longer
+// under a sanitizer).
 std::string firstVehicleState(GstElement* pipeline) {
   GstBus* bus = gst_element_get_bus(pipeline);
   std::string state;
-  auto deadline = std::chrono::steady_clock::now() + milliseconds(3000);
+  auto deadline = std::chrono::steady_clock::now() + wircam::testing::patience(milliseconds(3000));
   while (state.empty() && std::chrono::steady_clock::now() < deadline) {
     GstMessage* m = gst_bus_timed_pop_filtered(bus, 100 * GST_MSECOND, GST_MESSAGE_ELEMENT);
     if (!m) continue;
