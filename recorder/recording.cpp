@@ -404,8 +404,6 @@ void Recording::handleElementMessage(GstMessage* message) {
   std::string type = gst_structure_get_name(s);
   if (type == "splitmuxsink-fragment-opened") {
     stream->segment = gst_structure_get_string(s, "location");
-    // Frames come, so the device is live (its login event said so too).
-    followLinkState(*stream, "live");
     stream->telemetry->segmentOpened(stream->segment);
     if (auto failure = stream->telemetry->takeWriteFailure()) log(*failure);
     return;
