@@ -4,6 +4,8 @@
 #include <cctype>
 #include <cstdlib>
 
+#include "common/printable_text.h"
+
 namespace wircam::recorder {
 
 Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
@@ -15,7 +17,8 @@ Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
                  [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
   if (command == "follow/set") {
     if (upper != "ON" && upper != "OFF")
-      return unexpected("follow/set takes ON or OFF, not '" + payload.substr(0, 40) + "'");
+      return unexpected("follow/set takes ON or OFF, not '" + printableText(payload.substr(0, 40)) +
+                        "'");
     parsed.follow = upper == "ON";
     return parsed;
   }
@@ -24,7 +27,7 @@ Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
     long id = std::strtol(payload.c_str(), &end, 10);
     if (payload.empty() || *end != '\0' || id < -1 || id > 1000000)
       return unexpected("target/set takes a tag id (or -1: the largest), not '" +
-                        payload.substr(0, 40) + "'");
+                        printableText(payload.substr(0, 40)) + "'");
     parsed.kind = FleetCommand::Kind::kTarget;
     parsed.target = static_cast<int>(id);
     return parsed;
@@ -33,7 +36,8 @@ Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
     parsed.kind = FleetCommand::Kind::kRequestControl;
     return parsed;
   }
-  return unexpected("unknown command '" + command + "' (follow/set, target/set, request-control)");
+  return unexpected("unknown command '" + printableText(command) +
+                    "' (follow/set, target/set, request-control)");
 }
 
 }  // namespace wircam::recorder

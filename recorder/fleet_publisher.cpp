@@ -5,13 +5,9 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "log_line.h"
+
 namespace wircam::recorder {
-
-namespace {
-
-void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
-
-}  // namespace
 
 FleetPublisher::FleetPublisher(Settings settings, std::function<void(const FleetCommand&)> apply)
     : settings_(std::move(settings)), apply_(std::move(apply)) {
@@ -31,7 +27,7 @@ Expected<std::unique_ptr<FleetPublisher>, std::string> FleetPublisher::start(
       {.connected = [self](MqttClient& connected) { self->republish(connected); },
        .message = [self](const std::string& topic, const std::string& payload,
                          bool retained) { self->onMessage(topic, payload, retained); },
-       .log = [](const std::string& line) { log(line); }});
+       .log = [](const std::string& line) { logLine(line); }});
   if (!client) return unexpected(client.error());
   publisher->client_ = std::move(*client);
   return publisher;
@@ -68,16 +64,17 @@ void FleetPublisher::onMessage(const std::string& topicName, const std::string& 
   if (retained) {
     // A command is an act, not a state: one left retained would replay at
     // every restart.
-    log("ignoring the retained message on " + topicName +
-        " (commands are not retained; clear it with mosquitto_pub -r -n -t '" + topicName + "')");
+    std::string shown = printableText(topicName);
+    logLine("ignoring the retained message on " + shown +
+            " (commands are not retained; clear it with mosquitto_pub -r -n -t '" + shown + "')");
     return;
   }
   auto parsed = parseFleetCommand(stream, command, payload);
   if (parsed && std::find(settings_.streams.begin(), settings_.streams.end(), stream) ==
                     settings_.streams.end())
-    parsed = unexpected("no stream '" + stream + "' here");
+    parsed = unexpected("no stream '" + printableText(stream) + "' here");
   if (!parsed) {
-    log("MQTT " + topicName + ": " + parsed.error() + "; ignored");
+    logLine("MQTT " + printableText(topicName) + ": " + parsed.error() + "; ignored");
     return;
   }
   // To the main loop, where the pipeline is driven.

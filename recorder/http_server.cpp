@@ -5,6 +5,8 @@
 #include <mutex>
 #include <set>
 
+#include "common/printable_text.h"
+#include "http_connections.h"
 #include "http_routes.h"
 #include "live_view_page.h"
 #include "login_page.h"
@@ -35,7 +37,11 @@ void respondError(SoupServerMessage* message, guint status, const std::string& t
 
 // The API answers errors in JSON too, so scripts can read them.
 void respondJsonError(SoupServerMessage* message, guint status, const std::string& text) {
-  respond(message, status, "application/json", nlohmann::json{{"error", text}}.dump());
+  // The text may quote a path, which a client can make any bytes: bytes that
+  // are not UTF-8 are replaced rather than thrown on.
+  respond(message, status, "application/json",
+          nlohmann::json{{"error", text}}.dump(-1, ' ', false,
+                                               nlohmann::json::error_handler_t::replace));
 }
 
 }  // namespace
@@ -85,38 +91,32 @@ struct HttpServer::CameraFeed {
   nlohmann::json detections = nlohmann::json::array();  // the last ones
 };
 
-HttpServer::HttpServer(Content content, std::chrono::milliseconds idleTimeout)
-    : content_(std::move(content)), idleTimeout_(idleTimeout) {}
+HttpServer::HttpServer(Content content) : content_(std::move(content)) {}
 
 Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     const ServerAddress& address, Content content, std::chrono::milliseconds idleTimeout) {
-  std::unique_ptr<HttpServer> self(new HttpServer(std::move(content), idleTimeout));
+  std::unique_ptr<HttpServer> self(new HttpServer(std::move(content)));
   self->server_ = soup_server_new("server-header", "wirc-recorder", nullptr);
-  GError* error = nullptr;
   GSocketAddress* socket =
       g_inet_socket_address_new_from_string(address.listenHost().c_str(), address.port);
   if (!socket) return unexpected("--http: '" + address.host + "' is not an IP address");
-  gboolean listening =
-      soup_server_listen(self->server_, socket, SoupServerListenOptions(0), &error);
+  auto connections = HttpConnections::listen(self->server_, socket,
+                                             {.maxOpen = kMaxConnections,
+                                              .maxPerAddress = kMaxConnectionsPerAddress,
+                                              .idleTimeout = idleTimeout});
   g_object_unref(socket);
-  if (!listening) {
-    std::string text =
-        "--http: cannot listen on port " + std::to_string(address.port) + ": " + error->message;
-    g_error_free(error);
-    return unexpected(text);
-  }
-  // The port actually bound (the system's choice for port 0).
-  GSList* uris = soup_server_get_uris(self->server_);
-  int port = uris ? g_uri_get_port(static_cast<GUri*>(uris->data)) : address.port;
-  g_slist_free_full(uris, reinterpret_cast<GDestroyNotify>(g_uri_unref));
-  self->url_ = "http://" + address.listenHost() + ":" + std::to_string(port) + "/";
+  if (!connections)
+    return unexpected("--http: cannot listen on port " + std::to_string(address.port) + ": " +
+                      connections.error());
+  self->connections_ = std::move(*connections);
+  self->url_ =
+      "http://" + address.listenHost() + ":" + std::to_string(self->connections_->port()) + "/";
 
   soup_server_add_early_handler(self->server_, nullptr, onHeaders, self.get(), nullptr);
   soup_server_add_handler(self->server_, nullptr, onRequest, self.get(), nullptr);
   // Upgrades only the requests onRequest leaves unanswered (the drive mode's).
   soup_server_add_websocket_handler(self->server_, nullptr, nullptr, nullptr, onWebSocket,
                                     self.get(), nullptr);
-  g_signal_connect(self->server_, "request-started", G_CALLBACK(onRequestStarted), self.get());
   g_signal_connect(self->server_, "request-finished", G_CALLBACK(onRequestEnded), self.get());
   g_signal_connect(self->server_, "request-aborted", G_CALLBACK(onRequestEnded), self.get());
   for (size_t i = 0; i < self->content_.cameras.size(); ++i) {
@@ -190,30 +190,17 @@ HttpServer::~HttpServer() {
   }
 }
 
-// A new request, on a new or a kept-alive connection: too many open at
-// once and its connection is closed; otherwise reads and writes that wait
-// longer than the idle timeout end it (a half-open request holds nothing
-// for long).
-void HttpServer::onRequestStarted(SoupServer*, SoupServerMessage* message, gpointer data) {
-  auto* self = static_cast<HttpServer*>(data);
-  GSocket* socket = soup_server_message_get_socket(message);
-  if (++self->openRequests_ > kMaxRequests) {
-    if (socket) g_socket_shutdown(socket, TRUE, TRUE, nullptr);
-    return;
-  }
-  if (socket)
-    g_socket_set_timeout(socket, static_cast<guint>(std::max<int64_t>(
-                                     1, (self->idleTimeout_.count() + 999) / 1000)));
-}
-
-void HttpServer::onRequestEnded(SoupServer*, SoupServerMessage*, gpointer data) {
-  --static_cast<HttpServer*>(data)->openRequests_;
+void HttpServer::onRequestEnded(SoupServer*, SoupServerMessage* message, gpointer data) {
+  static_cast<HttpServer*>(data)->connections_->requestEnded(message);
 }
 
 // After the headers, before any body: only GET and HEAD are served, so a
 // body (however large it says it is) is refused unread.
 void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*, GHashTable*,
-                           gpointer) {
+                           gpointer data) {
+  auto* self = static_cast<HttpServer*>(data);
+  // Its connection is no longer idle: the request is answered, however long.
+  self->connections_->requestStarted(message);
   std::string method = soup_server_message_get_method(message);
   auto* headers = soup_server_message_get_request_headers(message);
   bool hasBody = soup_message_headers_get_content_length(headers) > 0 ||
@@ -227,7 +214,7 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*,
                            : "HTTP/1.1 413 Content Too Large\r\n";
   answer += "Content-Length: 0\r\nConnection: close\r\n\r\n";
   soup_message_body_set_accumulate(soup_server_message_get_request_body(message), FALSE);
-  if (GSocket* socket = soup_server_message_get_socket(message)) {
+  if (GSocket* socket = self->connections_->socketOf(message)) {
     g_socket_send(socket, answer.data(), answer.size(), nullptr, nullptr);
     g_socket_shutdown(socket, TRUE, TRUE, nullptr);
   }
@@ -513,13 +500,15 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
   std::error_code error;
   if (!isRecordingName(name) || fs::is_symlink(fs::symlink_status(file, error)) ||
       !fs::is_regular_file(file, error)) {
-    respondError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
+    respondJsonError(
+        message, SOUP_STATUS_NOT_FOUND,
+        "no recording named '" + printableText(name) + "'; GET /api/recordings lists them");
     return;
   }
   GError* mapError = nullptr;
   GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &mapError);
   if (!mapped) {
-    respondError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR, mapError->message);
+    respondJsonError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR, mapError->message);
     g_error_free(mapError);
     return;
   }
@@ -628,19 +617,16 @@ void HttpServer::refuseDriveUnlessAllowed(SoupServerMessage* message, const std:
   if (refusedWithoutToken(message, "driving")) return;
   if (std::none_of(feeds_.begin(), feeds_.end(),
                    [&](const auto& feed) { return feed->name == camera; }))
-    respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
-  // Allowed but not a WebSocket handshake: libsoup answers 400.
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+  // Allowed but not a WebSocket handshake: libsoup answers 400. Once
+  // upgraded it is not idle between a driver's commands: open until either
+  // side closes it.
+  connections_->upgrading(message);
 }
 
 void HttpServer::onWebSocket(SoupServer*, SoupServerMessage*, const char* path,
                              SoupWebsocketConnection* connection, gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
-  // The upgraded request never "finishes": it no longer counts as open,
-  // and it is not idle between a driver's commands.
-  --self->openRequests_;
-  if (GIOStream* stream = soup_websocket_connection_get_io_stream(connection);
-      G_IS_SOCKET_CONNECTION(stream))
-    g_socket_set_timeout(g_socket_connection_get_socket(G_SOCKET_CONNECTION(stream)), 0);
   std::string camera = routeOf(path).name;
   auto socket = std::make_unique<DriveSocket>(
       connection,

@@ -21,6 +21,7 @@
 #include "drive_socket.h"
 #include "fleet_command.h"
 #include "frame_tap.h"
+#include "http_connections.h"
 #include "http_routes.h"
 #include "recorder_options.h"
 
@@ -58,9 +59,13 @@ class HttpServer {
 
   // Limits that keep hostile clients from holding the recorder's memory or
   // connections: a request body is never read (only GET and HEAD are
-  // served), a connection silent for `idleTimeout` is closed, and at most
-  // kMaxRequests are open at once (the rest are closed at once).
-  static constexpr int kMaxRequests = 128;
+  // served), a connection with no request in progress for `idleTimeout`
+  // (silent, idle, or still sending its headers) is closed, and at most
+  // kMaxConnections are open at once, kMaxConnectionsPerAddress from one
+  // client address (the rest are closed at once). Every connection gives
+  // its place back however it ends.
+  static constexpr size_t kMaxConnections = 128;
+  static constexpr size_t kMaxConnectionsPerAddress = 64;
   // Recordings replayed at once (each a small pipeline); more get a 503.
   static constexpr size_t kMaxPlaybacks = 16;
   static Expected<std::unique_ptr<HttpServer>, std::string> start(
@@ -77,7 +82,7 @@ class HttpServer {
  private:
   struct Client;
   struct CameraFeed;
-  HttpServer(Content content, std::chrono::milliseconds idleTimeout);
+  explicit HttpServer(Content content);
 
   static void onRequest(SoupServer*, SoupServerMessage* message, const char* path,
                         GHashTable* query, gpointer self);
@@ -85,7 +90,6 @@ class HttpServer {
                           SoupWebsocketConnection* connection, gpointer self);
   static void onHeaders(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
                         gpointer self);
-  static void onRequestStarted(SoupServer*, SoupServerMessage* message, gpointer self);
   static void onRequestEnded(SoupServer*, SoupServerMessage* message, gpointer self);
   std::string page() const;  // the live view page with the current state
   bool authorised(SoupServerMessage* message) const;
@@ -116,8 +120,7 @@ class HttpServer {
   std::vector<std::unique_ptr<Client>> eventClients_;
   std::vector<std::unique_ptr<Client>> playbackClients_;  // each with its replay
   std::vector<std::unique_ptr<DriveSocket>> driveSockets_;
-  std::chrono::milliseconds idleTimeout_;
-  int openRequests_ = 0;  // main loop only
+  std::unique_ptr<HttpConnections> connections_;
   // Frames queued for the main loop check it: the server may be gone.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

@@ -13,6 +13,7 @@
 #include <string_view>
 
 #include "gst_json.h"
+#include "log_line.h"
 #include "segment_inspector.h"
 #include "telemetry_track_flags.h"
 #include "wall_clock.h"
@@ -50,13 +51,11 @@ std::optional<std::string> checkFamily(const std::string& family) {
   return "--detect " + family + ": not an AprilTag family (" + known + ")";
 }
 
-void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
-
 }  // namespace
 
 Recording::Recording(RecorderOptions options)
     : options_(std::move(options)),
-      retention_(options_.outDir, {options_.maxBytes, options_.minFree}, log),
+      retention_(options_.outDir, {options_.maxBytes, options_.minFree}, logLine),
       disk_(options_.outDir),
       index_(options_.outDir) {}
 
@@ -82,8 +81,8 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
     return inspectSegment(file);
   };
   if (size_t added = recording->index_.reconcile(inspect))
-    log("indexed " + std::to_string(added) + " segment(s) missing from " +
-        recording->index_.path().string());
+    logLine("indexed " + std::to_string(added) + " segment(s) missing from " +
+            recording->index_.path().string());
   recording->index_.save();
   auto plan = planPipeline(options);
   GError* parseError = nullptr;
@@ -161,7 +160,7 @@ std::optional<std::string> Recording::startServers() {
         std::chrono::milliseconds(static_cast<int64_t>(options_.httpIdleSeconds * 1000)));
     if (!server) return server.error();
     http_ = std::move(*server);
-    log("live view at " + http_->url());
+    logLine("live view at " + http_->url());
   }
   if (options_.mqtt) {
     FleetPublisher::Settings settings{.url = *parseMqttUrl(*options_.mqtt),
@@ -172,8 +171,8 @@ std::optional<std::string> Recording::startServers() {
         FleetPublisher::start(settings, [this](const FleetCommand& c) { applyCommand(c, "MQTT"); });
     if (!fleet) return fleet.error();
     fleet_ = std::move(*fleet);
-    log("MQTT to " + settings.url.host + ":" + std::to_string(settings.url.port) + " under " +
-        settings.prefix + "/");
+    logLine("MQTT to " + settings.url.host + ":" + std::to_string(settings.url.port) + " under " +
+            settings.prefix + "/");
   }
   if (!options_.onSegmentClosed.empty()) {
     hook_ = std::make_unique<SegmentHook>(
@@ -191,7 +190,7 @@ std::optional<std::string> Recording::startServers() {
     auto server = RtspServer::start(*options_.rtsp, cameras);
     if (!server) return server.error();
     rtsp_ = std::move(*server);
-    for (auto& camera : cameras) log("RTSP at " + rtsp_->url() + camera.path);
+    for (auto& camera : cameras) logLine("RTSP at " + rtsp_->url() + camera.path);
   }
   return std::nullopt;
 }
@@ -231,7 +230,7 @@ GstClockTime Recording::runningTime() const {
 void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime time) {
   if (!GST_CLOCK_TIME_IS_VALID(time)) return;
   stream.telemetry->write(std::move(line), time, unixMsOf(pipeline_, time));
-  if (auto failure = stream.telemetry->takeWriteFailure()) log(*failure);
+  if (auto failure = stream.telemetry->takeWriteFailure()) logLine(*failure);
 }
 
 void Recording::onSegmentClosed(Stream& stream, const std::string& file) {
@@ -310,7 +309,7 @@ std::optional<std::pair<guint, std::string>> Recording::deleteSegment(const std:
   if (auto error = removeSegment(video))
     return Refusal(SOUP_STATUS_INTERNAL_SERVER_ERROR,
                    "cannot delete '" + file + "': " + error.message());
-  log("deleted " + file + " (asked over HTTP)");
+  logLine("deleted " + file + " (asked over HTTP)");
   updateIndex({video.string()});
   return std::nullopt;
 }
@@ -348,7 +347,7 @@ std::optional<std::string> Recording::applyCommand(const FleetCommand& command, 
   GstElement* controller = element(s->plan.controller);
   if (!controller) {
     std::string why = command.stream + " does not follow (start with --detect FAMILY --follow)";
-    log(std::string(from) + " command ignored: " + why);
+    logLine(std::string(from) + " command ignored: " + why);
     return why;
   }
   nlohmann::json event = {{"type", "command"}};
@@ -365,7 +364,7 @@ std::optional<std::string> Recording::applyCommand(const FleetCommand& command, 
     event["request_control"] = true;
   }
   event["from"] = from;
-  log(command.stream + ": " + from + " " + event.dump());
+  logLine(command.stream + ": " + from + " " + event.dump());
   publishEvent(*s, event);
   writeTelemetry(*s, event, runningTime());
   publishFleetStatus(true);
@@ -383,7 +382,7 @@ std::optional<bool> Recording::drive(const std::string& stream, double steering,
 
 void Recording::updateIndex(const std::vector<std::string>& deleted) {
   for (const auto& file : deleted) index_.remove(std::filesystem::path(file).filename().string());
-  if (!index_.save()) log("cannot write " + index_.path().string());
+  if (!index_.save()) logLine("cannot write " + index_.path().string());
 }
 
 void Recording::followLinkState(Stream& stream, const std::string& linkState) {
@@ -405,7 +404,7 @@ void Recording::handleElementMessage(GstMessage* message) {
   if (type == "splitmuxsink-fragment-opened") {
     stream->segment = gst_structure_get_string(s, "location");
     stream->telemetry->segmentOpened(stream->segment);
-    if (auto failure = stream->telemetry->takeWriteFailure()) log(*failure);
+    if (auto failure = stream->telemetry->takeWriteFailure()) logLine(*failure);
     return;
   }
   if (type == "splitmuxsink-fragment-closed") {
@@ -418,7 +417,7 @@ void Recording::handleElementMessage(GstMessage* message) {
     // Link events: losses, logins, the control right, refusals. (A loss
     // ends the segment by itself: the planner cuts at the gap in frames.)
     std::string event = gst_structure_get_string(s, "event");
-    log(stream->plan.name + ": " + event);
+    logLine(stream->plan.name + ": " + printableText(event));
     line["type"] = "session";
     writeTelemetry(*stream, line, runningTime());
     publishEvent(*stream, line);
@@ -453,8 +452,8 @@ void Recording::handleElementMessage(GstMessage* message) {
     // The steered vehicle's own link (RCOIP, BTEMP, or WiRC) and its status
     // reports: battery, RSSI, pins.
     if (const char* state = gst_structure_get_string(s, "state"))
-      log(stream->plan.name + ": vehicle " + gst_structure_get_string(s, "event") + " (" + state +
-          ")");
+      logLine(stream->plan.name + ": vehicle " +
+              printableText(gst_structure_get_string(s, "event")) + " (" + state + ")");
     line["type"] = "vehicle";
     writeTelemetry(*stream, line, runningTime());
     if (line.contains("state")) publishEvent(*stream, line);  // link changes, not each report
@@ -490,7 +489,8 @@ void Recording::handlePosition(Stream& stream, const GstStructure* s) {
   gst_structure_get_uint(s, "beacon", &beacon);
   if (gst_structure_has_name(s, "marvelmind-stale")) {
     std::string reason = gst_structure_get_string(s, "reason");
-    log(stream.plan.name + ": position of beacon " + std::to_string(beacon) + " stale: " + reason);
+    logLine(stream.plan.name + ": position of beacon " + std::to_string(beacon) +
+            " stale: " + reason);
     stream.positionStale = reason;
     nlohmann::json line = {{"type", "position-stale"}, {"beacon", beacon}, {"reason", reason}};
     writeTelemetry(stream, line, runningTime());
@@ -527,14 +527,14 @@ void Recording::handleError(GstMessage* message) {
   gchar* debug = nullptr;
   gst_message_parse_error(message, &error, &debug);
   bool diskFull = g_error_matches(error, GST_RESOURCE_ERROR, GST_RESOURCE_ERROR_NO_SPACE_LEFT);
-  log(std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + error->message + "\n" +
-      (debug ? debug : ""));
+  logLine(std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + error->message + "\n" +
+          (debug ? debug : ""));
   g_error_free(error);
   g_free(debug);
   if (diskFull && !stopping_) {
     // A write failed: the other streams can still be finished.
     exitCode_ = kExitDiskFull;
-    log("the disk is full: finishing the other files; earlier segments are untouched");
+    logLine("the disk is full: finishing the other files; earlier segments are untouched");
     stop(nullptr);
     // The failed stream never reaches EOS: give the rest 5 s.
     timers_.push_back(g_timeout_add_seconds(
@@ -556,8 +556,8 @@ gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
       GError* error = nullptr;
       gchar* debug = nullptr;
       gst_message_parse_warning(message, &error, &debug);
-      log(std::string("warning from ") + GST_OBJECT_NAME(GST_MESSAGE_SRC(message)) + ": " +
-          error->message + " (" + (debug ? debug : "") + ")");
+      logLine(std::string("warning from ") + GST_OBJECT_NAME(GST_MESSAGE_SRC(message)) + ": " +
+              error->message + " (" + (debug ? debug : "") + ")");
       g_error_free(error);
       g_free(debug);
       break;
@@ -581,14 +581,14 @@ constexpr int kHookDrainSeconds = 15;
 
 void Recording::stop(const char* why) {
   stopping_ = true;
-  if (why) log(std::string(why) + ": finishing the files (a second signal stops at once)");
+  if (why) logLine(std::string(why) + ": finishing the files (a second signal stops at once)");
   bool anyRecorded = std::any_of(streams_.begin(), streams_.end(),
                                  [](const auto& s) { return !s->segment.empty(); });
   if (!anyRecorded) {
     // No device ever sent a frame: nothing to finish (and no EOS in flight
     // while the pipeline is torn down). Stopped by a signal while waiting
     // is how a service ends; a --duration that recorded nothing failed.
-    log("nothing was recorded: no device sent a frame");
+    logLine("nothing was recorded: no device sent a frame");
     if (exitCode_ == 0 && !stoppedBySignal_) exitCode_ = kExitError;
     g_main_loop_quit(loop_);
     return;
@@ -605,8 +605,9 @@ void Recording::stop(const char* why) {
         std::string idle;
         for (const auto& s : self->streams_)
           if (s->segment.empty()) idle += (idle.empty() ? "" : ", ") + s->plan.name;
-        log("gave up waiting for the pipeline to finish after " + std::to_string(kFinishSeconds) +
-            " s" + (idle.empty() ? "" : " (never received a frame: " + idle + ")"));
+        logLine("gave up waiting for the pipeline to finish after " +
+                std::to_string(kFinishSeconds) + " s" +
+                (idle.empty() ? "" : " (never received a frame: " + idle + ")"));
         g_main_loop_quit(self->loop_);
         return G_SOURCE_REMOVE;
       },
@@ -616,7 +617,7 @@ void Recording::stop(const char* why) {
 gboolean Recording::onStop(gpointer data) {
   auto* self = static_cast<Recording*>(data);
   if (self->stopping_) {
-    log("stopping now, without finishing the files");
+    logLine("stopping now, without finishing the files");
     if (self->exitCode_ == 0) self->exitCode_ = kExitError;
     g_main_loop_quit(self->loop_);
     if (self->hook_) self->hook_->stopDraining();
@@ -658,10 +659,10 @@ void Recording::guardDisk() {
   auto open = openSegments();
   updateIndex(retention_.enforce({open.begin(), open.end()}));
   if (!disk_.nearlyFull(rate)) return;
-  log("the disk under " + options_.outDir + " is full (" + std::to_string(disk_.free() >> 20) +
-      " MiB free, " + std::to_string(DiskGuard::reserveFor(rate) >> 20) +
-      " MiB kept to finish the files); stopping. Free some space or use --max-bytes / "
-      "--min-free to delete old segments as you go");
+  logLine("the disk under " + options_.outDir + " is full (" + std::to_string(disk_.free() >> 20) +
+          " MiB free, " + std::to_string(DiskGuard::reserveFor(rate) >> 20) +
+          " MiB kept to finish the files); stopping. Free some space or use --max-bytes / "
+          "--min-free to delete old segments as you go");
   exitCode_ = kExitDiskFull;
   stop(nullptr);
 }
@@ -806,7 +807,7 @@ int Recording::run() {
   if (hook_) {
     // The last segments' uploads get a little time; what is left is named.
     for (const auto& left : hook_->drain(std::chrono::seconds(kHookDrainSeconds)))
-      log("--on-segment-closed did not get to " + left + " before exit");
+      logLine("--on-segment-closed did not get to " + left + " before exit");
   }
   return exitCode_;
 }

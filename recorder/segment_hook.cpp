@@ -6,11 +6,11 @@
 
 #include <cstdio>
 
+#include "log_line.h"
+
 namespace wircam::recorder {
 
 namespace {
-
-void log(const std::string& line) { std::fprintf(stderr, "\nwirc-recorder: %s\n", line.c_str()); }
 
 // In a process group of its own, so a timeout stops what it started too.
 void ownProcessGroup(gpointer) { setpgid(0, 0); }
@@ -40,8 +40,8 @@ SegmentHook::~SegmentHook() {
 void SegmentHook::segmentClosed(const std::string& stream, const std::string& segment,
                                 const std::string& sidecar) {
   if (queue_.size() >= kMaxQueued) {
-    log("--on-segment-closed is " + std::to_string(queue_.size()) +
-        " segments behind; not handing over " + segment);
+    logLine("--on-segment-closed is " + std::to_string(queue_.size()) +
+            " segments behind; not handing over " + segment);
     report_(stream, {{"type", "hook-dropped"}, {"file", segment}});
     return;
   }
@@ -111,12 +111,12 @@ void SegmentHook::retryOrGiveUp(const std::string& why) {
                        {"try", job.tries},
                        {"reason", why}});
   if (last) {
-    log(what + "; giving up on it");
+    logLine(what + "; giving up on it");
     queue_.pop_front();
     return startNext();
   }
   guint delay = 1u << (job.tries - 1);
-  log(what + "; again in " + std::to_string(delay) + " s");
+  logLine(what + "; again in " + std::to_string(delay) + " s");
   retrySource_ = g_timeout_add_seconds(delay, onRetry, this);
 }
 

@@ -9,6 +9,7 @@
 
 #include "btemp/btemp_robot.h"
 #include "marvelmind_dashboard.h"
+#include "misbehaving_peers.h"
 #include "rcoip/rcoip_receiver.h"
 #include "wait_for.h"
 #include "wirc/device.h"
@@ -53,6 +54,28 @@ TEST(WircCli, RequestControlExitsZeroWhenGranted) {
   auto run = wircCli("request-control 1 --host 127.0.0.1 --port " + std::to_string(device->port()) +
                      " --priority 5");
   EXPECT_EQ(run.exitCode, 0) << run.output;
+}
+
+TEST(WircCli, TransmitterNamesWithC1ControlsAreEscaped) {
+  // A device lists a transmitter named with CSI (0x9B, which a terminal
+  // obeys as ESC [) and 0x92: Latin-1 C1 controls, not text.
+  std::vector<uint8_t> tlst = {2, 5};
+  std::string name =
+      "evil\x9B"
+      "2J\x92x";
+  tlst.insert(tlst.end(), name.begin(), name.end());
+  tlst.resize(2 + 64, 0);
+  testing::ScriptedPeer peer;
+  auto list = testing::framed(static_cast<uint8_t>(Command::Tlst), tlst);
+  auto end = testing::bytesOf(Tlend{});
+  list.insert(list.end(), end.begin(), end.end());
+  // Over and over, so the list also answers the TLR sent after the login.
+  peer.play({.chunks = {peer.wst()}, .flood = list});
+  auto run = wircCli("transmitters --host 127.0.0.1 --port " + std::to_string(peer.port()));
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("evil\\x9B2J\\x92x"), std::string::npos) << run.output;
+  for (unsigned char c : run.output) EXPECT_NE(c, 0x9B) << run.output;
+  EXPECT_EQ(run.output.find("\xC2\x9B"), std::string::npos);
 }
 
 TEST(WircCli, WifiNeedsACountryCode) {

@@ -134,6 +134,23 @@ TEST(WircRecorderHttp, ListsAndServesTheRecordings) {
   EXPECT_EQ(fetch(live.url + "api/status", "POST").status, 405u);
 }
 
+TEST(WircRecorderHttp, AnUnknownRecordingIsA404InJson) {
+  LiveRecorder live(startSequenceDevice(), {});
+  ASSERT_FALSE(live.url.empty()) << live.recorder->log();
+  // Also a name that is not UTF-8, with a newline: quoted, escaped, no crash.
+  for (const char* path :
+       {"recordings/nosuch.mkv", "recordings/%FF%0Anosuch.mkv", "recordings/nosuch.jsonl"}) {
+    auto missing = fetch(live.url + path);
+    EXPECT_EQ(missing.status, 404u) << path;
+    EXPECT_EQ(missing.contentType, "application/json") << path;
+    auto body = nlohmann::json::parse(missing.body, nullptr, false);
+    ASSERT_TRUE(body.is_object()) << missing.body;
+    EXPECT_NE(body.value("error", "").find("no recording named"), std::string::npos)
+        << missing.body;
+  }
+  EXPECT_EQ(fetch(live.url + "api/status").status, 200u);
+}
+
 TEST(WircRecorderHttp, EventsCarryTheDetections) {
   LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11"});
   ASSERT_FALSE(live.url.empty()) << live.recorder->log();

@@ -10,6 +10,7 @@
 #include "mqtt_broker.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
+#include "wait_for.h"
 #include "wirc/device.h"
 
 namespace {
@@ -237,6 +238,27 @@ TEST(RecorderMqtt, IgnoresRetainedJunkAndBadCommands) {
   EXPECT_NE(log.find("no stream 'no-such-stream'"), std::string::npos) << log;
   // Clean up the retained ones.
   car.probe.publish("wircam/" + car.stream + "/follow/set", "", true);
+}
+
+TEST(RecorderMqtt, PeerTextInCommandsCannotForgeOrCutLogLines) {
+  FollowedOverMqtt car;
+  ASSERT_TRUE(car.device);
+  ASSERT_TRUE(car.follow()) << car.recorder->log();
+  std::string follow = "wircam/" + car.stream + "/follow/set";
+  car.probe.publish(follow, "ON\nwirc-recorder: FORGED LINE");
+  car.probe.publish(follow,
+                    "\x1B[2J\x9B"
+                    "31mred");
+  car.probe.publish(follow, std::string("ON\0OFF", 6));
+  // The last one, whole: the zero byte no longer ends the line.
+  ASSERT_TRUE(
+      waitFor([&] { return car.recorder->log().find("ON\\x00OFF") != std::string::npos; }, 10s))
+      << car.recorder->log();
+  auto log = car.recorder->log();
+  EXPECT_EQ(log.find("\nwirc-recorder: FORGED"), std::string::npos) << log;
+  EXPECT_NE(log.find("not 'ON\\x0Awirc-recorder: FORGED LINE'"), std::string::npos) << log;
+  EXPECT_NE(log.find("not '\\x1B[2J\\x9B31mred'"), std::string::npos) << log;
+  EXPECT_EQ(log.find('\x1B'), std::string::npos) << log;
 }
 
 TEST(RecorderMqtt, AHangingHookIsStoppedRetriedAndReportedWhileRecordingGoesOn) {

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <optional>
 
+#include "wirc/crc16.h"
 #include "wirc/message_stream_parser.h"
 
 namespace wircam::testing {
@@ -35,6 +36,20 @@ FullAcceptQueuePeer::FullAcceptQueuePeer() {
 }
 
 std::vector<uint8_t> bytesOf(const wirc::Message& message) { return *wirc::encode(message); }
+
+std::vector<uint8_t> framed(uint8_t command, const std::vector<uint8_t>& body) {
+  std::vector<uint8_t> frame(4 + body.size() + 2);
+  frame[0] = wirc::kSync1;
+  frame[1] = wirc::kSync2;
+  frame[2] = command;
+  frame[3] = static_cast<uint8_t>(body.size());
+  std::copy(body.begin(), body.end(), frame.begin() + 4);
+  frame.resize(4 + body.size());
+  uint16_t crc = wirc::crc16Xmodem(std::span(frame).subspan(2));
+  frame.push_back(static_cast<uint8_t>(crc >> 8));
+  frame.push_back(static_cast<uint8_t>(crc & 0xFF));
+  return frame;
+}
 
 ScriptedPeer::ScriptedPeer(PeerScript script) : script_(std::move(script)) {
   listener_ = std::move(*listenTcp(SocketAddress::loopback(0)));

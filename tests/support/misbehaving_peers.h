@@ -80,6 +80,9 @@ class ScriptedPeer {
 
 // The scripted device's messages as bytes.
 std::vector<uint8_t> bytesOf(const wirc::Message& message);
+// A message frame with any body, CRC filled in: for what encode() refuses
+// to write (control bytes in a name, ...).
+std::vector<uint8_t> framed(uint8_t command, const std::vector<uint8_t>& body);
 
 // A loopback port nothing listens on (bound, then closed).
 uint16_t deadPort();

@@ -5,6 +5,7 @@
 
 #include "common/byte_reader.h"
 #include "common/byte_writer.h"
+#include "common/printable_text.h"
 #include "wirc/crc16.h"
 
 namespace wircam::wirc {
@@ -86,44 +87,9 @@ std::optional<ProtocolError> checkText(Command command, const char* field, const
   return std::nullopt;
 }
 
-// Whether `bytes` is UTF-8 by its byte pattern (overlong forms are not
-// looked for: the text is only shown, never interpreted).
-bool isUtf8(std::string_view bytes) {
-  for (size_t i = 0; i < bytes.size();) {
-    auto lead = static_cast<unsigned char>(bytes[i]);
-    size_t extra = lead < 0x80             ? 0
-                   : (lead & 0xE0) == 0xC0 ? 1
-                   : (lead & 0xF0) == 0xE0 ? 2
-                   : (lead & 0xF8) == 0xF0 ? 3
-                                           : 4;
-    if (extra > 3 || bytes.size() - i <= extra) return false;
-    for (size_t k = 1; k <= extra; ++k)
-      if ((static_cast<unsigned char>(bytes[i + k]) & 0xC0) != 0x80) return false;
-    i += extra + 1;
-  }
-  return true;
-}
-
-// A text field a peer sent, up to its first zero byte, made safe to show:
-// UTF-8 stays as it is, anything else is read as Latin-1; control
-// characters become \xNN.
+// A text field a peer sent, up to its first zero byte, made safe to show.
 std::string readText(ByteReader& r, size_t width) {
-  std::string raw = r.readFixedString(width);
-  bool utf8 = isUtf8(raw);
-  std::string text;
-  for (unsigned char c : raw) {
-    if (c < 0x20 || c == 0x7F) {
-      char escaped[5];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", c);
-      text += escaped;
-    } else if (c < 0x80 || utf8) {
-      text += static_cast<char>(c);
-    } else {
-      text += static_cast<char>(0xC0 | (c >> 6));
-      text += static_cast<char>(0x80 | (c & 0x3F));
-    }
-  }
-  return text;
+  return printableText(r.readFixedString(width));
 }
 
 void writeVersion(ByteWriter& w, Version v) {

@@ -10,7 +10,7 @@
 // period can be put on the wire through it; decode() applies the same rules
 // except to text: a peer's text fields are taken up to their first zero byte
 // whatever they hold, and made safe to show (UTF-8 kept, other bytes read as
-// Latin-1, control characters escaped as \xNN).
+// Latin-1, control characters, C1 included, escaped as \xNN: printableText()).
 #pragma once
 
 #include <array>
