@@ -16,7 +16,10 @@
  * `login-timeout` (or is lost with `reconnect=false`) ends the stream with
  * an error naming the cause, unless `wait-for-device` is set: then the
  * login is retried with backoff until the device appears (a recorder
- * started before its vehicle). Stopping sends EST and logs out, and never
+ * started before its vehicle). A login the device refuses (an ERR answering
+ * TL: unauthorised, busy) is a warning at once with the spec's meaning, is
+ * retried at the backoff's pace, and is what the error names if no login
+ * comes in time. Stopping sends EST and logs out, and never
  * waits on the network. Elements naming the same device share its login
  * only when the settings they were given agree (transmitter-name, priority,
  * reconnect, login-timeout, link-timeout, max-bad-messages, periods,
@@ -153,6 +156,9 @@ struct WircSrcState {
 
   Mutex refusalMutex;                                   // refusal is written on the event loop
   std::string refusal WIRCAM_GUARDED_BY(refusalMutex);  // the device refused this camera's STST
+  // The device's answer to the last login it refused (TL), reported at once
+  // and named again if no login comes in time.
+  std::string loginRefusal WIRCAM_GUARDED_BY(refusalMutex);
 
   Mutex statsMutex;  // the stats property reads the copy
   wirc::StreamReceiverStats stats WIRCAM_GUARDED_BY(statsMutex);
@@ -242,6 +248,25 @@ void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
     }
     signal(state->linkChanged);
   }
+  if (const auto* refused = std::get_if<link::DeviceRefused>(&event);
+      refused && refused->request == "TL") {
+    // The device's own answer, not a network fault: said at once (once for
+    // each different answer), while the link retries at its backoff's pace.
+    bool first;
+    {
+      MutexLock lock(state->refusalMutex);
+      first = state->loginRefusal != refused->meaning;
+      state->loginRefusal = refused->meaning;
+    }
+    if (first)
+      GST_ELEMENT_WARNING(self, RESOURCE, OPEN_READ,
+                          ("The WiRC device refused the login: %s (ERR %d)",
+                           refused->meaning.c_str(), refused->code),
+                          ("Retrying with backoff; the device's answer is in the link state. "
+                           "ERR %d is the device's own refusal (see its transmitter list and "
+                           "priority), not a network fault.",
+                           refused->code));
+  }
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), s));
 }
 
@@ -312,6 +337,7 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   {
     MutexLock lock(state->refusalMutex);
     state->refusal.clear();
+    state->loginRefusal.clear();
   }
   state->width = state->height = 0;
   state->loginDeadline = Clock::now() + std::chrono::milliseconds(settings.loginTimeoutMs + 500);
@@ -401,6 +427,20 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
   drain(state->linkChanged);
   auto status = state->session->sessionStatus();
   const char* where = settings.host.empty() ? "(discovery)" : settings.host.c_str();
+  std::string loginRefusal;
+  {
+    MutexLock lock(state->refusalMutex);
+    loginRefusal = state->loginRefusal;
+  }
+  bool noLoginYet = status.logins == 0 && status.state != link::LinkState::Live;
+  if (noLoginYet && !loginRefusal.empty() &&
+      (status.state == link::LinkState::Failed ||
+       (!settings.waitForDevice && Clock::now() >= state->loginDeadline))) {
+    GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
+                      ("The WiRC device %s refused the login: %s", where, loginRefusal.c_str()),
+                      ("%s", status.reason.c_str()));
+    return GST_FLOW_ERROR;
+  }
   if (status.state == link::LinkState::Failed) {
     if (status.logins == 0)
       GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,

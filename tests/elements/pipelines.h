@@ -18,8 +18,8 @@ inline GstElement* launch(const std::string& description) {
   return pipeline;
 }
 
-// The first error (or warning) on the bus within `timeout` as "message |
-// debug", or "" when none came.
+// The first error or warning (of the types asked for) on the bus within
+// `timeout` as "message | debug", or "" when none came.
 inline std::string busMessage(GstElement* pipeline, std::chrono::milliseconds timeout,
                               GstMessageType type = GST_MESSAGE_ERROR) {
   GstBus* bus = gst_element_get_bus(pipeline);
@@ -28,7 +28,7 @@ inline std::string busMessage(GstElement* pipeline, std::chrono::milliseconds ti
   if (message) {
     GError* error = nullptr;
     gchar* debug = nullptr;
-    if (type == GST_MESSAGE_WARNING)
+    if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_WARNING)
       gst_message_parse_warning(message, &error, &debug);
     else
       gst_message_parse_error(message, &error, &debug);

@@ -63,6 +63,32 @@ TEST(VehicleLinkElements, StopsAtOnceAgainstADeadPort) {
   expectQuickTeardown(wircam::testing::deadPort());
 }
 
+TEST(VehicleLinkElements, ARefusedLoginIsAWarningAtOnceAndTheErrorNamesTheRefusal) {
+  using wircam::testing::bytesOf;
+  wircam::testing::ScriptedPeer peer(
+      {.chunks = {bytesOf(wirc::Err{static_cast<uint8_t>(wirc::Command::Tl),
+                                    static_cast<uint16_t>(wirc::ErrorCode::Unauthorised)})}});
+  // reconnect=true, the default: the link retries, the element says why.
+  GstElement* pipeline =
+      launch("wircsrc host=127.0.0.1 login-timeout=1500 port=" + std::to_string(peer.port()) +
+             " ! fakesink");
+  auto start = std::chrono::steady_clock::now();
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  std::string warning = busMessage(pipeline, wircam::testing::patience(milliseconds(1000)),
+                                   GstMessageType(GST_MESSAGE_WARNING | GST_MESSAGE_ERROR));
+  auto warned = std::chrono::steady_clock::now() - start;
+  EXPECT_NE(warning.find("refused the login: unauthorised"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("(ERR 5)"), std::string::npos) << warning;
+  EXPECT_LT(warned, wircam::testing::patience(milliseconds(1000)));
+  // No login by the deadline: the error names the device's answer.
+  std::string error = busMessage(pipeline, wircam::testing::patience(milliseconds(5000)));
+  EXPECT_NE(error.find("refused the login: unauthorised"), std::string::npos) << error;
+  EXPECT_EQ(error.find("Check host/port"), std::string::npos) << error;
+  EXPECT_GE(peer.connections(), 2) << "retried";
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+}
+
 TEST(VehicleLinkElements, ASinkStartingFirstDoesNotOverrideTheSourcesLoginSettings) {
   auto device = startDevice();
   auto port = std::to_string(device->port());

@@ -93,6 +93,29 @@ TEST(HostileDevice, AFloodOfUnknownCommandsIsCountedAndTheDeviceDropped) {
   expectDroppedAsMisbehavingWithFlatMemory(repeated(unknown, 256));
 }
 
+TEST(HostileDevice, TheBackoffGrowsAcrossLoginsFollowedEachByGarbage) {
+  // The login succeeds every time; what comes after it gets the device
+  // dropped. A login is no success until the link has stayed up a while.
+  ScriptedPeer peer;
+  peer.play({.chunks = {peer.wst()}, .flood = repeated({0xAA, 0xBB}, 4096)});
+  auto session = linkTo(peer, {.maxBadMessages = 10});
+  Collected<link::StateChanged> states(*session);
+  std::vector<int> waits;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        waits.clear();
+        for (const auto& state : states.events())
+          if (auto at = state.reason.find("retrying in "); at != std::string::npos)
+            waits.push_back(std::stoi(state.reason.substr(at + 12)));
+        return waits.size() >= 4;
+      },
+      milliseconds(10000)))
+      << session->status().reason;
+  EXPECT_GE(peer.connections(), 4);
+  for (size_t i = 1; i < waits.size(); ++i)
+    EXPECT_EQ(waits[i], std::min(2 * waits[i - 1], 5000)) << "after login " << i;
+}
+
 TEST(HostileDevice, ADeviceThatFallsSilentIsLostAfterTheLinkTimeout) {
   ScriptedPeer peer;
   peer.play({.chunks = {peer.wst()}, .statusReports = 1});

@@ -28,6 +28,10 @@ using std::chrono::milliseconds;
 
 constexpr milliseconds kFirstBackoff{200};
 constexpr milliseconds kMaxBackoff{5000};
+// A login is only a success once the link has stayed up this long: a device
+// that misbehaves right after each login (a flood, a refusal of the stream)
+// would otherwise be logged in to every kFirstBackoff for ever.
+constexpr milliseconds kHealthyLink{10000};
 // Discovery listens this long (at most) for the devices to answer.
 constexpr milliseconds kDiscoveryWindow{1000};
 // One read callback takes at most this much, so a flooding device cannot
@@ -168,6 +172,7 @@ class TransmitterSession::Impl {
   Phase phase_ = Phase::Waiting;
   Clock::time_point attemptDeadline_;
   milliseconds backoff_ = kFirstBackoff;
+  std::optional<Clock::time_point> liveSince_;  // the current login's
   UniqueFd discovery_;
   EventLoop::Id discoveryWatch_ = 0;
   std::vector<DiscoveredDevice> found_;
@@ -442,9 +447,9 @@ void TransmitterSession::Impl::onConnected() {
 
 void TransmitterSession::Impl::onLoggedIn(const Wst& wst) {
   phase_ = Phase::LoggedIn;
-  backoff_ = kFirstBackoff;
   loop_.disarm(attemptTimer_);
   lastHeard_ = Clock::now();
+  liveSince_ = lastHeard_;
   std::map<uint8_t, uint16_t> streams;
   std::string address;
   {
@@ -547,6 +552,8 @@ void TransmitterSession::Impl::closeConnection() {
 
 void TransmitterSession::Impl::fail(const std::string& why, Retry retryWhen) {
   bool retryAtOnce = retryWhen == Retry::AtOnceForNewSettings;
+  if (liveSince_ && Clock::now() - *liveSince_ >= kHealthyLink) backoff_ = kFirstBackoff;
+  liveSince_.reset();
   closeConnection();
   loop_.disarm(pacerTimer_);
   loop_.disarm(statusTimer_);
