@@ -112,7 +112,7 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
         SegmentSplitter::Parts{.source = elementNamed(streamPlan.source),
                                .splitmux = elementNamed(streamPlan.muxer),
                                .transcoded = plan.transcoded},
-        *stream->planner, [telemetry = stream->telemetry.get()] { telemetry->flushEarly(); });
+        *stream->planner, [telemetry = stream->telemetry.get()] { telemetry->onFrame(); });
     if (!streamPlan.liveSink.empty())
       stream->frames = std::make_unique<FrameTap>(elementNamed(streamPlan.liveSink));
     for (const auto* element : {&streamPlan.source, &streamPlan.muxer, &streamPlan.detector,
@@ -593,6 +593,8 @@ void Recording::stop(const char* why) {
     g_main_loop_quit(loop_);
     return;
   }
+  // What waited for frames that will not come goes into the last files.
+  for (auto& s : streams_) s->telemetry->finish();
   // EOS from every source: each splitmuxsink closes its last segment cleanly.
   gst_element_send_event(pipeline_, gst_event_new_eos());
   // A splitmuxsink that never received a frame (the device never streamed)

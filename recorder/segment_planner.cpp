@@ -96,6 +96,13 @@ std::optional<PlannedSegment> SegmentPlanner::segmentAt(uint64_t runningTime) co
   return segments_.front();
 }
 
+std::optional<PlannedSegment> SegmentPlanner::segmentReaching(uint64_t runningTime) const {
+  MutexLock lock(mutex_);
+  for (const auto& segment : segments_)
+    if (runningTime <= segment.lastFrame) return segment;
+  return std::nullopt;
+}
+
 std::optional<PlannedSegment> SegmentPlanner::segmentOf(const std::string& path) const {
   MutexLock lock(mutex_);
   for (const auto& segment : segments_)

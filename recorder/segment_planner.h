@@ -60,6 +60,12 @@ class SegmentPlanner {
   // The segment a time belongs to: the last that started at or before it
   // (times before the first frame belong to the first segment).
   std::optional<PlannedSegment> segmentAt(uint64_t runningTime) const;
+  // Where a telemetry line of `runningTime` goes once the video has caught
+  // up with it: the first segment whose last frame so far is at or after it
+  // (a time before that segment's first frame, in the gap of an outage or
+  // before the first frame, lands on its start). nullopt while the time is
+  // past the newest frame: no file may hold anything after its last frame.
+  std::optional<PlannedSegment> segmentReaching(uint64_t runningTime) const;
   std::optional<PlannedSegment> segmentOf(const std::string& path) const;
   // The segment whose start is nearest `time`: splitmuxsink names a new file
   // by its first buffer, whose decoding time may be a little earlier.

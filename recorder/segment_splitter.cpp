@@ -23,8 +23,8 @@ void keepSegment(GstPadProbeInfo* info, GstSegment& segment) {
 }  // namespace
 
 SegmentSplitter::SegmentSplitter(Parts parts, SegmentPlanner& planner,
-                                 std::function<void()> onFirstSegment)
-    : parts_(parts), planner_(planner), onFirstSegment_(std::move(onFirstSegment)) {
+                                 std::function<void()> afterFrame)
+    : parts_(parts), planner_(planner), afterFrame_(std::move(afterFrame)) {
   gst_segment_init(&sourceSegment_, GST_FORMAT_TIME);
   constexpr auto kDataProbe =
       static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM);
@@ -61,7 +61,7 @@ GstPadProbeReturn SegmentSplitter::onSourceData(GstPad* pad, GstPadProbeInfo* in
   if (!GST_CLOCK_TIME_IS_VALID(time)) return GST_PAD_PROBE_OK;
   auto cut =
       self->planner_.onFrame(time, [self, time] { return unixMsOf(self->parts_.source, time); });
-  if (cut == SegmentPlanner::Cut::kFirst) self->onFirstSegment_();
+  self->afterFrame_();
   // The encoder makes this very frame a key frame (the event travels just
   // ahead of it): at a cut, and every kKeyFrameInterval, whatever the frame
   // rate, because splitmuxsink holds the newest GOP and the muxer writes

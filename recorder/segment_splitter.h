@@ -24,8 +24,8 @@ class SegmentSplitter {
     GstElement* splitmux;  // splitmuxsink
     bool transcoded;       // key frames come from an encoder that can be asked for one
   };
-  // `onFirstSegment` runs on the source's thread when the first frame comes.
-  SegmentSplitter(Parts parts, SegmentPlanner& planner, std::function<void()> onFirstSegment);
+  // `afterFrame` runs on the source's thread once each frame is planned.
+  SegmentSplitter(Parts parts, SegmentPlanner& planner, std::function<void()> afterFrame);
   ~SegmentSplitter();
   SegmentSplitter(const SegmentSplitter&) = delete;
   SegmentSplitter& operator=(const SegmentSplitter&) = delete;
@@ -40,7 +40,7 @@ class SegmentSplitter {
 
   Parts parts_;
   SegmentPlanner& planner_;
-  std::function<void()> onFirstSegment_;
+  std::function<void()> afterFrame_;
   GstPad* sourcePad_ = nullptr;
   GstPad* muxerPad_ = nullptr;
   gulong sourceProbe_ = 0, muxerProbe_ = 0, muxerAdded_ = 0, sinkAdded_ = 0, formatLocation_ = 0;

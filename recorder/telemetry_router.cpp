@@ -1,5 +1,7 @@
 #include "telemetry_router.h"
 
+#include <algorithm>
+
 namespace wircam::recorder {
 
 namespace {
@@ -10,24 +12,57 @@ constexpr size_t kOpenSidecars = 2;
 
 void TelemetryRouter::write(nlohmann::json line, uint64_t runningTime, int64_t unixMs) {
   MutexLock lock(mutex_);
-  auto segment = planner_.segmentAt(runningTime);
-  if (!segment) {
-    if (early_.size() < kMaxEarlyLines) early_.push_back({std::move(line), runningTime, unixMs});
+  if (finished_) {
+    if (auto segment = planner_.segmentAt(runningTime))
+      place({std::move(line), runningTime, unixMs}, *segment,
+            std::clamp(runningTime, segment->start, segment->lastFrame));
     return;
   }
-  place({std::move(line), runningTime, unixMs}, *segment);
+  if (waiting_.empty()) {
+    if (auto segment = planner_.segmentReaching(runningTime)) {
+      place({std::move(line), runningTime, unixMs}, *segment,
+            std::max(runningTime, segment->start));
+      return;
+    }
+  }
+  // Behind a waiting line (so lines keep their order), or past the video.
+  if (waiting_.size() == kMaxWaiting) {
+    waiting_.pop_front();
+    ++dropped_;
+  }
+  waiting_.push_back({std::move(line), runningTime, unixMs});
 }
 
-void TelemetryRouter::flushEarly() {
+void TelemetryRouter::onFrame() {
   MutexLock lock(mutex_);
-  auto first = planner_.current();
-  if (!first) return;
-  for (auto& line : early_) place(std::move(line), *first);
-  early_.clear();
+  writeWaiting();
 }
 
-void TelemetryRouter::place(Line line, const PlannedSegment& segment) {
-  uint64_t time = std::max(line.runningTime, segment.start);
+void TelemetryRouter::writeWaiting() {
+  while (!waiting_.empty()) {
+    Line& line = waiting_.front();
+    auto segment = planner_.segmentReaching(line.runningTime);
+    if (!segment) return;
+    uint64_t time = std::max(line.runningTime, segment->start);
+    place(std::move(line), *segment, time);
+    waiting_.pop_front();
+  }
+}
+
+void TelemetryRouter::finish() {
+  MutexLock lock(mutex_);
+  writeWaiting();
+  finished_ = true;
+  for (auto& line : waiting_) {
+    auto segment = planner_.segmentAt(line.runningTime);
+    if (!segment) continue;
+    uint64_t time = std::clamp(line.runningTime, segment->start, segment->lastFrame);
+    place(std::move(line), *segment, time);
+  }
+  waiting_.clear();
+}
+
+void TelemetryRouter::place(Line line, const PlannedSegment& segment, uint64_t time) {
   line.json["pts"] = time - segment.start;
   line.json["utc"] = SegmentPlanner::isoUtc(line.unixMs);
   std::string text = line.json.dump();
@@ -64,6 +99,11 @@ TelemetryLog& TelemetryRouter::sidecarOf(const std::string& segment) {
 
 std::optional<std::string> TelemetryRouter::takeWriteFailure() {
   MutexLock lock(mutex_);
+  if (dropped_ > 0 && !failure_) {
+    failure_ = std::to_string(dropped_) + " telemetry line(s) dropped while no video came (" +
+               std::to_string(kMaxWaiting) + " are kept for the next segment)";
+    dropped_ = 0;
+  }
   return std::exchange(failure_, std::nullopt);
 }
 

@@ -3,6 +3,12 @@
 // its text track. So a sidecar and its file's text track describe exactly
 // that file, on its own timeline ("pts" counts from its first frame), and
 // every line also says when it happened ("utc").
+//
+// No file holds a line past its last frame: a line newer than the newest
+// frame waits for the next one. If the video goes on in the same file it is
+// written at its own time; if the next frame opens a new file (the device
+// was lost meanwhile, or the segment was full), it goes at that file's
+// start, pts 0, as the lines from before the first frame do.
 #pragma once
 
 #include <cstdint>
@@ -25,18 +31,23 @@ class TelemetryRouter {
   TelemetryRouter(const SegmentPlanner& planner, TelemetryTrack& track)
       : planner_(planner), track_(track) {}
 
-  // Thread-safe. Lines from before the first frame (the login, the control
-  // right) wait for it, up to kMaxEarlyLines, and then go at pts 0.
+  // Thread-safe. A line past the newest frame waits (up to kMaxWaiting
+  // lines; older ones are dropped first, and counted).
   void write(nlohmann::json line, uint64_t runningTime, int64_t unixMs);
-  // The first segment began: the lines that waited for it are written.
-  void flushEarly();
+  // A frame was planned (on the source's thread): the lines it reaches are
+  // written.
+  void onFrame();
+  // The recording stops: the waiting lines, and any to come, are written
+  // into the newest file, at its last frame at the latest.
+  void finish();
   // A segment's file was opened: its sidecar exists from then on, even if
   // no line comes.
   void segmentOpened(const std::string& segment);
-  // The sidecars a problem was met writing, once each (for the log).
+  // The sidecars a problem was met writing, and lines dropped while the
+  // video was away, once each (for the log).
   std::optional<std::string> takeWriteFailure();
 
-  static constexpr size_t kMaxEarlyLines = 256;
+  static constexpr size_t kMaxWaiting = 1024;
 
  private:
   struct Line {
@@ -44,13 +55,17 @@ class TelemetryRouter {
     uint64_t runningTime;
     int64_t unixMs;
   };
-  void place(Line line, const PlannedSegment& segment) WIRCAM_REQUIRES(mutex_);
+  // Into `segment` at `time` (within its span).
+  void place(Line line, const PlannedSegment& segment, uint64_t time) WIRCAM_REQUIRES(mutex_);
+  void writeWaiting() WIRCAM_REQUIRES(mutex_);
   TelemetryLog& sidecarOf(const std::string& segment) WIRCAM_REQUIRES(mutex_);
 
   const SegmentPlanner& planner_;
   TelemetryTrack& track_;
   Mutex mutex_;
-  std::deque<Line> early_ WIRCAM_GUARDED_BY(mutex_);
+  std::deque<Line> waiting_ WIRCAM_GUARDED_BY(mutex_);  // oldest first
+  uint64_t dropped_ WIRCAM_GUARDED_BY(mutex_) = 0;      // since the last report
+  bool finished_ WIRCAM_GUARDED_BY(mutex_) = false;
   std::deque<std::unique_ptr<TelemetryLog>> sidecars_ WIRCAM_GUARDED_BY(mutex_);  // newest last
   std::optional<std::string> failure_ WIRCAM_GUARDED_BY(mutex_);
   std::string failedPath_ WIRCAM_GUARDED_BY(mutex_);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -164,6 +165,7 @@ TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
   ASSERT_EQ(recorder.wait(), 0) << recorder.log();
   auto videos = recorder.files(".mkv");
   ASSERT_EQ(videos.size(), 2u);
+  constexpr double kFramePeriod = 1.0 / 15;
   for (const auto& video : videos) {
     auto frames = probeFrames(video);
     ASSERT_GT(frames.size(), 15u) << video;
@@ -171,11 +173,32 @@ TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
     for (size_t i = 1; i < frames.size(); ++i)
       widest = std::max(widest, frames[i].pts - frames[i - 1].pts);
     EXPECT_LE(widest, 0.5) << video;
+    // Nothing in the file, its telemetry track included, runs on past its
+    // last frame (a player would show a frozen picture for the outage).
+    double lastFrame = frames.back().pts;
+    EXPECT_LE(probeDuration(video), lastFrame + kFramePeriod + 0.002) << video;
+    for (const auto& line : sidecarOf(video))
+      EXPECT_LE(line["pts"].get<double>() / 1e9, lastFrame + kFramePeriod) << video << line;
   }
-  // The loss is in the telemetry of the segment it ended.
-  std::string first;
-  for (const auto& line : sidecarOf(videos[0])) first += line.dump();
-  EXPECT_NE(first.find("link lost: the device closed the connection"), std::string::npos);
+  // The loss and the retries came between the files: they open the next
+  // file's sidecar, at pts 0 with their own time, as the login does.
+  auto second = sidecarOf(videos[1]);
+  auto loss = std::find_if(second.begin(), second.end(), [](const auto& line) {
+    return line.dump().find("link lost: the device closed the connection") != std::string::npos;
+  });
+  ASSERT_NE(loss, second.end());
+  EXPECT_EQ((*loss)["pts"], 0);
+  // Its own time: about 5 s before that file's first frame.
+  std::tm lost{};
+  std::string lostUtc = (*loss)["utc"];
+  ASSERT_EQ(std::sscanf(lostUtc.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d", &lost.tm_year, &lost.tm_mon,
+                        &lost.tm_mday, &lost.tm_hour, &lost.tm_min, &lost.tm_sec),
+            6);
+  lost.tm_year -= 1900;
+  lost.tm_mon -= 1;
+  EXPECT_LT(timegm(&lost), *utcOfName(videos[1].filename().string()) - 2) << lostUtc;
+  for (const auto& line : sidecarOf(videos[0]))
+    EXPECT_EQ(line.dump().find("link lost"), std::string::npos) << line;
 }
 
 TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {

@@ -105,6 +105,22 @@ TEST_F(SegmentPlannerTest, ATimeBelongsToTheLastSegmentStartedAtOrBeforeIt) {
   EXPECT_EQ(p.segmentStartingNear(second->start - 1000)->path, second->path);
 }
 
+TEST_F(SegmentPlannerTest, ALineReachesNoSegmentUntilAFrameCoversIt) {
+  auto p = planner({});
+  EXPECT_FALSE(p.segmentReaching(0)) << "no frame yet";
+  feed(p, kSecond, 15);  // 1 s .. 1.93 s
+  uint64_t last = kSecond + 14 * kFrame;
+  EXPECT_EQ(p.segmentReaching(0)->start, kSecond) << "before the first frame: its start";
+  EXPECT_EQ(p.segmentReaching(last)->start, kSecond);
+  EXPECT_FALSE(p.segmentReaching(last + 1)) << "past the newest frame: it waits";
+  // An outage: the device is back at 5 s, in a segment of its own.
+  feed(p, 5 * kSecond, 3);
+  EXPECT_EQ(p.segmentReaching(last)->start, kSecond);
+  EXPECT_EQ(p.segmentReaching(last + 1)->start, 5 * kSecond) << "the outage: the next start";
+  EXPECT_EQ(p.segmentReaching(4 * kSecond)->start, 5 * kSecond);
+  EXPECT_FALSE(p.segmentReaching(5 * kSecond + 2 * kFrame + 1));
+}
+
 TEST_F(SegmentPlannerTest, ASegmentLastsItsFramesSpanAndOnePeriod) {
   auto p = planner({});
   feed(p, 0, 16);
