@@ -60,8 +60,16 @@ namespace {
 Expected<UniqueFd, std::string> openSocket(int type, const SocketAddress& address) {
   UniqueFd fd(::socket(AF_INET, type | SOCK_CLOEXEC, 0));
   if (!fd.valid()) return unexpected("socket: " + errnoText(errno));
-  int on = 1;
-  setsockopt(fd.get(), SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+  // A TCP listener may take its port over from the connections of an
+  // earlier one still in TIME_WAIT (a device restarted on its port; Linux
+  // wants the flag on both), and the flag never lets a second socket bind a
+  // listening port. Never a datagram socket: Linux lets another
+  // SO_REUSEADDR socket bind the very same UDP port and take its datagrams,
+  // and hands a new port-0 bind a port such a socket holds.
+  if (type == SOCK_STREAM) {
+    int on = 1;
+    setsockopt(fd.get(), SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+  }
   if (::bind(fd.get(), address.raw(), address.size()) != 0)
     return unexpected("cannot bind " + address.toString() + ": " + errnoText(errno));
   return fd;
