@@ -316,8 +316,9 @@ TEST(Messages, ControlCharactersInReceivedTextAreEscaped) {
 
 TEST(Messages, C1ControlCharactersInReceivedTextAreEscaped) {
   // CSI (0x9B) and 0x92, as a TLST name: wirc-cli prints these names.
-  auto decoded = decode(agrNamed("csi\x9B"
-                                 "2Jx\x92"));
+  auto decoded =
+      decode(agrNamed("csi\x9B"
+                      "2Jx\x92"));
   ASSERT_TRUE(decoded.has_value()) << decoded.error().message();
   EXPECT_EQ(std::get<Agr>(*decoded).name, "csi\\x9B2Jx\\x92");
 }
