@@ -57,10 +57,15 @@ std::string positionsOf(const PositionSource& source, const std::string& name) {
 
 }  // namespace
 
+std::string PipelinePlan::description() const {
+  std::string all;
+  for (const auto& stream : streams) all += stream.description;
+  return all;
+}
+
 PipelinePlan planPipeline(const RecorderOptions& options) {
   PipelinePlan plan;
   plan.transcoded = options.codec != Codec::kJpeg;
-  std::string& d = plan.description;
   bool live = options.http || options.rtsp;
   size_t index = 0;
   for (const auto& device : options.devices) {
@@ -73,6 +78,7 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
     for (int camera : device.cameras) {
       auto i = std::to_string(index++);
       StreamPlan stream;
+      std::string& d = stream.description;
       stream.device = fileSafe(device.label);
       stream.camera = camera;
       stream.name = stream.device + "-cam" + std::to_string(camera);

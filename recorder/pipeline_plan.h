@@ -9,9 +9,11 @@
 
 namespace wircam::recorder {
 
-// One device camera and the names of its elements (empty: not in this run).
+// One device camera: its own pipeline, and the names of its elements
+// (empty: not in this run).
 struct StreamPlan {
-  std::string device;  // the device's label, made safe for file names
+  std::string description;  // gst-launch syntax
+  std::string device;       // the device's label, made safe for file names
   int camera = 0;
   std::string name;             // "<device>-cam<N>", also in file names and the live view
   std::string source;           // wircsrc
@@ -24,11 +26,14 @@ struct StreamPlan {
 };
 
 struct PipelinePlan {
-  std::string description;
   std::vector<StreamPlan> streams;
   bool transcoded = false;  // frames pass an encoder that makes key frames on request
+  // Every stream's pipeline, one after the other (for reading).
+  std::string description() const;
 };
 
+// Each stream is a pipeline of its own, so that a camera that never sends a
+// frame, errors or stalls holds no other camera's preroll, EOS or stop.
 // Per stream: wircsrc → [marvelmindpositions →] tee → queue → [decode → x264enc →] splitmuxsink,
 // an appsrc of telemetry text into the same splitmuxsink, and, when asked
 // for, a leaky branch to AprilTag detection (→ wirccontrol) and one to an

@@ -85,24 +85,27 @@ Expected<std::unique_ptr<Recording>, std::string> Recording::create(
             recording->index_.path().string());
   recording->index_.save();
   auto plan = planPipeline(options);
-  GError* parseError = nullptr;
-  recording->pipeline_ = gst_parse_launch(plan.description.c_str(), &parseError);
-  if (parseError) {
-    std::string message = parseError->message;
-    g_error_free(parseError);
-    return unexpected("cannot build the pipeline (are the wircam plugins on GST_PLUGIN_PATH?): " +
-                      message);
-  }
-  auto elementNamed = [&](const std::string& name) {
-    GstElement* found = gst_bin_get_by_name(GST_BIN(recording->pipeline_), name.c_str());
-    gst_object_unref(found);  // the pipeline keeps it
-    return found;
-  };
   SegmentLimits limits{.maxDuration = static_cast<uint64_t>(options.segmentSeconds * GST_SECOND),
                        .maxBytes = options.segmentBytes};
   for (auto& streamPlan : plan.streams) {
     auto stream = std::make_unique<Stream>();
     stream->plan = streamPlan;
+    GError* parseError = nullptr;
+    stream->pipeline = gst_parse_launch(streamPlan.description.c_str(), &parseError);
+    if (parseError) {
+      std::string message = parseError->message;
+      g_error_free(parseError);
+      if (stream->pipeline) gst_object_unref(stream->pipeline);
+      return unexpected("cannot build the pipeline (are the wircam plugins on GST_PLUGIN_PATH?): " +
+                        message);
+    }
+    // Named after its camera, so that the log says whose it is.
+    gst_object_set_name(GST_OBJECT(stream->pipeline), streamPlan.name.c_str());
+    auto elementNamed = [&](const std::string& name) {
+      GstElement* found = gst_bin_get_by_name(GST_BIN(stream->pipeline), name.c_str());
+      gst_object_unref(found);  // the pipeline keeps it
+      return found;
+    };
     stream->stateSinceUnixMs = g_get_real_time() / 1000;
     stream->planner = std::make_unique<SegmentPlanner>(options.outDir, streamPlan.name,
                                                        extensionOf(options.container), limits);
@@ -201,11 +204,12 @@ Recording::~Recording() {
   rtsp_.reset();
   hook_.reset();
   fleet_.reset();  // says offline
-  if (pipeline_) {
-    gst_element_set_state(pipeline_, GST_STATE_NULL);
-    streams_.clear();
-    gst_object_unref(pipeline_);
-  }
+  for (auto& stream : streams_) gst_element_set_state(stream->pipeline, GST_STATE_NULL);
+  // The splitters and taps hold the elements' pads: before the pipelines go.
+  std::vector<GstElement*> pipelines;
+  for (auto& stream : streams_) pipelines.push_back(stream->pipeline);
+  streams_.clear();
+  for (GstElement* pipeline : pipelines) gst_object_unref(pipeline);
   if (loop_) g_main_loop_unref(loop_);
 }
 
@@ -218,10 +222,16 @@ Recording::Stream* Recording::streamOf(GstMessage* message) {
   return nullptr;
 }
 
-GstClockTime Recording::runningTime() const {
+Recording::Stream* Recording::streamOfPipeline(GstObject* pipeline) {
+  for (auto& s : streams_)
+    if (GST_OBJECT(s->pipeline) == pipeline) return s.get();
+  return nullptr;
+}
+
+GstClockTime Recording::runningTime(const Stream& stream) const {
   GstClockTime now = GST_CLOCK_TIME_NONE;
-  if (GstClock* clock = gst_element_get_clock(pipeline_)) {
-    now = gst_clock_get_time(clock) - gst_element_get_base_time(pipeline_);
+  if (GstClock* clock = gst_element_get_clock(stream.pipeline)) {
+    now = gst_clock_get_time(clock) - gst_element_get_base_time(stream.pipeline);
     gst_object_unref(clock);
   }
   return now;
@@ -229,7 +239,7 @@ GstClockTime Recording::runningTime() const {
 
 void Recording::writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime time) {
   if (!GST_CLOCK_TIME_IS_VALID(time)) return;
-  stream.telemetry->write(std::move(line), time, unixMsOf(pipeline_, time));
+  stream.telemetry->write(std::move(line), time, unixMsOf(stream.pipeline, time));
   if (auto failure = stream.telemetry->takeWriteFailure()) logLine(*failure);
 }
 
@@ -266,9 +276,13 @@ void Recording::publishEvent(const Stream& stream, const nlohmann::json& event) 
 
 GstElement* Recording::element(const std::string& name) const {
   if (name.empty()) return nullptr;
-  GstElement* found = gst_bin_get_by_name(GST_BIN(pipeline_), name.c_str());
-  if (found) gst_object_unref(found);  // the pipeline keeps it
-  return found;
+  for (const auto& stream : streams_) {
+    GstElement* found = gst_bin_get_by_name(GST_BIN(stream->pipeline), name.c_str());
+    if (!found) continue;
+    gst_object_unref(found);  // the pipeline keeps it
+    return found;
+  }
+  return nullptr;
 }
 
 Recording::Control Recording::controlOf(const Stream& s) const {
@@ -366,7 +380,7 @@ std::optional<std::string> Recording::applyCommand(const FleetCommand& command, 
   event["from"] = from;
   logLine(command.stream + ": " + from + " " + event.dump());
   publishEvent(*s, event);
-  writeTelemetry(*s, event, runningTime());
+  writeTelemetry(*s, event, runningTime(*s));
   publishFleetStatus(true);
   return std::nullopt;
 }
@@ -408,7 +422,10 @@ void Recording::handleElementMessage(GstMessage* message) {
     return;
   }
   if (type == "splitmuxsink-fragment-closed") {
-    onSegmentClosed(*stream, gst_structure_get_string(s, "location"));
+    std::string file = gst_structure_get_string(s, "location");
+    // (Finalised in the background: the next file may be open already.)
+    if (file == stream->segment) stream->segment.clear();
+    onSegmentClosed(*stream, file);
     return;
   }
 
@@ -419,7 +436,7 @@ void Recording::handleElementMessage(GstMessage* message) {
     std::string event = gst_structure_get_string(s, "event");
     logLine(stream->plan.name + ": " + printableText(event));
     line["type"] = "session";
-    writeTelemetry(*stream, line, runningTime());
+    writeTelemetry(*stream, line, runningTime(*stream));
     publishEvent(*stream, line);
     if (const char* state = gst_structure_get_string(s, "state")) followLinkState(*stream, state);
     return;
@@ -437,7 +454,7 @@ void Recording::handleElementMessage(GstMessage* message) {
     stream->statusStale = stale;
     stream->statusAgeMs = age;
     // Rates over the time between two reports, whatever their interval.
-    GstClockTime now = runningTime();
+    GstClockTime now = runningTime(*stream);
     if (GST_CLOCK_TIME_IS_VALID(stream->statsTime) && now > stream->statsTime) {
       double seconds = static_cast<double>(now - stream->statsTime) / GST_SECOND;
       stream->fps = static_cast<double>(stream->frameCount - frames) / seconds;
@@ -455,7 +472,7 @@ void Recording::handleElementMessage(GstMessage* message) {
       logLine(stream->plan.name + ": vehicle " +
               printableText(gst_structure_get_string(s, "event")) + " (" + state + ")");
     line["type"] = "vehicle";
-    writeTelemetry(*stream, line, runningTime());
+    writeTelemetry(*stream, line, runningTime(*stream));
     if (line.contains("state")) publishEvent(*stream, line);  // link changes, not each report
     return;
   }
@@ -466,7 +483,7 @@ void Recording::handleElementMessage(GstMessage* message) {
   if (type == "wirc-drive") {
     // Driving by hand from the page: each command, and the dead-man's neutral.
     line["type"] = "drive";
-    writeTelemetry(*stream, line, runningTime());
+    writeTelemetry(*stream, line, runningTime(*stream));
     return;
   }
   if (type != "apriltag" && type != "wirc-control") return;
@@ -477,7 +494,7 @@ void Recording::handleElementMessage(GstMessage* message) {
   if (http_ && type == "apriltag") http_->publishDetections(stream->plan.name, line["detections"]);
   if (fleet_ && type == "apriltag")
     fleet_->detections(stream->plan.name,
-                       {{"utc", SegmentPlanner::isoUtc(unixMsOf(pipeline_, pts))},
+                       {{"utc", SegmentPlanner::isoUtc(unixMsOf(stream->pipeline, pts))},
                         {"frame", line.value("frame", 0)},
                         {"tags", line["detections"]}},
                        !line["detections"].empty());
@@ -493,7 +510,7 @@ void Recording::handlePosition(Stream& stream, const GstStructure* s) {
             " stale: " + reason);
     stream.positionStale = reason;
     nlohmann::json line = {{"type", "position-stale"}, {"beacon", beacon}, {"reason", reason}};
-    writeTelemetry(stream, line, runningTime());
+    writeTelemetry(stream, line, runningTime(stream));
     publishEvent(stream, line);
     return;
   }
@@ -504,8 +521,8 @@ void Recording::handlePosition(Stream& stream, const GstStructure* s) {
   // When it was measured (a position from before PLAYING has no running time).
   guint64 measured = GST_CLOCK_TIME_NONE;
   gst_structure_get_uint64(s, "running-time", &measured);
-  GstClockTime time = GST_CLOCK_TIME_IS_VALID(measured) ? measured : runningTime();
-  position.unixMs = unixMsOf(pipeline_, time);
+  GstClockTime time = GST_CLOCK_TIME_IS_VALID(measured) ? measured : runningTime(stream);
+  position.unixMs = unixMsOf(stream.pipeline, time);
   stream.position = position;
   stream.positionStale.clear();
   stream.trail.push_back(position);
@@ -531,19 +548,45 @@ void Recording::handleError(GstMessage* message) {
           (debug ? debug : ""));
   g_error_free(error);
   g_free(debug);
-  if (diskFull && !stopping_) {
+  Stream* stream = streamOf(message);
+  if (!stream) stream = streamOfPipeline(GST_MESSAGE_SRC(message));
+  if (diskFull) {
     // A write failed: the other streams can still be finished.
     exitCode_ = kExitDiskFull;
-    logLine("the disk is full: finishing the other files; earlier segments are untouched");
-    stop(nullptr);
-    // The failed stream never reaches EOS: give the rest 5 s.
-    timers_.push_back(g_timeout_add_seconds(
-        5, [](gpointer loop) { return g_main_loop_quit(static_cast<GMainLoop*>(loop)), FALSE; },
-        loop_));
+    if (stream) endStream(*stream);
+    if (!stopping_) {
+      logLine("the disk is full: finishing the other files; earlier segments are untouched");
+      stop(nullptr);
+    }
+    quitWhenAllEnded();
     return;
   }
   if (exitCode_ == 0) exitCode_ = kExitError;
-  g_main_loop_quit(loop_);
+  if (!stream) {
+    g_main_loop_quit(loop_);
+    return;
+  }
+  // One camera's error is its own: the others record on.
+  endStream(*stream);
+  logLine(stream->plan.name + ": stopped after the error above" +
+          (std::all_of(streams_.begin(), streams_.end(), [](const auto& s) { return s->ended; })
+               ? ""
+               : "; the other cameras record on"));
+  quitWhenAllEnded();
+}
+
+void Recording::endStream(Stream& stream) {
+  if (stream.ended) return;
+  stream.ended = true;
+  gst_element_set_state(stream.pipeline, GST_STATE_NULL);
+  // Its open file was not finished by EOS, but what it holds is playable
+  // (streamable Matroska, fragmented MP4): indexed like any other.
+  if (!stream.segment.empty()) onSegmentClosed(stream, std::exchange(stream.segment, ""));
+}
+
+void Recording::quitWhenAllEnded() {
+  if (std::all_of(streams_.begin(), streams_.end(), [](const auto& s) { return s->ended; }))
+    g_main_loop_quit(loop_);
 }
 
 gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
@@ -566,7 +609,12 @@ gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
       self->handleError(message);
       break;
     case GST_MESSAGE_EOS:
-      g_main_loop_quit(self->loop_);
+      // A camera's pipeline finished its files (after the stop's EOS).
+      if (Stream* stream = self->streamOfPipeline(GST_MESSAGE_SRC(message))) {
+        stream->ended = true;
+        stream->segment.clear();
+      }
+      self->quitWhenAllEnded();
       break;
     default:
       break;
@@ -575,15 +623,15 @@ gboolean Recording::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
 }
 
 namespace {
-constexpr guint kFinishSeconds = 10;
 constexpr int kHookDrainSeconds = 15;
 }  // namespace
 
 void Recording::stop(const char* why) {
+  if (stopping_) return;
   stopping_ = true;
   if (why) logLine(std::string(why) + ": finishing the files (a second signal stops at once)");
-  bool anyRecorded = std::any_of(streams_.begin(), streams_.end(),
-                                 [](const auto& s) { return !s->segment.empty(); });
+  auto hasFrames = [](const auto& s) { return s->planner->current().has_value(); };
+  bool anyRecorded = std::any_of(streams_.begin(), streams_.end(), hasFrames);
   if (!anyRecorded) {
     // No device ever sent a frame: nothing to finish (and no EOS in flight
     // while the pipeline is torn down). Stopped by a signal while waiting
@@ -595,25 +643,32 @@ void Recording::stop(const char* why) {
   }
   // What waited for frames that will not come goes into the last files.
   for (auto& s : streams_) s->telemetry->finish();
-  // EOS from every source: each splitmuxsink closes its last segment cleanly.
-  gst_element_send_event(pipeline_, gst_event_new_eos());
-  // A splitmuxsink that never received a frame (the device never streamed)
-  // does not pass EOS on, so the pipeline's EOS would never come: finished
-  // segments close within a second or two, so after kFinishSeconds stop.
-  timers_.push_back(g_timeout_add_seconds(
-      kFinishSeconds,
-      [](gpointer data) {
-        auto* self = static_cast<Recording*>(data);
-        std::string idle;
-        for (const auto& s : self->streams_)
-          if (s->segment.empty()) idle += (idle.empty() ? "" : ", ") + s->plan.name;
-        logLine("gave up waiting for the pipeline to finish after " +
-                std::to_string(kFinishSeconds) + " s" +
-                (idle.empty() ? "" : " (never received a frame: " + idle + ")"));
-        g_main_loop_quit(self->loop_);
-        return G_SOURCE_REMOVE;
-      },
-      this));
+  // EOS to each camera that has frames to finish: its splitmuxsink closes
+  // its last segment cleanly. A camera that never sent one has nothing to
+  // finish (and would never pass EOS on).
+  for (auto& s : streams_) {
+    if (s->ended) continue;
+    if (!hasFrames(s))
+      s->ended = true;
+    else
+      gst_element_send_event(s->pipeline, gst_event_new_eos());
+  }
+  timers_.push_back(g_timeout_add(kFinishTimeMs, onFinishDeadline, this));
+  quitWhenAllEnded();
+}
+
+gboolean Recording::onFinishDeadline(gpointer data) {
+  auto* self = static_cast<Recording*>(data);
+  std::string late;
+  for (auto& s : self->streams_) {
+    if (s->ended) continue;
+    late += (late.empty() ? "" : ", ") + s->plan.name;
+    self->endStream(*s);
+  }
+  logLine("cut off after " + std::to_string(kFinishTimeMs) + " ms: " + late +
+          " (its last file is indexed as it is)");
+  g_main_loop_quit(self->loop_);
+  return G_SOURCE_REMOVE;
 }
 
 gboolean Recording::onStop(gpointer data) {
@@ -767,8 +822,11 @@ std::vector<std::string> Recording::openSegments() const {
 
 int Recording::run() {
   loop_ = g_main_loop_new(nullptr, FALSE);
-  GstBus* bus = gst_element_get_bus(pipeline_);
-  gst_bus_add_watch(bus, onBusMessage, this);
+  for (auto& s : streams_) {
+    GstBus* bus = gst_element_get_bus(s->pipeline);
+    gst_bus_add_watch(bus, onBusMessage, this);
+    gst_object_unref(bus);
+  }
   g_unix_signal_add(SIGINT, onStop, this);
   g_unix_signal_add(SIGTERM, onStop, this);
   if (options_.duration)
@@ -788,23 +846,31 @@ int Recording::run() {
         },
         this));
 
-  if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE) {
+  auto removeWatches = [this] {
+    for (auto& s : streams_) {
+      GstBus* bus = gst_element_get_bus(s->pipeline);
+      gst_bus_remove_watch(bus);
+      gst_object_unref(bus);
+    }
+  };
+  for (auto& s : streams_) {
+    if (gst_element_set_state(s->pipeline, GST_STATE_PLAYING) != GST_STATE_CHANGE_FAILURE) continue;
     // The error itself comes on the bus; show it.
+    GstBus* bus = gst_element_get_bus(s->pipeline);
     if (GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR)) {
       handleError(message);
       gst_message_unref(message);
     }
-    gst_bus_remove_watch(bus);
     gst_object_unref(bus);
+    removeWatches();
     return kExitError;
   }
   g_main_loop_run(loop_);
   // The run is over: its timers must not fire while the hooks drain.
   for (guint id : timers_)
     if (GSource* timer = g_main_context_find_source_by_id(nullptr, id)) g_source_destroy(timer);
-  gst_bus_remove_watch(bus);
-  gst_object_unref(bus);
-  gst_element_set_state(pipeline_, GST_STATE_NULL);
+  removeWatches();
+  for (auto& s : streams_) gst_element_set_state(s->pipeline, GST_STATE_NULL);
   printStatus();
   if (hook_) {
     // The last segments' uploads get a little time; what is left is named.

@@ -1,6 +1,9 @@
-// One wirc-recorder run: the pipeline of pipeline_plan.h, its bus turned
-// into telemetry (sidecar and text track), the status display, the disk
-// guard, and the web and RTSP servers when asked for.
+// One wirc-recorder run: a pipeline per camera (pipeline_plan.h), their
+// buses turned into telemetry (sidecar and text track), the status display,
+// the disk guard, and the web and RTSP servers when asked for. A camera's
+// EOS, error or silence is its own: the others record on, and a stop
+// finishes every camera that has frames within kFinishTime, cutting off (and
+// naming) any that cannot.
 #pragma once
 
 #include <gst/gst.h>
@@ -37,6 +40,10 @@ inline constexpr int kExitDiskFull = 3;
 
 class Recording {
  public:
+  // How long a stop waits for the cameras to finish their files: the
+  // process ends within 3 s of it, whatever a camera or device does.
+  static constexpr guint kFinishTimeMs = 2500;
+
   static Expected<std::unique_ptr<Recording>, std::string> create(const RecorderOptions& options);
   ~Recording();
 
@@ -47,6 +54,8 @@ class Recording {
  private:
   struct Stream {
     StreamPlan plan;
+    GstElement* pipeline = nullptr;  // this camera's alone
+    bool ended = false;              // reached EOS, or was stopped (an error, the stop's deadline)
     std::unique_ptr<SegmentPlanner> planner;
     std::optional<TelemetryTrack> track;
     std::unique_ptr<TelemetryRouter> telemetry;
@@ -76,6 +85,11 @@ class Recording {
   explicit Recording(RecorderOptions options);
   std::optional<std::string> startServers();  // the problem, if any
   static gboolean onBusMessage(GstBus* bus, GstMessage* message, gpointer self);
+  static gboolean onFinishDeadline(gpointer self);
+  // Tears one camera's pipeline down (its open segment indexed as it is).
+  void endStream(Stream& stream);
+  // Ends the run once every camera has ended (all stopped, or all failed).
+  void quitWhenAllEnded();
   static gboolean onStop(gpointer self);  // SIGINT, SIGTERM
   static gboolean onDurationOver(gpointer self);
   static gboolean onTick(gpointer self);
@@ -109,20 +123,20 @@ class Recording {
   void onSegmentClosed(Stream& stream, const std::string& file);
   void followLinkState(Stream& stream, const std::string& linkState);
   void updateIndex(const std::vector<std::string>& deleted);
-  GstClockTime runningTime() const;
+  GstClockTime runningTime(const Stream& stream) const;
   void printStatus();
   void guardDisk();
   nlohmann::json status() const;
   nlohmann::json trails() const;
   std::vector<std::string> openSegments() const;
   Stream* streamOf(GstMessage* message);
+  Stream* streamOfPipeline(GstObject* pipeline);
   Stream* streamNamed(const std::string& name);
 
   RecorderOptions options_;
   Retention retention_;
   DiskGuard disk_;
   RecordingIndex index_;
-  GstElement* pipeline_ = nullptr;
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Stream>> streams_;
   std::map<std::string, Stream*> streamByElement_;  // element name → its stream

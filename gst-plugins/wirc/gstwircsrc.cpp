@@ -43,6 +43,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <deque>
@@ -487,6 +488,22 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
   return GST_FLOW_OK;
 }
 
+// The running time at which a frame's first packet arrived: the pipeline
+// clock's now less the frame's age, the two clocks read back to back (a
+// thread preempted between them, as a loaded machine does, would date one
+// frame late and the next one before it).
+static GstClockTime frame_timestamp(GstWircSrc* self, Clock::time_point firstPacket) {
+  GstClock* clock = gst_element_get_clock(GST_ELEMENT(self));
+  if (!clock) return GST_CLOCK_TIME_NONE;
+  GstClockTime now = gst_clock_get_time(clock);
+  auto age = Clock::now() - firstPacket;
+  gst_object_unref(clock);
+  GstClockTime base = gst_element_get_base_time(GST_ELEMENT(self));
+  auto ageNs = static_cast<GstClockTime>(
+      std::max<int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(age).count()));
+  return now > base + ageNs ? now - base - ageNs : 0;
+}
+
 static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
   auto* self = GST_WIRC_SRC(pushsrc);
   auto* state = self->state;
@@ -527,7 +544,7 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
 
   wirc::AssembledFrame frame = std::move(state->ready.front());
   state->ready.pop_front();
-  auto age = Clock::now() - frame.firstPacketTime;
+  GstClockTime pts = frame_timestamp(self, frame.firstPacketTime);
   bool discont = frame.discont;
   GstBuffer* buffer = gst::wrapFrame(std::move(frame));
 
@@ -535,15 +552,7 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
     gst_base_src_set_caps(GST_BASE_SRC(self), caps);
     gst_caps_unref(caps);
   }
-  // PTS: the pipeline clock when the frame's first packet arrived.
-  if (GstClock* clock = gst_element_get_clock(GST_ELEMENT(self))) {
-    GstClockTime now = gst_clock_get_time(clock);
-    GstClockTime base = gst_element_get_base_time(GST_ELEMENT(self));
-    auto ageNs = static_cast<GstClockTime>(
-        std::chrono::duration_cast<std::chrono::nanoseconds>(age).count());
-    GST_BUFFER_PTS(buffer) = now > base + ageNs ? now - base - ageNs : 0;
-    gst_object_unref(clock);
-  }
+  GST_BUFFER_PTS(buffer) = pts;
   if (discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
   *out = buffer;
   return GST_FLOW_OK;

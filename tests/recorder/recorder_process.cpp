@@ -67,6 +67,19 @@ int RecorderProcess::wait() {
   return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
 }
 
+std::optional<int> RecorderProcess::waitExit(std::chrono::milliseconds timeout) {
+  auto end = std::chrono::steady_clock::now() + timeout;
+  while (!exited_) {
+    if (waitpid(pid_, &status_, WNOHANG) == pid_) {
+      exited_ = true;
+      break;
+    }
+    if (std::chrono::steady_clock::now() >= end) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return wait();
+}
+
 void RecorderProcess::signal(int number) { kill(pid_, number); }
 
 std::string RecorderProcess::statusLines() const {

@@ -26,6 +26,9 @@ class RecorderProcess {
 
   // The exit code, or 128 + signal.
   int wait();
+  // The same, or nullopt if it is still running after `timeout` (not
+  // stretched: callers stretch what only bounds a failure).
+  std::optional<int> waitExit(std::chrono::milliseconds timeout);
   void signal(int number);
   pid_t pid() const { return pid_; }
   const std::filesystem::path& out() const { return out_; }

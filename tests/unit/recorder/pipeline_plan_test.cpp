@@ -29,7 +29,7 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   const auto& s = plan.streams[0];
   EXPECT_EQ(s.name, "10.0.0.2-cam0");
   EXPECT_FALSE(plan.transcoded);
-  const auto& d = plan.description;
+  const auto& d = plan.description();
   EXPECT_TRUE(has(d, "wircsrc name=" + s.source + " host=10.0.0.2 port=1984"));
   EXPECT_TRUE(has(d, "wait-for-device=true"));
   EXPECT_TRUE(has(d, "splitmuxsink name=" + s.muxer + " async-finalize=true"));
@@ -51,16 +51,20 @@ TEST(PipelinePlan, H264InMp4IsTranscodedAndKeepsTheTextTrack) {
   auto plan = planPipeline(
       optionsOf({"--device", "rover", "--out", "/rec", "--codec", "h264", "--format", "mp4"}));
   EXPECT_TRUE(plan.transcoded);
-  EXPECT_TRUE(has(plan.description, "x264enc"));
-  EXPECT_TRUE(has(plan.description, "muxer-factory=mp4mux"));
-  EXPECT_TRUE(has(plan.description, "title=telemetry\""));
-  EXPECT_TRUE(has(plan.description, ".subtitle_%u"));
+  EXPECT_TRUE(has(plan.description(), "x264enc"));
+  EXPECT_TRUE(has(plan.description(), "muxer-factory=mp4mux"));
+  EXPECT_TRUE(has(plan.description(), "title=telemetry\""));
+  EXPECT_TRUE(has(plan.description(), ".subtitle_%u"));
+}
+
+PipelinePlan twoFollowedDevicesOfTwoCameras() {
+  return planPipeline(
+      optionsOf({"--device", "a", "--device", "b", "--camera", "0", "--camera", "1", "--out",
+                 "/rec", "--detect", "tag36h11", "--follow", "--http", ":0"}));
 }
 
 TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
-  auto plan = planPipeline(
-      optionsOf({"--device", "a", "--device", "b", "--camera", "0", "--camera", "1", "--out",
-                 "/rec", "--detect", "tag36h11", "--follow", "--http", ":0"}));
+  auto plan = twoFollowedDevicesOfTwoCameras();
   ASSERT_EQ(plan.streams.size(), 4u);
   std::set<std::string> names;
   for (const auto& s : plan.streams) {
@@ -72,13 +76,29 @@ TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
   EXPECT_FALSE(plan.streams[0].controller.empty());
   EXPECT_TRUE(plan.streams[1].controller.empty());
   EXPECT_FALSE(plan.streams[2].controller.empty());
-  EXPECT_TRUE(has(plan.description, "family=tag36h11"));
+  EXPECT_TRUE(has(plan.description(), "family=tag36h11"));
 }
 
 TEST(PipelinePlan, AControlUriSteersItsVehicle) {
   auto plan = planPipeline(optionsOf({"--device", "127.0.0.1:2000,control=rcoip://10.0.0.9:9000",
                                       "--out", "/rec", "--detect", "tag36h11", "--follow"}));
-  EXPECT_TRUE(has(plan.description, "protocol=rcoip host=10.0.0.9 port=9000"));
+  EXPECT_TRUE(has(plan.description(), "protocol=rcoip host=10.0.0.9 port=9000"));
+}
+
+TEST(PipelinePlan, EachCameraIsAPipelineOfItsOwn) {
+  auto plan = twoFollowedDevicesOfTwoCameras();
+  ASSERT_EQ(plan.streams.size(), 4u);
+  for (const auto& stream : plan.streams) {
+    // Everything it names is in its own description, nothing another names.
+    for (const auto* name : {&stream.source, &stream.muxer, &stream.telemetrySource,
+                             &stream.detector, &stream.liveSink}) {
+      EXPECT_TRUE(has(stream.description, "name=" + *name)) << *name;
+    }
+    for (const auto& other : plan.streams) {
+      if (&other == &stream) continue;
+      EXPECT_FALSE(has(stream.description, "name=" + other.source + " ")) << other.source;
+    }
+  }
 }
 
 }  // namespace
