@@ -665,8 +665,9 @@ gboolean Recording::onFinishDeadline(gpointer data) {
     late += (late.empty() ? "" : ", ") + s->plan.name;
     self->endStream(*s);
   }
-  logLine("cut off after " + std::to_string(kFinishTimeMs) + " ms: " + late +
-          " (its last file is indexed as it is)");
+  if (!late.empty())
+    logLine("cut off after " + std::to_string(kFinishTimeMs) + " ms: " + late +
+            " (its last file is indexed as it is)");
   g_main_loop_quit(self->loop_);
   return G_SOURCE_REMOVE;
 }
