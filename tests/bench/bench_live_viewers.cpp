@@ -69,6 +69,7 @@ struct Viewers {
   long rssEndKb = 0;      // and at the end
   long peakKb = 0;        // its peak (VmHWM), at the end
   double cpuSeconds = 0;  // what the server used while watched
+  int connected = 0;      // of the viewers asked for
 };
 
 // Opens `count` connections to port, asks for `path` and, for the first
@@ -88,10 +89,12 @@ Viewers watch(pid_t server, uint16_t port, const std::string& path, int count, d
     ::send(socket->get(), request.data(), request.size(), MSG_NOSIGNAL);
     sockets.push_back(std::move(*socket));
   }
-  int readers = count / 2;
+  // Half of those that got in read; a server that turned some away says so.
+  int readers = static_cast<int>(sockets.size()) / 2;
   std::vector<long> parts(sockets.size(), 0);
   std::vector<std::string> tails(sockets.size());
   Viewers result;
+  result.connected = static_cast<int>(sockets.size());
   double cpuBefore = cpuSeconds(server);
   auto start = Clock::now();
   auto end =
@@ -158,8 +161,11 @@ int main(int argc, char** argv) {
               "MB mid → end", "peak MB", "reader fps · recorded frames");
   auto row = [seconds](const char* name, int count, const Viewers& seen,
                        const std::string& recorded) {
-    std::printf("%-37s | %-7d | %5.1f  | %5.1f → %-5.1f  | %6.1f  | %5.1f · %s\n", name, count,
-                100.0 * seen.cpuSeconds / seconds, static_cast<double>(seen.rssMiddleKb) / 1024,
+    std::string shown = std::to_string(count);
+    if (seen.connected != count) shown += " (" + std::to_string(seen.connected) + " in)";
+    std::printf("%-37s | %-7s | %5.1f  | %5.1f → %-5.1f  | %6.1f  | %5.1f · %s\n", name,
+                shown.c_str(), 100.0 * seen.cpuSeconds / seconds,
+                static_cast<double>(seen.rssMiddleKb) / 1024,
                 static_cast<double>(seen.rssEndKb) / 1024, static_cast<double>(seen.peakKb) / 1024,
                 seen.fastFps, recorded.c_str());
   };
