@@ -1,8 +1,5 @@
 #include "http_connections.h"
 
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-
 #include <algorithm>
 
 namespace wircam::recorder {
@@ -92,9 +89,6 @@ gboolean HttpConnections::onIncoming(GSocketService*, GSocketConnection* connect
   GSocket* socket = g_socket_connection_get_socket(connection);
   // Writes to a client that stopped reading give up after this long.
   g_socket_set_timeout(socket, self->socketTimeoutSeconds_);
-  // Frames go out as they come, not gathered (libsoup does this only for
-  // sockets it accepted itself).
-  g_socket_set_option(socket, IPPROTO_TCP, TCP_NODELAY, TRUE, nullptr);
   self->accepted_[endpoint] = {connection, socket, *slot};
   g_object_weak_ref(G_OBJECT(connection), onConnectionGone,
                     new GoneWatch{self, endpoint, connection, self->alive_});

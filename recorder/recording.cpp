@@ -399,7 +399,9 @@ void Recording::updateIndex(const std::vector<std::string>& deleted) {
   if (!index_.save()) logLine("cannot write " + index_.path().string());
 }
 
-void Recording::followLinkState(Stream& stream, const std::string& linkState) {
+void Recording::followLinkState(Stream& stream, const std::string& linkState,
+                                const std::string& reason) {
+  stream.linkReason = linkState == "live" ? "" : printableText(reason);
   std::string state = stream.state;
   if (linkState == "live") state = "live";
   // Until the first login the device is awaited; afterwards it went away.
@@ -438,7 +440,10 @@ void Recording::handleElementMessage(GstMessage* message) {
     line["type"] = "session";
     writeTelemetry(*stream, line, runningTime(*stream));
     publishEvent(*stream, line);
-    if (const char* state = gst_structure_get_string(s, "state")) followLinkState(*stream, state);
+    if (const char* state = gst_structure_get_string(s, "state")) {
+      const char* reason = gst_structure_get_string(s, "reason");
+      followLinkState(*stream, state, reason ? reason : "");
+    }
     return;
   }
   if (type == "wirc-stats") {
@@ -767,6 +772,7 @@ nlohmann::json Recording::status() const {
         {"camera", s->plan.camera},
         {"state", s->state},
         {"state_since_utc", SegmentPlanner::isoUtc(s->stateSinceUnixMs)},
+        {"link_reason", s->linkReason},
         {"frames", s->frameCount},
         {"fps", s->fps},
         {"loss_percent", total > 0 ? 100.0 * static_cast<double>(s->incomplete) / total : 0.0},

@@ -80,6 +80,7 @@ class Recording {
     // "waiting for device" until the first login, then "live" or "offline".
     std::string state = "waiting for device";
     int64_t stateSinceUnixMs = 0;
+    std::string linkReason;  // why the link is not live (a refusal, a loss), while it is not
   };
 
   explicit Recording(RecorderOptions options);
@@ -121,7 +122,7 @@ class Recording {
   GstElement* element(const std::string& name) const;
   void writeTelemetry(Stream& stream, nlohmann::json line, GstClockTime runningTime);
   void onSegmentClosed(Stream& stream, const std::string& file);
-  void followLinkState(Stream& stream, const std::string& linkState);
+  void followLinkState(Stream& stream, const std::string& linkState, const std::string& reason);
   void updateIndex(const std::vector<std::string>& deleted);
   GstClockTime runningTime(const Stream& stream) const;
   void printStatus();
