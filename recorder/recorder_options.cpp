@@ -66,7 +66,8 @@ file and exits 0.
   --http-token T         every request needs "Authorization: Bearer T" or the
                          cookie the page's /login sets (16 characters at least);
                          control, driving and deleting need it always
-  --http-idle-timeout S  close an HTTP connection silent for S seconds (default 10)
+  --http-idle-timeout S  close an HTTP connection with no request in progress (silent,
+                         idle, or still sending its headers) for S seconds (default 10)
   --mqtt mqtt://[USER:PASS@]HOST[:PORT]
                          publish status, detections and events to an MQTT
                          broker and take follow/target commands (below)

@@ -214,10 +214,12 @@ Recording::~Recording() {
 }
 
 Recording::Stream* Recording::streamOf(GstMessage* message) {
-  // Elements inside a splitmuxsink (its filesink) are found by their parent.
+  // Elements inside a splitmuxsink (its filesink) are found by their
+  // parent; anything else by the camera's pipeline it is in.
   for (GstObject* object = GST_MESSAGE_SRC(message); object; object = GST_OBJECT_PARENT(object)) {
     auto found = streamByElement_.find(GST_OBJECT_NAME(object) ? GST_OBJECT_NAME(object) : "");
     if (found != streamByElement_.end()) return found->second;
+    if (Stream* stream = streamOfPipeline(object)) return stream;
   }
   return nullptr;
 }
@@ -554,7 +556,6 @@ void Recording::handleError(GstMessage* message) {
   g_error_free(error);
   g_free(debug);
   Stream* stream = streamOf(message);
-  if (!stream) stream = streamOfPipeline(GST_MESSAGE_SRC(message));
   if (diskFull) {
     // A write failed: the other streams can still be finished.
     exitCode_ = kExitDiskFull;

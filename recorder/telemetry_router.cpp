@@ -12,12 +12,7 @@ constexpr size_t kOpenSidecars = 2;
 
 void TelemetryRouter::write(nlohmann::json line, uint64_t runningTime, int64_t unixMs) {
   MutexLock lock(mutex_);
-  if (finished_) {
-    if (auto segment = planner_.segmentAt(runningTime))
-      place({std::move(line), runningTime, unixMs}, *segment,
-            std::clamp(runningTime, segment->start, segment->lastFrame));
-    return;
-  }
+  if (finished_) return placeByItsLastFrame({std::move(line), runningTime, unixMs});
   if (waiting_.empty()) {
     if (auto segment = planner_.segmentReaching(runningTime)) {
       place({std::move(line), runningTime, unixMs}, *segment,
@@ -53,13 +48,15 @@ void TelemetryRouter::finish() {
   MutexLock lock(mutex_);
   writeWaiting();
   finished_ = true;
-  for (auto& line : waiting_) {
-    auto segment = planner_.segmentAt(line.runningTime);
-    if (!segment) continue;
-    uint64_t time = std::clamp(line.runningTime, segment->start, segment->lastFrame);
-    place(std::move(line), *segment, time);
-  }
+  for (auto& line : waiting_) placeByItsLastFrame(std::move(line));
   waiting_.clear();
+}
+
+void TelemetryRouter::placeByItsLastFrame(Line line) {
+  auto segment = planner_.segmentAt(line.runningTime);
+  if (!segment) return;
+  uint64_t time = std::clamp(line.runningTime, segment->start, segment->lastFrame);
+  place(std::move(line), *segment, time);
 }
 
 void TelemetryRouter::place(Line line, const PlannedSegment& segment, uint64_t time) {

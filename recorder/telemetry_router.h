@@ -58,6 +58,9 @@ class TelemetryRouter {
   // Into `segment` at `time` (within its span).
   void place(Line line, const PlannedSegment& segment, uint64_t time) WIRCAM_REQUIRES(mutex_);
   void writeWaiting() WIRCAM_REQUIRES(mutex_);
+  // Once no frame will come: into the segment its time falls in, at that
+  // segment's last frame at the latest.
+  void placeByItsLastFrame(Line line) WIRCAM_REQUIRES(mutex_);
   TelemetryLog& sidecarOf(const std::string& segment) WIRCAM_REQUIRES(mutex_);
 
   const SegmentPlanner& planner_;
