@@ -26,6 +26,7 @@
 #include <string>
 
 #include "tag_tracker.h"
+#include "wirc_bus_messages.h"
 #include "wirc_tag_meta.h"
 
 GST_DEBUG_CATEGORY_STATIC(apriltag_detect_debug);
@@ -212,9 +213,9 @@ static GstFlowReturn gst_apriltag_detect_transform_frame_ip(GstVideoFilter* filt
     gst_value_list_append_and_take_value(&list, &value);
   }
 
-  GstStructure* message =
-      gst_structure_new("apriltag", "timestamp", G_TYPE_UINT64, GST_BUFFER_PTS(frame->buffer),
-                        "frame", G_TYPE_UINT64, state->frames++, nullptr);
+  GstStructure* message = gst_structure_new(wircam::bus::AprilTags::kName, "timestamp",
+                                            G_TYPE_UINT64, GST_BUFFER_PTS(frame->buffer), "frame",
+                                            G_TYPE_UINT64, state->frames++, nullptr);
   gst_structure_take_value(message, "detections", &list);
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), message));
   GST_LOG_OBJECT(self, "%zu tags", detections.size());

@@ -1,6 +1,7 @@
 #include "frame_buffers.h"
 
 #include "wirc/jpeg_info.h"
+#include "wirc_bus_messages.h"
 
 namespace wircam::gst {
 
@@ -25,14 +26,15 @@ GstCaps* jpegCapsIfChanged(GstBuffer* frame, int& width, int& height) {
                              nullptr);
 }
 GstStructure* statsStructure(const wirc::AssemblerStats& s, uint64_t foreignPackets) {
-  return gst_structure_new(
-      "wirc-stats", "packets", G_TYPE_UINT64, s.packets, "bytes", G_TYPE_UINT64, s.payloadBytes,
-      "frames-complete", G_TYPE_UINT64, s.framesComplete, "frames-incomplete", G_TYPE_UINT64,
-      s.framesDropped(), "frames-timed-out", G_TYPE_UINT64, s.framesTimedOut, "frames-superseded",
-      G_TYPE_UINT64, s.framesSuperseded, "frames-late", G_TYPE_UINT64, s.packetsLate,
-      "packets-duplicate", G_TYPE_UINT64, s.packetsDuplicate, "packets-invalid", G_TYPE_UINT64,
-      s.packetsInvalid, "packets-foreign", G_TYPE_UINT64, foreignPackets, "keepalives",
-      G_TYPE_UINT64, s.keepalives, "sender-restarts", G_TYPE_UINT64, s.senderRestarts, nullptr);
+  return gst_structure_new(wircam::bus::Stats::kName, "packets", G_TYPE_UINT64, s.packets, "bytes",
+                           G_TYPE_UINT64, s.payloadBytes, "frames-complete", G_TYPE_UINT64,
+                           s.framesComplete, "frames-incomplete", G_TYPE_UINT64, s.framesDropped(),
+                           "frames-timed-out", G_TYPE_UINT64, s.framesTimedOut, "frames-superseded",
+                           G_TYPE_UINT64, s.framesSuperseded, "frames-late", G_TYPE_UINT64,
+                           s.packetsLate, "packets-duplicate", G_TYPE_UINT64, s.packetsDuplicate,
+                           "packets-invalid", G_TYPE_UINT64, s.packetsInvalid, "packets-foreign",
+                           G_TYPE_UINT64, foreignPackets, "keepalives", G_TYPE_UINT64, s.keepalives,
+                           "sender-restarts", G_TYPE_UINT64, s.senderRestarts, nullptr);
 }
 
 }  // namespace wircam::gst

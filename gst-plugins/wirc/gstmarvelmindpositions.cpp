@@ -32,6 +32,7 @@
 #include "common/mutex.h"
 #include "glib_locker.h"
 #include "marvelmind/position_client.h"
+#include "wirc_bus_messages.h"
 #include "wirc_position_meta.h"
 
 GST_DEBUG_CATEGORY_STATIC(marvelmind_positions_debug);
@@ -159,7 +160,7 @@ static void on_position_event(GstMarvelmindPositions* self, const mm::PositionEv
       history.push_back(p);
       if (history.size() > kHistory) history.pop_front();
     }
-    s = gst_structure_new("marvelmind-position", "beacon", G_TYPE_UINT, guint{p.beacon}, "x",
+    s = gst_structure_new(wircam::bus::Position::kName, "beacon", G_TYPE_UINT, guint{p.beacon}, "x",
                           G_TYPE_DOUBLE, p.x, "y", G_TYPE_DOUBLE, p.y, "z", G_TYPE_DOUBLE, p.z,
                           "timestamp", G_TYPE_DOUBLE, p.timestamp, "running-time", G_TYPE_UINT64,
                           runningTime, nullptr);
@@ -169,8 +170,9 @@ static void on_position_event(GstMarvelmindPositions* self, const mm::PositionEv
       MutexLock lock(state->mutex);
       state->history.erase(stale->beacon);
     }
-    s = gst_structure_new("marvelmind-stale", "beacon", G_TYPE_UINT, guint{stale->beacon}, "reason",
-                          G_TYPE_STRING, stale->reason.c_str(), nullptr);
+    s = gst_structure_new(wircam::bus::PositionStale::kName, "beacon", G_TYPE_UINT,
+                          guint{stale->beacon}, "reason", G_TYPE_STRING, stale->reason.c_str(),
+                          nullptr);
   }
   if (s) gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), s));
 }

@@ -66,6 +66,7 @@
 #include "manual_drive.h"
 #include "target_follower.h"
 #include "wirc/transmitter_session.h"
+#include "wirc_bus_messages.h"
 #include "wirc_tag_meta.h"
 
 GST_DEBUG_CATEGORY_STATIC(wirc_control_debug);
@@ -256,16 +257,17 @@ static void on_link_event(GstWircControl* self, const link::LinkEvent& event) {
   if (const auto* right = std::get_if<link::ControlRightChanged>(&event)) {
     bool had = state->hasControl.exchange(right->hasControl);
     GST_INFO_OBJECT(self, "%s", link::describe(event).c_str());
-    post_control_right(self, gst_structure_new("wirc-control-right", "has-control", G_TYPE_BOOLEAN,
-                                               right->hasControl, "holder", G_TYPE_STRING,
-                                               right->holder.c_str(), nullptr));
+    post_control_right(self, gst_structure_new(wircam::bus::ControlRight::kName, "has-control",
+                                               G_TYPE_BOOLEAN, right->hasControl, "holder",
+                                               G_TYPE_STRING, right->holder.c_str(), nullptr));
     if (had != right->hasControl) g_object_notify_by_pspec(G_OBJECT(self), hasControlSpec);
   } else if (const auto* answer = std::get_if<link::ControlRequestAnswered>(&event)) {
     GST_INFO_OBJECT(self, "%s", link::describe(event).c_str());
-    post_control_right(self, gst_structure_new("wirc-control-right", "has-control", G_TYPE_BOOLEAN,
-                                               state->hasControl.load(), "request", G_TYPE_STRING,
-                                               answer->granted ? "granted" : "denied", "reason",
-                                               G_TYPE_STRING, answer->reason.c_str(), nullptr));
+    post_control_right(
+        self, gst_structure_new(wircam::bus::ControlRight::kName, "has-control", G_TYPE_BOOLEAN,
+                                state->hasControl.load(), "request", G_TYPE_STRING,
+                                answer->granted ? "granted" : "denied", "reason", G_TYPE_STRING,
+                                answer->reason.c_str(), nullptr));
   } else if (const auto* report = std::get_if<link::TelemetryReceived>(&event)) {
     gst_element_post_message(
         GST_ELEMENT(self),
@@ -276,9 +278,9 @@ static void on_link_event(GstWircControl* self, const link::LinkEvent& event) {
         GST_ELEMENT(self),
         gst_message_new_element(
             GST_OBJECT(self),
-            gst_structure_new("wirc-vehicle", "event", G_TYPE_STRING, link::describe(event).c_str(),
-                              "state", G_TYPE_STRING, link::linkStateName(changed->state),
-                              nullptr)));
+            gst_structure_new(wircam::bus::Vehicle::kName, "event", G_TYPE_STRING,
+                              link::describe(event).c_str(), "state", G_TYPE_STRING,
+                              link::linkStateName(changed->state), nullptr)));
     std::shared_ptr<link::VehicleLink> session;
     {
       gst::GLibLocker lock(self);
@@ -308,11 +310,11 @@ static void post_drive(GstWircControl* self, const char* reason, const link::Pul
       GST_ELEMENT(self),
       gst_message_new_element(
           GST_OBJECT(self),
-          gst_structure_new("wirc-drive", "reason", G_TYPE_STRING, reason, "steering-pulse",
-                            G_TYPE_UINT, static_cast<guint>(pulses[steeringChannel - 1]),
-                            "throttle-pulse", G_TYPE_UINT,
-                            static_cast<guint>(pulses[throttleChannel - 1]), "has-control",
-                            G_TYPE_BOOLEAN, self->state->hasControl.load(), nullptr)));
+          gst_structure_new(
+              wircam::bus::Drive::kName, "reason", G_TYPE_STRING, reason, "steering-pulse",
+              G_TYPE_UINT, static_cast<guint>(pulses[steeringChannel - 1]), "throttle-pulse",
+              G_TYPE_UINT, static_cast<guint>(pulses[throttleChannel - 1]), "has-control",
+              G_TYPE_BOOLEAN, self->state->hasControl.load(), nullptr)));
 }
 
 static gboolean gst_wirc_control_drive(GstWircControl* self, gdouble steering, gdouble throttle) {
@@ -479,14 +481,15 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
       gst_message_new_element(
           GST_OBJECT(self),
           gst_structure_new(
-              "wirc-control", "timestamp", G_TYPE_UINT64, GST_BUFFER_PTS(buffer), "target-visible",
-              G_TYPE_BOOLEAN, step.targetVisible, "enabled", G_TYPE_BOOLEAN, settings.enabled,
-              "has-control", G_TYPE_BOOLEAN, state->hasControl.load(), "bearing", G_TYPE_DOUBLE,
-              command.bearingRad, "distance", G_TYPE_DOUBLE, command.distance, "steering",
-              G_TYPE_DOUBLE, command.steering, "throttle", G_TYPE_DOUBLE, command.throttle,
-              "steering-pulse", G_TYPE_UINT, static_cast<guint>(command.steeringPulse),
-              "throttle-pulse", G_TYPE_UINT, static_cast<guint>(command.throttlePulse), "manual",
-              G_TYPE_BOOLEAN, manual, nullptr)));
+              wircam::bus::Control::kName, "timestamp", G_TYPE_UINT64, GST_BUFFER_PTS(buffer),
+              "target-visible", G_TYPE_BOOLEAN, step.targetVisible, "enabled", G_TYPE_BOOLEAN,
+              settings.enabled, "has-control", G_TYPE_BOOLEAN, state->hasControl.load(), "bearing",
+              G_TYPE_DOUBLE, command.bearingRad, "distance", G_TYPE_DOUBLE, command.distance,
+              "steering", G_TYPE_DOUBLE, command.steering, "throttle", G_TYPE_DOUBLE,
+              command.throttle, "steering-pulse", G_TYPE_UINT,
+              static_cast<guint>(command.steeringPulse), "throttle-pulse", G_TYPE_UINT,
+              static_cast<guint>(command.throttlePulse), "manual", G_TYPE_BOOLEAN, manual,
+              nullptr)));
   return GST_FLOW_OK;
 }
 

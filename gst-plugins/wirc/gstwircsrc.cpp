@@ -58,6 +58,7 @@
 #include "login_properties.h"
 #include "wirc/stream_receiver.h"
 #include "wirc/transmitter_session.h"
+#include "wirc_bus_messages.h"
 #include "wirc_uri.h"
 
 GST_DEBUG_CATEGORY_STATIC(wirc_src_debug);
@@ -154,6 +155,7 @@ struct WircSrcState {
   int width = 0;
   int height = 0;
   Clock::time_point nextStats;
+  GstClockTime lastPts = GST_CLOCK_TIME_NONE;  // the newest frame's, on the streaming thread
 
   Mutex refusalMutex;                                   // refusal is written on the event loop
   std::string refusal WIRCAM_GUARDED_BY(refusalMutex);  // the device refused this camera's STST
@@ -235,7 +237,7 @@ void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
   std::string text = link::describe(event);
   GST_INFO_OBJECT(self, "link: %s", text.c_str());
   GstStructure* s =
-      gst_structure_new("wirc-session", "event", G_TYPE_STRING, text.c_str(), nullptr);
+      gst_structure_new(wircam::bus::Session::kName, "event", G_TYPE_STRING, text.c_str(), nullptr);
   if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
     signal(state->linkChanged);
     gst_structure_set(s, "state", G_TYPE_STRING, link::linkStateName(changed->state), "reason",
@@ -341,6 +343,7 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
     state->loginRefusal.clear();
   }
   state->width = state->height = 0;
+  state->lastPts = GST_CLOCK_TIME_NONE;
   state->loginDeadline = Clock::now() + std::chrono::milliseconds(settings.loginTimeoutMs + 500);
   state->nextStats = Clock::now() + std::chrono::milliseconds(settings.statsIntervalMs);
   publishStats(self);
@@ -488,20 +491,42 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
   return GST_FLOW_OK;
 }
 
-// The running time at which a frame's first packet arrived: the pipeline
-// clock's now less the frame's age, the two clocks read back to back (a
-// thread preempted between them, as a loaded machine does, would date one
-// frame late and the next one before it).
+// The pipeline clock's time at which a frame's first packet arrived. With
+// GStreamer's monotonic system clock (what a pipeline uses unless told
+// otherwise) that is the arrival time itself: steady_clock reads the same
+// CLOCK_MONOTONIC, so the time is exact however loaded the machine. With any
+// other clock: its now less the frame's age, the two read back to back.
+static GstClockTime arrival_clock_time(GstClock* clock, Clock::time_point firstPacket) {
+  auto sinceBoot =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(firstPacket.time_since_epoch());
+  GstClockType type = GST_CLOCK_TYPE_REALTIME;
+  if (GST_IS_SYSTEM_CLOCK(clock)) g_object_get(clock, "clock-type", &type, nullptr);
+  if (type == GST_CLOCK_TYPE_MONOTONIC) {
+    GstClockTime internal, external, rateNum, rateDenom;
+    gst_clock_get_calibration(clock, &internal, &external, &rateNum, &rateDenom);
+    return gst_clock_adjust_with_calibration(clock, static_cast<GstClockTime>(sinceBoot.count()),
+                                             internal, external, rateNum, rateDenom);
+  }
+  GstClockTime now = gst_clock_get_time(clock);
+  auto age = std::max<int64_t>(
+      0, std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - firstPacket).count());
+  return now > static_cast<GstClockTime>(age) ? now - static_cast<GstClockTime>(age) : 0;
+}
+
+// A frame's running time: when its first packet arrived, and never before the
+// previous frame's (a frame completed late, after a newer one, takes the
+// newer one's time), so no segment ever sees time step back from its start.
 static GstClockTime frame_timestamp(GstWircSrc* self, Clock::time_point firstPacket) {
   GstClock* clock = gst_element_get_clock(GST_ELEMENT(self));
   if (!clock) return GST_CLOCK_TIME_NONE;
-  GstClockTime now = gst_clock_get_time(clock);
-  auto age = Clock::now() - firstPacket;
+  GstClockTime arrival = arrival_clock_time(clock, firstPacket);
   gst_object_unref(clock);
   GstClockTime base = gst_element_get_base_time(GST_ELEMENT(self));
-  auto ageNs = static_cast<GstClockTime>(
-      std::max<int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(age).count()));
-  return now > base + ageNs ? now - base - ageNs : 0;
+  GstClockTime pts = arrival > base ? arrival - base : 0;
+  auto& last = self->state->lastPts;
+  if (GST_CLOCK_TIME_IS_VALID(last) && pts < last) pts = last;
+  last = pts;
+  return pts;
 }
 
 static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {

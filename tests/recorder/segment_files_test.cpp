@@ -213,7 +213,7 @@ TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {
   std::this_thread::sleep_for(milliseconds(2500));  // login attempts fail meanwhile
   EXPECT_NE(recorder.statusLines().find("waiting for device"), std::string::npos);
   auto status = nlohmann::json::parse(fetch(*url + "api/status").body);
-  EXPECT_EQ(status["streams"][0]["state"], "waiting for device") << status;
+  EXPECT_EQ(status["streams"][0]["state"], "connecting") << status;
   auto device = startSequenceDevice(port);
   ASSERT_TRUE(device);
   std::this_thread::sleep_for(milliseconds(5000));  // the backoff, then 2-3 s of frames

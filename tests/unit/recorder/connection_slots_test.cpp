@@ -1,4 +1,4 @@
-#include "connection_slots.h"
+#include "http/connection_slots.h"
 
 #include <gtest/gtest.h>
 

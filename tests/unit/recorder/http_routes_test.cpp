@@ -1,5 +1,5 @@
 // Which resource a request path names, and which recording names are served.
-#include "http_routes.h"
+#include "http/http_routes.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // wirc-recorder's command line: the new options and their errors.
-#include "recorder_options.h"
+#include "app/recorder_options.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The recording index: entries in time order, saved whole, read back, and
 // reconciled with the folder (files it lacks read in, deleted ones dropped).
-#include "recording_index.h"
+#include "record/recording_index.h"
 
 #include <gtest/gtest.h>
 

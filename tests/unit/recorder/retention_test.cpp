@@ -1,13 +1,13 @@
 // Retention: the oldest finished segments go first, with their sidecars,
 // never an open one, and only until the limit holds.
-#include "retention.h"
+#include "record/retention.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include "disk_guard.h"
+#include "record/disk_guard.h"
 #include "temp_folder_test.h"
 
 namespace {

@@ -1,6 +1,6 @@
 // Where segments begin: at the first frame, at their length, at the byte
 // limit and at a gap in the frames; and which segment a time belongs to.
-#include "segment_planner.h"
+#include "record/segment_planner.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // A segment's sidecar: named after the video, created when asked, lines
 // appended (a reopened sidecar keeps what it had), failures reported.
-#include "telemetry_log.h"
+#include "record/telemetry_log.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

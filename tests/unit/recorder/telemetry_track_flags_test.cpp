@@ -1,7 +1,7 @@
 // Marking the telemetry track leaves anything that is not a recording's
 // header exactly as it was (the real files are checked with ffprobe in
 // tests/recorder/segment_files_test.cpp).
-#include "telemetry_track_flags.h"
+#include "telemetry/telemetry_track_flags.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,0 +1,36 @@
+// wirc-recorder: records WiRC cameras into segmented files with telemetry.
+#include <gst/gst.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "app/recorder_options.h"
+#include "app/supervisor.h"
+
+int main(int argc, char** argv) {
+  using namespace wircam::recorder;
+  auto options = parseOptions(argc, argv);
+  if (!options) {
+    if (options.error() == "help") {
+      std::fputs(usage(), stdout);
+      return 0;
+    }
+    std::fprintf(stderr, "wirc-recorder: %s (see wirc-recorder --help)\n", options.error().c_str());
+    return 2;
+  }
+  // The plugins of an uninstalled build sit beside bin/ in gst-plugins/.
+  auto plugins =
+      std::filesystem::canonical("/proc/self/exe").parent_path().parent_path() / "gst-plugins";
+  if (std::filesystem::exists(plugins)) {
+    const char* path = g_getenv("GST_PLUGIN_PATH");
+    std::string joined = plugins.string() + (path ? ":" + std::string(path) : "");
+    g_setenv("GST_PLUGIN_PATH", joined.c_str(), TRUE);
+  }
+  gst_init(&argc, &argv);
+  auto supervisor = Supervisor::create(*options);
+  if (!supervisor) {
+    std::fprintf(stderr, "wirc-recorder: %s\n", supervisor.error().c_str());
+    return 1;
+  }
+  return (*supervisor)->run();
+}

@@ -1,0 +1,535 @@
+#include "app/recorder_options.h"
+
+#include <getopt.h>
+#include <glib.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+
+#include "marvelmind/position_client.h"
+#include "fleet/mqtt_url.h"
+#include "wirc/channel_list.h"
+
+namespace wircam::recorder {
+
+const char* usage() {
+  return R"(Usage: wirc-recorder --device HOST[:PORT] [--device ...] --out DIR [OPTIONS]
+
+Records the cameras of one or more WiRC devices into segmented files, the
+JPEG frames muxed as they arrive (no re-encoding) or transcoded to H.264,
+with the telemetry in a JSON-lines sidecar per segment and as a text track in
+the file. A device that is off is waited for. SIGINT or SIGTERM finishes every
+file and exits 0.
+
+  --device HOST[:PORT][,control=URI]
+                         a device to record (default port 1984); repeatable.
+                         Without --device the device is found by discovery.
+                         control=rcoip://H:P or btemp://H:P: with --follow,
+                         steer that RCOIP receiver or BTEMP robot instead of
+                         the WiRC device (whose camera is still recorded)
+  --config FILE          read devices and options from an INI file (below)
+  --camera N             camera to record (default 0); repeatable
+  --out DIR              where the files go (created if missing)
+  --segment S            seconds per segment (default 60)
+  --segment-size SIZE    also end a segment at SIZE (e.g. 100M)
+  --format mkv|mp4       container (default mkv); mp4 needs --codec h264
+  --codec jpeg|h264      jpeg: the camera's frames as they are (default);
+                         h264: transcoded with x264enc (gstreamer1.0-plugins-ugly)
+  --bitrate KBPS         H.264 bit rate (default 2000)
+  --detect FAMILY        find AprilTags (e.g. tag36h11); detections go to telemetry
+  --follow               steer the vehicle after the largest tag (needs --detect)
+  --marvelmind HOST[:PORT]
+                         a Marvelmind dashboard (port default 49200) to ask
+                         where the vehicle is; with --beacon
+  --beacon ADDR[,ADDR]   the vehicle's mobile beacon address(es), 1..254:
+                         its positions go to telemetry ("position", metres),
+                         /api/status and the live view's map
+  --periods US,...       channel periods the login sets (CCFG): 12 values or
+                         one for all, 5000..20000 µs (default 20000)
+  --failsafe US,...      what each channel does when the link is lost (FCFG):
+                         800..2200 µs, 0 = hold, 65535 = no pulse (default 1500).
+                         Every login sends both; the device takes them from the
+                         first transmitter logged in (so they overwrite what
+                         wirc-cli configure set) and refuses them to later ones
+  --duration S           stop after S seconds
+  --status S             seconds between status updates (default 1)
+  --stall-timeout S      a camera logged in but without a frame for S seconds
+                         is "no-video": its file is closed and its pipeline
+                         started again, with backoff (default 5)
+  --max-bytes SIZE       keep the recordings under SIZE (e.g. 500M, 20G) by
+                         deleting the oldest finished segments
+  --min-free SIZE        delete the oldest finished segments while the disk
+                         has less than SIZE free
+  --http [HOST]:PORT     web server: live view, playback, control and drive
+                         mode at /, status at /api/status, cameras at
+                         /api/cameras, recordings at /api/recordings (e.g.
+                         --http :8080). Without HOST it listens on 127.0.0.1
+                         only; another HOST (e.g. 0.0.0.0) needs --http-token
+  --http-token T         every request needs "Authorization: Bearer T" or the
+                         cookie the page's /login sets (16 characters at least);
+                         control, driving and deleting need it always
+  --http-idle-timeout S  close an HTTP connection with no request in progress (silent,
+                         idle, or still sending its headers) for S seconds (default 10)
+  --mqtt mqtt://[USER:PASS@]HOST[:PORT]
+                         publish status, detections and events to an MQTT
+                         broker and take follow/target commands (below)
+  --mqtt-prefix P        topic prefix (default wircam)
+  --mqtt-detections-rate HZ
+                         at most HZ detection messages per second and stream
+                         (default 0: every frame with tags)
+  --on-segment-closed CMD
+                         run CMD (split like a shell would, never through
+                         one) with the segment's path and its sidecar's as
+                         two more arguments, for each segment as it closes;
+                         failures are retried with backoff (e.g. a script
+                         that runs rclone: README.md, "Fleets")
+  --hook-timeout S       a hook running longer is stopped and retried (default 600)
+  --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>; without
+                         HOST on 127.0.0.1 only
+  -h, --help             this text
+
+Config file (GKeyFile/INI): a [recorder] group with the long options as keys
+(out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
+min-free, status, stall-timeout, http, http-token, http-idle-timeout, rtsp, periods, failsafe, marvelmind,
+beacon, mqtt, mqtt-prefix, mqtt-detections-rate, on-segment-closed,
+hook-timeout), and one [device NAME] group per vehicle with host, port, cameras
+(e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as on the command
+line), marvelmind and beacon:
+
+  [recorder]
+  out=recordings
+  detect=tag36h11
+  [device rover]
+  host=192.168.1.1
+  cameras=0;1
+  follow=true
+  marvelmind=192.168.1.50:49200
+  beacon=5
+
+Files: DIR/<device>-cam<N>-YYYYMMDDTHHMMSSZ.mkv (or .mp4), named by the UTC
+time of their first frame, each starting at 0 on a key frame; a segment also
+ends where the device was lost. Beside each, <same name>.jsonl with one JSON
+object per event: {"pts": ns on the segment's timeline, "utc": "...Z", "type":
+"stats"|"detections"|"control"|"session"|"vehicle"|"position"|"position-stale",
+...}; the same objects are
+the file's text track "telemetry". DIR/index.json lists the finished segments
+(camera, file, start_utc, duration_s, frames, bytes).
+
+MQTT topics (PREFIX/STREAM, STREAM as in the file names):
+  PREFIX/available          online/offline, retained; offline is the last will
+  PREFIX/STREAM/status      retained JSON: state, fps, loss, battery_v,
+                            has_control, following, position; on change and
+                            at least every 5 s
+  PREFIX/STREAM/detections  JSON per frame with tags (and one when they go)
+  PREFIX/STREAM/events      session events, {"type":"segment-closed",...},
+                            hook failures
+  PREFIX/STREAM/follow/set  ON or OFF (takes effect at once; OFF = neutral)
+  PREFIX/STREAM/target/set  a tag id (-1: the largest)
+
+Exit status: 0 finished cleanly (or stopped by a signal before any frame),
+1 error (or --duration ended with nothing recorded), 2 bad arguments, 3 the
+disk filled (the open segments were finished first).
+)";
+}
+
+const char* extensionOf(Container container) {
+  return container == Container::kMp4 ? ".mp4" : ".mkv";
+}
+
+namespace {
+std::optional<double> number(const char* text);
+}  // namespace
+
+std::optional<ServerAddress> parseServerAddress(const std::string& text) {
+  auto colon = text.rfind(':');
+  if (colon == std::string::npos) return std::nullopt;
+  auto port = number(text.substr(colon + 1).c_str());
+  if (!port || *port < 0 || *port > 65535) return std::nullopt;
+  return ServerAddress{text.substr(0, colon), static_cast<uint16_t>(*port)};
+}
+
+namespace {
+
+// "500M", "20G", "1048576": bytes.
+std::optional<uint64_t> size(const char* text) {
+  char* end = nullptr;
+  double value = std::strtod(text, &end);
+  if (end == text || !std::isfinite(value) || value < 0) return std::nullopt;
+  std::string unit = end;
+  double scale = unit.empty()  ? 1
+                 : unit == "K" ? 1e3
+                 : unit == "M" ? 1e6
+                 : unit == "G" ? 1e9
+                 : unit == "T" ? 1e12
+                               : 0;
+  // Past 2^64 bytes the cast would be undefined, and no disk is that big.
+  if (scale == 0 || value * scale >= 1.8e19) return std::nullopt;
+  return static_cast<uint64_t>(value * scale);
+}
+
+std::optional<double> number(const char* text) {
+  char* end = nullptr;
+  double value = std::strtod(text, &end);
+  // NaN passes every range check and then casts to garbage: refused here.
+  if (end == text || *end != '\0' || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+Expected<DeviceTarget, std::string> deviceTarget(const std::string& argument) {
+  DeviceTarget target;
+  std::string text = argument.substr(0, argument.find(','));
+  if (text.size() < argument.size()) {
+    std::string extra = argument.substr(text.size() + 1);
+    if (extra.rfind("control=", 0) != 0)
+      return unexpected("--device " + argument + ": after the comma only control=URI");
+    auto control = parseControlTarget(extra.substr(8));
+    if (!control) return unexpected("--device " + argument + ": " + control.error());
+    target.control = *control;
+  }
+  auto colon = text.rfind(':');
+  target.host = text.substr(0, colon);
+  if (colon != std::string::npos) {
+    auto port = number(text.substr(colon + 1).c_str());
+    if (!port || *port < 1 || *port > 65535) return unexpected("bad port in --device " + text);
+    target.port = static_cast<uint16_t>(*port);
+  }
+  if (target.host.empty())
+    return unexpected("--device needs a host, as in 192.168.1.1 or 127.0.0.1:1984");
+  target.label = target.host + (target.port == 1984 ? "" : "-" + std::to_string(target.port));
+  return target;
+}
+
+// Applies one option given by its long name (from the command line or the
+// config file's [recorder] group).
+std::optional<std::string> applyOption(RecorderOptions& o, const std::string& name,
+                                       const char* value);
+
+Expected<std::vector<DeviceTarget>, std::string> loadConfig(const char* path, RecorderOptions& o) {
+  std::unique_ptr<GKeyFile, decltype(&g_key_file_free)> file(g_key_file_new(), g_key_file_free);
+  GError* error = nullptr;
+  if (!g_key_file_load_from_file(file.get(), path, G_KEY_FILE_NONE, &error)) {
+    std::string message = std::string("cannot read --config ") + path + ": " + error->message;
+    g_error_free(error);
+    return unexpected(message);
+  }
+  std::vector<DeviceTarget> devices;
+  gsize count = 0;
+  std::unique_ptr<gchar*, decltype(&g_strfreev)> groups(g_key_file_get_groups(file.get(), &count),
+                                                        g_strfreev);
+  for (gsize g = 0; g < count; ++g) {
+    std::string group = groups.get()[g];
+    gsize keyCount = 0;
+    std::unique_ptr<gchar*, decltype(&g_strfreev)> keys(
+        g_key_file_get_keys(file.get(), group.c_str(), &keyCount, nullptr), g_strfreev);
+    auto value = [&](const char* key) -> std::string {
+      gchar* text = g_key_file_get_string(file.get(), group.c_str(), key, nullptr);
+      std::string out = text ? text : "";
+      g_free(text);
+      return out;
+    };
+    if (group == "recorder") {
+      for (gsize k = 0; k < keyCount; ++k) {
+        std::string key = keys.get()[k];
+        if (auto problem = applyOption(o, key, value(key.c_str()).c_str()))
+          return unexpected(std::string(path) + " [recorder] " + key + ": " + *problem);
+      }
+    } else if (group.rfind("device ", 0) == 0) {
+      DeviceTarget device;
+      device.label = group.substr(7);
+      for (gsize k = 0; k < keyCount; ++k) {
+        std::string key = keys.get()[k];
+        std::string text = value(key.c_str());
+        auto where = std::string(path) + " [" + group + "] " + key;
+        if (key == "host") {
+          device.host = text;
+        } else if (key == "port") {
+          auto port = number(text.c_str());
+          if (!port || *port < 1 || *port > 65535)
+            return unexpected(where + ": a port is 1..65535");
+          device.port = static_cast<uint16_t>(*port);
+        } else if (key == "cameras") {
+          gsize n = 0;
+          std::unique_ptr<gint, decltype(&g_free)> list(
+              g_key_file_get_integer_list(file.get(), group.c_str(), "cameras", &n, nullptr),
+              g_free);
+          if (!list) return unexpected(where + ": a list like 0;1");
+          for (gsize i = 0; i < n; ++i) device.cameras.push_back(list.get()[i]);
+        } else if (key == "follow") {
+          device.follow = text == "true" || text == "1";
+        } else if (key == "control") {
+          auto control = parseControlTarget(text);
+          if (!control) return unexpected(where + ": " + control.error());
+          device.control = *control;
+        } else if (key == "marvelmind") {
+          device.marvelmind = text;
+        } else if (key == "beacon") {
+          device.beacons = text;
+        } else {
+          return unexpected(where +
+                            ": unknown key (host, port, cameras, follow, control, marvelmind, "
+                            "beacon)");
+        }
+      }
+      if (device.host.empty()) return unexpected(std::string(path) + " [" + group + "] needs host");
+      devices.push_back(std::move(device));
+    } else {
+      return unexpected(std::string(path) + ": unknown group [" + group +
+                        "] ([recorder] or [device NAME])");
+    }
+  }
+  return devices;
+}
+
+std::optional<std::string> applyOption(RecorderOptions& o, const std::string& name,
+                                       const char* value) {
+  if (name == "out") {
+    o.outDir = value;
+  } else if (name == "segment") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 1) return "seconds >= 1";
+    o.segmentSeconds = *seconds;
+  } else if (name == "segment-size") {
+    auto bytes = size(value);
+    if (!bytes || *bytes < 100000) return "a size of at least 100K, like 100M";
+    o.segmentBytes = *bytes;
+  } else if (name == "format") {
+    std::string format = value;
+    if (format != "mkv" && format != "mp4") return "mkv or mp4";
+    o.container = format == "mp4" ? Container::kMp4 : Container::kMatroska;
+  } else if (name == "codec") {
+    std::string codec = value;
+    if (codec != "jpeg" && codec != "h264") return "jpeg or h264";
+    o.codec = codec == "h264" ? Codec::kH264 : Codec::kJpeg;
+  } else if (name == "bitrate") {
+    auto kbps = number(value);
+    if (!kbps || *kbps < 50 || *kbps > 100000) return "kbit/s, 50..100000";
+    o.h264Kbps = static_cast<unsigned>(*kbps);
+  } else if (name == "http" || name == "rtsp") {
+    auto address = parseServerAddress(value);
+    if (!address) return "[HOST]:PORT, as in :8080 or 127.0.0.1:8080";
+    (name == "http" ? o.http : o.rtsp) = *address;
+  } else if (name == "http-token") {
+    std::string token = value;
+    if (token.size() < 16 || token.find_first_of(" ;,\"\\") != std::string::npos)
+      return "at least 16 characters, no spaces, quotes, commas or semicolons (e.g. from "
+             "openssl rand -hex 16)";
+    o.httpToken = token;
+  } else if (name == "http-idle-timeout") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 0.1 || *seconds > 3600) return "seconds, 0.1..3600";
+    o.httpIdleSeconds = *seconds;
+  } else if (name == "stall-timeout") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 0.5 || *seconds > 3600) return "seconds, 0.5..3600";
+    o.stallSeconds = *seconds;
+  } else if (name == "detect") {
+    o.detectFamily = value;
+  } else if (name == "follow") {
+    o.follow = std::string(value) != "false" && std::string(value) != "0";
+  } else if (name == "duration") {
+    auto seconds = number(value);
+    if (!seconds || *seconds <= 0) return "seconds > 0";
+    o.duration = *seconds;
+  } else if (name == "status") {
+    auto seconds = number(value);
+    if (!seconds || *seconds <= 0) return "seconds > 0";
+    o.statusSeconds = *seconds;
+  } else if (name == "max-bytes" || name == "min-free") {
+    auto bytes = size(value);
+    if (!bytes) return "a size like 500M or 20G";
+    (name == "max-bytes" ? o.maxBytes : o.minFree) = *bytes;
+  } else if (name == "periods" || name == "failsafe") {
+    auto channels = wirc::parseChannelList(value);
+    if (!channels) return channels.error();
+    auto valid = name == "periods" ? wirc::validate(wirc::Ccfg{*channels})
+                                   : wirc::validate(wirc::Fcfg{*channels});
+    if (valid) return valid->message();
+    (name == "periods" ? o.periods : o.failsafe) = value;
+  } else if (name == "mqtt") {
+    auto url = parseMqttUrl(value);
+    if (!url) return url.error();
+    o.mqtt = value;
+  } else if (name == "mqtt-prefix") {
+    std::string prefix = value;
+    if (prefix.empty() || prefix.find_first_of("+#") != std::string::npos ||
+        prefix.front() == '/' || prefix.back() == '/')
+      return "a topic prefix without + # or a leading or trailing /, like wircam or lab/rovers";
+    o.mqttPrefix = prefix;
+  } else if (name == "mqtt-detections-rate") {
+    auto rate = number(value);
+    if (!rate || *rate < 0 || *rate > 1000) return "messages per second, 0..1000 (0: every frame)";
+    o.mqttDetectionsRate = *rate;
+  } else if (name == "on-segment-closed") {
+    gchar** argv = nullptr;
+    GError* error = nullptr;
+    if (!g_shell_parse_argv(value, nullptr, &argv, &error)) {
+      std::string problem = error->message;
+      g_error_free(error);
+      return "cannot split the command: " + problem;
+    }
+    o.onSegmentClosed.assign(argv, argv + g_strv_length(argv));
+    g_strfreev(argv);
+  } else if (name == "hook-timeout") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 1 || *seconds > 86400) return "seconds, 1..86400";
+    o.hookTimeoutSeconds = *seconds;
+  } else if (name == "marvelmind") {
+    o.marvelmind = value;
+  } else if (name == "beacon") {
+    o.beacons = value;
+  } else if (name == "camera") {
+    auto camera = number(value);
+    if (!camera || *camera < 0 || *camera > 255) return "0..255";
+    o.cameras.push_back(static_cast<int>(*camera));
+  } else {
+    return "unknown option";
+  }
+  return std::nullopt;
+}
+
+// The dashboard and beacons of a device, both or neither.
+Expected<std::optional<PositionSource>, std::string> positionSource(
+    const std::optional<std::string>& dashboard, const std::optional<std::string>& beacons) {
+  if (!dashboard && !beacons) return std::optional<PositionSource>();
+  if (!dashboard)
+    return unexpected(std::string("beacon= needs marvelmind=HOST[:PORT] (--marvelmind)"));
+  if (!beacons)
+    return unexpected("marvelmind " + *dashboard + " needs the vehicle's beacon (--beacon ADDR)");
+  PositionSource source;
+  auto colon = dashboard->rfind(':');
+  source.host = dashboard->substr(0, colon);
+  if (colon != std::string::npos) {
+    auto port = number(dashboard->substr(colon + 1).c_str());
+    if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
+      return unexpected("marvelmind '" + *dashboard + "': a port is 1..65535");
+    source.port = static_cast<uint16_t>(*port);
+  }
+  if (source.host.empty() || source.host.find_first_of("/ \"'") != std::string::npos)
+    return unexpected("marvelmind '" + *dashboard + "' needs a host, as in 192.168.1.50:49200");
+  auto parsed = marvelmind::parseBeacons(*beacons);
+  if (!parsed) return unexpected(parsed.error());
+  for (uint8_t beacon : *parsed)
+    source.beacons += (source.beacons.empty() ? "" : ",") + std::to_string(beacon);
+  return std::optional<PositionSource>(source);
+}
+
+}  // namespace
+
+Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri) {
+  auto scheme = uri.find("://");
+  ControlTarget target;
+  target.protocol = uri.substr(0, scheme);
+  if (scheme == std::string::npos ||
+      (target.protocol != "wirc" && target.protocol != "rcoip" && target.protocol != "btemp"))
+    return unexpected("control '" + uri + "' is not rcoip://HOST:PORT, btemp://HOST:PORT or " +
+                      "wirc://HOST:PORT");
+  std::string address = uri.substr(scheme + 3);
+  auto colon = address.rfind(':');
+  target.host = address.substr(0, colon);
+  if (colon != std::string::npos) {
+    auto port = number(address.substr(colon + 1).c_str());
+    if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
+      return unexpected("control '" + uri + "': a port is 1..65535");
+    target.port = static_cast<uint16_t>(*port);
+  }
+  if (target.host.empty() || target.host.find_first_of("/ \"'") != std::string::npos)
+    return unexpected("control '" + uri + "' needs a host, as in rcoip://192.168.4.1:9048");
+  return target;
+}
+
+Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
+  enum { kDevice = 1000, kConfig, kValue };
+  // Every other long option is applied by applyOption() under its own name.
+  static const option options[] = {{"device", required_argument, nullptr, kDevice},
+                                   {"config", required_argument, nullptr, kConfig},
+                                   {"camera", required_argument, nullptr, kValue},
+                                   {"out", required_argument, nullptr, kValue},
+                                   {"segment", required_argument, nullptr, kValue},
+                                   {"segment-size", required_argument, nullptr, kValue},
+                                   {"format", required_argument, nullptr, kValue},
+                                   {"codec", required_argument, nullptr, kValue},
+                                   {"bitrate", required_argument, nullptr, kValue},
+                                   {"http", required_argument, nullptr, kValue},
+                                   {"rtsp", required_argument, nullptr, kValue},
+                                   {"http-idle-timeout", required_argument, nullptr, kValue},
+                                   {"stall-timeout", required_argument, nullptr, kValue},
+                                   {"http-token", required_argument, nullptr, kValue},
+                                   {"detect", required_argument, nullptr, kValue},
+                                   {"follow", no_argument, nullptr, kValue},
+                                   {"duration", required_argument, nullptr, kValue},
+                                   {"status", required_argument, nullptr, kValue},
+                                   {"max-bytes", required_argument, nullptr, kValue},
+                                   {"min-free", required_argument, nullptr, kValue},
+                                   {"periods", required_argument, nullptr, kValue},
+                                   {"failsafe", required_argument, nullptr, kValue},
+                                   {"marvelmind", required_argument, nullptr, kValue},
+                                   {"mqtt", required_argument, nullptr, kValue},
+                                   {"mqtt-prefix", required_argument, nullptr, kValue},
+                                   {"mqtt-detections-rate", required_argument, nullptr, kValue},
+                                   {"on-segment-closed", required_argument, nullptr, kValue},
+                                   {"hook-timeout", required_argument, nullptr, kValue},
+                                   {"beacon", required_argument, nullptr, kValue},
+                                   {"help", no_argument, nullptr, 'h'},
+                                   {nullptr, 0, nullptr, 0}};
+  RecorderOptions o;
+  o.outDir.clear();
+  optind = 1;
+  int opt, index = 0;
+  while ((opt = getopt_long(argc, argv, "h", options, &index)) != -1) {
+    switch (opt) {
+      case 'h':
+        return unexpected("help");
+      case kDevice: {
+        auto target = deviceTarget(optarg);
+        if (!target) return unexpected(target.error());
+        o.devices.push_back(*target);
+        break;
+      }
+      case kConfig: {
+        auto devices = loadConfig(optarg, o);
+        if (!devices) return unexpected(devices.error());
+        o.devices.insert(o.devices.end(), devices->begin(), devices->end());
+        break;
+      }
+      case kValue: {
+        std::string name = options[index].name;
+        if (auto problem = applyOption(o, name, optarg ? optarg : "true"))
+          return unexpected("--" + name + ": " + *problem);
+        break;
+      }
+      default:
+        return unexpected("unknown option");
+    }
+  }
+  if (optind < argc) return unexpected(std::string("unexpected argument '") + argv[optind] + "'");
+  if (o.outDir.empty()) return unexpected("--out DIR (or out= in the config) is needed");
+  if (o.follow && o.detectFamily.empty()) return unexpected("--follow needs --detect FAMILY");
+  if (o.container == Container::kMp4 && o.codec == Codec::kJpeg)
+    return unexpected(
+        "--format mp4 needs --codec h264: GStreamer's mp4mux cannot carry the camera's JPEG "
+        "frames as they are (use mkv to keep them untouched)");
+  if (o.http && o.httpToken.empty() && !o.http->host.empty() && o.http->host != "127.0.0.1" &&
+      o.http->host != "localhost")
+    return unexpected("--http " + o.http->host + ":" + std::to_string(o.http->port) +
+                      " would open the recorder beyond this machine without authentication: "
+                      "give --http-token T (or leave HOST out for 127.0.0.1 only)");
+  if (o.devices.empty()) o.devices.push_back({"", 1984, "discovered"});
+  if (o.cameras.empty()) o.cameras.push_back(0);
+  for (auto& device : o.devices) {
+    if (device.cameras.empty()) device.cameras = o.cameras;
+    if (!device.follow) device.follow = o.follow;
+    if (device.control && !*device.follow)
+      return unexpected("device " + device.label +
+                        " has control=, which steers only with follow (--follow or follow=true)");
+    if (*device.follow && o.detectFamily.empty())
+      return unexpected("device " + device.label + " follows, which needs detect=FAMILY");
+    auto positions = positionSource(device.marvelmind ? device.marvelmind : o.marvelmind,
+                                    device.beacons ? device.beacons : o.beacons);
+    if (!positions) return unexpected("device " + device.label + ": " + positions.error());
+    device.positions = *positions;
+  }
+  return o;
+}
+
+}  // namespace wircam::recorder

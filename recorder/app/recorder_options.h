@@ -1,0 +1,104 @@
+// What wirc-recorder was asked to do, read from its command line.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/expected.h"
+#include "marvelmind/marvelmind_messages.h"
+
+namespace wircam::recorder {
+
+// What steers a following vehicle when it is not the WiRC device itself:
+// "rcoip://HOST:PORT" or "btemp://HOST:PORT" (":PORT" optional: 9048,
+// 16980; "wirc://" names another WiRC device).
+struct ControlTarget {
+  std::string protocol;  // wirc, rcoip or btemp
+  std::string host;
+  uint16_t port = 0;  // 0: the protocol's default
+  bool operator==(const ControlTarget&) const = default;
+};
+Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri);
+
+// A Marvelmind dashboard and the vehicle's beacons on it.
+struct PositionSource {
+  std::string host;
+  uint16_t port = marvelmind::kDefaultDashboardPort;
+  std::string beacons;  // "5" or "5,6"
+  bool operator==(const PositionSource&) const = default;
+};
+
+struct DeviceTarget {
+  std::string host;  // empty: discover
+  uint16_t port = 1984;
+  std::string label;                     // in file names: the host, or the config section's name
+  std::vector<int> cameras;              // empty: the recorder-wide --camera list
+  std::optional<bool> follow;            // unset: the recorder-wide --follow
+  std::optional<ControlTarget> control;  // unset: steer the WiRC device itself
+  // Unset: the recorder-wide --marvelmind/--beacon, if any.
+  std::optional<std::string> marvelmind;  // HOST[:PORT] of the dashboard
+  std::optional<std::string> beacons;
+  std::optional<PositionSource> positions;  // resolved from the two above
+};
+
+// Where a server listens: "[HOST]:PORT"; no host means this machine only
+// (127.0.0.1; 0.0.0.0 for every interface), port 0 one the system picks
+// (the recorder prints it).
+struct ServerAddress {
+  std::string host;
+  uint16_t port = 0;
+  std::string listenHost() const { return host.empty() ? "127.0.0.1" : host; }
+};
+std::optional<ServerAddress> parseServerAddress(const std::string& text);
+
+// How the frames are stored: as the camera sent them, or re-encoded.
+enum class Codec { kJpeg, kH264 };
+enum class Container { kMatroska, kMp4 };
+
+struct RecorderOptions {
+  std::vector<DeviceTarget> devices;
+  std::vector<int> cameras;  // default {0}
+  std::string outDir = ".";
+  double segmentSeconds = 60;
+  uint64_t segmentBytes = 0;  // 0: segments end by time only
+  Container container = Container::kMatroska;
+  Codec codec = Codec::kJpeg;
+  unsigned h264Kbps = 2000;
+  std::string detectFamily;  // empty: no detection
+  bool follow = false;       // needs detectFamily
+  std::optional<double> duration;
+  double statusSeconds = 1;
+  double stallSeconds = 5;  // logged in without a frame this long: no-video, restarted
+  uint64_t maxBytes = 0;  // retention: 0 = unlimited
+  uint64_t minFree = 0;
+  std::optional<ServerAddress> http;  // unset: no web server
+  std::optional<ServerAddress> rtsp;  // unset: no RTSP server
+  double httpIdleSeconds = 10;        // a connection silent this long is closed
+  std::string httpToken;              // empty: this machine only, no authentication
+  // What the login tells the device (CCFG, FCFG), as channel lists; only the
+  // first transmitter's login configures it. Unset: wircsrc's defaults.
+  std::optional<std::string> periods;
+  std::optional<std::string> failsafe;
+  // Fleets: MQTT (unset: none) and the closed-segment hook (empty: none).
+  std::optional<std::string> mqtt;  // mqtt://[user:pass@]HOST[:PORT]
+  std::string mqttPrefix = "wircam";
+  double mqttDetectionsRate = 0;             // per second and stream at most; 0 = every frame
+  std::vector<std::string> onSegmentClosed;  // the command and its arguments
+  double hookTimeoutSeconds = 600;
+  // Marvelmind positions of every device that names none of its own.
+  std::optional<std::string> marvelmind;  // HOST[:PORT]
+  std::optional<std::string> beacons;
+};
+
+// The file name extension of a container, with its dot.
+const char* extensionOf(Container container);
+
+// The options, or an error message naming the bad argument; --help text in
+// `usage()`. `--config FILE` reads a GKeyFile first; options given on the
+// command line after it override its [recorder] group.
+Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv);
+const char* usage();
+
+}  // namespace wircam::recorder

@@ -1,0 +1,425 @@
+#include "app/supervisor.h"
+
+#include <glib-unix.h>
+#include <libsoup/soup.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+
+#include "log_line.h"
+#include "record/segment_inspector.h"
+#include "record/segment_planner.h"
+#include "status/camera_report.h"
+#include "telemetry/telemetry_track.h"
+#include "telemetry/telemetry_track_flags.h"
+
+namespace wircam::recorder {
+
+namespace {
+
+// --detect FAMILY against the families apriltagdetect knows (its GEnum).
+std::optional<std::string> checkFamily(const std::string& family) {
+  if (family.empty()) return std::nullopt;
+  GstElement* detector = gst_element_factory_make("apriltagdetect", nullptr);
+  if (!detector) return "--detect needs apriltagdetect: are the wircam plugins on GST_PLUGIN_PATH?";
+  auto* spec =
+      G_PARAM_SPEC_ENUM(g_object_class_find_property(G_OBJECT_GET_CLASS(detector), "family"));
+  std::string known;
+  bool found = false;
+  for (guint i = 0; i < spec->enum_class->n_values; ++i) {
+    std::string nick = spec->enum_class->values[i].value_nick;
+    found |= nick == family;
+    known += (known.empty() ? "" : ", ") + nick;
+  }
+  gst_object_unref(detector);
+  if (found) return std::nullopt;
+  return "--detect " + family + ": not an AprilTag family (" + known + ")";
+}
+
+// A stop's own bound, past the cameras' kFinishTime: whatever a camera or
+// device does, the run ends within 3 s of it.
+constexpr guint kStopBoundMs = 2900;
+constexpr int kHookDrainSeconds = 15;
+
+}  // namespace
+
+Supervisor::Supervisor(RecorderOptions options)
+    : options_(std::move(options)),
+      retention_(options_.outDir, {options_.maxBytes, options_.minFree}, logLine),
+      disk_(options_.outDir),
+      index_(options_.outDir),
+      commands_([this](const std::string& name) { return cameraNamed(name); },
+                [this](Camera& camera, const nlohmann::json& applied) {
+                  event(camera, applied);
+                  publishFleetStatus(true);
+                }) {}
+
+Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
+    const RecorderOptions& options) {
+  std::error_code error;
+  std::filesystem::create_directories(options.outDir, error);
+  if (error) return unexpected("cannot create '" + options.outDir + "': " + error.message());
+  if (access(options.outDir.c_str(), W_OK) != 0)
+    return unexpected("cannot write into '" + options.outDir + "'");
+  if (options.codec == Codec::kH264 &&
+      !gst_registry_check_feature_version(gst_registry_get(), "x264enc", 1, 0, 0))
+    return unexpected(
+        "--codec h264 needs x264enc, from Debian's gstreamer1.0-plugins-ugly "
+        "(tools/install-deps installs it)");
+  if (auto problem = checkFamily(options.detectFamily)) return unexpected(*problem);
+
+  std::unique_ptr<Supervisor> supervisor(new Supervisor(options));
+  // Segments the index lacks (a crash's last one, or a lost index).
+  auto inspect = [](const std::filesystem::path& file) {
+    markTelemetryTrack(file);  // a file the recorder did not finish
+    return inspectSegment(file);
+  };
+  if (size_t added = supervisor->index_.reconcile(inspect))
+    logLine("indexed " + std::to_string(added) + " segment(s) missing from " +
+            supervisor->index_.path().string());
+  supervisor->index_.save();
+  auto plan = planPipeline(options);
+  CameraFiles files{
+      .folder = options.outDir,
+      .extension = extensionOf(options.container),
+      .limits = {.maxDuration = static_cast<uint64_t>(options.segmentSeconds * GST_SECOND),
+                 .maxBytes = options.segmentBytes},
+      .transcoded = plan.transcoded};
+  CameraHealth::Policy health{.stallTimeout = std::chrono::milliseconds(
+                                  static_cast<int64_t>(options.stallSeconds * 1000))};
+  for (auto& stream : plan.streams) {
+    auto camera = Camera::create(stream, files, health, *supervisor);
+    if (!camera) return unexpected(camera.error());
+    supervisor->cameras_.push_back(std::move(*camera));
+  }
+  if (auto problem = supervisor->startServers()) return unexpected(*problem);
+  return supervisor;
+}
+
+std::optional<std::string> Supervisor::startServers() {
+  if (options_.http) {
+    HttpServer::Content content;
+    for (auto& c : cameras_) content.cameras.push_back({c->name(), c->frames()});
+    content.recordingsFolder = options_.outDir;
+    content.token = options_.httpToken;
+    content.status = [this] { return status(); };
+    content.trails = [this] { return trails(); };
+    content.cameraStates = [this] {
+      nlohmann::json cameras = nlohmann::json::array();
+      for (const auto& c : cameras_) cameras.push_back(cameraJson(c->report()));
+      return cameras;
+    };
+    content.deleteRecording = [this](const std::string& file) { return deleteSegment(file); };
+    content.recordings = [this] {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& entry : index_.entries()) list.push_back(toJson(entry));
+      return list;
+    };
+    content.openSegments = [this] { return openSegments(); };
+    content.command = [this](const FleetCommand& c) { return commands_.apply(c, "web"); };
+    content.drive = [this](const std::string& camera, double steering, double throttle) {
+      return commands_.drive(camera, steering, throttle);
+    };
+    auto server = HttpServer::start(
+        *options_.http, std::move(content),
+        std::chrono::milliseconds(static_cast<int64_t>(options_.httpIdleSeconds * 1000)));
+    if (!server) return server.error();
+    http_ = std::move(*server);
+    logLine("live view at " + http_->url());
+  }
+  if (options_.mqtt) {
+    FleetPublisher::Settings settings{.url = *parseMqttUrl(*options_.mqtt),
+                                      .prefix = options_.mqttPrefix,
+                                      .detectionsRate = options_.mqttDetectionsRate};
+    for (auto& c : cameras_) settings.streams.push_back(c->name());
+    auto fleet = FleetPublisher::start(
+        settings, [this](const FleetCommand& c) { commands_.apply(c, "MQTT"); });
+    if (!fleet) return fleet.error();
+    fleet_ = std::move(*fleet);
+    logLine("MQTT to " + settings.url.host + ":" + std::to_string(settings.url.port) + " under " +
+            settings.prefix + "/");
+  }
+  if (!options_.onSegmentClosed.empty()) {
+    hook_ = std::make_unique<SegmentHook>(
+        options_.onSegmentClosed,
+        std::chrono::seconds(static_cast<int64_t>(options_.hookTimeoutSeconds)),
+        [this](const std::string& name, const nlohmann::json& hookEvent) {
+          if (Camera* c = cameraNamed(name)) event(*c, hookEvent);
+        });
+  }
+  if (options_.rtsp) {
+    std::vector<RtspServer::Camera> cameras;
+    for (auto& c : cameras_)
+      cameras.push_back(
+          {"/" + c->plan().device + "/cam" + std::to_string(c->plan().camera), c->frames()});
+    auto server = RtspServer::start(*options_.rtsp, cameras);
+    if (!server) return server.error();
+    rtsp_ = std::move(*server);
+    for (auto& camera : cameras) logLine("RTSP at " + rtsp_->url() + camera.path);
+  }
+  return std::nullopt;
+}
+
+Supervisor::~Supervisor() {
+  // The servers first: they listen to the cameras' frames.
+  http_.reset();
+  rtsp_.reset();
+  hook_.reset();
+  fleet_.reset();  // says offline
+  cameras_.clear();
+  if (loop_) g_main_loop_unref(loop_);
+}
+
+Camera* Supervisor::cameraNamed(const std::string& name) {
+  for (auto& c : cameras_)
+    if (c->name() == name) return c.get();
+  return nullptr;
+}
+
+void Supervisor::segmentClosed(Camera& camera, const std::string& file,
+                               const PlannedSegment& planned) {
+  markTelemetryTrack(file);
+  std::error_code error;
+  auto name = std::filesystem::path(file).filename().string();
+  index_.add({.camera = camera.name(),
+              .file = name,
+              .startUtc = SegmentPlanner::isoUtc(planned.startUnixMs),
+              .durationSeconds = planned.durationSeconds(),
+              .frames = planned.frames,
+              .bytes = std::filesystem::file_size(file, error)});
+  auto sidecar = TelemetryLog::pathFor(file);
+  event(camera, {{"type", "segment-closed"},
+                 {"file", name},
+                 {"path", file},
+                 {"sidecar", sidecar},
+                 {"start_utc", SegmentPlanner::isoUtc(planned.startUnixMs)},
+                 {"duration_s", planned.durationSeconds()},
+                 {"frames", planned.frames}});
+  if (hook_) hook_->segmentClosed(camera.name(), file, sidecar);
+  auto open = openSegments();
+  updateIndex(retention_.enforce({open.begin(), open.end()}));
+}
+
+void Supervisor::event(Camera& camera, const nlohmann::json& event) {
+  if (!fleet_) return;
+  nlohmann::json line = event;
+  line["utc"] = SegmentPlanner::isoUtc(g_get_real_time() / 1000);
+  fleet_->event(camera.name(), line);
+}
+
+void Supervisor::detections(Camera& camera, const nlohmann::json& line, int64_t unixMs) {
+  if (http_) http_->publishDetections(camera.name(), line["detections"]);
+  if (fleet_)
+    fleet_->detections(camera.name(),
+                       {{"utc", SegmentPlanner::isoUtc(unixMs)},
+                        {"frame", line.value("frame", 0)},
+                        {"tags", line["detections"]}},
+                       !line["detections"].empty());
+}
+
+void Supervisor::diskFull(Camera&) {
+  // A write failed: the other cameras can still finish their files.
+  exitCode_ = kExitDiskFull;
+  if (!stopping_) logLine("the disk is full: finishing the other files; earlier segments are untouched");
+  stop(nullptr);
+}
+
+void Supervisor::ended(Camera&) { quitWhenAllEnded(); }
+
+void Supervisor::quitWhenAllEnded() {
+  if (stopping_ &&
+      std::all_of(cameras_.begin(), cameras_.end(), [](const auto& c) { return c->ended(); }))
+    g_main_loop_quit(loop_);
+}
+
+void Supervisor::stop(const char* why) {
+  if (stopping_) return;
+  stopping_ = true;
+  if (why) logLine(std::string(why) + ": finishing the files (a second signal stops at once)");
+  bool anyRecorded = std::any_of(cameras_.begin(), cameras_.end(),
+                                 [](const auto& c) { return c->hasFrames(); });
+  if (!anyRecorded && exitCode_ == 0 && index_.entries().empty()) {
+    // No device ever sent a frame. Stopped by a signal while waiting is how
+    // a service ends; a --duration that recorded nothing failed.
+    logLine("nothing was recorded: no device sent a frame");
+    if (!stoppedBySignal_) exitCode_ = kExitError;
+  }
+  timers_.push_back(g_timeout_add(kStopBoundMs, onStopDeadline, this));
+  for (auto& c : cameras_) c->stop();
+  quitWhenAllEnded();
+}
+
+gboolean Supervisor::onStopDeadline(gpointer data) {
+  // Cameras cut themselves off at kFinishTime; this is the backstop.
+  g_main_loop_quit(static_cast<Supervisor*>(data)->loop_);
+  return G_SOURCE_REMOVE;
+}
+
+gboolean Supervisor::onSignal(gpointer data) {
+  auto* self = static_cast<Supervisor*>(data);
+  if (self->stopping_) {
+    logLine("stopping now, without finishing the files");
+    if (self->exitCode_ == 0) self->exitCode_ = kExitError;
+    g_main_loop_quit(self->loop_);
+    if (self->hook_) self->hook_->stopDraining();
+    return G_SOURCE_CONTINUE;
+  }
+  self->stoppedBySignal_ = true;
+  self->stop("stopping");
+  return G_SOURCE_CONTINUE;
+}
+
+gboolean Supervisor::onDurationOver(gpointer data) {
+  static_cast<Supervisor*>(data)->stop("--duration is over");
+  return G_SOURCE_REMOVE;
+}
+
+gboolean Supervisor::onHeartbeat(gpointer data) {
+  for (auto& c : static_cast<Supervisor*>(data)->cameras_) c->heartbeat();
+  return G_SOURCE_CONTINUE;
+}
+
+gboolean Supervisor::onCameraTick(gpointer data) {
+  for (auto& c : static_cast<Supervisor*>(data)->cameras_) c->tick();
+  return G_SOURCE_CONTINUE;
+}
+
+gboolean Supervisor::onTick(gpointer data) {
+  auto* self = static_cast<Supervisor*>(data);
+  self->printStatus();
+  self->guardDisk();
+  return G_SOURCE_CONTINUE;
+}
+
+void Supervisor::publishFleetStatus(bool force) {
+  if (!fleet_) return;
+  for (const auto& c : cameras_) fleet_->status(c->name(), fleetStatusJson(c->report()), force);
+}
+
+std::optional<std::pair<guint, std::string>> Supervisor::deleteSegment(const std::string& file) {
+  using Refusal = std::pair<guint, std::string>;
+  for (const auto& path : openSegments())
+    if (std::filesystem::path(path).filename() == file)
+      return Refusal(SOUP_STATUS_CONFLICT,
+                     "'" + file + "' is being recorded; it can go once closed");
+  const auto& entries = index_.entries();
+  if (std::none_of(entries.begin(), entries.end(), [&](const auto& e) { return e.file == file; }))
+    return Refusal(SOUP_STATUS_NOT_FOUND, "no recording named '" + file + "'");
+  auto video = std::filesystem::path(options_.outDir) / file;
+  if (auto error = removeSegment(video))
+    return Refusal(SOUP_STATUS_INTERNAL_SERVER_ERROR,
+                   "cannot delete '" + file + "': " + error.message());
+  logLine("deleted " + file + " (asked over HTTP)");
+  updateIndex({video.string()});
+  return std::nullopt;
+}
+
+void Supervisor::updateIndex(const std::vector<std::string>& deleted) {
+  for (const auto& file : deleted) index_.remove(std::filesystem::path(file).filename().string());
+  if (!index_.save()) logLine("cannot write " + index_.path().string());
+}
+
+void Supervisor::guardDisk() {
+  if (stopping_) return;
+  uint64_t rate = 0;
+  for (auto& c : cameras_) rate += static_cast<uint64_t>(c->kbps() * 1000 / 8);
+  if (!disk_.nearlyFull(rate)) return;
+  // Old segments may make room (--max-bytes/--min-free); if not, stop while
+  // the open segments can still be finished.
+  auto open = openSegments();
+  updateIndex(retention_.enforce({open.begin(), open.end()}));
+  if (!disk_.nearlyFull(rate)) return;
+  logLine("the disk under " + options_.outDir + " is full (" + std::to_string(disk_.free() >> 20) +
+          " MiB free, " + std::to_string(DiskGuard::reserveFor(rate) >> 20) +
+          " MiB kept to finish the files); stopping. Free some space or use --max-bytes / "
+          "--min-free to delete old segments as you go");
+  exitCode_ = kExitDiskFull;
+  stop(nullptr);
+}
+
+void Supervisor::printStatus() {
+  bool terminal = isatty(STDOUT_FILENO);
+  // On a terminal the lines are redrawn in place; in a log, appended.
+  if (terminal && statusShown_) std::printf("\033[%zuA", cameras_.size());
+  for (auto& c : cameras_)
+    std::printf("%s%s\n", terminal ? "\033[K" : "", statusLine(c->report()).c_str());
+  std::fflush(stdout);
+  statusShown_ = true;
+}
+
+std::string Supervisor::rtspOf(const Camera& camera) const {
+  if (!rtsp_) return "";
+  return rtsp_->url() + "/" + camera.plan().device + "/cam" + std::to_string(camera.plan().camera);
+}
+
+nlohmann::json Supervisor::status() const {
+  nlohmann::json streams = nlohmann::json::array();
+  for (const auto& c : cameras_) streams.push_back(statusJson(c->report(), rtspOf(*c)));
+  nlohmann::json result = {{"out", options_.outDir},
+                           {"free_bytes", disk_.free()},
+                           {"stopping", stopping_},
+                           {"streams", streams}};
+  if (fleet_) {
+    auto mqtt = fleet_->stats();
+    result["mqtt"] = {{"connected", fleet_->connected()},
+                      {"published", mqtt.published},
+                      {"dropped", mqtt.dropped},
+                      {"connects", mqtt.connects}};
+  }
+  return result;
+}
+
+nlohmann::json Supervisor::trails() const {
+  nlohmann::json trails = nlohmann::json::object();
+  for (const auto& c : cameras_)
+    if (!c->trail().empty()) trails[c->name()] = trailJson(c->trail(), c->positionStale());
+  return trails;
+}
+
+std::vector<std::string> Supervisor::openSegments() const {
+  std::vector<std::string> open;
+  for (const auto& c : cameras_)
+    if (!c->openSegment().empty()) open.push_back(c->openSegment());
+  return open;
+}
+
+int Supervisor::run() {
+  loop_ = g_main_loop_new(nullptr, FALSE);
+  g_unix_signal_add(SIGINT, onSignal, this);
+  g_unix_signal_add(SIGTERM, onSignal, this);
+  if (options_.duration)
+    timers_.push_back(
+        g_timeout_add(static_cast<guint>(*options_.duration * 1000), onDurationOver, this));
+  timers_.push_back(g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this));
+  timers_.push_back(g_timeout_add(Camera::kTickIntervalMs, onCameraTick, this));
+  timers_.push_back(
+      g_timeout_add(TelemetryTrack::kHeartbeatInterval / GST_MSECOND, onHeartbeat, this));
+  // Once a second, whatever --status says: the fleet's status is published
+  // on change and at least every FleetPublisher::kStatusInterval.
+  if (fleet_)
+    timers_.push_back(g_timeout_add_seconds(
+        1,
+        [](gpointer self) -> gboolean {
+          static_cast<Supervisor*>(self)->publishFleetStatus();
+          return G_SOURCE_CONTINUE;
+        },
+        this));
+  for (auto& c : cameras_)
+    if (!c->start()) return kExitError;
+  g_main_loop_run(loop_);
+  // The run is over: its timers must not fire while the hooks drain.
+  for (guint id : timers_)
+    if (GSource* timer = g_main_context_find_source_by_id(nullptr, id)) g_source_destroy(timer);
+  printStatus();
+  for (auto& c : cameras_) c->halt();  // what still runs (a second signal, the backstop)
+  if (hook_) {
+    // The last segments' uploads get a little time; what is left is named.
+    for (const auto& left : hook_->drain(std::chrono::seconds(kHookDrainSeconds)))
+      logLine("--on-segment-closed did not get to " + left + " before exit");
+  }
+  return exitCode_;
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,94 @@
+// One wirc-recorder run: the supervisor of its cameras (each a pipeline of
+// its own, camera/camera.h), and what they share: the index and retention,
+// the disk guard, the status display, the web, RTSP and MQTT servers, the
+// segment hook. A camera's fault, silence or stall is its own; a stop ends
+// every camera within Camera::kFinishTime, cutting off (and naming) any
+// that cannot finish.
+#pragma once
+
+#include <gst/gst.h>
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/command_dispatcher.h"
+#include "app/recorder_options.h"
+#include "camera/camera.h"
+#include "common/expected.h"
+#include "fleet/fleet_publisher.h"
+#include "http/http_server.h"
+#include "http/rtsp_server.h"
+#include "record/disk_guard.h"
+#include "record/recording_index.h"
+#include "record/retention.h"
+#include "record/segment_hook.h"
+
+namespace wircam::recorder {
+
+// Exit codes besides 0 (finished) and 2 (bad arguments, in main).
+inline constexpr int kExitError = 1;
+inline constexpr int kExitDiskFull = 3;
+
+class Supervisor : CameraObserver {
+ public:
+  static Expected<std::unique_ptr<Supervisor>, std::string> create(const RecorderOptions& options);
+  ~Supervisor() override;
+
+  // Records until SIGINT/SIGTERM, --duration, a full disk or an error;
+  // every file is finished (or cut off) before it returns. The exit code.
+  int run();
+
+ private:
+  explicit Supervisor(RecorderOptions options);
+  std::optional<std::string> startServers();  // the problem, if any
+
+  // CameraObserver
+  void segmentClosed(Camera& camera, const std::string& file,
+                     const PlannedSegment& planned) override;
+  void event(Camera& camera, const nlohmann::json& event) override;
+  void detections(Camera& camera, const nlohmann::json& line, int64_t unixMs) override;
+  void diskFull(Camera& camera) override;
+  void ended(Camera& camera) override;
+
+  void stop(const char* why);
+  static gboolean onStopDeadline(gpointer self);
+  static gboolean onSignal(gpointer self);  // SIGINT, SIGTERM
+  static gboolean onDurationOver(gpointer self);
+  static gboolean onTick(gpointer self);
+  static gboolean onCameraTick(gpointer self);
+  static gboolean onHeartbeat(gpointer self);
+  void quitWhenAllEnded();
+  void publishFleetStatus(bool force = false);
+  // DELETE /api/recordings/FILE: the HTTP status and reason when it cannot.
+  std::optional<std::pair<guint, std::string>> deleteSegment(const std::string& file);
+  void updateIndex(const std::vector<std::string>& deleted);
+  void printStatus();
+  void guardDisk();
+  std::string rtspOf(const Camera& camera) const;
+  nlohmann::json status() const;
+  nlohmann::json trails() const;
+  std::vector<std::string> openSegments() const;
+  Camera* cameraNamed(const std::string& name);
+
+  RecorderOptions options_;
+  Retention retention_;
+  DiskGuard disk_;
+  RecordingIndex index_;
+  GMainLoop* loop_ = nullptr;
+  std::vector<std::unique_ptr<Camera>> cameras_;
+  CommandDispatcher commands_;
+  std::unique_ptr<HttpServer> http_;
+  std::unique_ptr<RtspServer> rtsp_;
+  std::unique_ptr<FleetPublisher> fleet_;  // with --mqtt
+  std::unique_ptr<SegmentHook> hook_;      // with --on-segment-closed
+  std::vector<guint> timers_;              // the run's timeouts, removed when it ends
+  bool stopping_ = false;
+  bool stoppedBySignal_ = false;
+  int exitCode_ = 0;
+  bool statusShown_ = false;
+};
+
+}  // namespace wircam::recorder

@@ -1,0 +1,146 @@
+// One recorded camera under the supervisor: its pipeline (a new one after
+// each fault), its health, and what its elements say on their bus, turned
+// into its report, its telemetry and its events. Everything here runs on
+// the main loop, except the frames, which the pipeline's threads carry.
+//
+// A fault (a pipeline error, no video for the stall timeout, the device
+// lost while a file is open) closes the camera's open file at its last
+// frame (EOS, bounded by kFinishTime), tears its pipeline down and starts a
+// new one after CameraHealth's backoff. No other camera waits for any of it.
+#pragma once
+
+#include <gst/gst.h>
+
+#include <chrono>
+#include <deque>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "camera/camera_health.h"
+#include "camera/camera_pipeline.h"
+#include "camera/frame_tap.h"
+#include "camera/pipeline_plan.h"
+#include "status/camera_report.h"
+
+namespace wircam::recorder {
+
+class Camera;
+
+// What a camera tells the supervisor.
+class CameraObserver {
+ public:
+  virtual ~CameraObserver() = default;
+  // A file of the camera is finished (or cut off as it is): index it.
+  virtual void segmentClosed(Camera& camera, const std::string& file,
+                             const PlannedSegment& planned) = 0;
+  // A link change, a command, a segment: for MQTT's events.
+  virtual void event(Camera& camera, const nlohmann::json& event) = 0;
+  // A frame's detections, for the live view and MQTT.
+  virtual void detections(Camera& camera, const nlohmann::json& line, int64_t unixMs) = 0;
+  // A write failed for want of space: the recording must stop.
+  virtual void diskFull(Camera& camera) = 0;
+  // The camera stopped for good (after stop()).
+  virtual void ended(Camera& camera) = 0;
+};
+
+class Camera {
+ public:
+  // How long a stop or a fault waits for the open file to be finished.
+  static constexpr std::chrono::milliseconds kFinishTime{2500};
+
+  // Builds its first pipeline (a bad description is an error here, not a
+  // fault later). `liveFrames`: keep a FrameTap for the live outputs.
+  static Expected<std::unique_ptr<Camera>, std::string> create(StreamPlan plan, CameraFiles files,
+                                                               CameraHealth::Policy policy,
+                                                               CameraObserver& observer);
+  ~Camera();
+  Camera(const Camera&) = delete;
+  Camera& operator=(const Camera&) = delete;
+
+  // The first start; false if its pipeline could not even start (the
+  // error is logged). Later starts after faults are the camera's own.
+  bool start();
+  // Called every kTickInterval: the stall check, state changes.
+  void tick();
+  static constexpr guint kTickIntervalMs = 250;
+  // Finishes the open file (bounded by kFinishTime) and stops for good.
+  void stop();
+  // Stops for good at once, the open file indexed as it is (a second
+  // signal, the stop's backstop).
+  void halt();
+  bool ended() const { return ended_; }
+  bool hasFrames() const { return pipeline_ && pipeline_->hasFrames(); }
+
+  const StreamPlan& plan() const { return plan_; }
+  const std::string& name() const { return plan_.name; }
+  FrameTap* frames() { return plan_.liveSink.empty() ? nullptr : &frames_; }
+  // The wirccontrol of the running pipeline, or null (none, or restarting).
+  GstElement* controller() const;
+  CameraReport report() const;
+  const std::deque<Position>& trail() const { return trail_; }
+  bool positionStale() const { return !report_.positionStale.empty(); }
+  const std::string& openSegment() const { return report_.segment; }
+  double kbps() const { return report_.kbps; }
+  // A line of the camera's telemetry, now (a command, say).
+  void writeTelemetry(const nlohmann::json& line);
+  // The heartbeat of its text track, at its newest frame.
+  void heartbeat();
+
+ private:
+  Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy,
+         CameraObserver& observer);
+
+  static gboolean onBusMessage(GstBus* bus, GstMessage* message, gpointer self);
+  void watchBus();
+  void handleElementMessage(GstMessage* message);  // camera_messages.cpp
+  void handleSession(const GstStructure* s, nlohmann::json line);
+  void handleStats(const GstStructure* s, nlohmann::json line);
+  void handlePosition(const GstStructure* s);
+  void handleError(GstMessage* message);
+  void writeTelemetry(nlohmann::json line, GstClockTime runningTime);
+  // Tells the observer a file is done, as its planner knew it.
+  void closed(const std::string& file);
+  // The pipeline is to go: its open file finished first, then a new one.
+  void fault(CameraFault fault, const std::string& why);
+  // Finishes the open file: for good (the waiting telemetry goes into it),
+  // or before a restart (the waiting telemetry goes into the next run's).
+  enum class Then { kEnd, kRestart };
+  void finish(Then then);
+  static gboolean onFinishDeadline(gpointer self);
+  // Tears the pipeline down, its open file indexed as it is; then the
+  // next start, or the end.
+  void tearDown();
+
+  static gboolean onRestart(gpointer self);
+  bool play();
+  void followState();
+
+  StreamPlan plan_;
+  CameraFiles files_;
+  CameraObserver& observer_;
+  CameraHealth health_;
+  FrameTap frames_;
+  std::unique_ptr<CameraPipeline> pipeline_;
+  guint busWatch_ = 0;
+  guint finishDeadline_ = 0, restartTimer_ = 0;
+  CameraHealth::Clock::time_point restartAt_;  // of the pending restart
+  bool finishing_ = false;
+  bool stopping_ = false;
+  bool ended_ = false;
+  uint64_t framesSeen_ = 0;                      // the planner's frames at the last tick
+  GstClockTime statsTime_ = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
+  CameraState state_ = CameraState::kConnecting;  // as last said
+  bool everLive_ = false;                          // logged in at least once
+  struct Counts {
+    uint64_t frames = 0, incomplete = 0, bytes = 0;
+  };
+  Counts earlierRuns_, runCounts_;  // the sources' counts: past pipelines', this one's
+  std::optional<std::pair<bool, int>> carriedControl_;
+  std::deque<TelemetryRouter::Line> carriedTelemetry_;  // for the next run's first file  // following, target: for the next run
+  CameraReport report_;
+  std::deque<Position> trail_;  // the recent positions, for the live view's map
+};
+
+}  // namespace wircam::recorder

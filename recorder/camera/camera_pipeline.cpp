@@ -1,0 +1,64 @@
+#include "camera/camera_pipeline.h"
+
+namespace wircam::recorder {
+
+Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
+    const StreamPlan& plan, const CameraFiles& files, FrameTap* frames) {
+  std::unique_ptr<CameraPipeline> camera(new CameraPipeline);
+  GError* parseError = nullptr;
+  camera->pipeline_ = gst_parse_launch(plan.description.c_str(), &parseError);
+  if (parseError) {
+    std::string message = parseError->message;
+    g_error_free(parseError);
+    return unexpected("cannot build the pipeline (are the wircam plugins on GST_PLUGIN_PATH?): " +
+                      message);
+  }
+  // Named after its camera, so that the log says whose it is.
+  gst_object_set_name(GST_OBJECT(camera->pipeline_), plan.name.c_str());
+  camera->planner_ = std::make_unique<SegmentPlanner>(files.folder, plan.name, files.extension,
+                                                      files.limits);
+  camera->track_ = std::make_unique<TelemetryTrack>(camera->element(plan.telemetrySource));
+  camera->telemetry_ = std::make_unique<TelemetryRouter>(*camera->planner_, *camera->track_);
+  camera->splitter_ = std::make_unique<SegmentSplitter>(
+      SegmentSplitter::Parts{.source = camera->element(plan.source),
+                             .splitmux = camera->element(plan.muxer),
+                             .transcoded = files.transcoded},
+      *camera->planner_, [self = camera.get()] {
+        self->telemetry_->onFrame();
+        self->framesPlanned_.fetch_add(1, std::memory_order_relaxed);
+      });
+  if (frames && !plan.liveSink.empty()) {
+    frames->attach(camera->element(plan.liveSink));
+    camera->frames_ = frames;
+  }
+  return camera;
+}
+
+CameraPipeline::~CameraPipeline() {
+  if (!pipeline_) return;
+  gst_element_set_state(pipeline_, GST_STATE_NULL);
+  if (frames_) frames_->detach();
+  // The splitter holds the elements' pads: before the pipeline goes.
+  splitter_.reset();
+  telemetry_.reset();
+  track_.reset();
+  gst_object_unref(pipeline_);
+}
+
+GstElement* CameraPipeline::element(const std::string& name) const {
+  if (name.empty()) return nullptr;
+  GstElement* found = gst_bin_get_by_name(GST_BIN(pipeline_), name.c_str());
+  if (found) gst_object_unref(found);  // the pipeline keeps it
+  return found;
+}
+
+GstClockTime CameraPipeline::runningTime() const {
+  GstClockTime now = GST_CLOCK_TIME_NONE;
+  if (GstClock* clock = gst_element_get_clock(pipeline_)) {
+    now = gst_clock_get_time(clock) - gst_element_get_base_time(pipeline_);
+    gst_object_unref(clock);
+  }
+  return now;
+}
+
+}  // namespace wircam::recorder

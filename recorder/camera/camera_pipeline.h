@@ -1,0 +1,66 @@
+// One run of a camera's pipeline, from its start to its teardown: the
+// GstPipeline built from the camera's plan, and what follows its frames
+// into files (the segment planner and splitter, the telemetry track and
+// router). A camera restarted after a fault gets a new one; its files go on
+// under new names, each starting at its first frame.
+#pragma once
+
+#include <gst/gst.h>
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "camera/frame_tap.h"
+#include "camera/pipeline_plan.h"
+#include "camera/segment_splitter.h"
+#include "common/expected.h"
+#include "record/segment_planner.h"
+#include "telemetry/telemetry_router.h"
+#include "telemetry/telemetry_track.h"
+
+namespace wircam::recorder {
+
+struct CameraFiles {
+  std::string folder;
+  std::string extension;  // ".mkv", ".mp4"
+  SegmentLimits limits;
+  bool transcoded = false;  // frames pass an encoder that makes key frames on request
+};
+
+class CameraPipeline {
+ public:
+  // `frames` (the camera's live tap, or null) is attached to its appsink.
+  static Expected<std::unique_ptr<CameraPipeline>, std::string> build(const StreamPlan& plan,
+                                                                      const CameraFiles& files,
+                                                                      FrameTap* frames);
+  ~CameraPipeline();  // torn down (NULL) and released
+  CameraPipeline(const CameraPipeline&) = delete;
+  CameraPipeline& operator=(const CameraPipeline&) = delete;
+
+  GstElement* pipeline() const { return pipeline_; }
+  // An element of this pipeline by name (borrowed), or null.
+  GstElement* element(const std::string& name) const;
+  SegmentPlanner& planner() { return *planner_; }
+  TelemetryTrack& track() { return *track_; }
+  TelemetryRouter& telemetry() { return *telemetry_; }
+  // The running time now, or GST_CLOCK_TIME_NONE before PLAYING.
+  GstClockTime runningTime() const;
+  bool hasFrames() const { return planner_->current().has_value(); }
+  // Frames that reached the files' planner so far (any thread).
+  uint64_t framesPlanned() const { return framesPlanned_.load(); }
+
+ private:
+  CameraPipeline() = default;
+
+  GstElement* pipeline_ = nullptr;
+  FrameTap* frames_ = nullptr;
+  std::unique_ptr<SegmentPlanner> planner_;
+  std::unique_ptr<TelemetryTrack> track_;
+  std::unique_ptr<TelemetryRouter> telemetry_;
+  std::unique_ptr<SegmentSplitter> splitter_;
+  std::atomic<uint64_t> framesPlanned_{0};
+};
+
+}  // namespace wircam::recorder

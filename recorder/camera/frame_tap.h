@@ -1,0 +1,46 @@
+// The frames of one camera as they arrive (JPEG, untouched), handed to the
+// live outputs: the web server's MJPEG streams and the RTSP server. It
+// outlives the camera's pipelines: each run's appsink is attached in turn,
+// and the listeners stay.
+#pragma once
+
+#include <gst/gst.h>
+
+#include <functional>
+#include <map>
+
+#include "common/mutex.h"
+
+namespace wircam::recorder {
+
+class FrameTap {
+ public:
+  // Called on the streaming thread with a borrowed frame and its caps (the
+  // size from the JPEG's SOF); take a reference to keep it. Keep it short:
+  // the branch drops frames while it runs.
+  using Listener = std::function<void(GstSample* jpeg)>;
+
+  FrameTap() = default;
+  FrameTap(const FrameTap&) = delete;
+  FrameTap& operator=(const FrameTap&) = delete;
+  ~FrameTap();
+
+  // `appsink` is the live branch of the camera's running pipeline; borrowed
+  // until detach(), which comes before the pipeline goes.
+  void attach(GstElement* appsink);
+  void detach();
+
+  int listen(Listener listener);
+  void forget(int id);
+
+ private:
+  static GstFlowReturn onNewSample(GstElement* appsink, gpointer self);
+
+  GstElement* appsink_ = nullptr;
+  gulong handler_ = 0;
+  Mutex mutex_;
+  std::map<int, Listener> listeners_ WIRCAM_GUARDED_BY(mutex_);
+  int nextId_ WIRCAM_GUARDED_BY(mutex_) = 1;
+};
+
+}  // namespace wircam::recorder

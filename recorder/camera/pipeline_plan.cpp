@@ -1,0 +1,135 @@
+#include "camera/pipeline_plan.h"
+
+#include <cctype>
+#include <cstdint>
+#include <filesystem>
+
+#include "telemetry/telemetry_track_flags.h"
+
+namespace wircam::recorder {
+
+namespace {
+
+// A file name part made of safe characters only.
+std::string fileSafe(std::string text) {
+  for (char& c : text)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
+  return text;
+}
+
+// The muxer inside splitmuxsink. Crash safety: Matroska clusters and MP4
+// fragments of at most 0.5 s (the muxers write a cluster or fragment whole),
+// so a killed recorder leaves the open segment playable up to about its
+// last second.
+std::string muxerSettings(Container container) {
+  if (container == Container::kMp4)
+    return "muxer-factory=mp4mux "
+           "muxer-properties=\"properties,fragment-duration=(guint)500\"";
+  return "muxer-factory=matroskamux "
+         "muxer-properties=\"properties,max-cluster-duration=(gint64)500000000\"";
+}
+
+// What the frames pass through between the tee and the muxer.
+std::string encoder(const RecorderOptions& options) {
+  if (options.codec == Codec::kJpeg) return "";
+  // zerolatency: no B-frames and no look-ahead, so the live recording does
+  // not lag. The recorder asks for a key frame at each cut and every 0.5 s
+  // (SegmentSplitter); key-int-max is only a backstop.
+  return "tjpegdec ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
+         std::to_string(options.h264Kbps) + " key-int-max=60 ! h264parse ! ";
+}
+
+// wirccontrol's properties for the vehicle the device's tags steer: the
+// WiRC device itself, or the RCOIP receiver or BTEMP robot of control=.
+std::string controlOf(const DeviceTarget& device) {
+  if (!device.control)
+    return (device.host.empty() ? "" : " host=" + device.host) +
+           " port=" + std::to_string(device.port);
+  const auto& c = *device.control;
+  return " protocol=" + c.protocol + " host=" + c.host + " port=" + std::to_string(c.port);
+}
+
+// The element that joins the vehicle's Marvelmind positions to its frames.
+std::string positionsOf(const PositionSource& source, const std::string& name) {
+  return "marvelmindpositions name=" + name + " host=" + source.host +
+         " port=" + std::to_string(source.port) + " beacons=" + source.beacons + " ! ";
+}
+
+}  // namespace
+
+std::string PipelinePlan::description() const {
+  std::string all;
+  for (const auto& stream : streams) all += stream.description;
+  return all;
+}
+
+PipelinePlan planPipeline(const RecorderOptions& options) {
+  PipelinePlan plan;
+  plan.transcoded = options.codec != Codec::kJpeg;
+  bool live = options.http || options.rtsp;
+  size_t index = 0;
+  for (const auto& device : options.devices) {
+    bool controlled = false;
+    std::string host = device.host.empty() ? "" : " host=" + device.host;
+    std::string port = " port=" + std::to_string(device.port);
+    std::string login;  // what the login configures, when the user said
+    if (options.periods) login += " periods=" + *options.periods;
+    if (options.failsafe) login += " failsafe=" + *options.failsafe;
+    for (int camera : device.cameras) {
+      auto i = std::to_string(index++);
+      StreamPlan stream;
+      std::string& d = stream.description;
+      stream.device = fileSafe(device.label);
+      stream.camera = camera;
+      stream.name = stream.device + "-cam" + std::to_string(camera);
+      stream.source = "src" + i;
+      stream.muxer = "mux" + i;
+      stream.telemetrySource = "tel" + i;
+      if (!options.detectFamily.empty()) stream.detector = "det" + i;
+      if (!options.detectFamily.empty() && *device.follow && !controlled) {
+        stream.controller = "ctl" + i;
+        controlled = true;  // one controller per vehicle: the first camera's
+      }
+      if (live) stream.liveSink = "live" + i;
+      if (device.positions) stream.positions = "pos" + i;
+      // Only if the recorder could not name a file (it always can).
+      auto fallback = (std::filesystem::path(options.outDir) /
+                       (stream.name + "-unnamed-%03d" + extensionOf(options.container)))
+                          .string();
+      // wait-for-device: a recorder started before its vehicle waits for it.
+      d += "wircsrc name=" + stream.source + host + port + login +
+           " camera=" + std::to_string(camera) + " wait-for-device=true ! " +
+           (device.positions ? positionsOf(*device.positions, stream.positions) : "") +
+           "tee name=t" + i + " t" + i + ". ! queue max-size-time=3000000000 ! " +
+           encoder(options) + "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
+           muxerSettings(options.container) + " location=\"" + fallback + "\" ";
+      // The telemetry never blocks the main loop: past 1 MB waiting it
+      // drops. Its track is named by a stream tag (in Matroska a
+      // placeholder, rewritten when the file is finished: telemetry_track_flags.h).
+      std::string title(options.container == Container::kMatroska ? kTelemetryTrackPlaceholder
+                                                                  : kTelemetryTrackName);
+      d += "appsrc name=" + stream.telemetrySource +
+           " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
+           "caps=\"text/x-raw,format=(string)utf8\" ! taginject tags=\"title=" +
+           title + "\" ! " + stream.muxer + ".subtitle_%u ";
+      if (!stream.detector.empty()) {
+        // Detection must never hold the recording back: its queue drops.
+        d += "t" + i +
+             ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=" +
+             stream.detector + " quad-decimate=1 family=" + options.detectFamily;
+        if (!stream.controller.empty())
+          d += " ! wirccontrol name=" + stream.controller + controlOf(device);
+        d += " ! fakesink sync=false async=false ";
+      }
+      if (!stream.liveSink.empty()) {
+        d += "t" + i +
+             ". ! queue leaky=downstream max-size-buffers=2 ! appsink name=" + stream.liveSink +
+             " sync=false async=false max-buffers=2 drop=true ";
+      }
+      plan.streams.push_back(std::move(stream));
+    }
+  }
+  return plan;
+}
+
+}  // namespace wircam::recorder

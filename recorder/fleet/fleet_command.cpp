@@ -1,0 +1,43 @@
+#include "fleet/fleet_command.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+
+#include "common/printable_text.h"
+
+namespace wircam::recorder {
+
+Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
+                                                      const std::string& command,
+                                                      const std::string& payload) {
+  FleetCommand parsed{.kind = FleetCommand::Kind::kFollow, .stream = stream};
+  std::string upper = payload;
+  std::transform(upper.begin(), upper.end(), upper.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  if (command == "follow/set") {
+    if (upper != "ON" && upper != "OFF")
+      return unexpected("follow/set takes ON or OFF, not '" + printableText(payload.substr(0, 40)) +
+                        "'");
+    parsed.follow = upper == "ON";
+    return parsed;
+  }
+  if (command == "target/set") {
+    char* end = nullptr;
+    long id = std::strtol(payload.c_str(), &end, 10);
+    if (payload.empty() || *end != '\0' || id < -1 || id > 1000000)
+      return unexpected("target/set takes a tag id (or -1: the largest), not '" +
+                        printableText(payload.substr(0, 40)) + "'");
+    parsed.kind = FleetCommand::Kind::kTarget;
+    parsed.target = static_cast<int>(id);
+    return parsed;
+  }
+  if (command == "request-control") {
+    parsed.kind = FleetCommand::Kind::kRequestControl;
+    return parsed;
+  }
+  return unexpected("unknown command '" + printableText(command) +
+                    "' (follow/set, target/set, request-control)");
+}
+
+}  // namespace wircam::recorder

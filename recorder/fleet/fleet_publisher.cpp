@@ -1,0 +1,126 @@
+#include "fleet/fleet_publisher.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+
+#include "log_line.h"
+
+namespace wircam::recorder {
+
+FleetPublisher::FleetPublisher(Settings settings, std::function<void(const FleetCommand&)> apply)
+    : settings_(std::move(settings)), apply_(std::move(apply)) {
+  for (const auto& stream : settings_.streams) streams_[stream];
+}
+
+Expected<std::unique_ptr<FleetPublisher>, std::string> FleetPublisher::start(
+    const Settings& settings, std::function<void(const FleetCommand&)> apply) {
+  std::unique_ptr<FleetPublisher> publisher(new FleetPublisher(settings, std::move(apply)));
+  auto* self = publisher.get();
+  char host[256] = "host";
+  gethostname(host, sizeof host - 1);
+  std::string clientId = "wirc-recorder-" + std::string(host) + "-" + std::to_string(getpid());
+  MqttWill will{settings.prefix + "/available", "offline"};
+  auto client = MqttClient::start(
+      settings.url, clientId, will,
+      {.connected = [self](MqttClient& connected) { self->republish(connected); },
+       .message = [self](const std::string& topic, const std::string& payload,
+                         bool retained) { self->onMessage(topic, payload, retained); },
+       .log = [](const std::string& line) { logLine(line); }});
+  if (!client) return unexpected(client.error());
+  publisher->client_ = std::move(*client);
+  return publisher;
+}
+
+FleetPublisher::~FleetPublisher() {
+  client_.reset();  // says offline
+}
+
+std::string FleetPublisher::topic(const std::string& stream, const char* leaf) const {
+  return settings_.prefix + "/" + stream + "/" + leaf;
+}
+
+// On the MQTT thread, at each connection: who we are, what we know, and
+// what we listen to.
+void FleetPublisher::republish(MqttClient& client) {
+  client.publish(settings_.prefix + "/available", "online", true, 1);
+  {
+    std::lock_guard lock(retainedMutex_);
+    for (const auto& [stream, status] : retained_)
+      client.publish(topic(stream, "status"), status, true);
+  }
+  client.subscribe(settings_.prefix + "/+/follow/set");
+  client.subscribe(settings_.prefix + "/+/target/set");
+}
+
+void FleetPublisher::onMessage(const std::string& topicName, const std::string& payload,
+                               bool retained) {
+  // PREFIX/STREAM/follow/set: the stream is the level after the prefix.
+  std::string rest = topicName.substr(std::min(topicName.size(), settings_.prefix.size() + 1));
+  auto slash = rest.find('/');
+  std::string stream = rest.substr(0, slash);
+  std::string command = slash == std::string::npos ? "" : rest.substr(slash + 1);
+  if (retained) {
+    // A command is an act, not a state: one left retained would replay at
+    // every restart.
+    std::string shown = printableText(topicName);
+    logLine("ignoring the retained message on " + shown +
+            " (commands are not retained; clear it with mosquitto_pub -r -n -t '" + shown + "')");
+    return;
+  }
+  auto parsed = parseFleetCommand(stream, command, payload);
+  if (parsed && std::find(settings_.streams.begin(), settings_.streams.end(), stream) ==
+                    settings_.streams.end())
+    parsed = unexpected("no stream '" + printableText(stream) + "' here");
+  if (!parsed) {
+    logLine("MQTT " + printableText(topicName) + ": " + parsed.error() + "; ignored");
+    return;
+  }
+  // To the main loop, where the pipeline is driven.
+  auto* handed = new std::pair<FleetPublisher*, FleetCommand>(this, *parsed);
+  g_main_context_invoke_full(
+      nullptr, G_PRIORITY_HIGH,
+      [](gpointer data) {
+        auto* job = static_cast<std::pair<FleetPublisher*, FleetCommand>*>(data);
+        job->first->apply_(job->second);
+        return G_SOURCE_REMOVE;
+      },
+      handed,
+      [](gpointer data) { delete static_cast<std::pair<FleetPublisher*, FleetCommand>*>(data); });
+}
+
+void FleetPublisher::status(const std::string& stream, const nlohmann::json& status, bool force) {
+  auto& state = streams_[stream];
+  std::string text = status.dump();
+  auto now = std::chrono::steady_clock::now();
+  if (!force && text == state.lastStatus && now - state.statusAt < kStatusInterval) return;
+  state.lastStatus = text;
+  state.statusAt = now;
+  {
+    std::lock_guard lock(retainedMutex_);
+    retained_[stream] = text;
+  }
+  client_->publish(topic(stream, "status"), text, true);
+}
+
+void FleetPublisher::detections(const std::string& stream, const nlohmann::json& message,
+                                bool anyTags) {
+  auto& state = streams_[stream];
+  // Frames without tags say nothing, except the first after some had.
+  if (!anyTags && !state.hadTags) return;
+  auto now = std::chrono::steady_clock::now();
+  bool lostThem = !anyTags && state.hadTags;
+  if (!lostThem && settings_.detectionsRate > 0 &&
+      now - state.detectionsAt < std::chrono::duration<double>(1.0 / settings_.detectionsRate))
+    return;
+  state.hadTags = anyTags;
+  state.detectionsAt = now;
+  client_->publish(topic(stream, "detections"), message.dump());
+}
+
+void FleetPublisher::event(const std::string& stream, const nlohmann::json& event) {
+  client_->publish(topic(stream, "events"), event.dump());
+}
+
+}  // namespace wircam::recorder

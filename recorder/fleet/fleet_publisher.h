@@ -1,0 +1,70 @@
+// The recorder's MQTT topics (see wirc-recorder --help): availability with a
+// last will, each stream's retained status (on change, at least every 5 s),
+// its detections (rate-limited) and events, and the follow/target commands
+// it takes. Everything here runs on the GLib main loop; commands arrive on
+// the MQTT client's thread and are handed over to it.
+#pragma once
+
+#include <glib.h>
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/expected.h"
+#include "fleet/fleet_command.h"
+#include "fleet/mqtt_client.h"
+
+namespace wircam::recorder {
+
+class FleetPublisher {
+ public:
+  static constexpr std::chrono::seconds kStatusInterval{5};
+
+  struct Settings {
+    MqttUrl url;
+    std::string prefix;
+    double detectionsRate = 0;  // per second and stream; 0 = every frame
+    std::vector<std::string> streams;
+  };
+  // `apply` runs on the main loop for each valid live command.
+  static Expected<std::unique_ptr<FleetPublisher>, std::string> start(
+      const Settings& settings, std::function<void(const FleetCommand&)> apply);
+  // Says offline (retained) and disconnects, bounded.
+  ~FleetPublisher();
+
+  // Publishes when it differs from the last one, or kStatusInterval passed.
+  void status(const std::string& stream, const nlohmann::json& status, bool force = false);
+  void detections(const std::string& stream, const nlohmann::json& message, bool anyTags);
+  void event(const std::string& stream, const nlohmann::json& event);
+  MqttClient::Stats stats() const { return client_->stats(); }
+  bool connected() const { return client_->connected(); }
+
+ private:
+  struct StreamState {
+    std::string lastStatus;
+    std::chrono::steady_clock::time_point statusAt{};
+    std::chrono::steady_clock::time_point detectionsAt{};
+    bool hadTags = false;
+  };
+  FleetPublisher(Settings settings, std::function<void(const FleetCommand&)> apply);
+  std::string topic(const std::string& stream, const char* leaf) const;
+  void onMessage(const std::string& topic, const std::string& payload, bool retained);
+  void republish(MqttClient& client);
+
+  const Settings settings_;
+  const std::function<void(const FleetCommand&)> apply_;
+  std::unique_ptr<MqttClient> client_;
+  std::map<std::string, StreamState> streams_;  // main loop only (the MQTT thread reads settings_)
+  // The retained statuses, for a new connection (guarded: the MQTT thread reads it).
+  std::mutex retainedMutex_;
+  std::map<std::string, std::string> retained_;
+};
+
+}  // namespace wircam::recorder

@@ -1,0 +1,175 @@
+#include "fleet/mqtt_client.h"
+
+#include <mosquitto.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <cstdlib>
+
+#include "common/socket.h"
+
+namespace wircam::recorder {
+
+namespace {
+
+constexpr int kKeepaliveSeconds = 10;
+constexpr std::chrono::seconds kMaxBackoff{30};
+constexpr int kReachTimeoutMs = 2000;
+
+}  // namespace
+
+MqttClient::MqttClient(MqttUrl url, MqttWill will, mosquitto* handle, Handlers handlers)
+    : url_(std::move(url)),
+      handle_(handle),
+      handlers_(std::move(handlers)),
+      will_(std::move(will)) {}
+
+Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttUrl& url,
+                                                                     const std::string& clientId,
+                                                                     const MqttWill& will,
+                                                                     Handlers handlers) {
+  static const int initialised = mosquitto_lib_init();
+  (void)initialised;
+  mosquitto* handle = mosquitto_new(clientId.c_str(), true, nullptr);
+  if (!handle) return unexpected(std::string("cannot create an MQTT client"));
+  std::unique_ptr<MqttClient> client(new MqttClient(url, will, handle, std::move(handlers)));
+  mosquitto_user_data_set(handle, client.get());
+  mosquitto_threaded_set(handle, true);
+  if (!url.user.empty() &&
+      mosquitto_username_pw_set(handle, url.user.c_str(),
+                                url.password.empty() ? nullptr : url.password.c_str()) !=
+          MOSQ_ERR_SUCCESS)
+    return unexpected(std::string("the MQTT user name or password is not valid UTF-8"));
+  if (mosquitto_will_set(handle, will.topic.c_str(), static_cast<int>(will.payload.size()),
+                         will.payload.data(), 1, true) != MOSQ_ERR_SUCCESS)
+    return unexpected("cannot set the MQTT last will on '" + will.topic + "'");
+  mosquitto_connect_callback_set(handle, onConnect);
+  mosquitto_message_callback_set(handle, onMessage);
+  mosquitto_publish_callback_set(handle, onPublish);
+  client->thread_ = std::thread([c = client.get()] { c->run(); });
+  return client;
+}
+
+MqttClient::~MqttClient() {
+  stopping_ = true;
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  mosquitto_destroy(handle_);
+}
+
+void MqttClient::report(const std::string& line) {
+  // Each change once: a broker that stays away is not a line per retry.
+  if (line == lastReport_) return;
+  lastReport_ = line;
+  if (handlers_.log) handlers_.log(line);
+}
+
+bool MqttClient::reachable() {
+  // mosquitto_connect blocks until TCP gives up on a host that never
+  // answers; a bounded probe first keeps stops and retries prompt.
+  auto address = SocketAddress::resolve(url_.host, url_.port);
+  if (!address) return report("MQTT broker " + url_.host + ": " + address.error()), false;
+  auto socket = startConnectTcp(*address);
+  if (!socket) return report("MQTT broker " + address->toString() + ": " + socket.error()), false;
+  pollfd wait{.fd = socket->get(), .events = POLLOUT, .revents = 0};
+  for (int waited = 0; waited < kReachTimeoutMs && !stopping_; waited += 100)
+    if (poll(&wait, 1, 100) != 0) break;
+  int error = wait.revents ? pendingError(socket->get()) : ETIMEDOUT;
+  if (error != 0)
+    report("MQTT broker " + address->toString() + " cannot be reached (" + errnoText(error) +
+           "); retrying with backoff, the recording goes on");
+  return error == 0;
+}
+
+void MqttClient::waitBackoff() {
+  std::unique_lock lock(mutex_);
+  wake_.wait_for(lock, backoff_, [this] { return stopping_.load(); });
+  backoff_ = std::min(backoff_ * 2, kMaxBackoff);
+}
+
+void MqttClient::run() {
+  bool session = false;  // a TCP connection the library drives (CONNACK pending or connected)
+  while (!stopping_) {
+    if (!session) {
+      if (!reachable()) {
+        waitBackoff();
+        continue;
+      }
+      int rc = mosquitto_connect(handle_, url_.host.c_str(), url_.port, kKeepaliveSeconds);
+      if (rc != MOSQ_ERR_SUCCESS) {
+        report("MQTT broker " + url_.host + ": " + mosquitto_strerror(rc));
+        waitBackoff();
+        continue;
+      }
+      session = true;
+    }
+    int rc = mosquitto_loop(handle_, 100, 1);
+    if (rc != MOSQ_ERR_SUCCESS) {
+      session = false;
+      if (connected_.exchange(false))
+        report("lost the MQTT broker " + url_.host + ":" + std::to_string(url_.port) + " (" +
+               mosquitto_strerror(rc) + "); reconnecting with backoff");
+      waitBackoff();
+    }
+  }
+  if (connected_) {
+    // The last word, as the will would say it; then a clean goodbye.
+    mosquitto_publish(handle_, nullptr, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
+                      will_.payload.data(), 1, true);
+    for (int turn = 0; turn < 5 && mosquitto_want_write(handle_); ++turn)
+      mosquitto_loop(handle_, 100, 1);
+    mosquitto_disconnect(handle_);
+    mosquitto_loop(handle_, 100, 1);
+    connected_ = false;
+  }
+}
+
+void MqttClient::onConnect(mosquitto*, void* self, int rc) {
+  auto* client = static_cast<MqttClient*>(self);
+  if (rc != 0) {
+    client->report(std::string("the MQTT broker refused the connection: ") +
+                   mosquitto_connack_string(rc) + "; retrying with backoff");
+    mosquitto_disconnect(client->handle_);
+    return;
+  }
+  // What an earlier session left unsent is gone with it.
+  client->written_ = client->published_.load();
+  client->connected_ = true;
+  client->backoff_ = std::chrono::seconds(1);
+  ++client->connects_;
+  client->report("connected to the MQTT broker " + client->url_.host + ":" +
+                 std::to_string(client->url_.port));
+  if (client->handlers_.connected) client->handlers_.connected(*client);
+}
+
+void MqttClient::onMessage(mosquitto*, void* self, const mosquitto_message* message) {
+  auto* client = static_cast<MqttClient*>(self);
+  if (!client->handlers_.message || !message->topic) return;
+  std::string payload(static_cast<const char*>(message->payload),
+                      message->payload ? static_cast<size_t>(message->payloadlen) : 0);
+  client->handlers_.message(message->topic, payload, message->retain);
+}
+
+void MqttClient::onPublish(mosquitto*, void* self, int) {
+  ++static_cast<MqttClient*>(self)->written_;
+}
+
+bool MqttClient::publish(const std::string& topic, const std::string& payload, bool retain,
+                         int qos) {
+  if (!connected_ || published_ - written_ >= kMaxUnsent) return ++dropped_, false;
+  int rc = mosquitto_publish(handle_, nullptr, topic.c_str(), static_cast<int>(payload.size()),
+                             payload.data(), qos, retain);
+  if (rc != MOSQ_ERR_SUCCESS) return ++dropped_, false;
+  ++published_;
+  return true;
+}
+
+void MqttClient::subscribe(const std::string& pattern) {
+  mosquitto_subscribe(handle_, nullptr, pattern.c_str(), 1);
+}
+
+MqttClient::Stats MqttClient::stats() const {
+  return {.published = published_, .dropped = dropped_, .connects = connects_};
+}
+
+}  // namespace wircam::recorder

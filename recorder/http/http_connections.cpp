@@ -1,0 +1,163 @@
+#include "http/http_connections.h"
+
+#include <algorithm>
+
+namespace wircam::recorder {
+
+namespace {
+
+ConnectionSlots::Clock::time_point now() { return ConnectionSlots::Clock::now(); }
+
+// The client's IP address ("" if not IP).
+std::string hostOf(GSocketAddress* address) {
+  if (!G_IS_INET_SOCKET_ADDRESS(address)) return "";
+  gchar* host =
+      g_inet_address_to_string(g_inet_socket_address_get_address(G_INET_SOCKET_ADDRESS(address)));
+  std::string text = host;
+  g_free(host);
+  return text;
+}
+
+// "address:port": one TCP connection's client end.
+std::string endpointOf(GSocketAddress* address) {
+  if (!G_IS_INET_SOCKET_ADDRESS(address)) return "";
+  return hostOf(address) + ":" +
+         std::to_string(g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(address)));
+}
+
+struct GoneWatch {
+  HttpConnections* owner;
+  std::string endpoint;
+  GSocketConnection* connection;
+  std::weak_ptr<bool> alive;
+};
+
+}  // namespace
+
+HttpConnections::HttpConnections(SoupServer* server, ConnectionSlots::Limits limits)
+    : server_(server),
+      slots_(limits),
+      socketTimeoutSeconds_(static_cast<guint>(std::max<int64_t>(
+          1, (std::chrono::duration_cast<std::chrono::milliseconds>(limits.idleTimeout).count() +
+              999) /
+                 1000))) {}
+
+Expected<std::unique_ptr<HttpConnections>, std::string> HttpConnections::listen(
+    SoupServer* server, GSocketAddress* address, ConnectionSlots::Limits limits) {
+  std::unique_ptr<HttpConnections> self(new HttpConnections(server, limits));
+  self->service_ = g_socket_service_new();
+  // GLib's default backlog (10) drops the SYNs of a burst of clients, who
+  // then wait seconds to retry: let a whole cap's worth queue.
+  g_socket_listener_set_backlog(G_SOCKET_LISTENER(self->service_),
+                                static_cast<int>(limits.maxOpen));
+  GSocketAddress* bound = nullptr;
+  GError* error = nullptr;
+  if (!g_socket_listener_add_address(G_SOCKET_LISTENER(self->service_), address,
+                                     G_SOCKET_TYPE_STREAM, G_SOCKET_PROTOCOL_TCP, nullptr, &bound,
+                                     &error)) {
+    std::string text = error->message;
+    g_error_free(error);
+    return unexpected(text);
+  }
+  self->port_ = g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(bound));
+  g_object_unref(bound);
+  g_signal_connect(self->service_, "incoming", G_CALLBACK(onIncoming), self.get());
+  g_socket_service_start(self->service_);
+  self->sweep_ = g_timeout_add(static_cast<guint>(kSweepInterval.count()), onSweep, self.get());
+  return self;
+}
+
+HttpConnections::~HttpConnections() {
+  alive_.reset();
+  if (sweep_) g_source_remove(sweep_);
+  g_socket_service_stop(service_);
+  g_socket_listener_close(G_SOCKET_LISTENER(service_));
+  g_object_unref(service_);
+}
+
+gboolean HttpConnections::onIncoming(GSocketService*, GSocketConnection* connection, GObject*,
+                                     gpointer data) {
+  auto* self = static_cast<HttpConnections*>(data);
+  GSocketAddress* remote = g_socket_connection_get_remote_address(connection, nullptr);
+  std::string endpoint = remote ? endpointOf(remote) : "";
+  auto slot = remote ? self->slots_.admit(hostOf(remote), now()) : std::nullopt;
+  if (!slot) {
+    g_clear_object(&remote);
+    g_io_stream_close(G_IO_STREAM(connection), nullptr, nullptr);
+    return TRUE;
+  }
+  GSocket* socket = g_socket_connection_get_socket(connection);
+  // Writes to a client that stopped reading give up after this long.
+  g_socket_set_timeout(socket, self->socketTimeoutSeconds_);
+  self->accepted_[endpoint] = {connection, socket, *slot};
+  g_object_weak_ref(G_OBJECT(connection), onConnectionGone,
+                    new GoneWatch{self, endpoint, connection, self->alive_});
+  GSocketAddress* local = g_socket_connection_get_local_address(connection, nullptr);
+  GError* error = nullptr;
+  if (!soup_server_accept_iostream(self->server_, G_IO_STREAM(connection), local, remote, &error)) {
+    g_error_free(error);
+    g_io_stream_close(G_IO_STREAM(connection), nullptr, nullptr);
+  }
+  g_clear_object(&local);
+  g_clear_object(&remote);
+  return TRUE;
+}
+
+void HttpConnections::onConnectionGone(gpointer data, GObject*) {
+  std::unique_ptr<GoneWatch> watch(static_cast<GoneWatch*>(data));
+  if (watch->alive.expired()) return;
+  auto& accepted = watch->owner->accepted_;
+  auto it = accepted.find(watch->endpoint);
+  // (The sweep may have let it go already, once it saw it closed.)
+  if (it == accepted.end() || it->second.connection != watch->connection) return;
+  watch->owner->slots_.closed(it->second.slot);
+  accepted.erase(it);
+}
+
+gboolean HttpConnections::onSweep(gpointer data) {
+  auto* self = static_cast<HttpConnections*>(data);
+  // Closed by either side but not yet let go by libsoup: the slot is free.
+  for (auto it = self->accepted_.begin(); it != self->accepted_.end();) {
+    if (g_io_stream_is_closed(G_IO_STREAM(it->second.connection))) {
+      self->slots_.closed(it->second.slot);
+      it = self->accepted_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  auto due = self->slots_.expired(now());
+  for (auto& [endpoint, accepted] : self->accepted_)
+    if (std::find(due.begin(), due.end(), accepted.slot) != due.end())
+      // libsoup, reading, sees the end and lets the connection go.
+      g_socket_shutdown(accepted.socket, TRUE, TRUE, nullptr);
+  return G_SOURCE_CONTINUE;
+}
+
+const HttpConnections::Accepted* HttpConnections::find(SoupServerMessage* message) const {
+  GSocketAddress* remote = soup_server_message_get_remote_address(message);
+  if (!remote) return nullptr;
+  auto it = accepted_.find(endpointOf(remote));
+  return it == accepted_.end() ? nullptr : &it->second;
+}
+
+GSocket* HttpConnections::socketOf(SoupServerMessage* message) const {
+  const Accepted* accepted = find(message);
+  return accepted ? accepted->socket : nullptr;
+}
+
+void HttpConnections::requestStarted(SoupServerMessage* message) {
+  if (const Accepted* accepted = find(message)) slots_.requestStarted(accepted->slot);
+}
+
+void HttpConnections::requestEnded(SoupServerMessage* message) {
+  if (const Accepted* accepted = find(message)) slots_.requestEnded(accepted->slot, now());
+}
+
+void HttpConnections::upgrading(SoupServerMessage* message) {
+  if (const Accepted* accepted = find(message)) {
+    slots_.upgraded(accepted->slot);
+    g_socket_set_timeout(accepted->socket, 0);
+  }
+}
+
+}  // namespace wircam::recorder

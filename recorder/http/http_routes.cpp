@@ -1,0 +1,100 @@
+#include "http/http_routes.h"
+
+namespace wircam::recorder {
+
+namespace {
+
+constexpr std::string_view kLive = "/live/";
+constexpr std::string_view kMjpeg = ".mjpg";
+constexpr std::string_view kRecordings = "/recordings/";
+constexpr std::string_view kCameras = "/api/cameras/";
+constexpr std::string_view kSnapshot = "/snapshot.jpg";
+
+}  // namespace
+
+Route routeOf(std::string_view path) {
+  using Kind = Route::Kind;
+  if (path == "/" || path == "/index.html") return {Kind::Page, ""};
+  if (path == "/login") return {Kind::Login, ""};
+  if (path == "/api/status") return {Kind::Status, ""};
+  if (path == "/api/events") return {Kind::Events, ""};
+  if (path == "/api/cameras") return {Kind::Cameras, ""};
+  if (path == "/api/recordings") return {Kind::RecordingIndex, ""};
+  constexpr std::string_view kRecordingEntry = "/api/recordings/";
+  if (path.starts_with(kRecordingEntry) && path.size() > kRecordingEntry.size())
+    return {Kind::RecordingEntry, std::string(path.substr(kRecordingEntry.size()))};
+  if (path.starts_with(kCameras)) {
+    // NAME/ACTION, NAME without a slash
+    auto rest = path.substr(kCameras.size());
+    auto slash = rest.find('/');
+    if (slash != std::string_view::npos && slash > 0) {
+      std::string camera(rest.substr(0, slash));
+      auto action = rest.substr(slash + 1);
+      if (action == kSnapshot.substr(1)) return {Kind::Snapshot, camera};
+      if (action == "drive") return {Kind::Drive, camera};
+      if (action == "follow" || action == "target" || action == "request-control")
+        return {Kind::CameraCommand, camera, std::string(action)};
+    }
+  }
+  constexpr std::string_view kPlay = "/play/";
+  if (path.starts_with(kPlay) && path.ends_with(kMjpeg) &&
+      path.size() > kPlay.size() + kMjpeg.size())
+    return {Kind::Playback,
+            std::string(path.substr(kPlay.size(), path.size() - kPlay.size() - kMjpeg.size()))};
+  if (path.starts_with("/api/")) return {Kind::ApiNotFound, ""};
+  if (path.starts_with(kLive) && path.ends_with(kMjpeg) &&
+      path.size() > kLive.size() + kMjpeg.size())
+    return {Kind::Live,
+            std::string(path.substr(kLive.size(), path.size() - kLive.size() - kMjpeg.size()))};
+  if (path == "/recordings" || path == kRecordings) return {Kind::RecordingList, ""};
+  if (path.starts_with(kRecordings))
+    return {Kind::Recording, std::string(path.substr(kRecordings.size()))};
+  return {Kind::NotFound, ""};
+}
+
+namespace {
+
+bool sameSecret(std::string_view given, std::string_view token) {
+  // Every byte is looked at whatever differs, so timing says nothing.
+  unsigned char difference = given.size() == token.size() ? 0 : 1;
+  for (size_t i = 0; i < given.size(); ++i)
+    difference |= static_cast<unsigned char>(given[i] ^ token[i % token.size()]);
+  return difference == 0;
+}
+
+}  // namespace
+
+bool carriesToken(const char* authorization, const char* cookie, std::string_view token) {
+  if (token.empty()) return true;
+  constexpr std::string_view kBearer = "Bearer ";
+  if (authorization && std::string_view(authorization).starts_with(kBearer) &&
+      sameSecret(std::string_view(authorization).substr(kBearer.size()), token))
+    return true;
+  if (!cookie) return false;
+  // "a=1; wircam_token=T; b=2"
+  std::string_view cookies = cookie;
+  while (!cookies.empty()) {
+    auto end = cookies.find(';');
+    auto pair = cookies.substr(0, end);
+    while (!pair.empty() && pair.front() == ' ') pair.remove_prefix(1);
+    constexpr std::string_view kName = "wircam_token=";
+    if (pair.starts_with(kName) && sameSecret(pair.substr(kName.size()), token)) return true;
+    if (end == std::string_view::npos) break;
+    cookies.remove_prefix(end + 1);
+  }
+  return false;
+}
+
+const char* recordingContentType(std::string_view name) {
+  if (name.ends_with(".mkv")) return "video/x-matroska";
+  if (name.ends_with(".mp4")) return "video/mp4";
+  if (name.ends_with(".jsonl")) return "application/x-ndjson";
+  return nullptr;
+}
+
+bool isRecordingName(std::string_view name) {
+  return !name.empty() && name.front() != '.' && name.find('/') == std::string_view::npos &&
+         name.find('\0') == std::string_view::npos && recordingContentType(name) != nullptr;
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,642 @@
+#include "http/http_server.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <mutex>
+#include <set>
+
+#include "common/printable_text.h"
+#include "http/http_connections.h"
+#include "http/http_routes.h"
+#include "http/live_view_page.h"
+#include "http/login_page.h"
+#include "http/page_control_script.h"
+#include "http/page_player_script.h"
+#include "http/playback_stream.h"
+#include "record/telemetry_log.h"
+
+namespace wircam::recorder {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr char kBoundary[] = "wircframe";
+// A client this many frames behind is skipped until it catches up, so a
+// slow viewer never makes the recorder hold frames for it.
+constexpr int kMaxFramesInFlight = 3;
+
+void respond(SoupServerMessage* message, guint status, const char* type, const std::string& body) {
+  soup_server_message_set_status(message, status, nullptr);
+  soup_server_message_set_response(message, type, SOUP_MEMORY_COPY, body.data(), body.size());
+}
+
+void respondError(SoupServerMessage* message, guint status, const std::string& text) {
+  respond(message, status, "text/plain; charset=utf-8", text + "\n");
+}
+
+// The API answers errors in JSON too, so scripts can read them.
+void respondJsonError(SoupServerMessage* message, guint status, const std::string& text) {
+  // The text may quote a path, which a client can make any bytes: bytes that
+  // are not UTF-8 are replaced rather than thrown on.
+  respond(message, status, "application/json",
+          nlohmann::json{{"error", text}}.dump(-1, ' ', false,
+                                               nlohmann::json::error_handler_t::replace));
+}
+
+}  // namespace
+
+// One open streaming response: an MJPEG viewer, an event listener, or a
+// recording being replayed (which goes when the viewer does).
+struct HttpServer::Client {
+  SoupServerMessage* message;
+  int inFlight = 0;  // chunks appended but not yet written to the socket
+  gulong wroteHandler = 0, finishedHandler = 0;
+  std::unique_ptr<PlaybackStream> playback;
+};
+
+namespace {
+
+// One part of a multipart/x-mixed-replace stream, built in one piece: a
+// single copy of the frame per delivery. `extraHeaders` end in CRLF.
+GBytes* multipartFrame(GstBuffer* jpeg, const std::string& extraHeaders) {
+  GstMapInfo map;
+  if (!gst_buffer_map(jpeg, &map, GST_MAP_READ)) return nullptr;
+  std::string header =
+      std::string("--") + kBoundary +
+      "\r\nContent-Type: image/jpeg\r\nContent-Length: " + std::to_string(map.size) + "\r\n" +
+      extraHeaders + "\r\n";
+  GByteArray* part = g_byte_array_sized_new(static_cast<guint>(header.size() + map.size + 2));
+  g_byte_array_append(part, reinterpret_cast<const guint8*>(header.data()),
+                      static_cast<guint>(header.size()));
+  g_byte_array_append(part, map.data, static_cast<guint>(map.size));
+  g_byte_array_append(part, reinterpret_cast<const guint8*>("\r\n"), 2);
+  gst_buffer_unmap(jpeg, &map);
+  return g_byte_array_free_to_bytes(part);
+}
+
+}  // namespace
+
+struct HttpServer::CameraFeed {
+  std::string name;
+  FrameTap* frames;
+  int listener = 0;
+  std::vector<std::unique_ptr<Client>> clients;
+  std::atomic<int> clientCount{0};       // read on the streaming thread
+  std::atomic<int> width{0}, height{0};  // of the last frame, for the overlay
+  // The newest frame as the camera sent it, for snapshots (the streaming
+  // thread swaps it, the main loop reads it).
+  std::mutex latestMutex;
+  GstBuffer* latest = nullptr;
+  nlohmann::json detections = nlohmann::json::array();  // the last ones
+};
+
+HttpServer::HttpServer(Content content) : content_(std::move(content)) {}
+
+Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
+    const ServerAddress& address, Content content, std::chrono::milliseconds idleTimeout) {
+  std::unique_ptr<HttpServer> self(new HttpServer(std::move(content)));
+  self->server_ = soup_server_new("server-header", "wirc-recorder", nullptr);
+  GSocketAddress* socket =
+      g_inet_socket_address_new_from_string(address.listenHost().c_str(), address.port);
+  if (!socket) return unexpected("--http: '" + address.host + "' is not an IP address");
+  auto connections = HttpConnections::listen(self->server_, socket,
+                                             {.maxOpen = kMaxConnections,
+                                              .maxPerAddress = kMaxConnectionsPerAddress,
+                                              .idleTimeout = idleTimeout});
+  g_object_unref(socket);
+  if (!connections)
+    return unexpected("--http: cannot listen on port " + std::to_string(address.port) + ": " +
+                      connections.error());
+  self->connections_ = std::move(*connections);
+  self->url_ =
+      "http://" + address.listenHost() + ":" + std::to_string(self->connections_->port()) + "/";
+
+  soup_server_add_early_handler(self->server_, nullptr, onHeaders, self.get(), nullptr);
+  soup_server_add_handler(self->server_, nullptr, onRequest, self.get(), nullptr);
+  // Upgrades only the requests onRequest leaves unanswered (the drive mode's).
+  soup_server_add_websocket_handler(self->server_, nullptr, nullptr, nullptr, onWebSocket,
+                                    self.get(), nullptr);
+  g_signal_connect(self->server_, "request-finished", G_CALLBACK(onRequestEnded), self.get());
+  g_signal_connect(self->server_, "request-aborted", G_CALLBACK(onRequestEnded), self.get());
+  for (size_t i = 0; i < self->content_.cameras.size(); ++i) {
+    auto feed = std::make_unique<CameraFeed>();
+    feed->name = self->content_.cameras[i].name;
+    feed->frames = self->content_.cameras[i].frames;
+    CameraFeed* raw = feed.get();
+    HttpServer* server = self.get();
+    // Frames come on the streaming thread; clients live on the main loop.
+    feed->listener = feed->frames->listen([server, raw, i](GstSample* sample) {
+      // wircsrc puts the frame size (from the JPEG's SOF) in the caps.
+      const GstStructure* caps = gst_caps_get_structure(gst_sample_get_caps(sample), 0);
+      int width = 0, height = 0;
+      if (gst_structure_get_int(caps, "width", &width) &&
+          gst_structure_get_int(caps, "height", &height)) {
+        raw->width = width;
+        raw->height = height;
+      }
+      GstBuffer* jpeg = gst_sample_get_buffer(sample);
+      {
+        std::lock_guard lock(raw->latestMutex);
+        gst_buffer_replace(&raw->latest, jpeg);
+      }
+      if (raw->clientCount.load() == 0) return;
+      struct Delivery {
+        HttpServer* server;
+        size_t camera;
+        GstBuffer* jpeg;
+        std::weak_ptr<bool> alive;
+      };
+      auto* delivery = new Delivery{server, i, gst_buffer_ref(jpeg), server->alive_};
+      g_main_context_invoke_full(
+          nullptr, G_PRIORITY_DEFAULT,
+          [](gpointer data) -> gboolean {
+            auto* d = static_cast<Delivery*>(data);
+            if (!d->alive.expired()) d->server->sendFrame(d->camera, d->jpeg);
+            return G_SOURCE_REMOVE;
+          },
+          delivery,
+          [](gpointer data) {
+            auto* d = static_cast<Delivery*>(data);
+            gst_buffer_unref(d->jpeg);
+            delete d;
+          });
+    });
+    self->feeds_.push_back(std::move(feed));
+  }
+  return self;
+}
+
+HttpServer::~HttpServer() {
+  for (auto& feed : feeds_) {
+    feed->frames->forget(feed->listener);
+    gst_buffer_replace(&feed->latest, nullptr);
+  }
+  alive_.reset();
+  auto release = [](std::vector<std::unique_ptr<Client>>& clients) {
+    for (auto& client : clients) {
+      g_signal_handler_disconnect(client->message, client->wroteHandler);
+      g_signal_handler_disconnect(client->message, client->finishedHandler);
+    }
+    clients.clear();
+  };
+  for (auto& feed : feeds_) release(feed->clients);
+  release(eventClients_);
+  release(playbackClients_);
+  driveSockets_.clear();  // each sends neutral and closes
+  if (server_) {
+    soup_server_disconnect(server_);
+    g_object_unref(server_);
+  }
+}
+
+void HttpServer::onRequestEnded(SoupServer*, SoupServerMessage* message, gpointer data) {
+  static_cast<HttpServer*>(data)->connections_->requestEnded(message);
+}
+
+// After the headers, before any body: only GET and HEAD are served, so a
+// body (however large it says it is) is refused unread.
+void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*, GHashTable*,
+                           gpointer data) {
+  auto* self = static_cast<HttpServer*>(data);
+  // Its connection is no longer idle: the request is answered, however long.
+  self->connections_->requestStarted(message);
+  std::string method = soup_server_message_get_method(message);
+  auto* headers = soup_server_message_get_request_headers(message);
+  bool hasBody = soup_message_headers_get_content_length(headers) > 0 ||
+                 soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CHUNKED;
+  bool known = method == "GET" || method == "HEAD" || method == "DELETE" || method == "POST";
+  if (known && !hasBody) return;
+  // libsoup would read the whole body before answering: answer on the
+  // socket now, and close it. Nothing of this request was written yet.
+  std::string answer = !known
+                           ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE, POST\r\n"
+                           : "HTTP/1.1 413 Content Too Large\r\n";
+  answer += "Content-Length: 0\r\nConnection: close\r\n\r\n";
+  soup_message_body_set_accumulate(soup_server_message_get_request_body(message), FALSE);
+  if (GSocket* socket = self->connections_->socketOf(message)) {
+    g_socket_send(socket, answer.data(), answer.size(), nullptr, nullptr);
+    g_socket_shutdown(socket, TRUE, TRUE, nullptr);
+  }
+  soup_server_message_set_status(message, SOUP_STATUS_BAD_REQUEST, nullptr);
+}
+
+void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* path,
+                           GHashTable* query, gpointer data) {
+  auto* self = static_cast<HttpServer*>(data);
+  auto route = routeOf(path);
+  if (route.kind != Route::Kind::Login && !self->authorised(message)) {
+    // Pages get the sign-in form; the API, streams and files a 401 in JSON.
+    if (route.kind == Route::Kind::Page)
+      return respond(message, SOUP_STATUS_UNAUTHORIZED, "text/html; charset=utf-8", kLoginPage);
+    soup_message_headers_replace(soup_server_message_get_response_headers(message),
+                                 "WWW-Authenticate", "Bearer realm=\"wirc-recorder\"");
+    return respondJsonError(message, SOUP_STATUS_UNAUTHORIZED,
+                            "needs the access token: Authorization: Bearer T, or sign in at "
+                            "/login");
+  }
+  std::string method = soup_server_message_get_method(message);
+  if (method == "DELETE") {
+    if (route.kind != Route::Kind::Recording && route.kind != Route::Kind::RecordingEntry)
+      return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                              "only recordings can be deleted: DELETE /api/recordings/FILE");
+    return self->deleteRecording(message, route.name);
+  }
+  if (route.kind == Route::Kind::CameraCommand) return self->serveCommand(message, route, query);
+  if (method == "POST")
+    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                            "POST is for /api/cameras/NAME/follow, /target and /request-control");
+  switch (route.kind) {
+    case Route::Kind::RecordingEntry:
+      return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                              "GET /recordings/FILE downloads it; DELETE /api/recordings/FILE "
+                              "deletes it");
+    case Route::Kind::Login:
+      return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", kLoginPage);
+    case Route::Kind::Page:
+      return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", self->page());
+    case Route::Kind::Status:
+      return respond(message, SOUP_STATUS_OK, "application/json", self->content_.status().dump());
+    case Route::Kind::Events:
+      return self->serveEvents(message);
+    case Route::Kind::Live:
+      return self->serveLive(message, route.name);
+    case Route::Kind::RecordingList:
+      return self->serveRecordings(message, "");
+    case Route::Kind::Recording:
+      return self->serveRecordings(message, route.name);
+    case Route::Kind::Cameras:
+      return respond(message, SOUP_STATUS_OK, "application/json",
+                     self->content_.cameraStates().dump());
+    case Route::Kind::Snapshot:
+      return self->serveSnapshot(message, route.name);
+    case Route::Kind::RecordingIndex:
+      return self->serveRecordingIndex(message);
+    case Route::Kind::Playback:
+      return self->servePlayback(message, route.name, query);
+    case Route::Kind::Drive:
+      // Left unanswered when allowed: libsoup then upgrades it (onWebSocket).
+      return self->refuseDriveUnlessAllowed(message, route.name);
+    case Route::Kind::CameraCommand:
+      return;  // answered above
+    case Route::Kind::ApiNotFound:
+      return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
+                              "no such endpoint; /api/status, /api/events, /api/cameras, "
+                              "/api/cameras/NAME/snapshot.jpg, /api/cameras/NAME/follow, "
+                              "/api/cameras/NAME/target, /api/cameras/NAME/request-control, "
+                              "/api/cameras/NAME/drive, /api/recordings");
+    case Route::Kind::NotFound:
+      return respondError(
+          message, SOUP_STATUS_NOT_FOUND,
+          "not found; try /, /api/status, /api/events, /api/cameras, /api/recordings, "
+          "/live/CAMERA.mjpg or /recordings");
+  }
+}
+
+bool HttpServer::authorised(SoupServerMessage* message) const {
+  auto* headers = soup_server_message_get_request_headers(message);
+  return carriesToken(soup_message_headers_get_one(headers, "Authorization"),
+                      soup_message_headers_get_one(headers, "Cookie"), content_.token);
+}
+
+void HttpServer::openStream(SoupServerMessage* message, const char* contentType,
+                            std::vector<std::unique_ptr<Client>>& clients) {
+  soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
+  SoupMessageHeaders* headers = soup_server_message_get_response_headers(message);
+  soup_message_headers_set_encoding(headers, SOUP_ENCODING_CHUNKED);
+  soup_message_headers_set_content_type(headers, contentType, nullptr);
+  soup_message_headers_replace(headers, "Cache-Control", "no-cache, no-store");
+  // Written chunks are freed, not kept for the whole life of the response.
+  soup_message_body_set_accumulate(soup_server_message_get_response_body(message), FALSE);
+
+  auto client = std::make_unique<Client>();
+  client->message = message;
+  Client* raw = client.get();
+  // libsoup 3's wrote-chunk carries no argument: the handler is (message,
+  // data). A chunk-size parameter here would read the client from a stray
+  // register.
+  client->wroteHandler = g_signal_connect(
+      message, "wrote-chunk",
+      G_CALLBACK(+[](SoupServerMessage*, gpointer c) { --static_cast<Client*>(c)->inFlight; }),
+      raw);
+  struct Finished {
+    std::vector<std::unique_ptr<Client>>* clients;
+    Client* client;
+  };
+  client->finishedHandler = g_signal_connect_data(
+      message, "finished", G_CALLBACK(+[](SoupServerMessage*, gpointer data) {
+        // The viewer went away: forget it.
+        auto* f = static_cast<Finished*>(data);
+        auto& list = *f->clients;
+        auto it = std::find_if(list.begin(), list.end(),
+                               [&](const auto& c) { return c.get() == f->client; });
+        if (it != list.end()) {
+          g_signal_handler_disconnect(f->client->message, f->client->wroteHandler);
+          list.erase(it);  // the finished handler itself stays until the message dies
+        }
+      }),
+      new Finished{&clients, raw},
+      [](gpointer data, GClosure*) { delete static_cast<Finished*>(data); }, GConnectFlags(0));
+  clients.push_back(std::move(client));
+  soup_server_message_pause(message);
+}
+
+void HttpServer::send(std::vector<std::unique_ptr<Client>>& clients, GBytes* chunk) {
+  for (auto& client : clients) sendTo(*client, chunk);
+}
+
+void HttpServer::sendTo(Client& client, GBytes* chunk) {
+  if (client.inFlight >= kMaxFramesInFlight) return;
+  ++client.inFlight;
+  soup_message_body_append_bytes(soup_server_message_get_response_body(client.message), chunk);
+  soup_server_message_unpause(client.message);
+}
+
+void HttpServer::serveLive(SoupServerMessage* message, const std::string& camera) {
+  auto feed =
+      std::find_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f->name == camera; });
+  if (feed == feeds_.end()) {
+    respondError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+    return;
+  }
+  std::string type = std::string("multipart/x-mixed-replace; boundary=") + kBoundary;
+  openStream(message, type.c_str(), (*feed)->clients);
+  (*feed)->clientCount = static_cast<int>((*feed)->clients.size());
+}
+
+void HttpServer::sendFrame(size_t camera, GstBuffer* jpeg) {
+  auto& feed = *feeds_[camera];
+  feed.clientCount = static_cast<int>(feed.clients.size());
+  if (feed.clients.empty()) return;
+  GBytes* chunk = multipartFrame(jpeg, "");
+  if (!chunk) return;
+  send(feed.clients, chunk);
+  g_bytes_unref(chunk);
+}
+
+void HttpServer::serveEvents(SoupServerMessage* message) {
+  openStream(message, "text/event-stream", eventClients_);
+  GBytes* hello = g_bytes_new_static("retry: 2000\n\n", 13);
+  send(eventClients_, hello);
+  g_bytes_unref(hello);
+}
+
+std::string HttpServer::page() const {
+  nlohmann::json cameras = nlohmann::json::array();
+  // Each card starts in its camera's state (live, offline, ...), with the
+  // status figures, so the first picture is already right.
+  nlohmann::json status = content_.status ? content_.status() : nlohmann::json::object();
+  for (const auto& feed : feeds_) {
+    nlohmann::json camera = {{"name", feed->name},
+                             {"width", feed->width.load()},
+                             {"height", feed->height.load()},
+                             {"detections", feed->detections}};
+    for (const auto& stream : status.value("streams", nlohmann::json::array()))
+      if (stream.value("name", "") == feed->name) camera["status"] = stream;
+    cameras.push_back(camera);
+  }
+  nlohmann::json trails = content_.trails ? content_.trails() : nlohmann::json::object();
+  std::string state = nlohmann::json{{"cameras", cameras}, {"trails", trails}}.dump();
+  // Inside <script>, "</" could end it early.
+  for (size_t at = state.find("</"); at != std::string::npos; at = state.find("</", at))
+    state.replace(at, 2, "<\\/");
+  std::string html = kLiveViewPage;
+  auto put = [&html](std::string_view placeholder, std::string_view text) {
+    html.replace(html.find(placeholder), placeholder.size(), text);
+  };
+  put("PLAYER_SCRIPT", kPlayerScript);
+  put("CONTROL_SCRIPT", kControlScript);
+  put("INITIAL_STATE", state);
+  return html;
+}
+
+void HttpServer::publishDetections(const std::string& camera, const nlohmann::json& detections) {
+  for (auto& feed : feeds_)
+    if (feed->name == camera) feed->detections = detections;
+  if (eventClients_.empty()) return;
+  nlohmann::json event = {{"stream", camera}, {"detections", detections}};
+  std::string text = "event: detections\ndata: " + event.dump() + "\n\n";
+  GBytes* chunk = g_bytes_new(text.data(), text.size());
+  send(eventClients_, chunk);
+  g_bytes_unref(chunk);
+}
+
+void HttpServer::serveSnapshot(SoupServerMessage* message, const std::string& camera) {
+  auto feed =
+      std::find_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f->name == camera; });
+  if (feed == feeds_.end())
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+  GstBuffer* jpeg = nullptr;
+  {
+    std::lock_guard lock((*feed)->latestMutex);
+    gst_buffer_replace(&jpeg, (*feed)->latest);
+  }
+  if (!jpeg)
+    return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE,
+                            "camera '" + camera + "' has sent no frame yet");
+  // The frame untouched: the camera's own JPEG bytes.
+  GstMapInfo map;
+  if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
+    respond(message, SOUP_STATUS_OK, "image/jpeg",
+            std::string(reinterpret_cast<const char*>(map.data), map.size));
+    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Cache-Control",
+                                 "no-cache, no-store");
+    gst_buffer_unmap(jpeg, &map);
+  }
+  gst_buffer_unref(jpeg);
+}
+
+void HttpServer::deleteRecording(SoupServerMessage* message, const std::string& name) {
+  if (refusedWithoutToken(message, "deleting recordings")) return;
+  if (!isRecordingName(name) || name.ends_with(".jsonl"))
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
+  auto refused = content_.deleteRecording(name);
+  if (!refused) {
+    respond(message, SOUP_STATUS_OK, "application/json", nlohmann::json{{"deleted", name}}.dump());
+    return;
+  }
+  respondJsonError(message, refused->first, refused->second);
+}
+
+void HttpServer::serveRecordingIndex(SoupServerMessage* message) {
+  nlohmann::json list = content_.recordings();
+  for (auto& entry : list) {
+    gchar* escaped = g_uri_escape_string(entry["file"].get<std::string>().c_str(), nullptr, FALSE);
+    entry["url"] = std::string("/recordings/") + escaped;
+    g_free(escaped);
+  }
+  respond(message, SOUP_STATUS_OK, "application/json", list.dump());
+}
+
+void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& name) {
+  fs::path folder = content_.recordingsFolder;
+  if (name.empty()) {
+    auto open = content_.openSegments();
+    std::set<std::string> openNames;
+    for (const auto& path : open) {
+      openNames.insert(fs::path(path).filename().string());
+      openNames.insert(fs::path(TelemetryLog::pathFor(path)).filename().string());
+    }
+    nlohmann::json files = nlohmann::json::array();
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(folder, error)) {
+      // A symbolic link could lead anywhere on the machine: never listed.
+      if (entry.is_symlink(error) || !entry.is_regular_file(error) ||
+          !isRecordingName(entry.path().filename().string()))
+        continue;
+      auto file = entry.path().filename().string();
+      files.push_back({{"name", file},
+                       {"bytes", entry.file_size(error)},
+                       {"recording", openNames.count(file) > 0}});
+    }
+    std::sort(files.begin(), files.end(),
+              [](const auto& a, const auto& b) { return a["name"] < b["name"]; });
+    respond(message, SOUP_STATUS_OK, "application/json", files.dump());
+    return;
+  }
+  // Only plain names of recordings in the folder, never a symbolic link:
+  // no way out of it.
+  fs::path file = folder / name;
+  std::error_code error;
+  if (!isRecordingName(name) || fs::is_symlink(fs::symlink_status(file, error)) ||
+      !fs::is_regular_file(file, error)) {
+    respondJsonError(
+        message, SOUP_STATUS_NOT_FOUND,
+        "no recording named '" + printableText(name) + "'; GET /api/recordings lists them");
+    return;
+  }
+  GError* mapError = nullptr;
+  GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &mapError);
+  if (!mapped) {
+    respondJsonError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR, mapError->message);
+    g_error_free(mapError);
+    return;
+  }
+  GBytes* bytes = g_mapped_file_get_bytes(mapped);
+  g_mapped_file_unref(mapped);
+  soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
+  SoupMessageHeaders* headers = soup_server_message_get_response_headers(message);
+  soup_message_headers_set_content_type(headers, recordingContentType(name), nullptr);
+  // libsoup answers a Range request from the whole body: a <video> seeks.
+  soup_message_headers_replace(headers, "Accept-Ranges", "bytes");
+  soup_message_body_append_bytes(soup_server_message_get_response_body(message), bytes);
+  g_bytes_unref(bytes);
+}
+
+// Control and deletion are always behind the token: without one set, nobody
+// may (the page is then open to anyone who can reach this machine's port).
+bool HttpServer::refusedWithoutToken(SoupServerMessage* message, const char* what) {
+  if (!content_.token.empty()) return false;
+  respondJsonError(message, SOUP_STATUS_FORBIDDEN,
+                   std::string(what) + " needs the server started with --http-token");
+  return true;
+}
+
+void HttpServer::servePlayback(SoupServerMessage* message, const std::string& name,
+                               GHashTable* query) {
+  fs::path file = fs::path(content_.recordingsFolder) / name;
+  std::error_code error;
+  if (!isRecordingName(name) || !name.ends_with(".mkv") ||
+      fs::is_symlink(fs::symlink_status(file, error)) || !fs::is_regular_file(file, error))
+    return respondJsonError(
+        message, SOUP_STATUS_NOT_FOUND,
+        "no Matroska recording named '" + name + "' (MP4 recordings play from /recordings/FILE)");
+  double from = 0;
+  if (const char* text =
+          query ? static_cast<const char*>(g_hash_table_lookup(query, "from")) : nullptr) {
+    char* end = nullptr;
+    from = g_ascii_strtod(text, &end);
+    if (end == text || *end != '\0' || !std::isfinite(from) || from < 0)
+      return respondJsonError(
+          message, SOUP_STATUS_BAD_REQUEST,
+          "from= takes seconds into the recording, not '" + std::string(text).substr(0, 40) + "'");
+  }
+  if (playbackClients_.size() >= kMaxPlaybacks)
+    return respondJsonError(
+        message, SOUP_STATUS_SERVICE_UNAVAILABLE,
+        "already replaying " + std::to_string(kMaxPlaybacks) + " recordings; try again later");
+  PlaybackStream::Callbacks callbacks;
+  callbacks.frame = [this, message](GstBuffer* jpeg, double position) {
+    char header[48];
+    g_snprintf(header, sizeof header, "X-Position: %.3f\r\n", position);
+    GBytes* chunk = multipartFrame(jpeg, header);
+    if (!chunk) return;
+    for (auto& client : playbackClients_)
+      if (client->message == message) sendTo(*client, chunk);
+    g_bytes_unref(chunk);
+  };
+  callbacks.ended = [message](const std::string&) {
+    // The end of the response: the viewer's stream closes, its replay goes.
+    soup_message_body_complete(soup_server_message_get_response_body(message));
+    soup_server_message_unpause(message);
+  };
+  auto playback = PlaybackStream::start(file.string(), from, std::move(callbacks));
+  if (!playback)
+    return respondJsonError(message, SOUP_STATUS_UNSUPPORTED_MEDIA_TYPE, playback.error());
+  std::string type = std::string("multipart/x-mixed-replace; boundary=") + kBoundary;
+  openStream(message, type.c_str(), playbackClients_);
+  playbackClients_.back()->playback = std::move(*playback);
+}
+
+void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query) {
+  if (std::string(soup_server_message_get_method(message)) != "POST")
+    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                            "POST /api/cameras/NAME/" + route.action);
+  if (refusedWithoutToken(message, "controlling the vehicle")) return;
+  auto lookup = [&](const char* key) -> std::string {
+    const char* value = query ? static_cast<const char*>(g_hash_table_lookup(query, key)) : nullptr;
+    return value ? value : "";
+  };
+  // The same commands as over MQTT, with their checks.
+  std::string command = "request-control", payload;
+  if (route.action == "follow") {
+    std::string on = lookup("on");
+    if (on != "true" && on != "false")
+      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "follow takes on=true or on=false");
+    command = "follow/set";
+    payload = on == "true" ? "ON" : "OFF";
+  } else if (route.action == "target") {
+    command = "target/set";
+    payload = lookup("id");
+  }
+  auto parsed = parseFleetCommand(route.name, command, payload);
+  if (!parsed) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, parsed.error());
+  if (auto refused = content_.command(*parsed)) {
+    bool unknown = std::none_of(feeds_.begin(), feeds_.end(),
+                                [&](const auto& feed) { return feed->name == route.name; });
+    return respondJsonError(message, unknown ? SOUP_STATUS_NOT_FOUND : SOUP_STATUS_CONFLICT,
+                            *refused);
+  }
+  for (const auto& camera : content_.cameraStates())
+    if (camera.value("name", "") == route.name)
+      return respond(message, SOUP_STATUS_OK, "application/json", camera.dump());
+  respond(message, SOUP_STATUS_OK, "application/json", "{}");
+}
+
+void HttpServer::refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera) {
+  if (refusedWithoutToken(message, "driving")) return;
+  if (std::none_of(feeds_.begin(), feeds_.end(),
+                   [&](const auto& feed) { return feed->name == camera; }))
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+  // Allowed but not a WebSocket handshake: libsoup answers 400. Once
+  // upgraded it is not idle between a driver's commands: open until either
+  // side closes it.
+  connections_->upgrading(message);
+}
+
+void HttpServer::onWebSocket(SoupServer*, SoupServerMessage*, const char* path,
+                             SoupWebsocketConnection* connection, gpointer data) {
+  auto* self = static_cast<HttpServer*>(data);
+  std::string camera = routeOf(path).name;
+  auto socket = std::make_unique<DriveSocket>(
+      connection,
+      [self, camera](double steering, double throttle) {
+        return self->content_.drive(camera, steering, throttle);
+      },
+      [self](DriveSocket* closed) {
+        std::erase_if(self->driveSockets_, [&](const auto& s) { return s.get() == closed; });
+      });
+  self->driveSockets_.push_back(std::move(socket));
+}
+
+}  // namespace wircam::recorder

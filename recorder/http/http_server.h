@@ -1,0 +1,128 @@
+// wirc-recorder's web server (libsoup): the live view page, each camera as
+// MJPEG over HTTP (multipart/x-mixed-replace, the camera's frames as they
+// are), detections as server-sent events, the status as JSON, the
+// recordings to list, download, replay and delete, and the vehicle's
+// control (follow, target, control right, drive mode over a WebSocket).
+// Runs on the main loop's context.
+#pragma once
+
+#include <libsoup/soup.h>
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/expected.h"
+#include "http/drive_socket.h"
+#include "fleet/fleet_command.h"
+#include "camera/frame_tap.h"
+#include "http/http_connections.h"
+#include "http/http_routes.h"
+#include "app/recorder_options.h"
+
+namespace wircam::recorder {
+
+class HttpServer {
+ public:
+  struct Camera {
+    std::string name;
+    FrameTap* frames;  // borrowed; outlives the server
+  };
+  struct Content {
+    std::vector<Camera> cameras;
+    std::string recordingsFolder;
+    std::function<nlohmann::json()> status;  // called on the main thread
+    // /api/cameras: [{name, state, fps, has_control, following}, ...]
+    std::function<nlohmann::json()> cameraStates;
+    // /api/recordings: the recording index's entries (url added here)
+    std::function<nlohmann::json()> recordings;
+    std::string token;  // empty: no authentication (this machine only)
+    // Deletes a finished segment (video and sidecar) and its index entry;
+    // the HTTP status and reason when it cannot.
+    std::function<std::optional<std::pair<guint, std::string>>(const std::string& file)>
+        deleteRecording;
+    // Each stream's recent Marvelmind positions, for the page's map:
+    // {"<stream>": {"points": [{"x","y","utc"}, ...], "stale": bool}}.
+    std::function<nlohmann::json()> trails;
+    std::function<std::vector<std::string>()> openSegments;
+    // Follow, target, request-control from the page: why not, if refused.
+    std::function<std::optional<std::string>(const FleetCommand&)> command;
+    // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
+    std::function<std::optional<bool>(const std::string& camera, double steering, double throttle)>
+        drive;
+  };
+
+  // Limits that keep hostile clients from holding the recorder's memory or
+  // connections: a request body is never read (only GET and HEAD are
+  // served), a connection with no request in progress for `idleTimeout`
+  // (silent, idle, or still sending its headers) is closed, and at most
+  // kMaxConnections are open at once, kMaxConnectionsPerAddress from one
+  // client address (the rest are closed at once). Every connection gives
+  // its place back however it ends.
+  static constexpr size_t kMaxConnections = 128;
+  static constexpr size_t kMaxConnectionsPerAddress = 64;
+  // Recordings replayed at once (each a small pipeline); more get a 503.
+  static constexpr size_t kMaxPlaybacks = 16;
+  static Expected<std::unique_ptr<HttpServer>, std::string> start(
+      const ServerAddress& address, Content content,
+      std::chrono::milliseconds idleTimeout = std::chrono::seconds(10));
+  ~HttpServer();
+
+  // "http://HOST:PORT/", with the port the system picked for port 0.
+  const std::string& url() const { return url_; }
+
+  // Sends one camera's detections to every open page (main thread).
+  void publishDetections(const std::string& camera, const nlohmann::json& detections);
+
+ private:
+  struct Client;
+  struct CameraFeed;
+  explicit HttpServer(Content content);
+
+  static void onRequest(SoupServer*, SoupServerMessage* message, const char* path,
+                        GHashTable* query, gpointer self);
+  static void onWebSocket(SoupServer*, SoupServerMessage* message, const char* path,
+                          SoupWebsocketConnection* connection, gpointer self);
+  static void onHeaders(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
+                        gpointer self);
+  static void onRequestEnded(SoupServer*, SoupServerMessage* message, gpointer self);
+  std::string page() const;  // the live view page with the current state
+  bool authorised(SoupServerMessage* message) const;
+  void serveLive(SoupServerMessage* message, const std::string& camera);
+  void serveEvents(SoupServerMessage* message);
+  void serveSnapshot(SoupServerMessage* message, const std::string& camera);
+  void serveRecordingIndex(SoupServerMessage* message);
+  void deleteRecording(SoupServerMessage* message, const std::string& name);
+  void serveRecordings(SoupServerMessage* message, const std::string& name);
+  void servePlayback(SoupServerMessage* message, const std::string& name, GHashTable* query);
+  void serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query);
+  // Answers with the reason when a drive-mode WebSocket may not open;
+  // otherwise leaves the request to libsoup's upgrade.
+  void refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera);
+  bool refusedWithoutToken(SoupServerMessage* message, const char* what);
+  // Keeps `message` open as a stream of chunks in `clients`.
+  void openStream(SoupServerMessage* message, const char* contentType,
+                  std::vector<std::unique_ptr<Client>>& clients);
+  void send(std::vector<std::unique_ptr<Client>>& clients, GBytes* chunk);
+  // Skipped for a client kMaxFramesInFlight chunks behind.
+  void sendTo(Client& client, GBytes* chunk);
+  void sendFrame(size_t camera, GstBuffer* jpeg);
+
+  Content content_;
+  SoupServer* server_ = nullptr;
+  std::string url_;
+  std::vector<std::unique_ptr<CameraFeed>> feeds_;
+  std::vector<std::unique_ptr<Client>> eventClients_;
+  std::vector<std::unique_ptr<Client>> playbackClients_;  // each with its replay
+  std::vector<std::unique_ptr<DriveSocket>> driveSockets_;
+  std::unique_ptr<HttpConnections> connections_;
+  // Frames queued for the main loop check it: the server may be gone.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace wircam::recorder
