@@ -4,8 +4,7 @@
 
 namespace wircam::recorder {
 
-std::optional<std::string> CommandDispatcher::apply(const FleetCommand& command,
-                                                    const char* from) {
+std::optional<std::string> CommandDispatcher::apply(const FleetCommand& command, const char* from) {
   Camera* camera = find_(command.stream);
   if (!camera) return "no camera named '" + command.stream + "'";
   GstElement* controller = camera->controller();

@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <memory>
 
-#include "marvelmind/position_client.h"
 #include "fleet/mqtt_url.h"
+#include "marvelmind/position_client.h"
 #include "wirc/channel_list.h"
 
 namespace wircam::recorder {

@@ -71,7 +71,7 @@ struct RecorderOptions {
   std::optional<double> duration;
   double statusSeconds = 1;
   double stallSeconds = 5;  // logged in without a frame this long: no-video, restarted
-  uint64_t maxBytes = 0;  // retention: 0 = unlimited
+  uint64_t maxBytes = 0;    // retention: 0 = unlimited
   uint64_t minFree = 0;
   std::optional<ServerAddress> http;  // unset: no web server
   std::optional<ServerAddress> rtsp;  // unset: no RTSP server

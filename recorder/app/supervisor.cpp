@@ -87,8 +87,8 @@ Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
       .limits = {.maxDuration = static_cast<uint64_t>(options.segmentSeconds * GST_SECOND),
                  .maxBytes = options.segmentBytes},
       .transcoded = plan.transcoded};
-  CameraHealth::Policy health{.stallTimeout = std::chrono::milliseconds(
-                                  static_cast<int64_t>(options.stallSeconds * 1000))};
+  CameraHealth::Policy health{
+      .stallTimeout = std::chrono::milliseconds(static_cast<int64_t>(options.stallSeconds * 1000))};
   for (auto& stream : plan.streams) {
     auto camera = Camera::create(stream, files, health, *supervisor);
     if (!camera) return unexpected(camera.error());
@@ -222,7 +222,8 @@ void Supervisor::detections(Camera& camera, const nlohmann::json& line, int64_t 
 void Supervisor::diskFull(Camera&) {
   // A write failed: the other cameras can still finish their files.
   exitCode_ = kExitDiskFull;
-  if (!stopping_) logLine("the disk is full: finishing the other files; earlier segments are untouched");
+  if (!stopping_)
+    logLine("the disk is full: finishing the other files; earlier segments are untouched");
   stop(nullptr);
 }
 
@@ -238,8 +239,8 @@ void Supervisor::stop(const char* why) {
   if (stopping_) return;
   stopping_ = true;
   if (why) logLine(std::string(why) + ": finishing the files (a second signal stops at once)");
-  bool anyRecorded = std::any_of(cameras_.begin(), cameras_.end(),
-                                 [](const auto& c) { return c->hasFrames(); });
+  bool anyRecorded =
+      std::any_of(cameras_.begin(), cameras_.end(), [](const auto& c) { return c->hasFrames(); });
   if (!anyRecorded && exitCode_ == 0 && index_.entries().empty()) {
     // No device ever sent a frame. Stopped by a signal while waiting is how
     // a service ends; a --duration that recorded nothing failed.

@@ -27,8 +27,7 @@ Camera::Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy,
 Expected<std::unique_ptr<Camera>, std::string> Camera::create(StreamPlan plan, CameraFiles files,
                                                               CameraHealth::Policy policy,
                                                               CameraObserver& observer) {
-  std::unique_ptr<Camera> camera(
-      new Camera(std::move(plan), std::move(files), policy, observer));
+  std::unique_ptr<Camera> camera(new Camera(std::move(plan), std::move(files), policy, observer));
   auto pipeline = CameraPipeline::build(camera->plan_, camera->files_, camera->frames());
   if (!pipeline) return unexpected(pipeline.error());
   camera->pipeline_ = std::move(*pipeline);
@@ -166,8 +165,8 @@ void Camera::tearDown() {
   // A pipeline that ended by itself (no fault said so) failed too.
   if (!health_.restartPending()) restartAt_ = health_.fault(CameraFault::kError, now());
   auto delay = std::chrono::duration_cast<std::chrono::milliseconds>(restartAt_ - now());
-  restartTimer_ = g_timeout_add(static_cast<guint>(std::max<int64_t>(0, delay.count())),
-                                onRestart, this);
+  restartTimer_ =
+      g_timeout_add(static_cast<guint>(std::max<int64_t>(0, delay.count())), onRestart, this);
 }
 
 gboolean Camera::onRestart(gpointer data) {

@@ -89,8 +89,7 @@ class Camera {
   void heartbeat();
 
  private:
-  Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy,
-         CameraObserver& observer);
+  Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy, CameraObserver& observer);
 
   static gboolean onBusMessage(GstBus* bus, GstMessage* message, gpointer self);
   void watchBus();
@@ -129,16 +128,17 @@ class Camera {
   bool finishing_ = false;
   bool stopping_ = false;
   bool ended_ = false;
-  uint64_t framesSeen_ = 0;                      // the planner's frames at the last tick
+  uint64_t framesSeen_ = 0;                       // the planner's frames at the last tick
   GstClockTime statsTime_ = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
   CameraState state_ = CameraState::kConnecting;  // as last said
-  bool everLive_ = false;                          // logged in at least once
+  bool everLive_ = false;                         // logged in at least once
   struct Counts {
     uint64_t frames = 0, incomplete = 0, bytes = 0;
   };
   Counts earlierRuns_, runCounts_;  // the sources' counts: past pipelines', this one's
   std::optional<std::pair<bool, int>> carriedControl_;
-  std::deque<TelemetryRouter::Line> carriedTelemetry_;  // for the next run's first file  // following, target: for the next run
+  std::deque<TelemetryRouter::Line>
+      carriedTelemetry_;  // for the next run's first file  // following, target: for the next run
   CameraReport report_;
   std::deque<Position> trail_;  // the recent positions, for the live view's map
 };

@@ -15,8 +15,8 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
   }
   // Named after its camera, so that the log says whose it is.
   gst_object_set_name(GST_OBJECT(camera->pipeline_), plan.name.c_str());
-  camera->planner_ = std::make_unique<SegmentPlanner>(files.folder, plan.name, files.extension,
-                                                      files.limits);
+  camera->planner_ =
+      std::make_unique<SegmentPlanner>(files.folder, plan.name, files.extension, files.limits);
   camera->track_ = std::make_unique<TelemetryTrack>(camera->element(plan.telemetrySource));
   camera->telemetry_ = std::make_unique<TelemetryRouter>(*camera->planner_, *camera->track_);
   camera->splitter_ = std::make_unique<SegmentSplitter>(

@@ -8,10 +8,7 @@
 #include "common/printable_text.h"
 #include "http/http_connections.h"
 #include "http/http_routes.h"
-#include "http/live_view_page.h"
-#include "http/login_page.h"
-#include "http/page_control_script.h"
-#include "http/page_player_script.h"
+#include "http/page_resources.h"
 #include "http/playback_stream.h"
 #include "record/telemetry_log.h"
 
@@ -228,7 +225,8 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
   if (route.kind != Route::Kind::Login && !self->authorised(message)) {
     // Pages get the sign-in form; the API, streams and files a 401 in JSON.
     if (route.kind == Route::Kind::Page)
-      return respond(message, SOUP_STATUS_UNAUTHORIZED, "text/html; charset=utf-8", kLoginPage);
+      return respond(message, SOUP_STATUS_UNAUTHORIZED, "text/html; charset=utf-8",
+                     pageFile("login.html"));
     soup_message_headers_replace(soup_server_message_get_response_headers(message),
                                  "WWW-Authenticate", "Bearer realm=\"wirc-recorder\"");
     return respondJsonError(message, SOUP_STATUS_UNAUTHORIZED,
@@ -252,7 +250,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                               "GET /recordings/FILE downloads it; DELETE /api/recordings/FILE "
                               "deletes it");
     case Route::Kind::Login:
-      return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", kLoginPage);
+      return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", pageFile("login.html"));
     case Route::Kind::Page:
       return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", self->page());
     case Route::Kind::Status:
@@ -400,14 +398,7 @@ std::string HttpServer::page() const {
   // Inside <script>, "</" could end it early.
   for (size_t at = state.find("</"); at != std::string::npos; at = state.find("</", at))
     state.replace(at, 2, "<\\/");
-  std::string html = kLiveViewPage;
-  auto put = [&html](std::string_view placeholder, std::string_view text) {
-    html.replace(html.find(placeholder), placeholder.size(), text);
-  };
-  put("PLAYER_SCRIPT", kPlayerScript);
-  put("CONTROL_SCRIPT", kControlScript);
-  put("INITIAL_STATE", state);
-  return html;
+  return liveViewPage(state);
 }
 
 void HttpServer::publishDetections(const std::string& camera, const nlohmann::json& detections) {

@@ -17,13 +17,13 @@
 #include <string>
 #include <vector>
 
-#include "common/expected.h"
-#include "http/drive_socket.h"
-#include "fleet/fleet_command.h"
+#include "app/recorder_options.h"
 #include "camera/frame_tap.h"
+#include "common/expected.h"
+#include "fleet/fleet_command.h"
+#include "http/drive_socket.h"
 #include "http/http_connections.h"
 #include "http/http_routes.h"
-#include "app/recorder_options.h"
 
 namespace wircam::recorder {
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "common/expected.h"
-#include "camera/frame_tap.h"
 #include "app/recorder_options.h"
+#include "camera/frame_tap.h"
+#include "common/expected.h"
 
 namespace wircam::recorder {
 

@@ -105,11 +105,12 @@ std::string statusLine(const CameraReport& c) {
     where = text;
   }
   std::string state = c.state == "live" ? "" : "  [" + c.state + "]";
-  std::snprintf(line, sizeof line,
-                "%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V%s%s  %s%s",
-                c.name.c_str(), static_cast<unsigned long long>(c.frames), c.fps, lossPercent(c),
-                c.kbps, c.batteryMv / 1000.0, stale.c_str(), where.c_str(),
-                std::filesystem::path(c.segment).filename().c_str(), state.c_str());
+  std::snprintf(
+      line, sizeof line,
+      "%-20s %7llu frames %5.1f fps  loss %4.1f%%  %7.0f kbit/s  battery %5.2f V%s%s  %s%s",
+      c.name.c_str(), static_cast<unsigned long long>(c.frames), c.fps, lossPercent(c), c.kbps,
+      c.batteryMv / 1000.0, stale.c_str(), where.c_str(),
+      std::filesystem::path(c.segment).filename().c_str(), state.c_str());
   return line;
 }
 

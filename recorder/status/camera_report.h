@@ -39,7 +39,7 @@ struct CameraReport {
   unsigned batteryMv = 0;
   bool statusStale = false;  // the device stopped reporting; batteryMv is its last word
   uint64_t statusAgeMs = 0;
-  std::string segment;  // the file being written (a path), or empty
+  std::string segment;                   // the file being written (a path), or empty
   std::optional<ControlReport> control;  // with --follow, on the steering camera
   bool positions = false;                // with --marvelmind
   std::optional<Position> position;

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "http/http_routes.h"
 #include "app/recorder_options.h"
+#include "http/http_routes.h"
 
 using namespace wircam::recorder;
 

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "http_fetch.h"
 #include "misbehaving_peers.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
@@ -76,6 +77,87 @@ TEST(CameraIsolation, ASignalEndsTheRecorderWithinThreeSecondsWhateverASilentDev
   EXPECT_LT(Clock::now() - signalled, patience(3000ms));
   std::string camera = "127.0.0.1-" + std::to_string(good->port()) + "-cam0";
   EXPECT_GT(indexedFrames(recorder.out(), camera), 0u) << recorder.log();
+}
+
+// /api/cameras' entry of `camera`, or null.
+nlohmann::json cameraEntry(const std::string& url, const std::string& camera) {
+  auto cameras = nlohmann::json::parse(fetch(url + "api/cameras").body, nullptr, false);
+  if (cameras.is_array())
+    for (const auto& entry : cameras)
+      if (entry["name"] == camera) return entry;
+  return nullptr;
+}
+
+TEST(CameraIsolation, ASilentDeviceIsNoVideoAndStartedAgainWhileTheOtherRecords) {
+  auto good = startSequenceDevice();
+  ASSERT_TRUE(good);
+  SilentCamera silent;
+  RecorderProcess recorder(
+      good->port(), {"--device", silent.device(), "--stall-timeout", "1", "--http", "127.0.0.1:0"});
+  auto url = recorder.waitForLog("http://", 5000ms);
+  ASSERT_TRUE(url) << recorder.log();
+  std::string silentName = "127.0.0.1-" + std::to_string(silent.peer.port()) + "-cam0";
+  std::string goodName = "127.0.0.1-" + std::to_string(good->port()) + "-cam0";
+  EXPECT_TRUE(waitFor([&] { return cameraEntry(*url, silentName)["state"] == "no-video"; }, 10s))
+      << cameraEntry(*url, silentName) << recorder.log();
+  // Its pipeline is torn down and started again (and logs in again).
+  EXPECT_TRUE(waitFor([&] { return silent.peer.connections() >= 2; }, 10s)) << recorder.log();
+  EXPECT_NE(recorder.log().find(silentName + ": no frame for 1000 ms while logged in"),
+            std::string::npos)
+      << recorder.log();
+  EXPECT_EQ(cameraEntry(*url, goodName)["state"], "live");
+  auto status = nlohmann::json::parse(fetch(*url + "api/status").body);
+  for (const auto& stream : status["streams"]) {
+    if (stream["name"] == silentName) {
+      EXPECT_GE(stream["restarts"].get<int>(), 1) << stream;
+    }
+  }
+  auto signalled = Clock::now();
+  recorder.signal(SIGINT);
+  auto code = recorder.waitExit(patience(3000ms));
+  ASSERT_TRUE(code.has_value()) << "still running 3 s after SIGINT" << recorder.log();
+  EXPECT_EQ(*code, 0) << recorder.log();
+  EXPECT_LT(Clock::now() - signalled, patience(3000ms));
+  EXPECT_GT(indexedFrames(recorder.out(), goodName), 15u) << recorder.log();
+  EXPECT_EQ(indexedFrames(recorder.out(), silentName), 0u);
+}
+
+TEST(CameraIsolation, AVanishedDeviceHasItsFileFinishedAndIndexedWithinTheLinkTimeout) {
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  uint16_t port = device->port();
+  RecorderProcess recorder(port, {"--segment", "60", "--http", "127.0.0.1:0"});
+  auto url = recorder.waitForLog("http://", 5000ms);
+  ASSERT_TRUE(url) << recorder.log();
+  std::string name = "127.0.0.1-" + std::to_string(port) + "-cam0";
+  ASSERT_TRUE(waitFor([&] { return cameraEntry(*url, name)["state"] == "live"; }, 10s))
+      << recorder.log();
+  // Two seconds of frames.
+  ASSERT_TRUE(waitFor(
+      [&] {
+        auto status = nlohmann::json::parse(fetch(*url + "api/status").body, nullptr, false);
+        return status.is_object() && status["streams"][0]["frames"].get<int>() >= 30;
+      },
+      10s));
+  device.reset();
+  auto vanished = Clock::now();
+  // The link times out (2 s), then the file is finished: in the index, no
+  // longer the open segment, its length readable.
+  ASSERT_TRUE(waitFor([&] { return indexedFrames(recorder.out(), name) > 0; }, patience(4000ms)))
+      << recorder.log();
+  EXPECT_LT(Clock::now() - vanished, patience(3500ms));
+  EXPECT_EQ(cameraEntry(*url, name)["state"], "offline");
+  auto status = nlohmann::json::parse(fetch(*url + "api/status").body);
+  EXPECT_EQ(status["streams"][0]["segment"], "") << status;
+  auto videos = recorder.files(".mkv");
+  ASSERT_EQ(videos.size(), 1u);
+  EXPECT_GT(durationOf(videos[0]), GST_SECOND);
+  // The device comes back: the next file starts with its first frame.
+  device = startSequenceDevice(port);
+  ASSERT_TRUE(device);
+  EXPECT_TRUE(waitFor([&] { return recorder.files(".mkv").size() == 2; }, 15s)) << recorder.log();
+  recorder.signal(SIGINT);
+  ASSERT_EQ(recorder.waitExit(patience(3000ms)), 0) << recorder.log();
 }
 
 }  // namespace

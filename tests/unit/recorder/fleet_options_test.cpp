@@ -2,9 +2,9 @@
 // URL and the commands taken over MQTT.
 #include <gtest/gtest.h>
 
+#include "app/recorder_options.h"
 #include "fleet/fleet_command.h"
 #include "fleet/mqtt_url.h"
-#include "app/recorder_options.h"
 
 namespace wircam::recorder {
 namespace {

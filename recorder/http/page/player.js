@@ -1,15 +1,3 @@
-// The live view page's player (wirc-recorder's web server puts it into the
-// page): a Matroska segment replayed from /play/FILE.mjpg at real speed,
-// read as a stream of JPEG parts, each with its X-Position, so the page
-// knows where it is; an MP4 segment in a <video> element. Under it, the
-// segment's telemetry from its sidecar on a timeline: battery, detections,
-// commands (the follower's and the driver's), positions and session
-// events; a click seeks there.
-#pragma once
-
-namespace wircam::recorder {
-
-inline constexpr const char kPlayerScript[] = R"js(
 const player = { file: "", duration: 0, position: 0, abort: null, lines: [], objectUrl: "" };
 
 function indexOfBytes(bytes, pattern, from) {
@@ -191,6 +179,3 @@ function seekOnTimeline(event) {
 
 document.getElementById("timeline").addEventListener("click", seekOnTimeline);
 document.getElementById("player-close").addEventListener("click", closePlayer);
-)js";
-
-}  // namespace wircam::recorder

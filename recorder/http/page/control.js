@@ -1,16 +1,3 @@
-// The live view page's control of each followed camera's vehicle (the web
-// server puts it into the page): follow on/off, the target tag, asking
-// for the control right, and drive mode — the arrow keys or a gamepad
-// (the browser's Gamepad API), ten commands a second over a WebSocket,
-// each acknowledged so the round trip shows. The page stops the vehicle
-// when the tab is hidden or the socket closes; the server's dead-man does
-// when the page merely stops sending. Control needs the access token: the
-// server refuses it otherwise, and the card says why.
-#pragma once
-
-namespace wircam::recorder {
-
-inline constexpr const char kControlScript[] = R"js(
 const kDrivePeriodMs = 100;
 const keys = { ArrowUp: false, ArrowDown: false, ArrowLeft: false, ArrowRight: false };
 let driving = null;  // { name, socket, timer, seq, sent: Map(seq → time), view }
@@ -135,6 +122,3 @@ window.addEventListener("blur", () => { for (const key in keys) keys[key] = fals
 document.addEventListener("visibilitychange", () => {
   if (document.hidden) stopDriving("the tab was hidden");
 });
-)js";
-
-}  // namespace wircam::recorder

@@ -1,84 +1,3 @@
-// The page wirc-recorder's web server shows at "/": every camera live as
-// MJPEG (the camera's own frames, not re-encoded), the AprilTags found in
-// them drawn over the picture from the /api/events stream, the status, a
-// map of the vehicles' Marvelmind positions with their trails (when
-// --marvelmind is on) and the recordings. Self-contained: no scripts from
-// elsewhere. The server puts the cameras, their last detections and the
-// position trails in place of INITIAL_STATE, so the first picture already
-// carries its overlay and the map its trails, and the player
-// (page_player_script.h) and control (page_control_script.h) scripts in
-// place of PLAYER_SCRIPT and CONTROL_SCRIPT.
-#pragma once
-
-namespace wircam::recorder {
-
-inline constexpr const char kLiveViewPage[] = R"html(<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>wirc-recorder</title>
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<style>
-body { background: #15171a; color: #e8e8e8; font: 14px sans-serif; margin: 16px; }
-h1 { font-size: 20px; margin: 0 0 12px; } h2 { font-size: 16px; }
-.camera { display: inline-block; margin: 0 16px 16px 0; vertical-align: top; background: #202328;
-          border-radius: 8px; padding: 10px; width: min(640px, calc(100vw - 52px)); }
-.head { display: flex; align-items: center; gap: 8px; margin-bottom: 8px; flex-wrap: wrap; }
-.badge { border-radius: 4px; padding: 2px 8px; font-size: 12px; font-weight: bold; color: #fff; }
-.badge.live { background: #1b873f; } .badge.offline { background: #c53030; }
-.badge.waiting, .badge.connecting { background: #8a6d1d; }
-.since { color: #aab; font-size: 12px; }
-.view { position: relative; line-height: 0; background: #000; }
-.view img { display: block; width: 100%; height: auto; }
-.view svg { position: absolute; left: 0; top: 0; width: 100%; height: 100%; }
-.placeholder { display: none; aspect-ratio: 4 / 3; align-items: center; justify-content: center;
-               line-height: 1.4; color: #889; background: repeating-linear-gradient(45deg, #111,
-               #111 12px, #171717 12px, #171717 24px); font-size: 16px; text-align: center; }
-.camera:not([data-state="live"]) .view img, .camera:not([data-state="live"]) .view svg
-  { display: none; }
-.camera:not([data-state="live"]) .placeholder { display: flex; }
-.tag { fill: none; stroke: #00ff00; stroke-width: 3; }
-.label { fill: #00ff00; font: bold 18px sans-serif; }
-.stats { margin-top: 6px; color: #aab; font-family: monospace; }
-a { color: #8cf; } td { padding: 2px 12px 2px 0; }
-h3 { font-size: 14px; margin: 12px 0 4px; color: #ccd; }
-td.number { text-align: right; font-family: monospace; }
-button.delete { background: none; color: #e88; border: 1px solid #744; border-radius: 4px;
-                font: inherit; font-size: 12px; padding: 1px 8px; cursor: pointer; }
-#map { width: 100%; max-width: 480px; background: #0d0f12; border: 1px solid #333; }
-#map .grid { stroke: #263040; stroke-width: 1; vector-effect: non-scaling-stroke; }
-#map .trail { fill: none; stroke-width: 2; vector-effect: non-scaling-stroke; }
-#map .stale { stroke-dasharray: 4 3; opacity: 0.5; }
-#map text { font: 11px sans-serif; fill: #ccd; }
-[hidden] { display: none !important; }
-button { background: #2b3038; color: #e8e8e8; border: 1px solid #445; border-radius: 4px;
-         font: inherit; font-size: 13px; padding: 3px 10px; cursor: pointer; }
-button.on { background: #1b6f3f; border-color: #2a9d5c; }
-.controls { margin-top: 8px; display: flex; flex-wrap: wrap; gap: 6px; align-items: center; }
-.controls input { width: 4em; background: #15171a; color: #e8e8e8; border: 1px solid #445; }
-.drive-info { color: #8cf; font-family: monospace; }
-.control-message { flex-basis: 100%; color: #e88; }
-.camera[data-driving="true"] { outline: 2px solid #4fc3f7; }
-#player { max-width: 680px; background: #202328; border-radius: 8px; padding: 10px; }
-#player h2 { display: flex; gap: 8px; align-items: center; margin-top: 0; font-size: 15px; }
-#player-title { font-weight: normal; color: #aab; overflow-wrap: anywhere; flex: 1; }
-#player img, #player video { display: block; width: 100%; background: #000; }
-/* A phone: each recording's cells wrap instead of running off the side. */
-@media (max-width: 560px) {
-  #recordings tr { display: flex; flex-wrap: wrap; align-items: center; margin-bottom: 6px; }
-  body { margin: 8px; } .camera { width: calc(100vw - 36px); margin-right: 0; }
-}
-#timeline { display: block; width: 100%; height: 104px; margin-top: 8px; cursor: pointer; }
-</style></head>
-<body>
-<h1>wirc-recorder</h1>
-<div id="cameras"></div>
-<section id="positions" hidden><h2>Positions</h2><svg id="map" viewBox="0 0 480 360"></svg></section>
-<section id="player" hidden><h2>Playback <span id="player-title"></span>
-<button id="player-close">close</button></h2><img id="playback-image" alt="playback">
-<video id="playback-video" controls hidden></video>
-<div class="stats" id="playback-time"></div><canvas id="timeline"></canvas></section>
-<h2>Recordings</h2>
-<div id="recordings"></div>
-<p id="recording-message" class="since"></p>
-<script>
 "use strict";
 const svgNs = "http://www.w3.org/2000/svg";
 const views = {};
@@ -103,18 +22,24 @@ function addCamera(camera) {
   showDetections({ stream: camera.name, detections: camera.detections });
 }
 
-// live, offline, or waiting for device (with since when). Not live: a
-// placeholder saying so, never a broken image or a stale tag box; live
-// again: the picture reconnects.
+// live, no-video, offline, or connecting: waiting for the device (with
+// since when). Not live: a placeholder saying why, never a broken image or
+// a stale tag box; live again: the picture reconnects.
+const stateKinds = { "live": "live", "offline": "offline", "no-video": "novideo" };
+const stateWhy = {
+  "offline": "the device is off, out of range or gone; it is reconnected to when it is back",
+  "no-video": "the device is logged in but sends no frames (its camera unplugged, or its " +
+      "stream blocked); the camera is started again",
+};
 function setState(view, state, sinceUtc) {
-  const kind = state === "live" ? "live" : state === "offline" ? "offline" : "waiting";
+  const kind = stateKinds[state] || "waiting";
   const since = sinceUtc ? new Date(sinceUtc) : null;
   const sinceText = since ? "since " + since.toLocaleTimeString() : "";
   view.badge.className = "badge " + kind;
   view.badge.textContent = state;
   view.since.textContent = sinceText;
-  view.placeholder.textContent = state === "offline" ? `offline ${sinceText}: the device is ` +
-      "off, out of range or gone; it is reconnected to when it is back" : "waiting for device";
+  view.placeholder.textContent =
+      stateWhy[state] ? `${state} ${sinceText}: ${stateWhy[state]}` : "waiting for device";
   if (view.state !== kind) {
     view.box.dataset.state = kind;
     if (kind === "live") {
@@ -298,8 +223,6 @@ async function deleteSegment(file) {
   refresh();
 }
 
-PLAYER_SCRIPT
-CONTROL_SCRIPT
 
 function start() {
   // Built before the page's load event, so a screenshot at load shows them.
@@ -316,8 +239,3 @@ function start() {
   setInterval(refresh, 2000);
 }
 start();
-</script>
-</body></html>
-)html";
-
-}  // namespace wircam::recorder
