@@ -195,6 +195,7 @@ gboolean Camera::onRestart(gpointer data) {
 
 void Camera::closed(const std::string& file) {
   auto planned = pipeline_ ? pipeline_->planner().segmentOf(file) : std::nullopt;
+  ++filesClosed_;
   if (planned)
     observer_.segmentClosed(*this, file, *planned);
   else

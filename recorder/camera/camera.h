@@ -72,6 +72,8 @@ class Camera {
   void halt();
   bool ended() const { return ended_; }
   bool hasFrames() const { return pipeline_ && pipeline_->hasFrames(); }
+  // Whether any run of it has recorded a frame.
+  bool recordedAny() const { return filesClosed_ > 0 || hasFrames(); }
 
   const StreamPlan& plan() const { return plan_; }
   const std::string& name() const { return plan_.name; }
@@ -128,6 +130,7 @@ class Camera {
   bool finishing_ = false;
   bool stopping_ = false;
   bool ended_ = false;
+  uint64_t filesClosed_ = 0;
   uint64_t framesSeen_ = 0;                       // the planner's frames at the last tick
   GstClockTime statsTime_ = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
   CameraState state_ = CameraState::kConnecting;  // as last said

@@ -6,7 +6,9 @@
 #include <set>
 
 #include "common/printable_text.h"
+#include "http/camera_feed.h"
 #include "http/http_connections.h"
+#include "http/http_responses.h"
 #include "http/http_routes.h"
 #include "http/page_resources.h"
 #include "http/playback_stream.h"
@@ -23,34 +25,7 @@ constexpr char kBoundary[] = "wircframe";
 // slow viewer never makes the recorder hold frames for it.
 constexpr int kMaxFramesInFlight = 3;
 
-void respond(SoupServerMessage* message, guint status, const char* type, const std::string& body) {
-  soup_server_message_set_status(message, status, nullptr);
-  soup_server_message_set_response(message, type, SOUP_MEMORY_COPY, body.data(), body.size());
-}
-
-void respondError(SoupServerMessage* message, guint status, const std::string& text) {
-  respond(message, status, "text/plain; charset=utf-8", text + "\n");
-}
-
-// The API answers errors in JSON too, so scripts can read them.
-void respondJsonError(SoupServerMessage* message, guint status, const std::string& text) {
-  // The text may quote a path, which a client can make any bytes: bytes that
-  // are not UTF-8 are replaced rather than thrown on.
-  respond(message, status, "application/json",
-          nlohmann::json{{"error", text}}.dump(-1, ' ', false,
-                                               nlohmann::json::error_handler_t::replace));
-}
-
 }  // namespace
-
-// One open streaming response: an MJPEG viewer, an event listener, or a
-// recording being replayed (which goes when the viewer does).
-struct HttpServer::Client {
-  SoupServerMessage* message;
-  int inFlight = 0;  // chunks appended but not yet written to the socket
-  gulong wroteHandler = 0, finishedHandler = 0;
-  std::unique_ptr<PlaybackStream> playback;
-};
 
 namespace {
 
@@ -73,20 +48,6 @@ GBytes* multipartFrame(GstBuffer* jpeg, const std::string& extraHeaders) {
 }
 
 }  // namespace
-
-struct HttpServer::CameraFeed {
-  std::string name;
-  FrameTap* frames;
-  int listener = 0;
-  std::vector<std::unique_ptr<Client>> clients;
-  std::atomic<int> clientCount{0};       // read on the streaming thread
-  std::atomic<int> width{0}, height{0};  // of the last frame, for the overlay
-  // The newest frame as the camera sent it, for snapshots (the streaming
-  // thread swaps it, the main loop reads it).
-  std::mutex latestMutex;
-  GstBuffer* latest = nullptr;
-  nlohmann::json detections = nlohmann::json::array();  // the last ones
-};
 
 HttpServer::HttpServer(Content content) : content_(std::move(content)) {}
 
@@ -412,117 +373,6 @@ void HttpServer::publishDetections(const std::string& camera, const nlohmann::js
   g_bytes_unref(chunk);
 }
 
-void HttpServer::serveSnapshot(SoupServerMessage* message, const std::string& camera) {
-  auto feed =
-      std::find_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f->name == camera; });
-  if (feed == feeds_.end())
-    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
-  GstBuffer* jpeg = nullptr;
-  {
-    std::lock_guard lock((*feed)->latestMutex);
-    gst_buffer_replace(&jpeg, (*feed)->latest);
-  }
-  if (!jpeg)
-    return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE,
-                            "camera '" + camera + "' has sent no frame yet");
-  // The frame untouched: the camera's own JPEG bytes.
-  GstMapInfo map;
-  if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
-    respond(message, SOUP_STATUS_OK, "image/jpeg",
-            std::string(reinterpret_cast<const char*>(map.data), map.size));
-    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Cache-Control",
-                                 "no-cache, no-store");
-    gst_buffer_unmap(jpeg, &map);
-  }
-  gst_buffer_unref(jpeg);
-}
-
-void HttpServer::deleteRecording(SoupServerMessage* message, const std::string& name) {
-  if (refusedWithoutToken(message, "deleting recordings")) return;
-  if (!isRecordingName(name) || name.ends_with(".jsonl"))
-    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
-  auto refused = content_.deleteRecording(name);
-  if (!refused) {
-    respond(message, SOUP_STATUS_OK, "application/json", nlohmann::json{{"deleted", name}}.dump());
-    return;
-  }
-  respondJsonError(message, refused->first, refused->second);
-}
-
-void HttpServer::serveRecordingIndex(SoupServerMessage* message) {
-  nlohmann::json list = content_.recordings();
-  for (auto& entry : list) {
-    gchar* escaped = g_uri_escape_string(entry["file"].get<std::string>().c_str(), nullptr, FALSE);
-    entry["url"] = std::string("/recordings/") + escaped;
-    g_free(escaped);
-  }
-  respond(message, SOUP_STATUS_OK, "application/json", list.dump());
-}
-
-void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& name) {
-  fs::path folder = content_.recordingsFolder;
-  if (name.empty()) {
-    auto open = content_.openSegments();
-    std::set<std::string> openNames;
-    for (const auto& path : open) {
-      openNames.insert(fs::path(path).filename().string());
-      openNames.insert(fs::path(TelemetryLog::pathFor(path)).filename().string());
-    }
-    nlohmann::json files = nlohmann::json::array();
-    std::error_code error;
-    for (const auto& entry : fs::directory_iterator(folder, error)) {
-      // A symbolic link could lead anywhere on the machine: never listed.
-      if (entry.is_symlink(error) || !entry.is_regular_file(error) ||
-          !isRecordingName(entry.path().filename().string()))
-        continue;
-      auto file = entry.path().filename().string();
-      files.push_back({{"name", file},
-                       {"bytes", entry.file_size(error)},
-                       {"recording", openNames.count(file) > 0}});
-    }
-    std::sort(files.begin(), files.end(),
-              [](const auto& a, const auto& b) { return a["name"] < b["name"]; });
-    respond(message, SOUP_STATUS_OK, "application/json", files.dump());
-    return;
-  }
-  // Only plain names of recordings in the folder, never a symbolic link:
-  // no way out of it.
-  fs::path file = folder / name;
-  std::error_code error;
-  if (!isRecordingName(name) || fs::is_symlink(fs::symlink_status(file, error)) ||
-      !fs::is_regular_file(file, error)) {
-    respondJsonError(
-        message, SOUP_STATUS_NOT_FOUND,
-        "no recording named '" + printableText(name) + "'; GET /api/recordings lists them");
-    return;
-  }
-  GError* mapError = nullptr;
-  GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &mapError);
-  if (!mapped) {
-    respondJsonError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR, mapError->message);
-    g_error_free(mapError);
-    return;
-  }
-  GBytes* bytes = g_mapped_file_get_bytes(mapped);
-  g_mapped_file_unref(mapped);
-  soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
-  SoupMessageHeaders* headers = soup_server_message_get_response_headers(message);
-  soup_message_headers_set_content_type(headers, recordingContentType(name), nullptr);
-  // libsoup answers a Range request from the whole body: a <video> seeks.
-  soup_message_headers_replace(headers, "Accept-Ranges", "bytes");
-  soup_message_body_append_bytes(soup_server_message_get_response_body(message), bytes);
-  g_bytes_unref(bytes);
-}
-
-// Control and deletion are always behind the token: without one set, nobody
-// may (the page is then open to anyone who can reach this machine's port).
-bool HttpServer::refusedWithoutToken(SoupServerMessage* message, const char* what) {
-  if (!content_.token.empty()) return false;
-  respondJsonError(message, SOUP_STATUS_FORBIDDEN,
-                   std::string(what) + " needs the server started with --http-token");
-  return true;
-}
-
 void HttpServer::servePlayback(SoupServerMessage* message, const std::string& name,
                                GHashTable* query) {
   fs::path file = fs::path(content_.recordingsFolder) / name;
@@ -567,52 +417,6 @@ void HttpServer::servePlayback(SoupServerMessage* message, const std::string& na
   std::string type = std::string("multipart/x-mixed-replace; boundary=") + kBoundary;
   openStream(message, type.c_str(), playbackClients_);
   playbackClients_.back()->playback = std::move(*playback);
-}
-
-void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query) {
-  if (std::string(soup_server_message_get_method(message)) != "POST")
-    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                            "POST /api/cameras/NAME/" + route.action);
-  if (refusedWithoutToken(message, "controlling the vehicle")) return;
-  auto lookup = [&](const char* key) -> std::string {
-    const char* value = query ? static_cast<const char*>(g_hash_table_lookup(query, key)) : nullptr;
-    return value ? value : "";
-  };
-  // The same commands as over MQTT, with their checks.
-  std::string command = "request-control", payload;
-  if (route.action == "follow") {
-    std::string on = lookup("on");
-    if (on != "true" && on != "false")
-      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "follow takes on=true or on=false");
-    command = "follow/set";
-    payload = on == "true" ? "ON" : "OFF";
-  } else if (route.action == "target") {
-    command = "target/set";
-    payload = lookup("id");
-  }
-  auto parsed = parseFleetCommand(route.name, command, payload);
-  if (!parsed) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, parsed.error());
-  if (auto refused = content_.command(*parsed)) {
-    bool unknown = std::none_of(feeds_.begin(), feeds_.end(),
-                                [&](const auto& feed) { return feed->name == route.name; });
-    return respondJsonError(message, unknown ? SOUP_STATUS_NOT_FOUND : SOUP_STATUS_CONFLICT,
-                            *refused);
-  }
-  for (const auto& camera : content_.cameraStates())
-    if (camera.value("name", "") == route.name)
-      return respond(message, SOUP_STATUS_OK, "application/json", camera.dump());
-  respond(message, SOUP_STATUS_OK, "application/json", "{}");
-}
-
-void HttpServer::refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera) {
-  if (refusedWithoutToken(message, "driving")) return;
-  if (std::none_of(feeds_.begin(), feeds_.end(),
-                   [&](const auto& feed) { return feed->name == camera; }))
-    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
-  // Allowed but not a WebSocket handshake: libsoup answers 400. Once
-  // upgraded it is not idle between a driver's commands: open until either
-  // side closes it.
-  connections_->upgrading(message);
 }
 
 void HttpServer::onWebSocket(SoupServer*, SoupServerMessage*, const char* path,

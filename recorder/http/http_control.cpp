@@ -1,0 +1,66 @@
+// HttpServer's control of the vehicles: follow, target and control-right
+// commands, and who may drive; all behind the access token.
+#include "common/printable_text.h"
+#include "http/camera_feed.h"
+#include "http/http_responses.h"
+#include "http/http_routes.h"
+#include "http/http_server.h"
+
+namespace wircam::recorder {
+
+// Control and deletion are always behind the token: without one set, nobody
+// may (the page is then open to anyone who can reach this machine's port).
+bool HttpServer::refusedWithoutToken(SoupServerMessage* message, const char* what) {
+  if (!content_.token.empty()) return false;
+  respondJsonError(message, SOUP_STATUS_FORBIDDEN,
+                   std::string(what) + " needs the server started with --http-token");
+  return true;
+}
+
+void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query) {
+  if (std::string(soup_server_message_get_method(message)) != "POST")
+    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
+                            "POST /api/cameras/NAME/" + route.action);
+  if (refusedWithoutToken(message, "controlling the vehicle")) return;
+  auto lookup = [&](const char* key) -> std::string {
+    const char* value = query ? static_cast<const char*>(g_hash_table_lookup(query, key)) : nullptr;
+    return value ? value : "";
+  };
+  // The same commands as over MQTT, with their checks.
+  std::string command = "request-control", payload;
+  if (route.action == "follow") {
+    std::string on = lookup("on");
+    if (on != "true" && on != "false")
+      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "follow takes on=true or on=false");
+    command = "follow/set";
+    payload = on == "true" ? "ON" : "OFF";
+  } else if (route.action == "target") {
+    command = "target/set";
+    payload = lookup("id");
+  }
+  auto parsed = parseFleetCommand(route.name, command, payload);
+  if (!parsed) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, parsed.error());
+  if (auto refused = content_.command(*parsed)) {
+    bool unknown = std::none_of(feeds_.begin(), feeds_.end(),
+                                [&](const auto& feed) { return feed->name == route.name; });
+    return respondJsonError(message, unknown ? SOUP_STATUS_NOT_FOUND : SOUP_STATUS_CONFLICT,
+                            *refused);
+  }
+  for (const auto& camera : content_.cameraStates())
+    if (camera.value("name", "") == route.name)
+      return respond(message, SOUP_STATUS_OK, "application/json", camera.dump());
+  respond(message, SOUP_STATUS_OK, "application/json", "{}");
+}
+
+void HttpServer::refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera) {
+  if (refusedWithoutToken(message, "driving")) return;
+  if (std::none_of(feeds_.begin(), feeds_.end(),
+                   [&](const auto& feed) { return feed->name == camera; }))
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+  // Allowed but not a WebSocket handshake: libsoup answers 400. Once
+  // upgraded it is not idle between a driver's commands: open until either
+  // side closes it.
+  connections_->upgrading(message);
+}
+
+}  // namespace wircam::recorder

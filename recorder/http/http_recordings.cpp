@@ -1,0 +1,118 @@
+// HttpServer's recordings: snapshots of the live cameras, the index, the
+// files themselves (downloads, ranges) and their deletion.
+#include <filesystem>
+#include <set>
+
+#include "common/printable_text.h"
+#include "http/camera_feed.h"
+#include "http/http_responses.h"
+#include "http/http_server.h"
+#include "record/telemetry_log.h"
+
+namespace wircam::recorder {
+
+namespace fs = std::filesystem;
+
+void HttpServer::serveSnapshot(SoupServerMessage* message, const std::string& camera) {
+  auto feed =
+      std::find_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f->name == camera; });
+  if (feed == feeds_.end())
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no camera named '" + camera + "'");
+  GstBuffer* jpeg = nullptr;
+  {
+    std::lock_guard lock((*feed)->latestMutex);
+    gst_buffer_replace(&jpeg, (*feed)->latest);
+  }
+  if (!jpeg)
+    return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE,
+                            "camera '" + camera + "' has sent no frame yet");
+  // The frame untouched: the camera's own JPEG bytes.
+  GstMapInfo map;
+  if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
+    respond(message, SOUP_STATUS_OK, "image/jpeg",
+            std::string(reinterpret_cast<const char*>(map.data), map.size));
+    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Cache-Control",
+                                 "no-cache, no-store");
+    gst_buffer_unmap(jpeg, &map);
+  }
+  gst_buffer_unref(jpeg);
+}
+
+void HttpServer::deleteRecording(SoupServerMessage* message, const std::string& name) {
+  if (refusedWithoutToken(message, "deleting recordings")) return;
+  if (!isRecordingName(name) || name.ends_with(".jsonl"))
+    return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no recording named '" + name + "'");
+  auto refused = content_.deleteRecording(name);
+  if (!refused) {
+    respond(message, SOUP_STATUS_OK, "application/json", nlohmann::json{{"deleted", name}}.dump());
+    return;
+  }
+  respondJsonError(message, refused->first, refused->second);
+}
+
+void HttpServer::serveRecordingIndex(SoupServerMessage* message) {
+  nlohmann::json list = content_.recordings();
+  for (auto& entry : list) {
+    gchar* escaped = g_uri_escape_string(entry["file"].get<std::string>().c_str(), nullptr, FALSE);
+    entry["url"] = std::string("/recordings/") + escaped;
+    g_free(escaped);
+  }
+  respond(message, SOUP_STATUS_OK, "application/json", list.dump());
+}
+
+void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& name) {
+  fs::path folder = content_.recordingsFolder;
+  if (name.empty()) {
+    auto open = content_.openSegments();
+    std::set<std::string> openNames;
+    for (const auto& path : open) {
+      openNames.insert(fs::path(path).filename().string());
+      openNames.insert(fs::path(TelemetryLog::pathFor(path)).filename().string());
+    }
+    nlohmann::json files = nlohmann::json::array();
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(folder, error)) {
+      // A symbolic link could lead anywhere on the machine: never listed.
+      if (entry.is_symlink(error) || !entry.is_regular_file(error) ||
+          !isRecordingName(entry.path().filename().string()))
+        continue;
+      auto file = entry.path().filename().string();
+      files.push_back({{"name", file},
+                       {"bytes", entry.file_size(error)},
+                       {"recording", openNames.count(file) > 0}});
+    }
+    std::sort(files.begin(), files.end(),
+              [](const auto& a, const auto& b) { return a["name"] < b["name"]; });
+    respond(message, SOUP_STATUS_OK, "application/json", files.dump());
+    return;
+  }
+  // Only plain names of recordings in the folder, never a symbolic link:
+  // no way out of it.
+  fs::path file = folder / name;
+  std::error_code error;
+  if (!isRecordingName(name) || fs::is_symlink(fs::symlink_status(file, error)) ||
+      !fs::is_regular_file(file, error)) {
+    respondJsonError(
+        message, SOUP_STATUS_NOT_FOUND,
+        "no recording named '" + printableText(name) + "'; GET /api/recordings lists them");
+    return;
+  }
+  GError* mapError = nullptr;
+  GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &mapError);
+  if (!mapped) {
+    respondJsonError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR, mapError->message);
+    g_error_free(mapError);
+    return;
+  }
+  GBytes* bytes = g_mapped_file_get_bytes(mapped);
+  g_mapped_file_unref(mapped);
+  soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
+  SoupMessageHeaders* headers = soup_server_message_get_response_headers(message);
+  soup_message_headers_set_content_type(headers, recordingContentType(name), nullptr);
+  // libsoup answers a Range request from the whole body: a <video> seeks.
+  soup_message_headers_replace(headers, "Accept-Ranges", "bytes");
+  soup_message_body_append_bytes(soup_server_message_get_response_body(message), bytes);
+  g_bytes_unref(bytes);
+}
+
+}  // namespace wircam::recorder
