@@ -73,8 +73,14 @@ CameraHealth::Clock::time_point CameraHealth::fault(CameraFault fault, Clock::ti
     stallReported_ = true;
     noVideo_ = true;
   }
-  stateAtFault_ = fault == CameraFault::kStall ? CameraState::kNoVideo : state(now);
-  if (fault == CameraFault::kLoss) stateAtFault_ = CameraState::kOffline;
+  // Shown until the next run starts: what the fault says, or (an error)
+  // what the camera was.
+  if (fault == CameraFault::kStall)
+    stateAtFault_ = CameraState::kNoVideo;
+  else if (fault == CameraFault::kLoss)
+    stateAtFault_ = CameraState::kOffline;
+  else
+    stateAtFault_ = state(now);
   restartPending_ = true;
   ++consecutiveFaults_;
   return now + backoff();

@@ -39,6 +39,16 @@ uint64_t indexedFrames(const fs::path& out, const std::string& camera) {
   return frames;
 }
 
+// SIGINT ends the recorder with exit 0 within 3 s.
+void expectSigintEndsItWithinThreeSeconds(RecorderProcess& recorder) {
+  auto signalled = Clock::now();
+  recorder.signal(SIGINT);
+  auto code = recorder.waitExit(patience(3000ms));
+  ASSERT_TRUE(code.has_value()) << "still running 3 s after SIGINT" << recorder.log();
+  EXPECT_EQ(*code, 0) << recorder.log();
+  EXPECT_LT(Clock::now() - signalled, patience(3000ms));
+}
+
 TEST(CameraIsolation, ASilentDeviceHoldsUpNeitherTheOtherCameraNorTheDuration) {
   auto good = startSequenceDevice();
   ASSERT_TRUE(good);
@@ -69,12 +79,7 @@ TEST(CameraIsolation, ASignalEndsTheRecorderWithinThreeSecondsWhateverASilentDev
       },
       10s))
       << recorder.log();
-  auto signalled = Clock::now();
-  recorder.signal(SIGINT);
-  auto code = recorder.waitExit(patience(3000ms));
-  ASSERT_TRUE(code.has_value()) << "still running 3 s after SIGINT" << recorder.log();
-  EXPECT_EQ(*code, 0) << recorder.log();
-  EXPECT_LT(Clock::now() - signalled, patience(3000ms));
+  expectSigintEndsItWithinThreeSeconds(recorder);
   std::string camera = "127.0.0.1-" + std::to_string(good->port()) + "-cam0";
   EXPECT_GT(indexedFrames(recorder.out(), camera), 0u) << recorder.log();
 }
@@ -112,12 +117,7 @@ TEST(CameraIsolation, ASilentDeviceIsNoVideoAndStartedAgainWhileTheOtherRecords)
       EXPECT_GE(stream["restarts"].get<int>(), 1) << stream;
     }
   }
-  auto signalled = Clock::now();
-  recorder.signal(SIGINT);
-  auto code = recorder.waitExit(patience(3000ms));
-  ASSERT_TRUE(code.has_value()) << "still running 3 s after SIGINT" << recorder.log();
-  EXPECT_EQ(*code, 0) << recorder.log();
-  EXPECT_LT(Clock::now() - signalled, patience(3000ms));
+  expectSigintEndsItWithinThreeSeconds(recorder);
   EXPECT_GT(indexedFrames(recorder.out(), goodName), 15u) << recorder.log();
   EXPECT_EQ(indexedFrames(recorder.out(), silentName), 0u);
 }
