@@ -277,11 +277,6 @@ gboolean Supervisor::onDurationOver(gpointer data) {
   return G_SOURCE_REMOVE;
 }
 
-gboolean Supervisor::onHeartbeat(gpointer data) {
-  for (auto& c : static_cast<Supervisor*>(data)->cameras_) c->heartbeat();
-  return G_SOURCE_CONTINUE;
-}
-
 gboolean Supervisor::onCameraTick(gpointer data) {
   for (auto& c : static_cast<Supervisor*>(data)->cameras_) c->tick();
   return G_SOURCE_CONTINUE;
@@ -395,8 +390,6 @@ int Supervisor::run() {
         g_timeout_add(static_cast<guint>(*options_.duration * 1000), onDurationOver, this));
   timers_.push_back(g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this));
   timers_.push_back(g_timeout_add(Camera::kTickIntervalMs, onCameraTick, this));
-  timers_.push_back(
-      g_timeout_add(TelemetryTrack::kHeartbeatInterval / GST_MSECOND, onHeartbeat, this));
   // Once a second, whatever --status says: the fleet's status is published
   // on change and at least every FleetPublisher::kStatusInterval.
   if (fleet_)

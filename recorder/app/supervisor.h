@@ -59,7 +59,6 @@ class Supervisor : CameraObserver {
   static gboolean onDurationOver(gpointer self);
   static gboolean onTick(gpointer self);
   static gboolean onCameraTick(gpointer self);
-  static gboolean onHeartbeat(gpointer self);
   void quitWhenAllEnded();
   void publishFleetStatus(bool force = false);
   // DELETE /api/recordings/FILE: the HTTP status and reason when it cannot.

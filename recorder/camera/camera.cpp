@@ -122,7 +122,7 @@ void Camera::finish(Then then) {
     return;
   }
   finishing_ = true;
-  gst_element_send_event(pipeline_->pipeline(), gst_event_new_eos());
+  pipeline_->writer().end();
   finishDeadline_ = g_timeout_add(static_cast<guint>(kFinishTime.count()), onFinishDeadline, this);
 }
 
@@ -145,10 +145,13 @@ void Camera::tearDown() {
     g_object_get(control, "enabled", &enabled, "target-id", &target, nullptr);
     carriedControl_ = {enabled != FALSE, target};
   }
-  if (pipeline_) gst_element_set_state(pipeline_->pipeline(), GST_STATE_NULL);
-  // A file EOS did not finish is still playable (streamable Matroska,
-  // fragmented MP4): indexed like any other.
-  if (!report_.segment.empty()) closed(std::exchange(report_.segment, ""));
+  if (pipeline_) {
+    gst_element_set_state(pipeline_->pipeline(), GST_STATE_NULL);
+    // A file EOS did not finish is still playable (Matroska written in
+    // clusters, fragmented MP4): indexed like any other.
+    for (const auto& file : pipeline_->writer().files()) closed(file);
+  }
+  report_.segment.clear();
   pipeline_.reset();
   finishing_ = false;
   framesSeen_ = 0;

@@ -87,8 +87,6 @@ class Camera {
   double kbps() const { return report_.kbps; }
   // A line of the camera's telemetry, now (a command, say).
   void writeTelemetry(const nlohmann::json& line);
-  // The heartbeat of its text track, at its newest frame.
-  void heartbeat();
 
  private:
   Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy, CameraObserver& observer);

@@ -31,13 +31,6 @@ void Camera::writeTelemetry(const nlohmann::json& line) {
   if (pipeline_) writeTelemetry(line, pipeline_->runningTime());
 }
 
-void Camera::heartbeat() {
-  // At the newest frame the source has sent, never ahead of the video, and
-  // only once the first frame has opened a file.
-  if (!pipeline_) return;
-  if (auto open = pipeline_->planner().current()) pipeline_->track().heartbeat(open->lastFrame);
-}
-
 CameraReport Camera::report() const {
   CameraReport report = report_;
   report.everLive = everLive_;
@@ -140,17 +133,18 @@ void Camera::handlePosition(const GstStructure* s) {
 void Camera::handleElementMessage(GstMessage* message) {
   const GstStructure* s = gst_message_get_structure(message);
   if (!s || !pipeline_) return;
-  // splitmuxsink's own: the files it opens and finishes.
-  if (gst_structure_has_name(s, "splitmuxsink-fragment-opened")) {
+  // The files the SegmentWriter opens and finishes.
+  if (gst_structure_has_name(s, SegmentFile::kOpenedMessage)) {
     report_.segment = gst_structure_get_string(s, "location");
     pipeline_->telemetry().segmentOpened(report_.segment);
     if (auto failure = pipeline_->telemetry().takeWriteFailure()) logLine(*failure);
     return;
   }
-  if (gst_structure_has_name(s, "splitmuxsink-fragment-closed")) {
+  if (gst_structure_has_name(s, SegmentFile::kClosedMessage)) {
     std::string file = gst_structure_get_string(s, "location");
-    // (Finalised in the background: the next file may be open already.)
+    // (Finished on a streaming thread: the next file may be open already.)
     if (file == report_.segment) report_.segment.clear();
+    pipeline_->writer().release(file);
     closed(file);
     return;
   }

@@ -19,11 +19,14 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
       std::make_unique<SegmentPlanner>(files.folder, plan.name, files.extension, files.limits);
   camera->track_ = std::make_unique<TelemetryTrack>(camera->element(plan.telemetrySource));
   camera->telemetry_ = std::make_unique<TelemetryRouter>(*camera->planner_, *camera->track_);
-  camera->splitter_ = std::make_unique<SegmentSplitter>(
-      SegmentSplitter::Parts{.source = camera->element(plan.source),
-                             .splitmux = camera->element(plan.muxer),
-                             .transcoded = files.transcoded},
-      *camera->planner_, [self = camera.get()] {
+  camera->writer_ = std::make_unique<SegmentWriter>(
+      SegmentWriter::Parts{.pipeline = camera->pipeline_,
+                           .source = camera->element(plan.source),
+                           .videoTail = camera->element(plan.videoTail),
+                           .textTail = camera->element(plan.telemetryTail),
+                           .muxer = plan.muxer,
+                           .transcoded = files.transcoded},
+      *camera->planner_, *camera->track_, [self = camera.get()] {
         self->telemetry_->onFrame();
         self->framesPlanned_.fetch_add(1, std::memory_order_relaxed);
       });
@@ -38,8 +41,8 @@ CameraPipeline::~CameraPipeline() {
   if (!pipeline_) return;
   gst_element_set_state(pipeline_, GST_STATE_NULL);
   if (frames_) frames_->detach();
-  // The splitter holds the elements' pads: before the pipeline goes.
-  splitter_.reset();
+  // The writer holds the elements' pads: before the pipeline goes.
+  writer_.reset();
   telemetry_.reset();
   track_.reset();
   gst_object_unref(pipeline_);

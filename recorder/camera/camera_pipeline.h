@@ -1,6 +1,6 @@
 // One run of a camera's pipeline, from its start to its teardown: the
 // GstPipeline built from the camera's plan, and what follows its frames
-// into files (the segment planner and splitter, the telemetry track and
+// into files (the segment planner and writer, the telemetry track and
 // router). A camera restarted after a fault gets a new one; its files go on
 // under new names, each starting at its first frame.
 #pragma once
@@ -14,7 +14,7 @@
 
 #include "camera/frame_tap.h"
 #include "camera/pipeline_plan.h"
-#include "camera/segment_splitter.h"
+#include "camera/segment_writer.h"
 #include "common/expected.h"
 #include "record/segment_planner.h"
 #include "telemetry/telemetry_router.h"
@@ -45,6 +45,7 @@ class CameraPipeline {
   SegmentPlanner& planner() { return *planner_; }
   TelemetryTrack& track() { return *track_; }
   TelemetryRouter& telemetry() { return *telemetry_; }
+  SegmentWriter& writer() { return *writer_; }
   // The running time now, or GST_CLOCK_TIME_NONE before PLAYING.
   GstClockTime runningTime() const;
   bool hasFrames() const { return planner_->current().has_value(); }
@@ -59,7 +60,7 @@ class CameraPipeline {
   std::unique_ptr<SegmentPlanner> planner_;
   std::unique_ptr<TelemetryTrack> track_;
   std::unique_ptr<TelemetryRouter> telemetry_;
-  std::unique_ptr<SegmentSplitter> splitter_;
+  std::unique_ptr<SegmentWriter> writer_;
   std::atomic<uint64_t> framesPlanned_{0};
 };
 

@@ -2,7 +2,6 @@
 
 #include <cctype>
 #include <cstdint>
-#include <filesystem>
 
 #include "telemetry/telemetry_track_flags.h"
 
@@ -17,26 +16,26 @@ std::string fileSafe(std::string text) {
   return text;
 }
 
-// The muxer inside splitmuxsink. Crash safety: Matroska clusters and MP4
-// fragments of at most 0.5 s (the muxers write a cluster or fragment whole),
-// so a killed recorder leaves the open segment playable up to about its
-// last second.
-std::string muxerSettings(Container container) {
-  if (container == Container::kMp4)
-    return "muxer-factory=mp4mux "
-           "muxer-properties=\"properties,fragment-duration=(guint)500\"";
-  return "muxer-factory=matroskamux "
-         "muxer-properties=\"properties,max-cluster-duration=(gint64)500000000\"";
+// Each file's muxer. Crash safety: Matroska clusters and MP4 fragments of
+// at most 0.5 s (the muxers write a cluster or fragment whole), so a killed
+// recorder leaves the open segment playable up to about its last second.
+MuxerSpec muxerOf(Container container) {
+  if (container == Container::kMp4) return {"mp4mux", {{"fragment-duration", "500"}}};
+  return {"matroskamux", {{"max-cluster-duration", "500000000"}}};
 }
 
-// What the frames pass through between the tee and the muxer.
-std::string encoder(const RecorderOptions& options) {
+// What the frames pass through on their way to the file, ending in the
+// element named `tail`.
+std::string encoder(const RecorderOptions& options, const std::string& tail) {
   if (options.codec == Codec::kJpeg) return "";
   // zerolatency: no B-frames and no look-ahead, so the live recording does
   // not lag. The recorder asks for a key frame at each cut and every 0.5 s
-  // (SegmentSplitter); key-int-max is only a backstop.
+  // (SegmentWriter); key-int-max is only a backstop. The muxers take H.264
+  // as "avc" only, and the file is linked after the caps are settled.
   return "tjpegdec ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
-         std::to_string(options.h264Kbps) + " key-int-max=60 ! h264parse ! ";
+         std::to_string(options.h264Kbps) +
+         " key-int-max=60 ! h264parse ! capsfilter name=" + tail +
+         " caps=\"video/x-h264,stream-format=avc,alignment=au\" ";
 }
 
 // wirccontrol's properties for the vehicle the device's tags steer: the
@@ -52,7 +51,7 @@ std::string controlOf(const DeviceTarget& device) {
 // The element that joins the vehicle's Marvelmind positions to its frames.
 std::string positionsOf(const PositionSource& source, const std::string& name) {
   return "marvelmindpositions name=" + name + " host=" + source.host +
-         " port=" + std::to_string(source.port) + " beacons=" + source.beacons + " ! ";
+         " port=" + std::to_string(source.port) + " beacons=" + source.beacons + " ";
 }
 
 }  // namespace
@@ -83,8 +82,9 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       stream.camera = camera;
       stream.name = stream.device + "-cam" + std::to_string(camera);
       stream.source = "src" + i;
-      stream.muxer = "mux" + i;
       stream.telemetrySource = "tel" + i;
+      stream.telemetryTail = "teltag" + i;
+      stream.muxer = muxerOf(options.container);
       if (!options.detectFamily.empty()) stream.detector = "det" + i;
       if (!options.detectFamily.empty() && *device.follow && !controlled) {
         stream.controller = "ctl" + i;
@@ -92,17 +92,19 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       }
       if (live) stream.liveSink = "live" + i;
       if (device.positions) stream.positions = "pos" + i;
-      // Only if the recorder could not name a file (it always can).
-      auto fallback = (std::filesystem::path(options.outDir) /
-                       (stream.name + "-unnamed-%03d" + extensionOf(options.container)))
-                          .string();
+      bool branches = !stream.detector.empty() || live;
+      std::string tee = "t" + i;
       // wait-for-device: a recorder started before its vehicle waits for it.
       d += "wircsrc name=" + stream.source + host + port + login +
-           " camera=" + std::to_string(camera) + " wait-for-device=true ! " +
-           (device.positions ? positionsOf(*device.positions, stream.positions) : "") +
-           "tee name=t" + i + " t" + i + ". ! queue max-size-time=3000000000 ! " +
-           encoder(options) + "splitmuxsink name=" + stream.muxer + " async-finalize=true " +
-           muxerSettings(options.container) + " location=\"" + fallback + "\" ";
+           " camera=" + std::to_string(camera) + " wait-for-device=true ";
+      if (device.positions) d += "! " + positionsOf(*device.positions, stream.positions);
+      if (branches) d += "! tee name=" + tee + " ";
+      if (plan.transcoded) {
+        stream.videoTail = "enc" + i;
+        d += (branches ? tee + ". ! " : "! ") + encoder(options, stream.videoTail);
+      } else {
+        stream.videoTail = branches ? tee : device.positions ? stream.positions : stream.source;
+      }
       // The telemetry never blocks the main loop: past 1 MB waiting it
       // drops. Its track is named by a stream tag (in Matroska a
       // placeholder, rewritten when the file is finished: telemetry_track_flags.h).
@@ -110,11 +112,11 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
                                                                   : kTelemetryTrackName);
       d += "appsrc name=" + stream.telemetrySource +
            " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
-           "caps=\"text/x-raw,format=(string)utf8\" ! taginject tags=\"title=" +
-           title + "\" ! " + stream.muxer + ".subtitle_%u ";
+           "caps=\"text/x-raw,format=(string)utf8\" ! taginject name=" +
+           stream.telemetryTail + " tags=\"title=" + title + "\" ";
       if (!stream.detector.empty()) {
         // Detection must never hold the recording back: its queue drops.
-        d += "t" + i +
+        d += tee +
              ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=" +
              stream.detector + " quad-decimate=1 family=" + options.detectFamily;
         if (!stream.controller.empty())
@@ -122,7 +124,7 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
         d += " ! fakesink sync=false async=false ";
       }
       if (!stream.liveSink.empty()) {
-        d += "t" + i +
+        d += tee +
              ". ! queue leaky=downstream max-size-buffers=2 ! appsink name=" + stream.liveSink +
              " sync=false async=false max-buffers=2 drop=true ";
       }

@@ -3,11 +3,19 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/recorder_options.h"
 
 namespace wircam::recorder {
+
+// The muxer each file of a stream is written with, and its settings.
+struct MuxerSpec {
+  std::string factory;  // "matroskamux", "mp4mux"
+  std::vector<std::pair<std::string, std::string>>
+      properties;  // name, value (as gst-launch reads it)
+};
 
 // One device camera: its own pipeline, and the names of its elements
 // (empty: not in this run).
@@ -17,8 +25,10 @@ struct StreamPlan {
   int camera = 0;
   std::string name;             // "<device>-cam<N>", also in file names and the live view
   std::string source;           // wircsrc
-  std::string muxer;            // splitmuxsink
-  std::string telemetrySource;  // appsrc feeding the file's text track
+  std::string videoTail;        // the last element before the files' muxer (a tee: a new pad)
+  std::string telemetrySource;  // appsrc of the files' text track
+  std::string telemetryTail;    // the last element before the muxer on the text track
+  MuxerSpec muxer;              // each file's
   std::string detector;         // apriltagdetect, with --detect
   std::string controller;       // wirccontrol, on the first camera of a following device
   std::string liveSink;         // appsink of the frames as they arrive, with --http/--rtsp
@@ -34,11 +44,14 @@ struct PipelinePlan {
 
 // Each stream is a pipeline of its own, so that a camera that never sends a
 // frame, errors or stalls holds no other camera's preroll, EOS or stop.
-// Per stream: wircsrc → [marvelmindpositions →] tee → queue → [decode → x264enc →] splitmuxsink,
-// an appsrc of telemetry text into the same splitmuxsink, and, when asked
-// for, a leaky branch to AprilTag detection (→ wirccontrol) and one to an
-// appsink for the live view and RTSP. splitmuxsink never cuts on its own:
-// the recorder's SegmentSplitter tells it where (and names the files).
+// Per stream: wircsrc → [marvelmindpositions →] [tee →] [decode → x264enc →]
+// (the file), an appsrc of telemetry text → (the same file) and, when asked
+// for, a leaky branch off the tee to AprilTag detection (→ wirccontrol) and
+// one to an appsink for the live view and RTSP. The files themselves (a
+// muxer and a filesink each) are not in the description: the recorder's
+// SegmentWriter puts each in at its first frame and takes it out when it is
+// finished. No queue where nothing branches: the frames reach the file on
+// the source's own thread.
 PipelinePlan planPipeline(const RecorderOptions& options);
 
 }  // namespace wircam::recorder

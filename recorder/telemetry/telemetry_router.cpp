@@ -74,12 +74,8 @@ void TelemetryRouter::place(Line line, const PlannedSegment& segment, uint64_t t
     failedPath_ = sidecar.path();
     failure_ = "cannot write " + sidecar.path();
   }
-  // A line late for a segment whose file has moved on stays in the sidecar:
-  // in the text track it would land in the next file.
-  track_.write(text, time, [&](GstClockTime newest) {
-    auto trackSegment = planner_.segmentAt(newest);
-    return trackSegment && trackSegment->start > segment.start;
-  });
+  // A line late for a segment whose file has moved on stays in the sidecar.
+  track_.write(text, time, segment.start);
 }
 
 void TelemetryRouter::segmentOpened(const std::string& segment) {

@@ -2,19 +2,58 @@
 
 #include <gst/app/gstappsrc.h>
 
+#include <utility>
+
 namespace wircam::recorder {
 
-void TelemetryTrack::write(const std::string& json, GstClockTime pts,
-                           const std::function<bool(GstClockTime newest)>& tooLate) {
-  if (!GST_CLOCK_TIME_IS_VALID(pts)) return;
+bool TelemetryTrack::write(const std::string& json, GstClockTime pts, GstClockTime fileStart) {
+  if (!GST_CLOCK_TIME_IS_VALID(pts)) return false;
   // The lock spans the push so that buffers enter the appsrc in time order.
   MutexLock lock(mutex_);
-  if (tooLate && tooLate(last_)) return;
+  if (openFile_ == 0 || fileStart > openStart_) {
+    if (waiting_.size() == kMaxWaiting) waiting_.pop_front();
+    waiting_.push_back({json, pts, fileStart});
+    return true;
+  }
+  if (fileStart == openStart_) {
+    push(json, pts, openFile_);
+    return true;
+  }
+  // The file before, as long as the newest has not begun: after its first
+  // buffer, the text track has moved on.
+  if (fileStart != previousStart_ || sentFile_ == openFile_) return false;
+  push(json, pts, openFile_ - 1);
+  return true;
+}
+
+uint64_t TelemetryTrack::fileOpened(GstClockTime start) {
+  MutexLock lock(mutex_);
+  ++openFile_;
+  previousStart_ = std::exchange(openStart_, start);
+  while (!waiting_.empty() && waiting_.front().fileStart <= start) {
+    if (waiting_.front().fileStart == start)
+      push(waiting_.front().json, waiting_.front().pts, openFile_);
+    waiting_.pop_front();
+  }
+  return openFile_;
+}
+
+void TelemetryTrack::heartbeat(GstClockTime frameTime) {
+  MutexLock lock(mutex_);
+  if (openFile_ != 0) push({}, frameTime + 1, openFile_);
+}
+
+void TelemetryTrack::end() { gst_app_src_end_of_stream(GST_APP_SRC(source_)); }
+
+void TelemetryTrack::push(const std::string& json, GstClockTime pts, uint64_t file) {
+  if (file != sentFile_) last_ = 0;  // each file's times rise on their own
+  sentFile_ = file;
   GstBuffer* buffer =
       json.empty() ? gst_buffer_new() : gst_buffer_new_memdup(json.data(), json.size());
   last_ = std::max(last_, pts);
   GST_BUFFER_PTS(buffer) = last_;
   GST_BUFFER_DURATION(buffer) = GST_MSECOND;  // an event, not a caption to read
+  GST_BUFFER_OFFSET(buffer) = file;
   gst_app_src_push_buffer(GST_APP_SRC(source_), buffer);
 }
 

@@ -1,10 +1,16 @@
 // The telemetry as a timed text track inside the recording: each JSON line
-// becomes one UTF-8 text buffer at the running time it belongs to.
+// becomes one UTF-8 text buffer at the running time it belongs to, tagged
+// with the file it is for.
+//
+// Files are numbered as they open (1, 2, ...); a buffer's offset
+// (GST_BUFFER_OFFSET) is its file's number, which is how the SegmentWriter,
+// on the appsrc's thread, knows when the text moves on to the next file.
 #pragma once
 
 #include <gst/gst.h>
 
-#include <functional>
+#include <cstdint>
+#include <deque>
 #include <string>
 
 #include "common/mutex.h"
@@ -16,31 +22,47 @@ class TelemetryTrack {
   // `source` is the stream's appsrc (text/x-raw, format=utf8); borrowed.
   explicit TelemetryTrack(GstElement* source) : source_(source) {}
 
-  // A muxer wants the timestamps of a track to rise, but events arrive a
-  // little out of order (a detection is stamped with its frame's time, a
-  // little after later statistics). Such a line is placed at the latest
-  // time already written; its own "pts" field keeps the exact time.
-  // `tooLate`, asked with the newest buffer's time under the same lock as
-  // the heartbeats, may refuse it (the file has moved on): then nothing is
-  // written.
-  void write(const std::string& json, GstClockTime pts,
-             const std::function<bool(GstClockTime newest)>& tooLate = {});
+  // A line for the file that starts at running time `fileStart`. A muxer
+  // wants the timestamps of a track to rise, but events arrive a little out
+  // of order (a detection is stamped with its frame's time, a little after
+  // later statistics): such a line is placed at the latest time already
+  // written; its own "pts" field keeps the exact time.
+  // A line for a file not open yet waits for it; one for a file the track
+  // has moved past is refused (false): it stays in the sidecar only.
+  bool write(const std::string& json, GstClockTime pts, GstClockTime fileStart);
 
-  // An empty buffer, sent every kHeartbeatInterval at the newest frame's
-  // time. splitmuxsink hands a GOP to the muxer only once every track's
-  // input has passed its end, so a sparse track would hold the video back
-  // (and mp4mux waits for every track): this tells both that the telemetry
-  // has nothing before `frameTime`. (From a timer rather than with each
-  // frame: a GOP is one frame in JPEG, and each heartbeat costs a few
-  // thread wake-ups. Not ahead of the video: the text would only wait in
-  // splitmuxsink for it.)
-  void heartbeat(GstClockTime frameTime) { write({}, frameTime); }
-  static constexpr GstClockTime kHeartbeatInterval = GST_SECOND / 8;
+  // A file starting at `start` opened: the lines that waited for it go
+  // out. Returns its number.
+  uint64_t fileOpened(GstClockTime start);
+
+  // An empty buffer just after the newest frame, at every frame: a muxer
+  // hands on a frame only once every track has passed its time, so a
+  // sparse text track would hold the video back. This says the text has
+  // nothing before `frameTime` (and, 1 ns later, lets the frame go first).
+  void heartbeat(GstClockTime frameTime);
+
+  // No more lines: the text track ends after the ones sent.
+  void end();
+
+  static uint64_t fileOf(GstBuffer* buffer) { return GST_BUFFER_OFFSET(buffer); }
 
  private:
+  void push(const std::string& json, GstClockTime pts, uint64_t file) WIRCAM_REQUIRES(mutex_);
+
+  struct Waiting {
+    std::string json;
+    GstClockTime pts, fileStart;
+  };
+
   GstElement* source_;
-  mutable Mutex mutex_;  // lines and heartbeats come from the main loop, early lines from streaming
-  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;
+  Mutex mutex_;  // lines come from the main loop, heartbeats and openings from streaming
+  uint64_t openFile_ WIRCAM_GUARDED_BY(mutex_) = 0;       // the newest file's number (0: none)
+  GstClockTime openStart_ WIRCAM_GUARDED_BY(mutex_) = 0;  // and its start
+  GstClockTime previousStart_ WIRCAM_GUARDED_BY(mutex_) = GST_CLOCK_TIME_NONE;  // the one before's
+  uint64_t sentFile_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the file of the newest buffer sent
+  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the newest buffer's time
+  std::deque<Waiting> waiting_ WIRCAM_GUARDED_BY(mutex_);  // for files still to open
+  static constexpr size_t kMaxWaiting = 1024;
 };
 
 }  // namespace wircam::recorder

@@ -4,13 +4,17 @@
 //   stock:  N × multifilesrc ! rtpjpegpay ! udpsink  →  one gst-launch with
 //           N × (udpsrc ! rtpjpegdepay ! matroskamux ! filesink)
 // Senders are separate processes; the receiving process's CPU (user + system)
-// and peak memory come from wait4(). Frames are counted in the files.
+// and peak memory come from wait4(), its CPU over its whole life. Frames are
+// counted in the files. The senders stop first and the receiver 0.3 s later,
+// so "lost" counts the frames sent that did not reach a file, not those
+// sent while the receiver was told to stop.
 // Usage: bench_recorder_streams [SECONDS] [N...]   (default 10 s; 1 2 4 8)
 #include <gst/gst.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -61,8 +65,16 @@ int framesInFolder(const fs::path& folder) {
   return total;
 }
 
-// Threads of a process and all its descendants (the stock receiver runs
-// under `timeout`), counted halfway through its run.
+using Clock = std::chrono::steady_clock;
+// What the receiver gets to take in the last frames after the senders stop.
+constexpr auto kDrain = std::chrono::milliseconds(300);
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Threads of a process and all its descendants, counted halfway through
+// its run.
 int threadsOf(pid_t root) {
   std::map<pid_t, pid_t> parents;
   for (const auto& entry : fs::directory_iterator("/proc")) {
@@ -140,13 +152,17 @@ int main(int argc, char** argv) {
       devices += " --device 127.0.0.1:" + std::to_string(port);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    pid_t recorder =
-        spawn((bin / "wirc-recorder").string() + devices + " --out " + (work / "rec").string() +
-              " --segment 600 --duration " + std::to_string(seconds));
+    auto recorderStart = Clock::now();
+    pid_t recorder = spawn((bin / "wirc-recorder").string() + devices + " --out " +
+                           (work / "rec").string() + " --segment 600");
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
     int ourThreads = threadsOf(recorder);
-    Usage ours = waitForUsage(recorder);
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
     for (pid_t sim : sims) wircam::bench::stopGroup(sim, SIGINT);
+    std::this_thread::sleep_for(kDrain);
+    kill(recorder, SIGINT);
+    Usage ours = waitForUsage(recorder);
+    double ourSeconds = secondsSince(recorderStart);
     int sent = 0;
     for (int i = 0; i < n; ++i) sent += framesSent(work / ("sim" + std::to_string(i) + ".txt"));
     int recorded = framesInFolder(work / "rec");
@@ -164,8 +180,8 @@ int main(int argc, char** argv) {
           " ! rtpjpegdepay ! matroskamux ! filesink location=" +
           (work / "rtp" / (std::to_string(i) + ".mkv")).string();
     }
-    pid_t receiver =
-        spawn("timeout -s INT " + std::to_string(seconds + 1) + " gst-launch-1.0 -e" + receivers);
+    auto receiverStart = Clock::now();
+    pid_t receiver = spawn("gst-launch-1.0 -e" + receivers);
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     int rtpFrames = static_cast<int>(seconds * 15);
     std::vector<pid_t> senders;
@@ -179,7 +195,10 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
     int theirThreads = threadsOf(receiver);
     for (pid_t s : senders) waitpid(s, nullptr, 0);
+    std::this_thread::sleep_for(kDrain);
+    kill(receiver, SIGINT);
     Usage theirs = waitForUsage(receiver);
+    double theirSeconds = secondsSince(receiverStart);
     int rtpRecorded = framesInFolder(work / "rtp");
     int rtpSent = rtpFrames * n;
 
@@ -187,9 +206,9 @@ int main(int argc, char** argv) {
         "%-8d | lost %4d of %5d, %5.2f %%, %5.1f MB, %4d threads | lost %4d of %5d, %5.2f %%, "
         "%5.1f "
         "MB, %4d threads\n",
-        n, sent - recorded, sent, 100 * ours.cpuSeconds / seconds / n, ours.maxRssKb / 1024.0 / n,
-        ourThreads, rtpSent - rtpRecorded, rtpSent, 100 * theirs.cpuSeconds / (seconds + 1) / n,
-        theirs.maxRssKb / 1024.0 / n, theirThreads);
+        n, sent - recorded, sent, 100 * ours.cpuSeconds / ourSeconds / n,
+        ours.maxRssKb / 1024.0 / n, ourThreads, rtpSent - rtpRecorded, rtpSent,
+        100 * theirs.cpuSeconds / theirSeconds / n, theirs.maxRssKb / 1024.0 / n, theirThreads);
     std::fflush(stdout);
   }
   fs::remove_all(work);

@@ -32,17 +32,16 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   const auto& d = plan.description();
   EXPECT_TRUE(has(d, "wircsrc name=" + s.source + " host=10.0.0.2 port=1984"));
   EXPECT_TRUE(has(d, "wait-for-device=true"));
-  EXPECT_TRUE(has(d, "splitmuxsink name=" + s.muxer + " async-finalize=true"));
-  EXPECT_TRUE(has(d, "matroskamux"));
+  // The frames reach the file straight from the source: no tee, no queue,
+  // no thread between (the SegmentWriter puts each file in itself).
+  EXPECT_EQ(s.videoTail, s.source);
+  EXPECT_FALSE(has(d, "tee"));
+  EXPECT_FALSE(has(d, "queue"));
+  EXPECT_FALSE(has(d, "splitmuxsink"));
+  EXPECT_EQ(s.muxer.factory, "matroskamux");
   EXPECT_TRUE(has(d, "appsrc name=" + s.telemetrySource));
-  EXPECT_TRUE(has(d, s.muxer + ".subtitle_%u"));
+  EXPECT_TRUE(has(d, "taginject name=" + s.telemetryTail));
   EXPECT_TRUE(has(d, "title=telemetry-json-lines"));  // renamed when finished
-  // The recorder cuts the files: splitmuxsink has no limits of its own,
-  // and the old threshold workaround is gone.
-  auto splitmux = d.substr(d.find("splitmuxsink"), d.find("location=") - d.find("splitmuxsink"));
-  EXPECT_FALSE(has(splitmux, "max-size-time")) << splitmux;
-  EXPECT_FALSE(has(splitmux, "max-size-bytes")) << splitmux;
-  EXPECT_FALSE(has(d, "alignment-threshold"));
   EXPECT_FALSE(has(d, "x264enc"));
   EXPECT_TRUE(s.detector.empty() && s.controller.empty() && s.liveSink.empty());
 }
@@ -52,9 +51,11 @@ TEST(PipelinePlan, H264InMp4IsTranscodedAndKeepsTheTextTrack) {
       optionsOf({"--device", "rover", "--out", "/rec", "--codec", "h264", "--format", "mp4"}));
   EXPECT_TRUE(plan.transcoded);
   EXPECT_TRUE(has(plan.description(), "x264enc"));
-  EXPECT_TRUE(has(plan.description(), "muxer-factory=mp4mux"));
+  EXPECT_EQ(plan.streams[0].muxer.factory, "mp4mux");
   EXPECT_TRUE(has(plan.description(), "title=telemetry\""));
-  EXPECT_TRUE(has(plan.description(), ".subtitle_%u"));
+  // The muxers take H.264 as avc only: the encoder's output says so.
+  EXPECT_TRUE(has(plan.description(), "capsfilter name=" + plan.streams[0].videoTail +
+                                          " caps=\"video/x-h264,stream-format=avc"));
 }
 
 PipelinePlan twoFollowedDevicesOfTwoCameras() {
@@ -75,6 +76,8 @@ TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
   EXPECT_EQ(names.size(), 4u);  // element names do not collide
   EXPECT_FALSE(plan.streams[0].controller.empty());
   EXPECT_TRUE(plan.streams[1].controller.empty());
+  // Branches: the file's frames leave the tee by a pad of their own.
+  EXPECT_TRUE(has(plan.streams[0].description, "tee name=" + plan.streams[0].videoTail));
   EXPECT_FALSE(plan.streams[2].controller.empty());
   EXPECT_TRUE(has(plan.description(), "family=tag36h11"));
 }
@@ -90,7 +93,7 @@ TEST(PipelinePlan, EachCameraIsAPipelineOfItsOwn) {
   ASSERT_EQ(plan.streams.size(), 4u);
   for (const auto& stream : plan.streams) {
     // Everything it names is in its own description, nothing another names.
-    for (const auto* name : {&stream.source, &stream.muxer, &stream.telemetrySource,
+    for (const auto* name : {&stream.source, &stream.telemetrySource, &stream.telemetryTail,
                              &stream.detector, &stream.liveSink}) {
       EXPECT_TRUE(has(stream.description, "name=" + *name)) << *name;
     }

@@ -1,0 +1,80 @@
+#include "camera/segment_file.h"
+
+namespace wircam::recorder {
+
+Expected<std::unique_ptr<SegmentFile>, std::string> SegmentFile::open(GstElement* pipeline,
+                                                                      const MuxerSpec& muxer,
+                                                                      const std::string& path,
+                                                                      GstClockTime start,
+                                                                      uint64_t number) {
+  std::unique_ptr<SegmentFile> file(new SegmentFile);
+  file->pipeline_ = pipeline;
+  file->path_ = path;
+  file->start_ = start;
+  file->number_ = number;
+  file->muxer_ = gst_element_factory_make(muxer.factory.c_str(), nullptr);
+  file->sink_ = gst_element_factory_make("filesink", nullptr);
+  if (!file->muxer_ || !file->sink_) {
+    if (file->muxer_) gst_object_unref(file->muxer_);
+    if (file->sink_) gst_object_unref(file->sink_);
+    file->muxer_ = file->sink_ = nullptr;
+    return unexpected("no " + muxer.factory + " or filesink (gst-plugins-good)");
+  }
+  for (const auto& [name, value] : muxer.properties)
+    gst_util_set_object_arg(G_OBJECT(file->muxer_), name.c_str(), value.c_str());
+  // filesink would gather 64 KB before it writes: minutes of a low-rate
+  // stream that a crash would lose; the muxers write in pieces of a frame
+  // or more. Not async: a sink added to a playing pipeline must not take
+  // it back to PAUSED until its first frame.
+  g_object_set(file->sink_, "location", path.c_str(), "async", FALSE, nullptr);
+  gst_util_set_object_arg(G_OBJECT(file->sink_), "buffer-mode", "unbuffered");
+  gst_bin_add_many(GST_BIN(pipeline), file->muxer_, file->sink_, nullptr);
+  gst_element_link(file->muxer_, file->sink_);
+  GstPad* sinkPad = gst_element_get_static_pad(file->sink_, "sink");
+  gst_pad_add_probe(sinkPad, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, onSinkEvent, file.get(), nullptr);
+  gst_object_unref(sinkPad);
+  file->videoInput_ = gst_element_request_pad_simple(file->muxer_, "video_%u");
+  file->textInput_ = gst_element_request_pad_simple(file->muxer_, "subtitle_%u");
+  for (GstPad* input : {file->videoInput_, file->textInput_})
+    if (input) gst_pad_set_offset(input, -static_cast<gint64>(start));
+  // (Each failure is also an error on the bus, which restarts the camera.)
+  if (!file->videoInput_ || !file->textInput_)
+    return unexpected(muxer.factory + " takes no video or text input");
+  if (!gst_element_sync_state_with_parent(file->sink_) ||
+      !gst_element_sync_state_with_parent(file->muxer_))
+    return unexpected("cannot open " + path);
+  gst_element_post_message(
+      file->sink_,
+      gst_message_new_element(
+          GST_OBJECT(file->sink_),
+          gst_structure_new(kOpenedMessage, "location", G_TYPE_STRING, path.c_str(), nullptr)));
+  return file;
+}
+
+SegmentFile::~SegmentFile() {
+  if (!muxer_) return;
+  for (GstElement* element : {sink_, muxer_}) gst_element_set_state(element, GST_STATE_NULL);
+  for (GstPad* input : {videoInput_, textInput_}) {
+    if (!input) continue;
+    gst_element_release_request_pad(muxer_, input);
+    gst_object_unref(input);
+  }
+  for (GstElement* element : {sink_, muxer_}) gst_bin_remove(GST_BIN(pipeline_), element);
+}
+
+void SegmentFile::end(GstPad* input, std::atomic<bool>& ended) {
+  if (input && !ended.exchange(true)) gst_pad_send_event(input, gst_event_new_eos());
+}
+
+GstPadProbeReturn SegmentFile::onSinkEvent(GstPad*, GstPadProbeInfo* info, gpointer data) {
+  auto* self = static_cast<SegmentFile*>(data);
+  if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS)
+    gst_element_post_message(
+        self->sink_,
+        gst_message_new_element(GST_OBJECT(self->sink_),
+                                gst_structure_new(kClosedMessage, "location", G_TYPE_STRING,
+                                                  self->path_.c_str(), nullptr)));
+  return GST_PAD_PROBE_OK;
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,66 @@
+// One recorded file in a camera's pipeline: a muxer of GStreamer's own and a
+// filesink, added while the pipeline plays and removed once the file is
+// finished. Its inputs are shifted by the file's first frame's running
+// time, so that its timeline begins at 0.
+//
+// When the filesink has seen EOS (the muxer has finished the file) it posts
+// an element message named kClosedMessage with the file's "location"; the
+// camera then takes the file out of the pipeline on the main loop.
+#pragma once
+
+#include <gst/gst.h>
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "camera/pipeline_plan.h"
+#include "common/expected.h"
+
+namespace wircam::recorder {
+
+class SegmentFile {
+ public:
+  static constexpr const char* kOpenedMessage = "wircam-file-opened";
+  static constexpr const char* kClosedMessage = "wircam-file-closed";
+
+  // In `pipeline`, playing, writing `path`; posts kOpenedMessage. `number`
+  // is the file's (TelemetryTrack::fileOpened's).
+  static Expected<std::unique_ptr<SegmentFile>, std::string> open(GstElement* pipeline,
+                                                                  const MuxerSpec& muxer,
+                                                                  const std::string& path,
+                                                                  GstClockTime start,
+                                                                  uint64_t number);
+  // Out of the pipeline (NULL first). Not on a thread that streams into it.
+  ~SegmentFile();
+  SegmentFile(const SegmentFile&) = delete;
+  SegmentFile& operator=(const SegmentFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  GstClockTime start() const { return start_; }
+  uint64_t number() const { return number_; }
+  GstPad* videoInput() const { return videoInput_; }
+  GstPad* textInput() const { return textInput_; }
+
+  // The end of its frames, or of its text (EOS into that input, once).
+  void endVideo() { end(videoInput_, videoEnded_); }
+  void endText() { end(textInput_, textEnded_); }
+
+ private:
+  SegmentFile() = default;
+  static void end(GstPad* input, std::atomic<bool>& ended);
+  static GstPadProbeReturn onSinkEvent(GstPad* pad, GstPadProbeInfo* info, gpointer self);
+
+  GstElement* pipeline_ = nullptr;  // borrowed
+  GstElement* muxer_ = nullptr;     // owned by the pipeline while in it
+  GstElement* sink_ = nullptr;
+  GstPad* videoInput_ = nullptr;  // the muxer's request pads (ours)
+  GstPad* textInput_ = nullptr;
+  std::string path_;
+  GstClockTime start_ = 0;
+  uint64_t number_ = 0;
+  std::atomic<bool> videoEnded_{false}, textEnded_{false};
+};
+
+}  // namespace wircam::recorder

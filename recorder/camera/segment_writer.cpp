@@ -1,0 +1,227 @@
+#include "camera/segment_writer.h"
+
+#include <gst/video/video-event.h>
+
+#include "camera/wall_clock.h"
+#include "log_line.h"
+
+namespace wircam::recorder {
+
+namespace {
+
+constexpr auto kDataProbe =
+    static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM);
+// Blocking probes are the ones a pad re-reads its peer after, so they may
+// relink; they let every item through (PASS).
+constexpr auto kRelinkProbe = static_cast<GstPadProbeType>(kDataProbe | GST_PAD_PROBE_TYPE_BLOCK);
+
+// A buffer's running time on its pad's segment.
+GstClockTime runningTimeOf(const GstSegment& segment, GstBuffer* buffer) {
+  return gst_segment_to_running_time(&segment, GST_FORMAT_TIME, GST_BUFFER_DTS_OR_PTS(buffer));
+}
+
+bool isEvent(GstPadProbeInfo* info) {
+  return (GST_PAD_PROBE_INFO_TYPE(info) & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0;
+}
+
+// Keeps a pad's current segment, so buffers' running times can be known.
+void keepSegment(GstPadProbeInfo* info, GstSegment& segment) {
+  GstEvent* event = GST_PAD_PROBE_INFO_EVENT(info);
+  if (GST_EVENT_TYPE(event) == GST_EVENT_SEGMENT) gst_event_copy_segment(event, &segment);
+}
+
+// `output` feeds `to` instead of `from` (which may be null).
+void relink(GstPad* output, GstPad* from, GstPad* to) {
+  if (from) gst_pad_unlink(output, from);
+  if (gst_pad_link(output, to) != GST_PAD_LINK_OK)
+    logLine(std::string("cannot link ") + GST_OBJECT_NAME(GST_OBJECT_PARENT(output)) + " to " +
+            GST_OBJECT_NAME(GST_OBJECT_PARENT(to)));
+}
+
+}  // namespace
+
+SegmentWriter::SegmentWriter(Parts parts, SegmentPlanner& planner, TelemetryTrack& track,
+                             std::function<void()> afterFrame)
+    : parts_(std::move(parts)),
+      planner_(planner),
+      track_(track),
+      afterFrame_(std::move(afterFrame)) {
+  gst_segment_init(&sourceSegment_, GST_FORMAT_TIME);
+  gst_segment_init(&videoSegment_, GST_FORMAT_TIME);
+  sourcePad_ = gst_element_get_static_pad(parts_.source, "src");
+  videoPad_ = gst_element_get_static_pad(parts_.videoTail, "src");
+  if (!videoPad_) {  // a tee: the file's branch is a pad of its own
+    videoPad_ = gst_element_request_pad_simple(parts_.videoTail, "src_%u");
+    videoPadRequested_ = true;
+  }
+  textPad_ = gst_element_get_static_pad(parts_.textTail, "src");
+  // The frame must be planned (and its file opened) before it is routed:
+  // on one pad, in one probe.
+  if (videoPad_ == sourcePad_) {
+    videoProbe_ =
+        gst_pad_add_probe(videoPad_, kRelinkProbe, onSourceDataAndVideoOut, this, nullptr);
+  } else {
+    sourceProbe_ = gst_pad_add_probe(sourcePad_, kDataProbe, onSourceData, this, nullptr);
+    videoProbe_ = gst_pad_add_probe(videoPad_, kRelinkProbe, onVideoOut, this, nullptr);
+  }
+  textProbe_ = gst_pad_add_probe(textPad_, kRelinkProbe, onTextOut, this, nullptr);
+}
+
+SegmentWriter::~SegmentWriter() {
+  if (sourceProbe_) gst_pad_remove_probe(sourcePad_, sourceProbe_);
+  gst_pad_remove_probe(videoPad_, videoProbe_);
+  gst_pad_remove_probe(textPad_, textProbe_);
+  if (videoPadRequested_) gst_element_release_request_pad(parts_.videoTail, videoPad_);
+  for (GstPad* pad : {sourcePad_, videoPad_, textPad_}) gst_object_unref(pad);
+  MutexLock lock(mutex_);
+  files_.clear();
+}
+
+GstPadProbeReturn SegmentWriter::onSourceData(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  static_cast<SegmentWriter*>(data)->planFrame(pad, info);
+  return GST_PAD_PROBE_OK;
+}
+
+GstPadProbeReturn SegmentWriter::onVideoOut(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  return static_cast<SegmentWriter*>(data)->routeFrame(pad, info);
+}
+
+GstPadProbeReturn SegmentWriter::onSourceDataAndVideoOut(GstPad* pad, GstPadProbeInfo* info,
+                                                         gpointer data) {
+  auto* self = static_cast<SegmentWriter*>(data);
+  self->planFrame(pad, info);
+  return self->routeFrame(pad, info);
+}
+
+GstPadProbeReturn SegmentWriter::onTextOut(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  return static_cast<SegmentWriter*>(data)->routeText(pad, info);
+}
+
+void SegmentWriter::planFrame(GstPad* pad, GstPadProbeInfo* info) {
+  if (isEvent(info)) return keepSegment(info, sourceSegment_);
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  GstClockTime time = runningTimeOf(sourceSegment_, buffer);
+  if (!GST_CLOCK_TIME_IS_VALID(time)) return;
+  auto cut = planner_.onFrame(time, [this, time] { return unixMsOf(parts_.source, time); });
+  // The encoder makes this very frame a key frame (the event travels just
+  // ahead of it): at a cut, and every kKeyFrameInterval, whatever the frame
+  // rate, because the muxer writes whole GOPs, which is what a crash loses.
+  // The first frame is one anyway, and must not be asked for: x264enc
+  // (GStreamer 1.22) measures that request against a segment it has not
+  // set up yet, and then ignores every later one.
+  if (cut == SegmentPlanner::Cut::kFirst) lastKeyFrame_ = time;
+  bool due = time >= lastKeyFrame_ + kKeyFrameInterval;
+  if (parts_.transcoded && (cut == SegmentPlanner::Cut::kNext || due)) {
+    gst_pad_push_event(pad, gst_video_event_new_downstream_force_key_unit(
+                                GST_BUFFER_PTS(buffer), GST_CLOCK_TIME_NONE, time, TRUE, 0));
+    lastKeyFrame_ = time;
+  }
+  if (cut != SegmentPlanner::Cut::kNone) open(time);
+  afterFrame_();
+  track_.heartbeat(time);
+}
+
+void SegmentWriter::open(GstClockTime start) {
+  auto planned = planner_.current();
+  if (!planned) return;
+  MutexLock lock(mutex_);
+  auto file = SegmentFile::open(parts_.pipeline, parts_.muxer, planned->path, start, opened_ + 1);
+  if (!file) {
+    // Its error is on the bus too, and the camera starts again.
+    logLine(std::string(GST_OBJECT_NAME(parts_.pipeline)) + ": " + file.error());
+    broken_ = true;
+    return;
+  }
+  ++opened_;
+  files_.push_back(std::move(*file));
+  // Its text goes out from now on (numbered as the files are).
+  track_.fileOpened(start);
+}
+
+// Ending and relinking happen under the lock: release() (the main loop)
+// deletes a file once both its inputs have ended, which may be at once.
+// (The lock is never taken by a thread inside a muxer: ours are upstream.)
+GstPadProbeReturn SegmentWriter::routeFrame(GstPad* pad, GstPadProbeInfo* info) {
+  if (isEvent(info)) {
+    keepSegment(info, videoSegment_);
+    if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_PASS;
+    MutexLock lock(mutex_);
+    for (const auto& file : files_) file->endVideo();
+    return GST_PAD_PROBE_DROP;
+  }
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  GstClockTime time = runningTimeOf(videoSegment_, buffer);
+  {
+    MutexLock lock(mutex_);
+    if (broken_ || !GST_CLOCK_TIME_IS_VALID(time)) return GST_PAD_PROBE_DROP;
+    // The newest file that starts at or before this frame.
+    SegmentFile* to = nullptr;
+    for (const auto& file : files_)
+      if (file->start() <= time) to = file.get();
+    if (!to) return GST_PAD_PROBE_DROP;  // before the first file
+    if (to != video_) {
+      for (const auto& file : files_) {  // the frames of every file before are over
+        if (file.get() == to) break;
+        file->endVideo();
+      }
+      relink(pad, video_ ? video_->videoInput() : nullptr, to->videoInput());
+      video_ = to;
+    }
+  }
+  planner_.addBytes(gst_buffer_get_size(buffer));
+  return GST_PAD_PROBE_PASS;
+}
+
+GstPadProbeReturn SegmentWriter::routeText(GstPad* pad, GstPadProbeInfo* info) {
+  MutexLock lock(mutex_);
+  if (isEvent(info)) {
+    if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_PASS;
+    for (const auto& file : files_) file->endText();
+    return GST_PAD_PROBE_DROP;
+  }
+  uint64_t number = TelemetryTrack::fileOf(GST_PAD_PROBE_INFO_BUFFER(info));
+  if (text_ && text_->number() == number) return GST_PAD_PROBE_PASS;
+  SegmentFile* to = nullptr;
+  for (const auto& file : files_)
+    if (file->number() == number) to = file.get();
+  // (A file that would not open, or a line late for a finished one.)
+  if (!to || (text_ && text_->number() > number)) return GST_PAD_PROBE_DROP;
+  for (const auto& file : files_) {  // the text of every file before is over
+    if (file.get() == to) break;
+    file->endText();
+  }
+  relink(pad, text_ ? text_->textInput() : nullptr, to->textInput());
+  text_ = to;
+  return GST_PAD_PROBE_PASS;
+}
+
+void SegmentWriter::end() {
+  track_.end();
+  gst_element_send_event(parts_.source, gst_event_new_eos());
+}
+
+void SegmentWriter::release(const std::string& path) {
+  std::unique_ptr<SegmentFile> finished;
+  {
+    MutexLock lock(mutex_);
+    for (auto it = files_.begin(); it != files_.end(); ++it) {
+      if ((*it)->path() != path) continue;
+      finished = std::move(*it);
+      files_.erase(it);
+      break;
+    }
+    if (!finished) return;
+    if (video_ == finished.get()) video_ = nullptr;
+    if (text_ == finished.get()) text_ = nullptr;
+  }
+  finished.reset();  // out of the pipeline, outside the lock
+}
+
+std::vector<std::string> SegmentWriter::files() const {
+  MutexLock lock(mutex_);
+  std::vector<std::string> paths;
+  for (const auto& file : files_) paths.push_back(file->path());
+  return paths;
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,93 @@
+// Writes one stream's frames and telemetry into the files the
+// SegmentPlanner plans, each file a muxer and a filesink of its own
+// (SegmentFile), with no queue and no thread of its own:
+// - a probe where the frames leave the source shows each to the planner;
+//   at a cut it opens the next file there and then (forcing a key frame
+//   first when the stream is transcoded, as every 0.5 s), and after each
+//   frame it sends the text track's heartbeat;
+// - a probe where the frames leave for the file moves them to the newest
+//   file at its first frame, ending the one before (EOS), and counts bytes;
+// - a probe where the telemetry leaves for the file does the same for the
+//   text, on the appsrc's thread, by the file number each buffer carries.
+// A file is finished once both its inputs have ended; the camera then
+// takes it out of the pipeline (release()).
+#pragma once
+
+#include <gst/gst.h>
+
+#include <deque>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "camera/pipeline_plan.h"
+#include "camera/segment_file.h"
+#include "common/mutex.h"
+#include "record/segment_planner.h"
+#include "telemetry/telemetry_track.h"
+
+namespace wircam::recorder {
+
+class SegmentWriter {
+ public:
+  struct Parts {
+    GstElement* pipeline;
+    GstElement* source;     // wircsrc: frames are planned as they leave it
+    GstElement* videoTail;  // frames leave it for the file (a tee: by a pad of their own)
+    GstElement* textTail;   // the telemetry leaves it for the file
+    MuxerSpec muxer;
+    bool transcoded;  // key frames come from an encoder that can be asked for one
+  };
+  // `afterFrame` runs on the source's thread once each frame is planned.
+  SegmentWriter(Parts parts, SegmentPlanner& planner, TelemetryTrack& track,
+                std::function<void()> afterFrame);
+  ~SegmentWriter();
+  SegmentWriter(const SegmentWriter&) = delete;
+  SegmentWriter& operator=(const SegmentWriter&) = delete;
+
+  // The end of the recording: EOS from the source, and the text track ends
+  // after its lines; each open file is finished.
+  void end();
+  // A file is finished (its SegmentFile::kClosedMessage): out of the
+  // pipeline. On the main loop.
+  void release(const std::string& path);
+  // The files still in the pipeline, finished or not (a run cut off
+  // indexes them as they are).
+  std::vector<std::string> files() const;
+
+ private:
+  static GstPadProbeReturn onSourceData(GstPad* pad, GstPadProbeInfo* info, gpointer self);
+  static GstPadProbeReturn onVideoOut(GstPad* pad, GstPadProbeInfo* info, gpointer self);
+  static GstPadProbeReturn onSourceDataAndVideoOut(GstPad* pad, GstPadProbeInfo* info,
+                                                   gpointer self);
+  static GstPadProbeReturn onTextOut(GstPad* pad, GstPadProbeInfo* info, gpointer self);
+  void planFrame(GstPad* pad, GstPadProbeInfo* info);
+  GstPadProbeReturn routeFrame(GstPad* pad, GstPadProbeInfo* info);
+  GstPadProbeReturn routeText(GstPad* pad, GstPadProbeInfo* info);
+  void open(GstClockTime start);
+
+  Parts parts_;
+  SegmentPlanner& planner_;
+  TelemetryTrack& track_;
+  std::function<void()> afterFrame_;
+  GstPad* sourcePad_ = nullptr;
+  GstPad* videoPad_ = nullptr;  // ours when requested from a tee
+  bool videoPadRequested_ = false;
+  GstPad* textPad_ = nullptr;
+  gulong sourceProbe_ = 0, videoProbe_ = 0, textProbe_ = 0;
+
+  static constexpr GstClockTime kKeyFrameInterval = GST_SECOND / 2;
+  GstSegment sourceSegment_{};     // the source's segment, on its thread
+  GstSegment videoSegment_{};      // the frames' segment where they leave, on that thread
+  GstClockTime lastKeyFrame_ = 0;  // asked of the encoder, on the source's thread
+
+  mutable Mutex mutex_;
+  std::deque<std::unique_ptr<SegmentFile>> files_ WIRCAM_GUARDED_BY(mutex_);  // oldest first
+  uint64_t opened_ WIRCAM_GUARDED_BY(mutex_) = 0;
+  bool broken_ WIRCAM_GUARDED_BY(mutex_) = false;  // a file would not open: frames are dropped
+  SegmentFile* video_ WIRCAM_GUARDED_BY(mutex_) = nullptr;  // the file the frames go to
+  SegmentFile* text_ WIRCAM_GUARDED_BY(mutex_) = nullptr;   // the file the text goes to
+};
+
+}  // namespace wircam::recorder
