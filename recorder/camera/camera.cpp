@@ -149,7 +149,7 @@ void Camera::tearDown() {
     gst_element_set_state(pipeline_->pipeline(), GST_STATE_NULL);
     // A file EOS did not finish is still playable (Matroska written in
     // clusters, fragmented MP4): indexed like any other.
-    for (const auto& file : pipeline_->writer().files()) closed(file);
+    for (const auto& file : pipeline_->writer().unfinished()) closed(file);
   }
   report_.segment.clear();
   pipeline_.reset();

@@ -144,7 +144,7 @@ void Camera::handleElementMessage(GstMessage* message) {
     std::string file = gst_structure_get_string(s, "location");
     // (Finished on a streaming thread: the next file may be open already.)
     if (file == report_.segment) report_.segment.clear();
-    pipeline_->writer().release(file);
+    pipeline_->writer().finished(file, !finishing_);
     closed(file);
     return;
   }

@@ -19,9 +19,13 @@ std::string fileSafe(std::string text) {
 // Each file's muxer. Crash safety: Matroska clusters and MP4 fragments of
 // at most 0.5 s (the muxers write a cluster or fragment whole), so a killed
 // recorder leaves the open segment playable up to about its last second.
+// The text track's gaps (TelemetryTrack::heartbeat) reach matroskamux as
+// GAP events, for which it writes nothing, not even to the duration;
+// mp4mux (an aggregator, GStreamer 1.22) stalls on GAP events, and gets
+// empty buffers instead, as it did inside splitmuxsink.
 MuxerSpec muxerOf(Container container) {
-  if (container == Container::kMp4) return {"mp4mux", {{"fragment-duration", "500"}}};
-  return {"matroskamux", {{"max-cluster-duration", "500000000"}}};
+  if (container == Container::kMp4) return {"mp4mux", {{"fragment-duration", "500"}}, false};
+  return {"matroskamux", {{"max-cluster-duration", "500000000"}}, true};
 }
 
 // What the frames pass through on their way to the file, ending in the
@@ -111,7 +115,8 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       std::string title(options.container == Container::kMatroska ? kTelemetryTrackPlaceholder
                                                                   : kTelemetryTrackName);
       d += "appsrc name=" + stream.telemetrySource +
-           " is-live=true format=time max-bytes=1000000 leaky-type=downstream "
+           " is-live=true format=time min-latency=0 max-latency=-1 max-bytes=1000000 "
+           "leaky-type=downstream "
            "caps=\"text/x-raw,format=(string)utf8\" ! taginject name=" +
            stream.telemetryTail + " tags=\"title=" + title + "\" ";
       if (!stream.detector.empty()) {

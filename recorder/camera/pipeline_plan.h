@@ -13,8 +13,11 @@ namespace wircam::recorder {
 // The muxer each file of a stream is written with, and its settings.
 struct MuxerSpec {
   std::string factory;  // "matroskamux", "mp4mux"
-  std::vector<std::pair<std::string, std::string>>
-      properties;  // name, value (as gst-launch reads it)
+  // Name and value, as gst-launch reads them.
+  std::vector<std::pair<std::string, std::string>> properties;
+  // A gap reaches the muxer as a GAP event (matroskamux writes nothing for
+  // it), or as an empty buffer (mp4mux stalls on GAP events).
+  bool textGapEvents = false;
 };
 
 // One device camera: its own pipeline, and the names of its elements

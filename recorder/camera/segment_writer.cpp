@@ -2,6 +2,8 @@
 
 #include <gst/video/video-event.h>
 
+#include <algorithm>
+
 #include "camera/wall_clock.h"
 #include "log_line.h"
 
@@ -133,6 +135,9 @@ void SegmentWriter::open(GstClockTime start) {
     return;
   }
   ++opened_;
+  // At a stop the text may end before the last frames have come through:
+  // a file they open then has all the text it will get.
+  if (textEnded_) (*file)->endText();
   files_.push_back(std::move(*file));
   // Its text goes out from now on (numbered as the files are).
   track_.fileOpened(start);
@@ -173,26 +178,43 @@ GstPadProbeReturn SegmentWriter::routeFrame(GstPad* pad, GstPadProbeInfo* info) 
 }
 
 GstPadProbeReturn SegmentWriter::routeText(GstPad* pad, GstPadProbeInfo* info) {
-  MutexLock lock(mutex_);
   if (isEvent(info)) {
     if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_PASS;
+    MutexLock lock(mutex_);
+    textEnded_ = true;
     for (const auto& file : files_) file->endText();
     return GST_PAD_PROBE_DROP;
   }
-  uint64_t number = TelemetryTrack::fileOf(GST_PAD_PROBE_INFO_BUFFER(info));
-  if (text_ && text_->number() == number) return GST_PAD_PROBE_PASS;
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  if (!moveText(pad, TelemetryTrack::fileOf(buffer))) return GST_PAD_PROBE_DROP;
+  if (!TelemetryTrack::isGap(buffer)) return GST_PAD_PROBE_PASS;
+  if (!parts_.muxer.textGapEvents) {  // an empty buffer, as the muxer wants it
+    buffer = gst_buffer_make_writable(buffer);
+    GST_BUFFER_FLAG_UNSET(buffer, GST_BUFFER_FLAG_GAP);
+    GST_PAD_PROBE_INFO_DATA(info) = buffer;
+    return GST_PAD_PROBE_PASS;
+  }
+  // A gap goes on as a GAP event (through this probe again, as an event):
+  // the muxer writes nothing for it, not even to the file's duration.
+  gst_pad_push_event(pad, gst_event_new_gap(GST_BUFFER_PTS(buffer), GST_BUFFER_DURATION(buffer)));
+  return GST_PAD_PROBE_DROP;
+}
+
+bool SegmentWriter::moveText(GstPad* pad, uint64_t number) {
+  MutexLock lock(mutex_);
+  if (text_ && text_->number() == number) return true;
   SegmentFile* to = nullptr;
   for (const auto& file : files_)
     if (file->number() == number) to = file.get();
   // (A file that would not open, or a line late for a finished one.)
-  if (!to || (text_ && text_->number() > number)) return GST_PAD_PROBE_DROP;
+  if (!to || (text_ && text_->number() > number)) return false;
   for (const auto& file : files_) {  // the text of every file before is over
     if (file.get() == to) break;
     file->endText();
   }
   relink(pad, text_ ? text_->textInput() : nullptr, to->textInput());
   text_ = to;
-  return GST_PAD_PROBE_PASS;
+  return true;
 }
 
 void SegmentWriter::end() {
@@ -200,27 +222,30 @@ void SegmentWriter::end() {
   gst_element_send_event(parts_.source, gst_event_new_eos());
 }
 
-void SegmentWriter::release(const std::string& path) {
-  std::unique_ptr<SegmentFile> finished;
+void SegmentWriter::finished(const std::string& path, bool release) {
+  std::unique_ptr<SegmentFile> file;
   {
     MutexLock lock(mutex_);
-    for (auto it = files_.begin(); it != files_.end(); ++it) {
-      if ((*it)->path() != path) continue;
-      finished = std::move(*it);
-      files_.erase(it);
-      break;
-    }
-    if (!finished) return;
-    if (video_ == finished.get()) video_ = nullptr;
-    if (text_ == finished.get()) text_ = nullptr;
+    finished_.push_back(path);
+    if (!release) return;
+    auto it = std::find_if(files_.begin(), files_.end(),
+                           [&](const auto& candidate) { return candidate->path() == path; });
+    if (it == files_.end()) return;
+    file = std::move(*it);
+    files_.erase(it);
+    std::erase(finished_, path);
+    if (video_ == file.get()) video_ = nullptr;
+    if (text_ == file.get()) text_ = nullptr;
   }
-  finished.reset();  // out of the pipeline, outside the lock
+  file.reset();  // out of the pipeline, outside the lock
 }
 
-std::vector<std::string> SegmentWriter::files() const {
+std::vector<std::string> SegmentWriter::unfinished() const {
   MutexLock lock(mutex_);
   std::vector<std::string> paths;
-  for (const auto& file : files_) paths.push_back(file->path());
+  for (const auto& file : files_)
+    if (std::find(finished_.begin(), finished_.end(), file->path()) == finished_.end())
+      paths.push_back(file->path());
   return paths;
 }
 

@@ -49,12 +49,12 @@ class SegmentWriter {
   // The end of the recording: EOS from the source, and the text track ends
   // after its lines; each open file is finished.
   void end();
-  // A file is finished (its SegmentFile::kClosedMessage): out of the
-  // pipeline. On the main loop.
-  void release(const std::string& path);
-  // The files still in the pipeline, finished or not (a run cut off
-  // indexes them as they are).
-  std::vector<std::string> files() const;
+  // A file is finished (its SegmentFile::kClosedMessage), and, with
+  // `release`, out of the pipeline. (Not while the run ends: the filesink
+  // has yet to tell the pipeline its EOS.) On the main loop.
+  void finished(const std::string& path, bool release);
+  // The files not finished yet (a run cut off indexes them as they are).
+  std::vector<std::string> unfinished() const;
 
  private:
   static GstPadProbeReturn onSourceData(GstPad* pad, GstPadProbeInfo* info, gpointer self);
@@ -65,6 +65,8 @@ class SegmentWriter {
   void planFrame(GstPad* pad, GstPadProbeInfo* info);
   GstPadProbeReturn routeFrame(GstPad* pad, GstPadProbeInfo* info);
   GstPadProbeReturn routeText(GstPad* pad, GstPadProbeInfo* info);
+  // The text goes to file `number` from now on; false: it has no file.
+  bool moveText(GstPad* pad, uint64_t number);
   void open(GstClockTime start);
 
   Parts parts_;
@@ -84,8 +86,10 @@ class SegmentWriter {
 
   mutable Mutex mutex_;
   std::deque<std::unique_ptr<SegmentFile>> files_ WIRCAM_GUARDED_BY(mutex_);  // oldest first
+  std::vector<std::string> finished_ WIRCAM_GUARDED_BY(mutex_);  // of those still in files_
   uint64_t opened_ WIRCAM_GUARDED_BY(mutex_) = 0;
-  bool broken_ WIRCAM_GUARDED_BY(mutex_) = false;  // a file would not open: frames are dropped
+  bool broken_ WIRCAM_GUARDED_BY(mutex_) = false;     // a file would not open: frames are dropped
+  bool textEnded_ WIRCAM_GUARDED_BY(mutex_) = false;  // the text track has ended (a stop)
   SegmentFile* video_ WIRCAM_GUARDED_BY(mutex_) = nullptr;  // the file the frames go to
   SegmentFile* text_ WIRCAM_GUARDED_BY(mutex_) = nullptr;   // the file the text goes to
 };

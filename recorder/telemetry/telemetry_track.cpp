@@ -40,12 +40,12 @@ uint64_t TelemetryTrack::fileOpened(GstClockTime start) {
 
 void TelemetryTrack::heartbeat(GstClockTime frameTime) {
   MutexLock lock(mutex_);
-  if (openFile_ != 0) push({}, frameTime + 1, openFile_);
+  if (openFile_ != 0) push({}, frameTime + 1, openFile_, true);
 }
 
 void TelemetryTrack::end() { gst_app_src_end_of_stream(GST_APP_SRC(source_)); }
 
-void TelemetryTrack::push(const std::string& json, GstClockTime pts, uint64_t file) {
+void TelemetryTrack::push(const std::string& json, GstClockTime pts, uint64_t file, bool gap) {
   if (file != sentFile_) last_ = 0;  // each file's times rise on their own
   sentFile_ = file;
   GstBuffer* buffer =
@@ -54,6 +54,7 @@ void TelemetryTrack::push(const std::string& json, GstClockTime pts, uint64_t fi
   GST_BUFFER_PTS(buffer) = last_;
   GST_BUFFER_DURATION(buffer) = GST_MSECOND;  // an event, not a caption to read
   GST_BUFFER_OFFSET(buffer) = file;
+  if (gap) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_GAP);
   gst_app_src_push_buffer(GST_APP_SRC(source_), buffer);
 }
 

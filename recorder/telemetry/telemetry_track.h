@@ -35,11 +35,16 @@ class TelemetryTrack {
   // out. Returns its number.
   uint64_t fileOpened(GstClockTime start);
 
-  // An empty buffer just after the newest frame, at every frame: a muxer
-  // hands on a frame only once every track has passed its time, so a
-  // sparse text track would hold the video back. This says the text has
-  // nothing before `frameTime` (and, 1 ns later, lets the frame go first).
+  // A muxer hands on a frame only once every track has passed its time,
+  // so a sparse text track would hold the video back: at each frame the
+  // text says it has nothing until just after it (a gap: an empty buffer
+  // flagged GAP, which the SegmentWriter passes on as the muxer wants it).
+  // (A gap further ahead would spare the text's thread most wake-ups, but
+  // matroskamux then stalled a frame now and then.)
   void heartbeat(GstClockTime frameTime);
+  static bool isGap(GstBuffer* buffer) {
+    return GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_GAP) && gst_buffer_get_size(buffer) == 0;
+  }
 
   // No more lines: the text track ends after the ones sent.
   void end();
@@ -47,7 +52,8 @@ class TelemetryTrack {
   static uint64_t fileOf(GstBuffer* buffer) { return GST_BUFFER_OFFSET(buffer); }
 
  private:
-  void push(const std::string& json, GstClockTime pts, uint64_t file) WIRCAM_REQUIRES(mutex_);
+  void push(const std::string& json, GstClockTime pts, uint64_t file, bool gap = false)
+      WIRCAM_REQUIRES(mutex_);
 
   struct Waiting {
     std::string json;
@@ -60,7 +66,7 @@ class TelemetryTrack {
   GstClockTime openStart_ WIRCAM_GUARDED_BY(mutex_) = 0;  // and its start
   GstClockTime previousStart_ WIRCAM_GUARDED_BY(mutex_) = GST_CLOCK_TIME_NONE;  // the one before's
   uint64_t sentFile_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the file of the newest buffer sent
-  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the newest buffer's time
+  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the newest line's time
   std::deque<Waiting> waiting_ WIRCAM_GUARDED_BY(mutex_);  // for files still to open
   static constexpr size_t kMaxWaiting = 1024;
 };
