@@ -110,16 +110,6 @@ std::optional<PlannedSegment> SegmentPlanner::segmentOf(const std::string& path)
   return std::nullopt;
 }
 
-std::optional<PlannedSegment> SegmentPlanner::segmentStartingNear(uint64_t time) const {
-  MutexLock lock(mutex_);
-  const PlannedSegment* nearest = nullptr;
-  auto distance = [time](uint64_t start) { return start > time ? start - time : time - start; };
-  for (const auto& segment : segments_)
-    if (!nearest || distance(segment.start) < distance(nearest->start)) nearest = &segment;
-  if (!nearest) return std::nullopt;
-  return *nearest;
-}
-
 std::optional<PlannedSegment> SegmentPlanner::current() const {
   MutexLock lock(mutex_);
   if (segments_.empty()) return std::nullopt;

@@ -2,7 +2,7 @@
 // out of the source, before any queue: a segment ends at its length, at its
 // byte limit, or at a gap in the frames (the device was lost), and the next
 // begins with the frame after. Deciding this up front (rather than learning
-// it from splitmuxsink a GOP later) is what lets every telemetry line be
+// it from the muxer a GOP later) is what lets every telemetry line be
 // written into the segment its time falls in the moment it is written.
 //
 // GStreamer-free: times are pipeline running times in nanoseconds, wall
@@ -67,9 +67,6 @@ class SegmentPlanner {
   // past the newest frame: no file may hold anything after its last frame.
   std::optional<PlannedSegment> segmentReaching(uint64_t runningTime) const;
   std::optional<PlannedSegment> segmentOf(const std::string& path) const;
-  // The segment whose start is nearest `time`: splitmuxsink names a new file
-  // by its first buffer, whose decoding time may be a little earlier.
-  std::optional<PlannedSegment> segmentStartingNear(uint64_t time) const;
   std::optional<PlannedSegment> current() const;
 
   // "20261122T143205Z", the form file names use.

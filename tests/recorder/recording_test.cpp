@@ -148,7 +148,7 @@ TEST(WircRecorder, SigintFinishesEveryFileAndExitsZero) {
 
 // What a crash costs: the frames the device sent that are not in the file.
 // Clusters (Matroska) and fragments (MP4) of 1 s, and the one GOP
-// splitmuxsink holds back, lose at most 1.5 s.
+// the muxer is writing, lose at most 1.5 s.
 void expectPlayableAfterKill9(const std::vector<std::string>& options, const char* extension) {
   auto device = startSequenceDevice();
   RecorderProcess recorder(device->port(), options);
