@@ -143,7 +143,7 @@ void SegmentWriter::open(GstClockTime start) {
   track_.fileOpened(start);
 }
 
-// Ending and relinking happen under the lock: release() (the main loop)
+// Ending and relinking happen under the lock: finished() (the main loop)
 // deletes a file once both its inputs have ended, which may be at once.
 // (The lock is never taken by a thread inside a muxer: ours are upstream.)
 GstPadProbeReturn SegmentWriter::routeFrame(GstPad* pad, GstPadProbeInfo* info) {

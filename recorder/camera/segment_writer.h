@@ -10,7 +10,7 @@
 // - a probe where the telemetry leaves for the file does the same for the
 //   text, on the appsrc's thread, by the file number each buffer carries.
 // A file is finished once both its inputs have ended; the camera then
-// takes it out of the pipeline (release()).
+// takes it out of the pipeline (finished()).
 #pragma once
 
 #include <gst/gst.h>
