@@ -12,9 +12,11 @@
 namespace wircam::testing {
 
 // Known distinct frames at `fps`; `port` 0 picks one.
-inline std::unique_ptr<wirc::Device> startSequenceDevice(uint16_t port = 0, double fps = 15) {
-  auto device = wirc::Device::start({.port = port, .fps = fps, .fragmentSize = 8000},
-                                    std::make_shared<sim::JpegSequenceScene>(sceneFrames()));
+inline std::unique_ptr<wirc::Device> startSequenceDevice(uint16_t port = 0, double fps = 15,
+                                                         wirc::Impairments impairments = {}) {
+  auto device = wirc::Device::start(
+      {.port = port, .fps = fps, .fragmentSize = 8000, .impairments = impairments},
+      std::make_shared<sim::JpegSequenceScene>(sceneFrames()));
   return device ? std::move(*device) : nullptr;
 }
 

@@ -93,6 +93,8 @@ Impairments of the video stream (all seeded by --seed, repeatable):
   --start-frame N      first frame number (e.g. 4294967290 to test wrap-around)
   --reserved-bits      set the version's reserved bits 31..17
   --stray P            per frame, probability of a forged packet from another port
+  --misdirect PORT     stream to this port of the receiver instead of the one it
+                       asked for (a NAT or firewall that maps it wrong)
   --seed N             random seed (default 1)
 
   -h, --help           show this text
@@ -138,6 +140,7 @@ enum Option {
   kStartFrame,
   kReservedBits,
   kStray,
+  kMisdirect,
   kSeed,
   kMarvelmind,
   kMarvelmindBeacons,
@@ -186,6 +189,7 @@ const option kOptions[] = {
     {"start-frame", required_argument, nullptr, kStartFrame},
     {"reserved-bits", no_argument, nullptr, kReservedBits},
     {"stray", required_argument, nullptr, kStray},
+    {"misdirect", required_argument, nullptr, kMisdirect},
     {"seed", required_argument, nullptr, kSeed},
     {"marvelmind", required_argument, nullptr, kMarvelmind},
     {"marvelmind-beacons", required_argument, nullptr, kMarvelmindBeacons},
@@ -397,6 +401,10 @@ int main(int argc, char** argv) {
         break;
       case kStray:
         device.impairments.strayRate = number(optarg, "stray", 0, 1);
+        break;
+      case kMisdirect:
+        device.impairments.misdirectPort =
+            static_cast<uint16_t>(number(optarg, "misdirect", 1, 65535));
         break;
       case kSeed:
         device.impairments.seed = static_cast<uint32_t>(number(optarg, "seed", 0, 4294967295.0));

@@ -496,9 +496,11 @@ void Device::Impl::handle(Connection& c, const Stst& m) {
   streams_.erase(key);
   Impairments impairments = config_.impairments;
   impairments.seed += c.id * 31u + m.camera;  // distinct, repeatable per stream
-  streams_.emplace(key, StreamSender(video_.get(), stray_.get(), c.peer.withPort(m.port),
-                                     config_.fragmentSize, impairments));
-  log("camera " + std::to_string(m.camera) + " streaming to " + c.peer.withPort(m.port).toString());
+  auto destination =
+      c.peer.withPort(impairments.misdirectPort ? impairments.misdirectPort : m.port);
+  streams_.emplace(key, StreamSender(video_.get(), stray_.get(), destination, config_.fragmentSize,
+                                     impairments));
+  log("camera " + std::to_string(m.camera) + " streaming to " + destination.toString());
 }
 
 void Device::Impl::handle(Connection& c, const Est& m) {

@@ -22,6 +22,9 @@ struct Impairments {
   size_t fragmentJitter = 0;  // fragment sizes vary by up to ± this many bytes
   bool reservedBits = false;  // set the version's reserved bits 31..17
   double strayRate = 0;       // per frame: a forged datagram from another port
+  // When set, every stream goes to this port of the receiver's host instead
+  // of the one STST named: a NAT or firewall in between that maps it wrong.
+  uint16_t misdirectPort = 0;
   uint32_t startFrameNumber = 0;
   uint32_t seed = 1;
 };
