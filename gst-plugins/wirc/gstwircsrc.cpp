@@ -20,7 +20,10 @@
  * TL: unauthorised, busy) is a warning at once with the spec's meaning, is
  * retried at the backoff's pace, and is what the error names if no login
  * comes in time. Stopping sends EST and logs out, and never
- * waits on the network. Elements naming the same device share its login
+ * waits on the network. The `end-of-stream` action signal ends the stream
+ * from its own thread after the frames already whole (an application's
+ * stop that never blocks, unlike sending EOS to a source whose thread is
+ * held up downstream). Elements naming the same device share its login
  * only when the settings they were given agree (transmitter-name, priority,
  * reconnect, login-timeout, link-timeout, max-bad-messages, periods,
  * failsafe); a conflict is an error naming both elements.
@@ -145,6 +148,9 @@ struct WircSrcState {
   UniqueFd socket;
   UniqueFd wake;         // unlock() writes here to end a blocking receive
   UniqueFd linkChanged;  // the session's listener writes here
+  // end-of-stream writes here; start() drains it. For the element's life,
+  // so that the signal never races stop() closing it.
+  UniqueFd endRequest{eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)};
   Clock::time_point loginDeadline;
   bool streaming = false;  // the link was live and the camera exists
   std::deque<wirc::AssembledFrame> ready;
@@ -333,6 +339,7 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   if (!openStreamSocket(self, settings.streamPort)) return FALSE;
   state->session = std::move(*session);
   state->wake = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
+  drain(state->endRequest);
   state->linkChanged = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
   state->receiver.emplace(wirc::FrameAssemblerConfig{
       .frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)});
@@ -384,6 +391,8 @@ static gboolean gst_wirc_src_unlock_stop(GstBaseSrc* base) {
   drain(GST_WIRC_SRC(base)->state->wake);
   return TRUE;
 }
+
+static void gst_wirc_src_end_of_stream(GstWircSrc* self) { signal(self->state->endRequest); }
 
 static gboolean gst_wirc_src_query(GstBaseSrc* base, GstQuery* query) {
   if (GST_QUERY_TYPE(query) == GST_QUERY_LATENCY) {
@@ -548,11 +557,12 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
                   .count()) +
               1,
           0, 100);
-    std::array<pollfd, 3> fds = {pollfd{state->socket.get(), POLLIN, 0},
-                                 pollfd{state->wake.get(), POLLIN, 0},
-                                 pollfd{state->linkChanged.get(), POLLIN, 0}};
+    std::array<pollfd, 4> fds = {
+        pollfd{state->socket.get(), POLLIN, 0}, pollfd{state->wake.get(), POLLIN, 0},
+        pollfd{state->linkChanged.get(), POLLIN, 0}, pollfd{state->endRequest.get(), POLLIN, 0}};
     ::poll(fds.data(), fds.size(), timeoutMs);
     if (fds[1].revents & POLLIN) return GST_FLOW_FLUSHING;
+    if (fds[3].revents & POLLIN) return GST_FLOW_EOS;  // basesrc pushes the EOS
     // Until the first login, poll's timeout is what checks the deadline.
     checkLink = (fds[2].revents & POLLIN) || !state->streaming;
     if (fds[0].revents & POLLIN) receive_batch(self);
@@ -866,6 +876,10 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
                            "instead of failing after login-timeout; needs reconnect=true",
                            DEFAULT_WAIT_FOR_DEVICE, kReady));
   gst::installLoginProperties(gobject, PROP_PERIODS, PROP_FAILSAFE);
+  g_signal_new_class_handler("end-of-stream", G_TYPE_FROM_CLASS(klass),
+                             static_cast<GSignalFlags>(G_SIGNAL_RUN_LAST | G_SIGNAL_ACTION),
+                             G_CALLBACK(gst_wirc_src_end_of_stream), nullptr, nullptr, nullptr,
+                             G_TYPE_NONE, 0);
 
   gst_element_class_add_static_pad_template(element, &src_template);
   gst_element_class_set_static_metadata(

@@ -35,9 +35,10 @@ void keepSegment(GstPadProbeInfo* info, GstSegment& segment) {
 // `output` feeds `to` instead of `from` (which may be null).
 void relink(GstPad* output, GstPad* from, GstPad* to) {
   if (from) gst_pad_unlink(output, from);
-  if (gst_pad_link(output, to) != GST_PAD_LINK_OK)
+  GstPadLinkReturn linked = gst_pad_link(output, to);
+  if (linked != GST_PAD_LINK_OK)
     logLine(std::string("cannot link ") + GST_OBJECT_NAME(GST_OBJECT_PARENT(output)) + " to " +
-            GST_OBJECT_NAME(GST_OBJECT_PARENT(to)));
+            GST_OBJECT_NAME(GST_OBJECT_PARENT(to)) + ": " + gst_pad_link_get_name(linked));
 }
 
 }  // namespace
@@ -219,7 +220,9 @@ bool SegmentWriter::moveText(GstPad* pad, uint64_t number) {
 
 void SegmentWriter::end() {
   track_.end();
-  gst_element_send_event(parts_.source, gst_event_new_eos());
+  // Not gst_element_send_event(EOS): basesrc takes the stream lock for it,
+  // and would hold the main loop for as long as a frame is held downstream.
+  g_signal_emit_by_name(parts_.source, "end-of-stream");
 }
 
 void SegmentWriter::finished(const std::string& path, bool release) {

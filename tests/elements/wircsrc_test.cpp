@@ -3,6 +3,7 @@
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
+#include <future>
 #include <thread>
 
 #include "buffer_bytes.h"
@@ -185,6 +186,43 @@ TEST(WircSrc, PcdKeepsFlowingWhileThePipelineIsBlocked) {
   EXPECT_TRUE(waitFor([&] { return device->stats().pcdReceived > 20; }));
   EXPECT_EQ(device->stats().failsafeEntries, 0u);
   gst_pad_remove_probe(pad, probe);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pad);
+  gst_object_unref(src);
+  gst_object_unref(pipeline);
+}
+
+TEST(WircSrc, EndOfStreamNeverWaitsForAThreadHeldDownstreamAndEndsTheStreamAfterIt) {
+  auto device = startDevice(ephemeral());
+  GstElement* pipeline = launch(
+      "wircsrc name=src host=127.0.0.1 port=" + std::to_string(device->port()) + " ! fakesink");
+  GstElement* src = gst_bin_get_by_name(GST_BIN(pipeline), "src");
+  GstPad* pad = gst_element_get_static_pad(src, "src");
+  // The first frame is held, as a muxer waiting for another input holds it.
+  std::promise<void> held;
+  gulong block = gst_pad_add_probe(
+      pad, static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BLOCK | GST_PAD_PROBE_TYPE_BUFFER),
+      [](GstPad*, GstPadProbeInfo*, gpointer promise) {
+        static_cast<std::promise<void>*>(promise)->set_value();
+        return GST_PAD_PROBE_OK;
+      },
+      &held, nullptr);
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  ASSERT_EQ(held.get_future().wait_for(std::chrono::seconds(5)), std::future_status::ready);
+  // (gst_element_send_event(EOS) would wait here for as long as the frame
+  // is held: basesrc takes the stream lock for it.)
+  auto ended =
+      std::async(std::launch::async, [src] { g_signal_emit_by_name(src, "end-of-stream"); });
+  EXPECT_EQ(ended.wait_for(milliseconds(1000)), std::future_status::ready);
+  gst_pad_remove_probe(pad, block);
+  GstBus* bus = gst_element_get_bus(pipeline);
+  GstMessage* eos = gst_bus_timed_pop_filtered(
+      bus, 3 * GST_SECOND, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
+  ASSERT_NE(eos, nullptr);
+  EXPECT_EQ(GST_MESSAGE_TYPE(eos), GST_MESSAGE_EOS);
+  gst_message_unref(eos);
+  gst_object_unref(bus);
+  ended.wait();
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(pad);
   gst_object_unref(src);
