@@ -68,12 +68,13 @@ void SegmentFile::end(GstPad* input, std::atomic<bool>& ended) {
 
 GstPadProbeReturn SegmentFile::onSinkEvent(GstPad*, GstPadProbeInfo* info, gpointer data) {
   auto* self = static_cast<SegmentFile*>(data);
-  if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS)
-    gst_element_post_message(
-        self->sink_,
-        gst_message_new_element(GST_OBJECT(self->sink_),
-                                gst_structure_new(kClosedMessage, "location", G_TYPE_STRING,
-                                                  self->path_.c_str(), nullptr)));
+  if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_OK;
+  self->closed_ = true;
+  gst_element_post_message(
+      self->sink_,
+      gst_message_new_element(GST_OBJECT(self->sink_),
+                              gst_structure_new(kClosedMessage, "location", G_TYPE_STRING,
+                                                self->path_.c_str(), nullptr)));
   return GST_PAD_PROBE_OK;
 }
 

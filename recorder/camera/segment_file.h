@@ -46,6 +46,9 @@ class SegmentFile {
   // The end of its frames, or of its text (EOS into that input, once).
   void endVideo() { end(videoInput_, videoEnded_); }
   void endText() { end(textInput_, textEnded_); }
+  // The muxer has finished the file (its EOS reached the filesink): an
+  // input fed now would answer EOS, which stops the thread feeding it.
+  bool closed() const { return closed_; }
 
  private:
   SegmentFile() = default;
@@ -60,7 +63,7 @@ class SegmentFile {
   std::string path_;
   GstClockTime start_ = 0;
   uint64_t number_ = 0;
-  std::atomic<bool> videoEnded_{false}, textEnded_{false};
+  std::atomic<bool> videoEnded_{false}, textEnded_{false}, closed_{false};
 };
 
 }  // namespace wircam::recorder

@@ -32,9 +32,14 @@ void keepSegment(GstPadProbeInfo* info, GstSegment& segment) {
   if (GST_EVENT_TYPE(event) == GST_EVENT_SEGMENT) gst_event_copy_segment(event, &segment);
 }
 
-// `output` feeds `to` instead of `from` (which may be null).
-void relink(GstPad* output, GstPad* from, GstPad* to) {
-  if (from) gst_pad_unlink(output, from);
+// `output` feeds `to` instead of whatever it fed. (Its peer, not the file
+// we last linked it to: a muxer may finish its file, and the file leave
+// the pipeline, before the input we fed it ends.)
+void relink(GstPad* output, GstPad* to) {
+  if (GstPad* peer = gst_pad_get_peer(output)) {
+    gst_pad_unlink(output, peer);
+    gst_object_unref(peer);
+  }
   GstPadLinkReturn linked = gst_pad_link(output, to);
   if (linked != GST_PAD_LINK_OK)
     logLine(std::string("cannot link ") + GST_OBJECT_NAME(GST_OBJECT_PARENT(output)) + " to " +
@@ -170,7 +175,7 @@ GstPadProbeReturn SegmentWriter::routeFrame(GstPad* pad, GstPadProbeInfo* info) 
         if (file.get() == to) break;
         file->endVideo();
       }
-      relink(pad, video_ ? video_->videoInput() : nullptr, to->videoInput());
+      relink(pad, to->videoInput());
       video_ = to;
     }
   }
@@ -203,17 +208,17 @@ GstPadProbeReturn SegmentWriter::routeText(GstPad* pad, GstPadProbeInfo* info) {
 
 bool SegmentWriter::moveText(GstPad* pad, uint64_t number) {
   MutexLock lock(mutex_);
-  if (text_ && text_->number() == number) return true;
+  if (text_ && text_->number() == number) return !text_->closed();
   SegmentFile* to = nullptr;
   for (const auto& file : files_)
     if (file->number() == number) to = file.get();
   // (A file that would not open, or a line late for a finished one.)
-  if (!to || (text_ && text_->number() > number)) return false;
+  if (!to || to->closed() || (text_ && text_->number() > number)) return false;
   for (const auto& file : files_) {  // the text of every file before is over
     if (file.get() == to) break;
     file->endText();
   }
-  relink(pad, text_ ? text_->textInput() : nullptr, to->textInput());
+  relink(pad, to->textInput());
   text_ = to;
   return true;
 }
