@@ -1,5 +1,3 @@
-#include "wirc/device_impl.h"
-
 #include <poll.h>
 #include <sys/eventfd.h>
 #include <sys/socket.h>
@@ -15,15 +13,15 @@
 #include <mutex>
 #include <thread>
 
+#include "wirc/device_impl.h"
 #include "wirc/message_stream_parser.h"
 #include "wirc/mjpeg_packet.h"
 
 namespace wircam::wirc {
 
+using device_detail::Connection;
 using std::chrono::duration_cast;
 using std::chrono::milliseconds;
-using device_detail::Connection;
-
 
 std::optional<std::string> Device::Impl::openListener() {
   auto address = SocketAddress::resolve(config_.bindAddress, port_);
@@ -228,7 +226,6 @@ void Device::Impl::readConnection(Connection& c) {
                   if (!c.closing) handleMessage(c, result);
                 });
 }
-
 
 void Device::Impl::readDiscovery() {
   sockaddr_in from{};

@@ -4,6 +4,7 @@
 // does).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <deque>
 #include <list>
@@ -14,6 +15,7 @@
 
 #include "wirc/device.h"
 #include "wirc/message_stream_parser.h"
+#include "wirc/mjpeg_packet.h"
 
 namespace wircam::wirc {
 
