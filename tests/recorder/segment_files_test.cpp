@@ -17,8 +17,14 @@
 #include "http_fetch.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
+#include "wait_for.h"
 
 namespace {
+
+// Frames the recorder's one camera has recorded, from /api/status.
+uint64_t framesRecorded(const std::string& url);
+// Whether the recorder's log says `text` within 10 s.
+bool logSays(const wircam::testing::RecorderProcess& recorder, const std::string& text);
 
 namespace fs = std::filesystem;
 using namespace wircam;
@@ -154,13 +160,22 @@ INSTANTIATE_TEST_SUITE_P(Formats, SegmentFiles,
 TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
   auto device = startSequenceDevice();
   uint16_t port = device->port();
-  RecorderProcess recorder(port, {"--segment", "60"});
-  std::this_thread::sleep_for(milliseconds(3000));
+  RecorderProcess recorder(port, {"--segment", "60", "--http", "127.0.0.1:0"});
+  auto url = recorder.waitForLog("http://", milliseconds(5000));
+  ASSERT_TRUE(url) << recorder.log();
+  ASSERT_TRUE(waitFor([&] { return framesRecorded(*url) >= 30; }, milliseconds(10000)))
+      << recorder.log();
   device.reset();
-  std::this_thread::sleep_for(milliseconds(5000));
+  // The device stays off while the recorder backs off (200 + 400 + 800 +
+  // 1600 ms): the outage the loss line's own time must show.
+  ASSERT_TRUE(logSays(recorder, "retrying in 1600 ms")) << recorder.log();
   device = startSequenceDevice(port);
   ASSERT_TRUE(device);
-  std::this_thread::sleep_for(milliseconds(4000));
+  // The second file: a second and a half of frames.
+  ASSERT_TRUE(waitFor([&] { return recorder.files(".mkv").size() == 2; }, milliseconds(10000)));
+  uint64_t back = framesRecorded(*url);
+  ASSERT_TRUE(waitFor([&] { return framesRecorded(*url) >= back + 22; }, milliseconds(10000)))
+      << recorder.log();
   recorder.signal(SIGINT);
   ASSERT_EQ(recorder.wait(), 0) << recorder.log();
   auto videos = recorder.files(".mkv");
@@ -210,13 +225,18 @@ TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {
   RecorderProcess recorder(port, {"--segment", "60", "--http", "127.0.0.1:0"});
   auto url = recorder.waitForLog("http://", milliseconds(5000));
   ASSERT_TRUE(url) << recorder.log();
-  std::this_thread::sleep_for(milliseconds(2500));  // login attempts fail meanwhile
-  EXPECT_NE(recorder.statusLines().find("waiting for device"), std::string::npos);
+  // Login attempts fail meanwhile.
+  ASSERT_TRUE(logSays(recorder, "retrying in 400 ms")) << recorder.log();
+  ASSERT_TRUE(waitFor(
+      [&] { return recorder.statusLines().find("waiting for device") != std::string::npos; },
+      milliseconds(5000)));
   auto status = nlohmann::json::parse(fetch(*url + "api/status").body);
   EXPECT_EQ(status["streams"][0]["state"], "connecting") << status;
   auto device = startSequenceDevice(port);
   ASSERT_TRUE(device);
-  std::this_thread::sleep_for(milliseconds(5000));  // the backoff, then 2-3 s of frames
+  // The backoff, then two seconds of frames.
+  ASSERT_TRUE(waitFor([&] { return framesRecorded(*url) >= 30; }, milliseconds(15000)))
+      << recorder.log();
   status = nlohmann::json::parse(fetch(*url + "api/status").body);
   EXPECT_EQ(status["streams"][0]["state"], "live") << status;
   recorder.signal(SIGTERM);
@@ -233,10 +253,21 @@ TEST(SegmentFilesStartUp, StoppedWhileWaitingItEndsCleanly) {
     port = probe->port();
   }
   RecorderProcess recorder(port, {"--segment", "60"});
-  std::this_thread::sleep_for(milliseconds(2000));
+  ASSERT_TRUE(logSays(recorder, "retrying in 400 ms")) << recorder.log();
   recorder.signal(SIGTERM);
   EXPECT_EQ(recorder.wait(), 0) << recorder.log();
   EXPECT_NE(recorder.log().find("nothing was recorded"), std::string::npos) << recorder.log();
+}
+
+uint64_t framesRecorded(const std::string& url) {
+  auto status = nlohmann::json::parse(fetch(url + "api/status").body, nullptr, false);
+  if (!status.is_object() || status["streams"].empty()) return 0;
+  return status["streams"][0]["frames"].get<uint64_t>();
+}
+
+bool logSays(const RecorderProcess& recorder, const std::string& text) {
+  return waitFor([&] { return recorder.log().find(text) != std::string::npos; },
+                 milliseconds(10000));
 }
 
 }  // namespace
