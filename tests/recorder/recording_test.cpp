@@ -11,6 +11,7 @@
 
 #include "recorder_process.h"
 #include "simulated_device.h"
+#include "wait_for.h"
 
 namespace {
 
@@ -136,7 +137,9 @@ TEST(WircRecorder, RefusesMp4WithoutTranscoding) {
 TEST(WircRecorder, SigintFinishesEveryFileAndExitsZero) {
   auto device = startSequenceDevice();
   RecorderProcess recorder(device->port(), {"--segment", "60"});
-  std::this_thread::sleep_for(milliseconds(3000));
+  // Two seconds of frames on their way into the file.
+  ASSERT_TRUE(waitFor([&] { return device->stats().framesSent >= 30; }, milliseconds(10000)));
+  ASSERT_TRUE(waitFor([&] { return recorder.files(".mkv").size() == 1; }, milliseconds(5000)));
   recorder.signal(SIGINT);
   ASSERT_EQ(recorder.wait(), 0) << recorder.log();
   auto videos = recorder.files(".mkv");
@@ -152,7 +155,8 @@ TEST(WircRecorder, SigintFinishesEveryFileAndExitsZero) {
 void expectPlayableAfterKill9(const std::vector<std::string>& options, const char* extension) {
   auto device = startSequenceDevice();
   RecorderProcess recorder(device->port(), options);
-  std::this_thread::sleep_for(milliseconds(8000));
+  // Four seconds of frames: clusters or fragments written, one under way.
+  ASSERT_TRUE(waitFor([&] { return device->stats().framesSent >= 60; }, milliseconds(15000)));
   recorder.signal(SIGKILL);
   recorder.wait();
   uint64_t sent = device->stats().framesSent;
