@@ -11,6 +11,7 @@
 #include "http_fetch.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
+#include "wait_for.h"
 
 namespace {
 
@@ -106,15 +107,23 @@ TEST(WircRecorderHttp, LiveMjpegCarriesTheCamerasFramesUntouched) {
 TEST(WircRecorderHttp, ListsAndServesTheRecordings) {
   LiveRecorder live(startSequenceDevice(), {"--segment", "1"});
   ASSERT_FALSE(live.url.empty()) << live.recorder->log();
-  std::this_thread::sleep_for(milliseconds(3500));
-  auto files = nlohmann::json::parse(fetch(live.url + "recordings").body);
+  // A file finished (1 s segments) and the next being written.
+  nlohmann::json files;
   const nlohmann::json* finished = nullptr;
   bool recording = false;
-  for (const auto& file : files) {
-    if (file["recording"]) recording = true;
-    std::string name = file["name"];
-    if (!file["recording"] && name.ends_with(".mkv")) finished = &file;
-  }
+  waitFor(
+      [&] {
+        files = nlohmann::json::parse(fetch(live.url + "recordings").body, nullptr, false);
+        finished = nullptr;
+        recording = false;
+        for (const auto& file : files) {
+          if (file["recording"]) recording = true;
+          std::string name = file["name"];
+          if (!file["recording"] && name.ends_with(".mkv")) finished = &file;
+        }
+        return recording && finished;
+      },
+      milliseconds(10000));
   EXPECT_TRUE(recording);
   ASSERT_NE(finished, nullptr) << files.dump();
   auto download = fetch(live.url + "recordings/" + (*finished)["name"].get<std::string>());
@@ -192,11 +201,13 @@ TEST(WircRecorderHttp, CameraSnapshotAndRecordingApi) {
   ASSERT_FALSE(live.url.empty()) << live.recorder->log();
   // Exact fields: name, state (live|offline|connecting), fps, has_control, following.
   nlohmann::json cameras;
-  for (int attempt = 0; attempt < 50; ++attempt) {
-    std::this_thread::sleep_for(milliseconds(100));
-    cameras = nlohmann::json::parse(fetch(live.url + "api/cameras").body);
-    if (cameras[0]["state"] == "live" && cameras[0]["fps"].get<double>() > 0) break;
-  }
+  waitFor(
+      [&] {
+        cameras = nlohmann::json::parse(fetch(live.url + "api/cameras").body, nullptr, false);
+        return cameras.is_array() && !cameras.empty() && cameras[0]["state"] == "live" &&
+               cameras[0]["fps"].get<double>() > 0;
+      },
+      milliseconds(10000));
   ASSERT_EQ(cameras.size(), 1u);
   EXPECT_EQ(cameras[0]["name"], live.camera());
   EXPECT_EQ(cameras[0]["state"], "live");
@@ -214,10 +225,12 @@ TEST(WircRecorderHttp, CameraSnapshotAndRecordingApi) {
   EXPECT_EQ(fetch(live.url + "api/nothing").status, 404u);
   // The recording index, each with a URL that downloads it.
   nlohmann::json recordings;
-  for (int attempt = 0; attempt < 50 && recordings.empty(); ++attempt) {
-    std::this_thread::sleep_for(milliseconds(100));
-    recordings = nlohmann::json::parse(fetch(live.url + "api/recordings").body);
-  }
+  waitFor(
+      [&] {
+        recordings = nlohmann::json::parse(fetch(live.url + "api/recordings").body, nullptr, false);
+        return recordings.is_array() && !recordings.empty();
+      },
+      milliseconds(10000));
   ASSERT_FALSE(recordings.empty());
   auto first = recordings[0];
   for (const char* field : {"camera", "file", "start_utc", "duration_s", "frames", "bytes", "url"})
@@ -243,8 +256,13 @@ TEST(WircRecorderHttp, TheCameraCardSaysLiveThenOfflineWhenTheDeviceStops) {
   EXPECT_GT(picture.count(0x9f, 0xcb, 0xec, 20), 20000) << "no camera picture in " << liveShot;
   EXPECT_LT(picture.count(0xc5, 0x30, 0x30, 10), 20) << liveShot;
 
-  live.device.reset();                              // the car is switched off
-  std::this_thread::sleep_for(milliseconds(3500));  // the link timeout (2 s) and a status
+  live.device.reset();  // the car is switched off
+  ASSERT_TRUE(waitFor(
+      [&] {
+        auto cameras = nlohmann::json::parse(fetch(live.url + "api/cameras").body, nullptr, false);
+        return cameras.is_array() && !cameras.empty() && cameras[0]["state"] == "offline";
+      },
+      milliseconds(10000)));
   auto offlineShot = fs::path(WIRCAM_SCREENSHOT_DIR) / "card-offline.png";
   ASSERT_TRUE(screenshot(live.url, offlineShot, 800, 700));
   picture = readPng(offlineShot);
