@@ -189,7 +189,11 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
     auto pulses = car.device->outputs().pulses;
     return pulses[kThrottle] > 1500 && pulses[kSteering] > 1500;
   }));
-  std::this_thread::sleep_for(milliseconds(800));
+  // The car drives forward and to the left for as long as the keys are held.
+  waitFor([&] {
+    auto now = car.scene->truthNow().car;
+    return std::hypot(now.x - before.x, now.y - before.y) > 0.1 && now.theta > before.theta;
+  });
   auto after = car.scene->truthNow().car;
   EXPECT_GT(std::hypot(after.x - before.x, after.y - before.y), 0.1) << "the car moved";
   EXPECT_GT(after.theta, before.theta) << "and turned left";
