@@ -40,7 +40,8 @@ class TelemetryTrack {
   // text says it has nothing until just after it (a gap: an empty buffer
   // flagged GAP, which the SegmentWriter passes on as the muxer wants it).
   // (A gap further ahead would spare the text's thread most wake-ups, but
-  // matroskamux then stalled a frame now and then.)
+  // a line that comes behind a gap the muxer has passed is then lost or
+  // misplaced: tried, and the recorder's tests failed.)
   void heartbeat(GstClockTime frameTime);
   static bool isGap(GstBuffer* buffer) {
     return GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_GAP) && gst_buffer_get_size(buffer) == 0;

@@ -41,10 +41,17 @@ nlohmann::json streamEntry(const std::string& url, const std::string& camera) {
   return status.is_object() ? entryNamed(status["streams"], camera) : nullptr;
 }
 
-void expectSigintEndsItWithinThreeSeconds(RecorderProcess& recorder) {
+uint64_t framesOf(const std::string& url, const std::string& camera) {
+  auto stream = streamEntry(url, camera);
+  return stream.is_object() ? stream["frames"].get<uint64_t>() : 0;
+}
+
+void expectSigintEndsItWithinThreeSeconds(RecorderProcess& recorder,
+                                          const std::function<void()>& meanwhile) {
   using Clock = std::chrono::steady_clock;
   auto signalled = Clock::now();
   recorder.signal(SIGINT);
+  if (meanwhile) meanwhile();
   auto code = recorder.waitExit(patience(std::chrono::milliseconds(3000)));
   ASSERT_TRUE(code.has_value()) << "still running 3 s after SIGINT" << recorder.log();
   EXPECT_EQ(*code, 0) << recorder.log();

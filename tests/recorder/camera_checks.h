@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -33,7 +34,12 @@ nlohmann::json cameraEntry(const std::string& url, const std::string& camera);
 // /api/status's stream entry of `camera`, or null.
 nlohmann::json streamEntry(const std::string& url, const std::string& camera);
 
-// SIGINT ends the recorder with exit 0 within 3 s.
-void expectSigintEndsItWithinThreeSeconds(RecorderProcess& recorder);
+// /api/status's frames of `camera`: 0 until it is listed.
+uint64_t framesOf(const std::string& url, const std::string& camera);
+
+// SIGINT ends the recorder with exit 0 within 3 s, `meanwhile` done just
+// after the signal.
+void expectSigintEndsItWithinThreeSeconds(RecorderProcess& recorder,
+                                          const std::function<void()>& meanwhile = {});
 
 }  // namespace wircam::testing

@@ -174,9 +174,7 @@ TEST(RecorderMqtt, RejoinsABrokerRestartedMidRun) {
   }
   broker.kill();
   // The recorder notices and backs off.
-  ASSERT_TRUE(waitFor(
-      [&] { return recorder.log().find("lost the MQTT broker") != std::string::npos; }, 10s))
-      << recorder.log();
+  ASSERT_TRUE(recorder.waitForText("lost the MQTT broker", 10s)) << recorder.log();
   ASSERT_TRUE(broker.start());
   MqttProbe probe(broker.port(), "wircam/#");
   // Back within its backoff (a few seconds), with its retained status again.
@@ -226,10 +224,7 @@ TEST(RecorderMqtt, IgnoresRetainedJunkAndBadCommands) {
   car.probe.publish("wircam/" + car.stream + "/target/set", "7x");
   car.probe.publish("wircam/no-such-stream/follow/set", "OFF");
   // All three refused (the last sent is the last refused).
-  ASSERT_TRUE(waitFor(
-      [&] { return car.recorder->log().find("no stream 'no-such-stream'") != std::string::npos; },
-      10s))
-      << car.recorder->log();
+  ASSERT_TRUE(car.recorder->waitForText("no stream 'no-such-stream'", 10s)) << car.recorder->log();
   // Still following: no junk turned it off.
   EXPECT_TRUE(car.probe.waitFor(
       "wircam/" + car.stream + "/status", [](auto& m) { return parsed(m)["following"] == true; },

@@ -114,6 +114,11 @@ std::optional<std::string> RecorderProcess::waitForLog(const std::string& prefix
   return std::nullopt;
 }
 
+bool RecorderProcess::waitForText(const std::string& text,
+                                  std::chrono::milliseconds timeout) const {
+  return waitFor([&] { return log().find(text) != std::string::npos; }, timeout);
+}
+
 GstClockTime durationOf(const fs::path& file) {
   GstDiscoverer* discoverer = gst_discoverer_new(10 * GST_SECOND, nullptr);
   std::string uri = "file://" + fs::absolute(file).string();

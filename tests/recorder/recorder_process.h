@@ -42,6 +42,9 @@ class RecorderProcess {
   // nullopt after `timeout` (stretched under a sanitizer).
   std::optional<std::string> waitForLog(const std::string& prefix,
                                         std::chrono::milliseconds timeout);
+  // Whether the log says `text` (anywhere) within `timeout` (stretched
+  // likewise).
+  bool waitForText(const std::string& text, std::chrono::milliseconds timeout) const;
 
  private:
   std::filesystem::path folder_;  // out_ and the log

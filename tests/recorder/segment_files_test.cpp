@@ -14,17 +14,13 @@
 #include <sstream>
 #include <thread>
 
+#include "camera_checks.h"
 #include "http_fetch.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
 #include "wait_for.h"
 
 namespace {
-
-// Frames the recorder's one camera has recorded, from /api/status.
-uint64_t framesRecorded(const std::string& url);
-// Whether the recorder's log says `text` within 10 s.
-bool logSays(const wircam::testing::RecorderProcess& recorder, const std::string& text);
 
 namespace fs = std::filesystem;
 using namespace wircam;
@@ -163,18 +159,19 @@ TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
   RecorderProcess recorder(port, {"--segment", "60", "--http", "127.0.0.1:0"});
   auto url = recorder.waitForLog("http://", milliseconds(5000));
   ASSERT_TRUE(url) << recorder.log();
-  ASSERT_TRUE(waitFor([&] { return framesRecorded(*url) >= 30; }, milliseconds(10000)))
+  ASSERT_TRUE(waitFor([&] { return framesOf(*url, cameraName(port)) >= 30; }, milliseconds(10000)))
       << recorder.log();
   device.reset();
   // The device stays off while the recorder backs off (200 + 400 + 800 +
   // 1600 ms): the outage the loss line's own time must show.
-  ASSERT_TRUE(logSays(recorder, "retrying in 1600 ms")) << recorder.log();
+  ASSERT_TRUE(recorder.waitForText("retrying in 1600 ms", milliseconds(10000))) << recorder.log();
   device = startSequenceDevice(port);
   ASSERT_TRUE(device);
   // The second file: a second and a half of frames.
   ASSERT_TRUE(waitFor([&] { return recorder.files(".mkv").size() == 2; }, milliseconds(10000)));
-  uint64_t back = framesRecorded(*url);
-  ASSERT_TRUE(waitFor([&] { return framesRecorded(*url) >= back + 22; }, milliseconds(10000)))
+  uint64_t back = framesOf(*url, cameraName(port));
+  ASSERT_TRUE(
+      waitFor([&] { return framesOf(*url, cameraName(port)) >= back + 22; }, milliseconds(10000)))
       << recorder.log();
   recorder.signal(SIGINT);
   ASSERT_EQ(recorder.wait(), 0) << recorder.log();
@@ -226,7 +223,7 @@ TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {
   auto url = recorder.waitForLog("http://", milliseconds(5000));
   ASSERT_TRUE(url) << recorder.log();
   // Login attempts fail meanwhile.
-  ASSERT_TRUE(logSays(recorder, "retrying in 400 ms")) << recorder.log();
+  ASSERT_TRUE(recorder.waitForText("retrying in 400 ms", milliseconds(10000))) << recorder.log();
   ASSERT_TRUE(waitFor(
       [&] { return recorder.statusLines().find("waiting for device") != std::string::npos; },
       milliseconds(5000)));
@@ -235,7 +232,7 @@ TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {
   auto device = startSequenceDevice(port);
   ASSERT_TRUE(device);
   // The backoff, then two seconds of frames.
-  ASSERT_TRUE(waitFor([&] { return framesRecorded(*url) >= 30; }, milliseconds(15000)))
+  ASSERT_TRUE(waitFor([&] { return framesOf(*url, cameraName(port)) >= 30; }, milliseconds(15000)))
       << recorder.log();
   status = nlohmann::json::parse(fetch(*url + "api/status").body);
   EXPECT_EQ(status["streams"][0]["state"], "live") << status;
@@ -253,21 +250,10 @@ TEST(SegmentFilesStartUp, StoppedWhileWaitingItEndsCleanly) {
     port = probe->port();
   }
   RecorderProcess recorder(port, {"--segment", "60"});
-  ASSERT_TRUE(logSays(recorder, "retrying in 400 ms")) << recorder.log();
+  ASSERT_TRUE(recorder.waitForText("retrying in 400 ms", milliseconds(10000))) << recorder.log();
   recorder.signal(SIGTERM);
   EXPECT_EQ(recorder.wait(), 0) << recorder.log();
   EXPECT_NE(recorder.log().find("nothing was recorded"), std::string::npos) << recorder.log();
-}
-
-uint64_t framesRecorded(const std::string& url) {
-  auto status = nlohmann::json::parse(fetch(url + "api/status").body, nullptr, false);
-  if (!status.is_object() || status["streams"].empty()) return 0;
-  return status["streams"][0]["frames"].get<uint64_t>();
-}
-
-bool logSays(const RecorderProcess& recorder, const std::string& text) {
-  return waitFor([&] { return recorder.log().find(text) != std::string::npos; },
-                 milliseconds(10000));
 }
 
 }  // namespace
