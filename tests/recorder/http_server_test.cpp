@@ -77,13 +77,15 @@ TEST(WircRecorderHttp, StatusIsJsonWithEachStream) {
   // Rates need two statistics reports, a second apart.
   Response response;
   nlohmann::json status;
-  for (int attempt = 0; attempt < 50; ++attempt) {
-    std::this_thread::sleep_for(milliseconds(100));
-    response = fetch(live.url + "api/status");
-    ASSERT_EQ(response.status, 200u);
-    status = nlohmann::json::parse(response.body);
-    if (status["streams"][0]["fps"].get<double>() > 0) break;
-  }
+  waitFor(
+      [&] {
+        response = fetch(live.url + "api/status");
+        status = nlohmann::json::parse(response.body, nullptr, false);
+        return status.is_object() && !status["streams"].empty() &&
+               status["streams"][0]["fps"].get<double>() > 0;
+      },
+      milliseconds(10000));
+  ASSERT_EQ(response.status, 200u);
   EXPECT_EQ(response.contentType, "application/json");
   ASSERT_EQ(status["streams"].size(), 1u);
   auto stream = status["streams"][0];

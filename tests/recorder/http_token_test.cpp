@@ -10,6 +10,7 @@
 #include "http_fetch.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
+#include "wait_for.h"
 
 namespace {
 
@@ -72,10 +73,13 @@ TEST(WircRecorderHttpToken, DeletingARecordingNeedsTheTokenAndAFinishedSegment) 
   ASSERT_TRUE(url) << recorder.log();
   Headers token = {{"Authorization", std::string("Bearer ") + kToken}};
   nlohmann::json segments;
-  for (int attempt = 0; attempt < 60 && segments.size() < 1; ++attempt) {
-    std::this_thread::sleep_for(milliseconds(100));
-    segments = nlohmann::json::parse(fetch(*url + "api/recordings", "GET", token).body);
-  }
+  waitFor(
+      [&] {
+        segments = nlohmann::json::parse(fetch(*url + "api/recordings", "GET", token).body, nullptr,
+                                         false);
+        return segments.is_array() && !segments.empty();
+      },
+      milliseconds(10000));
   ASSERT_FALSE(segments.empty());
   std::string file = segments[0]["file"];
   auto path = recorder.out() / file;

@@ -12,6 +12,7 @@
 #include "http_fetch.h"
 #include "marvelmind_dashboard.h"
 #include "recorder_process.h"
+#include "wait_for.h"
 #include "wirc/device.h"
 
 namespace {
@@ -170,11 +171,13 @@ TEST(RecorderPositions, StatusCarriesTheLatestAndTheMapDrawsTheTrail) {
   // The dashboard stops: the position goes stale in the status.
   car.dashboard.reset();
   nlohmann::json stale;
-  for (int i = 0; i < 40 && !stale.is_object(); ++i) {
-    std::this_thread::sleep_for(100ms);
-    auto p = nlohmann::json::parse(fetch(*url + "api/status").body)["streams"][0]["position"];
-    if (p.value("stale", false)) stale = p;
-  }
+  waitFor(
+      [&] {
+        auto p = nlohmann::json::parse(fetch(*url + "api/status").body)["streams"][0]["position"];
+        if (p.is_object() && p.value("stale", false)) stale = p;
+        return stale.is_object();
+      },
+      10s);
   ASSERT_TRUE(stale.is_object()) << recorder.log();
   EXPECT_NE(stale["stale_reason"].get<std::string>().find("no reply"), std::string::npos);
   recorder.signal(SIGTERM);
