@@ -181,6 +181,10 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     std::string codec = value;
     if (codec != "jpeg" && codec != "h264") return "jpeg or h264";
     o.codec = codec == "h264" ? Codec::kH264 : Codec::kJpeg;
+  } else if (name == "telemetry-track") {
+    std::string track = value;
+    if (track != "on" && track != "off") return "on or off";
+    o.telemetryTrack = track == "on";
   } else if (name == "bitrate") {
     auto kbps = number(value);
     if (!kbps || *kbps < 50 || *kbps > 100000) return "kbit/s, 50..100000";
@@ -330,6 +334,7 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"format", required_argument, nullptr, kValue},
                                    {"codec", required_argument, nullptr, kValue},
                                    {"bitrate", required_argument, nullptr, kValue},
+                                   {"telemetry-track", required_argument, nullptr, kValue},
                                    {"http", required_argument, nullptr, kValue},
                                    {"rtsp", required_argument, nullptr, kValue},
                                    {"http-idle-timeout", required_argument, nullptr, kValue},

@@ -65,6 +65,9 @@ struct RecorderOptions {
   uint64_t segmentBytes = 0;  // 0: segments end by time only
   Container container = Container::kMatroska;
   Codec codec = Codec::kJpeg;
+  // The telemetry as a text track in each file too (always in the sidecar).
+  // Without it a stream is one thread and no hand-off per frame.
+  bool telemetryTrack = true;
   unsigned h264Kbps = 2000;
   std::string detectFamily;  // empty: no detection
   bool follow = false;       // needs detectFamily

@@ -27,6 +27,11 @@ file and exits 0.
   --codec jpeg|h264      jpeg: the camera's frames as they are (default);
                          h264: transcoded with x264enc (gstreamer1.0-plugins-ugly)
   --bitrate KBPS         H.264 bit rate (default 2000)
+  --telemetry-track on|off
+                         the telemetry as the file's text track too (default
+                         on); off: in the sidecar only, which spares a thread
+                         per camera and the muxer waiting on the text at every
+                         frame (for many cameras on a small machine)
   --detect FAMILY        find AprilTags (e.g. tag36h11); detections go to telemetry
   --follow               steer the vehicle after the largest tag (needs --detect)
   --marvelmind HOST[:PORT]
@@ -80,7 +85,7 @@ file and exits 0.
   -h, --help             this text
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
-(out, segment, segment-size, format, codec, bitrate, detect, follow, max-bytes,
+(out, segment, segment-size, format, codec, bitrate, telemetry-track, detect, follow, max-bytes,
 min-free, status, stall-timeout, http, http-token, http-idle-timeout, rtsp, periods, failsafe, marvelmind,
 beacon, mqtt, mqtt-prefix, mqtt-detections-rate, on-segment-closed,
 hook-timeout), and one [device NAME] group per vehicle with host, port, cameras
@@ -103,7 +108,7 @@ ends where the device was lost. Beside each, <same name>.jsonl with one JSON
 object per event: {"pts": ns on the segment's timeline, "utc": "...Z", "type":
 "stats"|"detections"|"control"|"session"|"vehicle"|"position"|"position-stale",
 ...}; the same objects are
-the file's text track "telemetry". DIR/index.json lists the finished segments
+the file's text track "telemetry" (unless --telemetry-track off). DIR/index.json lists the finished segments
 (camera, file, start_utc, duration_s, frames, bytes).
 
 MQTT topics (PREFIX/STREAM, STREAM as in the file names):

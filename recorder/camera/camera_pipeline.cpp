@@ -13,6 +13,13 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
     return unexpected("cannot build the pipeline (are the wircam plugins on GST_PLUGIN_PATH?): " +
                       message);
   }
+  // A description of one element (wircsrc alone, without a text track or
+  // branches) parses to that element, not to a pipeline.
+  if (!GST_IS_PIPELINE(camera->pipeline_)) {
+    GstElement* alone = camera->pipeline_;
+    camera->pipeline_ = gst_pipeline_new(nullptr);
+    gst_bin_add(GST_BIN(camera->pipeline_), alone);
+  }
   // Named after its camera, so that the log says whose it is.
   gst_object_set_name(GST_OBJECT(camera->pipeline_), plan.name.c_str());
   camera->planner_ =

@@ -58,6 +58,20 @@ std::string positionsOf(const PositionSource& source, const std::string& name) {
          " port=" + std::to_string(source.port) + " beacons=" + source.beacons + " ";
 }
 
+// The telemetry's appsrc, on to the files' text track. It never blocks the
+// main loop: past 1 MB waiting it drops. Its track is named by a stream tag
+// (in Matroska a placeholder, rewritten when the file is finished:
+// telemetry_track_flags.h).
+std::string telemetryTrack(const RecorderOptions& options, const StreamPlan& stream) {
+  std::string title(options.container == Container::kMatroska ? kTelemetryTrackPlaceholder
+                                                              : kTelemetryTrackName);
+  return "appsrc name=" + stream.telemetrySource +
+         " is-live=true format=time min-latency=0 max-latency=-1 max-bytes=1000000 "
+         "leaky-type=downstream "
+         "caps=\"text/x-raw,format=(string)utf8\" ! taginject name=" +
+         stream.telemetryTail + " tags=\"title=" + title + "\" ";
+}
+
 }  // namespace
 
 std::string PipelinePlan::description() const {
@@ -86,9 +100,12 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       stream.camera = camera;
       stream.name = stream.device + "-cam" + std::to_string(camera);
       stream.source = "src" + i;
-      stream.telemetrySource = "tel" + i;
-      stream.telemetryTail = "teltag" + i;
       stream.muxer = muxerOf(options.container);
+      stream.muxer.text = options.telemetryTrack;
+      if (options.telemetryTrack) {
+        stream.telemetrySource = "tel" + i;
+        stream.telemetryTail = "teltag" + i;
+      }
       if (!options.detectFamily.empty()) stream.detector = "det" + i;
       if (!options.detectFamily.empty() && *device.follow && !controlled) {
         stream.controller = "ctl" + i;
@@ -109,16 +126,7 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       } else {
         stream.videoTail = branches ? tee : device.positions ? stream.positions : stream.source;
       }
-      // The telemetry never blocks the main loop: past 1 MB waiting it
-      // drops. Its track is named by a stream tag (in Matroska a
-      // placeholder, rewritten when the file is finished: telemetry_track_flags.h).
-      std::string title(options.container == Container::kMatroska ? kTelemetryTrackPlaceholder
-                                                                  : kTelemetryTrackName);
-      d += "appsrc name=" + stream.telemetrySource +
-           " is-live=true format=time min-latency=0 max-latency=-1 max-bytes=1000000 "
-           "leaky-type=downstream "
-           "caps=\"text/x-raw,format=(string)utf8\" ! taginject name=" +
-           stream.telemetryTail + " tags=\"title=" + title + "\" ";
+      if (options.telemetryTrack) d += telemetryTrack(options, stream);
       if (!stream.detector.empty()) {
         // Detection must never hold the recording back: its queue drops.
         d += tee +

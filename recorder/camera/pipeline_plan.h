@@ -18,6 +18,7 @@ struct MuxerSpec {
   // A gap reaches the muxer as a GAP event (matroskamux writes nothing for
   // it), or as an empty buffer (mp4mux stalls on GAP events).
   bool textGapEvents = false;
+  bool text = true;  // the file has the telemetry text track
 };
 
 // One device camera: its own pipeline, and the names of its elements
@@ -29,7 +30,7 @@ struct StreamPlan {
   std::string name;             // "<device>-cam<N>", also in file names and the live view
   std::string source;           // wircsrc
   std::string videoTail;        // the last element before the files' muxer (a tee: a new pad)
-  std::string telemetrySource;  // appsrc of the files' text track
+  std::string telemetrySource;  // appsrc of the files' text track (empty: no track)
   std::string telemetryTail;    // the last element before the muxer on the text track
   MuxerSpec muxer;              // each file's
   std::string detector;         // apriltagdetect, with --detect
@@ -48,7 +49,8 @@ struct PipelinePlan {
 // Each stream is a pipeline of its own, so that a camera that never sends a
 // frame, errors or stalls holds no other camera's preroll, EOS or stop.
 // Per stream: wircsrc → [marvelmindpositions →] [tee →] [decode → x264enc →]
-// (the file), an appsrc of telemetry text → (the same file) and, when asked
+// (the file), an appsrc of telemetry text → (the same file, unless
+// --telemetry-track off) and, when asked
 // for, a leaky branch off the tee to AprilTag detection (→ wirccontrol) and
 // one to an appsink for the live view and RTSP. The files themselves (a
 // muxer and a filesink each) are not in the description: the recorder's

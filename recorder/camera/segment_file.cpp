@@ -34,11 +34,11 @@ Expected<std::unique_ptr<SegmentFile>, std::string> SegmentFile::open(GstElement
   gst_pad_add_probe(sinkPad, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, onSinkEvent, file.get(), nullptr);
   gst_object_unref(sinkPad);
   file->videoInput_ = gst_element_request_pad_simple(file->muxer_, "video_%u");
-  file->textInput_ = gst_element_request_pad_simple(file->muxer_, "subtitle_%u");
+  if (muxer.text) file->textInput_ = gst_element_request_pad_simple(file->muxer_, "subtitle_%u");
   for (GstPad* input : {file->videoInput_, file->textInput_})
     if (input) gst_pad_set_offset(input, -static_cast<gint64>(start));
   // (Each failure is also an error on the bus, which restarts the camera.)
-  if (!file->videoInput_ || !file->textInput_)
+  if (!file->videoInput_ || (muxer.text && !file->textInput_))
     return unexpected(muxer.factory + " takes no video or text input");
   if (!gst_element_sync_state_with_parent(file->sink_) ||
       !gst_element_sync_state_with_parent(file->muxer_))

@@ -62,7 +62,7 @@ SegmentWriter::SegmentWriter(Parts parts, SegmentPlanner& planner, TelemetryTrac
     videoPad_ = gst_element_request_pad_simple(parts_.videoTail, "src_%u");
     videoPadRequested_ = true;
   }
-  textPad_ = gst_element_get_static_pad(parts_.textTail, "src");
+  if (parts_.textTail) textPad_ = gst_element_get_static_pad(parts_.textTail, "src");
   // The frame must be planned (and its file opened) before it is routed:
   // on one pad, in one probe.
   if (videoPad_ == sourcePad_) {
@@ -72,15 +72,16 @@ SegmentWriter::SegmentWriter(Parts parts, SegmentPlanner& planner, TelemetryTrac
     sourceProbe_ = gst_pad_add_probe(sourcePad_, kDataProbe, onSourceData, this, nullptr);
     videoProbe_ = gst_pad_add_probe(videoPad_, kRelinkProbe, onVideoOut, this, nullptr);
   }
-  textProbe_ = gst_pad_add_probe(textPad_, kRelinkProbe, onTextOut, this, nullptr);
+  if (textPad_) textProbe_ = gst_pad_add_probe(textPad_, kRelinkProbe, onTextOut, this, nullptr);
 }
 
 SegmentWriter::~SegmentWriter() {
   if (sourceProbe_) gst_pad_remove_probe(sourcePad_, sourceProbe_);
   gst_pad_remove_probe(videoPad_, videoProbe_);
-  gst_pad_remove_probe(textPad_, textProbe_);
+  if (textProbe_) gst_pad_remove_probe(textPad_, textProbe_);
   if (videoPadRequested_) gst_element_release_request_pad(parts_.videoTail, videoPad_);
-  for (GstPad* pad : {sourcePad_, videoPad_, textPad_}) gst_object_unref(pad);
+  for (GstPad* pad : {sourcePad_, videoPad_, textPad_})
+    if (pad) gst_object_unref(pad);
   MutexLock lock(mutex_);
   files_.clear();
 }

@@ -35,7 +35,7 @@ class SegmentWriter {
     GstElement* pipeline;
     GstElement* source;     // wircsrc: frames are planned as they leave it
     GstElement* videoTail;  // frames leave it for the file (a tee: by a pad of their own)
-    GstElement* textTail;   // the telemetry leaves it for the file
+    GstElement* textTail;   // the telemetry leaves it for the file (null: no text track)
     MuxerSpec muxer;
     bool transcoded;  // key frames come from an encoder that can be asked for one
   };

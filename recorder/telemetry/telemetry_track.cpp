@@ -7,7 +7,7 @@
 namespace wircam::recorder {
 
 bool TelemetryTrack::write(const std::string& json, GstClockTime pts, GstClockTime fileStart) {
-  if (!GST_CLOCK_TIME_IS_VALID(pts)) return false;
+  if (!source_ || !GST_CLOCK_TIME_IS_VALID(pts)) return false;
   // The lock spans the push so that buffers enter the appsrc in time order.
   MutexLock lock(mutex_);
   if (openFile_ == 0 || fileStart > openStart_) {
@@ -39,11 +39,14 @@ uint64_t TelemetryTrack::fileOpened(GstClockTime start) {
 }
 
 void TelemetryTrack::heartbeat(GstClockTime frameTime) {
+  if (!source_) return;
   MutexLock lock(mutex_);
   if (openFile_ != 0) push({}, frameTime + 1, openFile_, true);
 }
 
-void TelemetryTrack::end() { gst_app_src_end_of_stream(GST_APP_SRC(source_)); }
+void TelemetryTrack::end() {
+  if (source_) gst_app_src_end_of_stream(GST_APP_SRC(source_));
+}
 
 void TelemetryTrack::push(const std::string& json, GstClockTime pts, uint64_t file, bool gap) {
   if (file != sentFile_) last_ = 0;  // each file's times rise on their own

@@ -20,6 +20,7 @@ namespace wircam::recorder {
 class TelemetryTrack {
  public:
   // `source` is the stream's appsrc (text/x-raw, format=utf8); borrowed.
+  // Null: the files have no text track, and every line is refused.
   explicit TelemetryTrack(GstElement* source) : source_(source) {}
 
   // A line for the file that starts at running time `fileStart`. A muxer

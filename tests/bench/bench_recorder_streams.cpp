@@ -1,6 +1,7 @@
 // How many CIF/15 fps streams one recorder process records, and its CPU and
 // memory per stream, beside the stock alternative receiving the same frames.
 //   wircam: N × wirc-sim --frames DIR  →  one wirc-recorder with N --device
+//   (again with --telemetry-track off: the telemetry in the sidecar only)
 //   stock:  N × multifilesrc ! rtpjpegpay ! udpsink  →  one gst-launch with
 //           N × (udpsrc ! rtpjpegdepay ! matroskamux ! filesink)
 // Senders are separate processes; the receiving process's CPU (user + system)
@@ -114,6 +115,90 @@ int framesSent(const fs::path& summary) {
   return 0;
 }
 
+// One receiver's run: frames sent and recorded, its resources.
+struct Run {
+  int sent = 0, recorded = 0, threads = 0;
+  Usage usage;
+  double seconds = 0;
+  std::string row(int streams) const {
+    char text[128];
+    std::snprintf(text, sizeof text, "lost %4d of %5d, %5.2f %%, %5.2f MB, %4d thr",
+                  sent - recorded, sent, 100 * usage.cpuSeconds / seconds / streams,
+                  usage.maxRssKb / 1024.0 / streams, threads);
+    return text;
+  }
+};
+
+// N × wirc-sim --frames → one wirc-recorder (with `extra` options).
+Run recordWithWircam(const fs::path& work, const fs::path& bin, int basePort, int n, double seconds,
+                     const std::string& extra) {
+  fs::remove_all(work / "rec");
+  std::vector<pid_t> sims;
+  std::string devices;
+  for (int i = 0; i < n; ++i) {
+    int port = basePort + 2 * i;
+    sims.push_back(spawn((bin / "wirc-sim").string() + " --port " + std::to_string(port) +
+                             " --frames " + (work / "frames").string(),
+                         (work / ("sim" + std::to_string(i) + ".txt")).string()));
+    devices += " --device 127.0.0.1:" + std::to_string(port);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  Run run;
+  auto start = Clock::now();
+  pid_t recorder = spawn((bin / "wirc-recorder").string() + devices + " --out " +
+                         (work / "rec").string() + " --segment 600" + extra);
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+  run.threads = threadsOf(recorder);
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+  for (pid_t sim : sims) wircam::bench::stopGroup(sim, SIGINT);
+  std::this_thread::sleep_for(kDrain);
+  kill(recorder, SIGINT);
+  run.usage = waitForUsage(recorder);
+  run.seconds = secondsSince(start);
+  for (int i = 0; i < n; ++i) run.sent += framesSent(work / ("sim" + std::to_string(i) + ".txt"));
+  run.recorded = framesInFolder(work / "rec");
+  return run;
+}
+
+// N × (multifilesrc ! rtpjpegpay ! udpsink) → one gst-launch of
+// N × (udpsrc ! rtpjpegdepay ! matroskamux ! filesink).
+Run recordWithStock(const fs::path& work, int basePort, int n, double seconds) {
+  fs::remove_all(work / "rtp");
+  fs::create_directories(work / "rtp");
+  std::string receivers;
+  for (int i = 0; i < n; ++i) {
+    int port = basePort + 2 * i + 1;
+    receivers += " udpsrc port=" + std::to_string(port) +
+                 " buffer-size=8388608 "
+                 "caps=application/x-rtp,media=video,clock-rate=90000,encoding-name=JPEG,payload=26"
+                 " ! rtpjpegdepay ! matroskamux ! filesink location=" +
+                 (work / "rtp" / (std::to_string(i) + ".mkv")).string();
+  }
+  Run run;
+  auto start = Clock::now();
+  pid_t receiver = spawn("gst-launch-1.0 -e" + receivers);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  int frames = static_cast<int>(seconds * 15);
+  std::vector<pid_t> senders;
+  for (int i = 0; i < n; ++i)
+    senders.push_back(
+        spawn("gst-launch-1.0 multifilesrc location=" + (work / "frames" / "%05d.jpg").string() +
+              " loop=true num-buffers=" + std::to_string(frames) +
+              " caps=image/jpeg,width=352,height=288,framerate=15/1 ! identity sleep-time=66666"
+              " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" +
+              std::to_string(basePort + 2 * i + 1)));
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+  run.threads = threadsOf(receiver);
+  for (pid_t s : senders) waitpid(s, nullptr, 0);
+  std::this_thread::sleep_for(kDrain);
+  kill(receiver, SIGINT);
+  run.usage = waitForUsage(receiver);
+  run.seconds = secondsSince(start);
+  run.sent = frames * n;
+  run.recorded = framesInFolder(work / "rtp");
+  return run;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -136,79 +221,15 @@ int main(int argc, char** argv) {
   }
   int basePort = 21000 + getpid() % 20000;
 
-  std::printf("%-8s | %-54s | %-54s\n", "streams",
-              "wirc-recorder: lost, CPU %/stream, MB/stream, threads",
+  std::printf("%-8s | %-46s | %-46s | %-46s\n", "streams",
+              "wirc-recorder: lost, CPU, memory, threads", "--telemetry-track off: same",
               "udpsrc ! rtpjpegdepay ! matroskamux: same");
   for (int n : counts) {
-    // wircam
-    fs::remove_all(work / "rec");
-    std::vector<pid_t> sims;
-    std::string devices;
-    for (int i = 0; i < n; ++i) {
-      int port = basePort + 2 * i;
-      sims.push_back(spawn((bin / "wirc-sim").string() + " --port " + std::to_string(port) +
-                               " --frames " + (work / "frames").string(),
-                           (work / ("sim" + std::to_string(i) + ".txt")).string()));
-      devices += " --device 127.0.0.1:" + std::to_string(port);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    auto recorderStart = Clock::now();
-    pid_t recorder = spawn((bin / "wirc-recorder").string() + devices + " --out " +
-                           (work / "rec").string() + " --segment 600");
-    std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
-    int ourThreads = threadsOf(recorder);
-    std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
-    for (pid_t sim : sims) wircam::bench::stopGroup(sim, SIGINT);
-    std::this_thread::sleep_for(kDrain);
-    kill(recorder, SIGINT);
-    Usage ours = waitForUsage(recorder);
-    double ourSeconds = secondsSince(recorderStart);
-    int sent = 0;
-    for (int i = 0; i < n; ++i) sent += framesSent(work / ("sim" + std::to_string(i) + ".txt"));
-    int recorded = framesInFolder(work / "rec");
-
-    // stock
-    fs::remove_all(work / "rtp");
-    fs::create_directories(work / "rtp");
-    std::string receivers;
-    for (int i = 0; i < n; ++i) {
-      int port = basePort + 2 * i + 1;
-      receivers +=
-          " udpsrc port=" + std::to_string(port) +
-          " buffer-size=8388608 "
-          "caps=application/x-rtp,media=video,clock-rate=90000,encoding-name=JPEG,payload=26"
-          " ! rtpjpegdepay ! matroskamux ! filesink location=" +
-          (work / "rtp" / (std::to_string(i) + ".mkv")).string();
-    }
-    auto receiverStart = Clock::now();
-    pid_t receiver = spawn("gst-launch-1.0 -e" + receivers);
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    int rtpFrames = static_cast<int>(seconds * 15);
-    std::vector<pid_t> senders;
-    for (int i = 0; i < n; ++i)
-      senders.push_back(
-          spawn("gst-launch-1.0 multifilesrc location=" + (work / "frames" / "%05d.jpg").string() +
-                " loop=true num-buffers=" + std::to_string(rtpFrames) +
-                " caps=image/jpeg,width=352,height=288,framerate=15/1 ! identity sleep-time=66666"
-                " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" +
-                std::to_string(basePort + 2 * i + 1)));
-    std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
-    int theirThreads = threadsOf(receiver);
-    for (pid_t s : senders) waitpid(s, nullptr, 0);
-    std::this_thread::sleep_for(kDrain);
-    kill(receiver, SIGINT);
-    Usage theirs = waitForUsage(receiver);
-    double theirSeconds = secondsSince(receiverStart);
-    int rtpRecorded = framesInFolder(work / "rtp");
-    int rtpSent = rtpFrames * n;
-
-    std::printf(
-        "%-8d | lost %4d of %5d, %5.2f %%, %5.1f MB, %4d threads | lost %4d of %5d, %5.2f %%, "
-        "%5.1f "
-        "MB, %4d threads\n",
-        n, sent - recorded, sent, 100 * ours.cpuSeconds / ourSeconds / n,
-        ours.maxRssKb / 1024.0 / n, ourThreads, rtpSent - rtpRecorded, rtpSent,
-        100 * theirs.cpuSeconds / theirSeconds / n, theirs.maxRssKb / 1024.0 / n, theirThreads);
+    Run track = recordWithWircam(work, bin, basePort, n, seconds, "");
+    Run sidecarOnly = recordWithWircam(work, bin, basePort, n, seconds, " --telemetry-track off");
+    Run stock = recordWithStock(work, basePort, n, seconds);
+    std::printf("%-8d | %s | %s | %s\n", n, track.row(n).c_str(), sidecarOnly.row(n).c_str(),
+                stock.row(n).c_str());
     std::fflush(stdout);
   }
   fs::remove_all(work);

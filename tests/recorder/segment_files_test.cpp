@@ -153,6 +153,38 @@ INSTANTIATE_TEST_SUITE_P(Formats, SegmentFiles,
                            return std::string(format.param.codec) + "_" + format.param.container;
                          });
 
+TEST(SegmentFilesSidecarOnly, WithTheTelemetryTrackOffAFileIsItsFramesAndTheSidecarKeepsAll) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(),
+                           {"--segment", "2", "--duration", "5", "--telemetry-track", "off"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto videos = recorder.files(".mkv");
+  ASSERT_GE(videos.size(), 2u);
+  auto index = nlohmann::json::parse(std::ifstream(recorder.out() / "index.json"));
+  ASSERT_EQ(index["segments"].size(), videos.size()) << index;
+  for (const auto& video : videos) {
+    SCOPED_TRACE(video.filename().string());
+    EXPECT_EQ(run("ffprobe -v error -show_entries stream=codec_type -of csv=p=0 '" +
+                  video.string() + "'"),
+              "video\n");
+    EXPECT_EQ(run("ffmpeg -v error -i '" + video.string() + "' -f null -"), "");
+    auto frames = probeFrames(video);
+    ASSERT_GT(frames.size(), 10u);
+    EXPECT_TRUE(frames.front().key);
+    EXPECT_LT(frames.front().pts, 0.1);
+    for (const auto& segment : index["segments"]) {
+      if (segment["file"] == video.filename().string()) {
+        EXPECT_EQ(segment["frames"], static_cast<int>(frames.size())) << segment;
+      }
+    }
+    EXPECT_FALSE(sidecarOf(video).empty());
+  }
+  std::string sidecar;
+  for (const auto& line : sidecarOf(videos[0])) sidecar += line.dump();
+  EXPECT_NE(sidecar.find("logged in"), std::string::npos);
+  EXPECT_NE(sidecar.find("\"stats\""), std::string::npos);
+}
+
 TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
   auto device = startSequenceDevice();
   uint16_t port = device->port();

@@ -45,6 +45,18 @@ TEST(RecorderOptions, IdleTimeoutIsInSeconds) {
   EXPECT_FALSE(parse({"--out", "x", "--http-idle-timeout", "0"}).has_value());
 }
 
+TEST(RecorderOptions, TheTelemetryTrackIsOnUnlessTurnedOff) {
+  auto byDefault = parse({"--out", "x"});
+  ASSERT_TRUE(byDefault.has_value()) << byDefault.error();
+  EXPECT_TRUE(byDefault->telemetryTrack);
+  auto off = parse({"--out", "x", "--telemetry-track", "off"});
+  ASSERT_TRUE(off.has_value()) << off.error();
+  EXPECT_FALSE(off->telemetryTrack);
+  auto neither = parse({"--out", "x", "--telemetry-track", "no"});
+  ASSERT_FALSE(neither.has_value());
+  EXPECT_EQ(neither.error(), "--telemetry-track: on or off");
+}
+
 TEST(RecorderOptions, RefusesNumbersNoFieldCanHold) {
   // Found by fuzz_recorder_input: these used to reach a cast that is undefined.
   EXPECT_FALSE(parse({"--out", "x", "--max-bytes", "1e120"}).has_value());

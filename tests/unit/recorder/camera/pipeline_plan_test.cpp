@@ -39,6 +39,7 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   EXPECT_FALSE(has(d, "queue"));
   EXPECT_FALSE(has(d, "splitmuxsink"));
   EXPECT_EQ(s.muxer.factory, "matroskamux");
+  EXPECT_TRUE(s.muxer.text);
   EXPECT_TRUE(has(d, "appsrc name=" + s.telemetrySource));
   EXPECT_TRUE(has(d, "taginject name=" + s.telemetryTail));
   EXPECT_TRUE(has(d, "title=telemetry-json-lines"));  // renamed when finished
@@ -56,6 +57,17 @@ TEST(PipelinePlan, H264InMp4IsTranscodedAndKeepsTheTextTrack) {
   // The muxers take H.264 as avc only: the encoder's output says so.
   EXPECT_TRUE(has(plan.description(), "capsfilter name=" + plan.streams[0].videoTail +
                                           " caps=\"video/x-h264,stream-format=avc"));
+}
+
+TEST(PipelinePlan, WithoutTheTelemetryTrackAStreamIsItsSourceAlone) {
+  auto plan = planPipeline(
+      optionsOf({"--device", "10.0.0.2", "--out", "/rec", "--telemetry-track", "off"}));
+  const auto& s = plan.streams[0];
+  EXPECT_FALSE(s.muxer.text);
+  EXPECT_TRUE(s.telemetrySource.empty() && s.telemetryTail.empty());
+  EXPECT_FALSE(has(plan.description(), "appsrc"));
+  EXPECT_FALSE(has(plan.description(), "taginject"));
+  EXPECT_EQ(s.videoTail, s.source);  // one element: the camera's one thread
 }
 
 PipelinePlan twoFollowedDevicesOfTwoCameras() {
