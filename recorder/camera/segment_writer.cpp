@@ -195,16 +195,8 @@ GstPadProbeReturn SegmentWriter::routeText(GstPad* pad, GstPadProbeInfo* info) {
   GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
   if (!moveText(pad, TelemetryTrack::fileOf(buffer))) return GST_PAD_PROBE_DROP;
   if (!TelemetryTrack::isGap(buffer)) return GST_PAD_PROBE_PASS;
-  if (!parts_.muxer.textGapEvents) {  // an empty buffer, as the muxer wants it
-    buffer = gst_buffer_make_writable(buffer);
-    GST_BUFFER_FLAG_UNSET(buffer, GST_BUFFER_FLAG_GAP);
-    GST_PAD_PROBE_INFO_DATA(info) = buffer;
-    return GST_PAD_PROBE_PASS;
-  }
-  // A gap goes on as a GAP event (through this probe again, as an event):
-  // the muxer writes nothing for it, not even to the file's duration.
-  gst_pad_push_event(pad, gst_event_new_gap(GST_BUFFER_PTS(buffer), GST_BUFFER_DURATION(buffer)));
-  return GST_PAD_PROBE_DROP;
+  // (A GAP event comes through this probe again, as an event.)
+  return TelemetryTrack::passGap(pad, info, parts_.muxer.textGapEvents);
 }
 
 bool SegmentWriter::moveText(GstPad* pad, uint64_t number) {

@@ -44,6 +44,18 @@ void TelemetryTrack::heartbeat(GstClockTime frameTime) {
   if (openFile_ != 0) push({}, frameTime + 1, openFile_, true);
 }
 
+GstPadProbeReturn TelemetryTrack::passGap(GstPad* pad, GstPadProbeInfo* info, bool asEvent) {
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  if (!asEvent) {
+    buffer = gst_buffer_make_writable(buffer);
+    GST_BUFFER_FLAG_UNSET(buffer, GST_BUFFER_FLAG_GAP);
+    GST_PAD_PROBE_INFO_DATA(info) = buffer;
+    return GST_PAD_PROBE_PASS;
+  }
+  gst_pad_push_event(pad, gst_event_new_gap(GST_BUFFER_PTS(buffer), GST_BUFFER_DURATION(buffer)));
+  return GST_PAD_PROBE_DROP;
+}
+
 void TelemetryTrack::end() {
   if (source_) gst_app_src_end_of_stream(GST_APP_SRC(source_));
 }

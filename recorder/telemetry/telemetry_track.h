@@ -47,6 +47,11 @@ class TelemetryTrack {
   static bool isGap(GstBuffer* buffer) {
     return GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_GAP) && gst_buffer_get_size(buffer) == 0;
   }
+  // A probe's answer to a gap (isGap) on its way out of `pad` to a muxer:
+  // as a GAP event, for which matroskamux writes nothing, not even to the
+  // file's duration (`asEvent`); or as a plain empty buffer, for mp4mux
+  // (an aggregator, GStreamer 1.22), which stalls on GAP events.
+  static GstPadProbeReturn passGap(GstPad* pad, GstPadProbeInfo* info, bool asEvent);
 
   // No more lines: the text track ends after the ones sent.
   void end();

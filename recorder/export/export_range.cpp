@@ -1,0 +1,118 @@
+#include "export/export_range.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <set>
+
+#include "record/recording_index.h"
+#include "record/segment_inspector.h"
+
+namespace wircam::recorder {
+
+namespace fs = std::filesystem;
+
+std::optional<int64_t> parseIsoTime(const std::string& text) {
+  std::tm tm{};
+  int consumed = 0;
+  if (std::sscanf(text.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d%n", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
+                  &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &consumed) != 6 ||
+      consumed != 19)
+    return std::nullopt;
+  if (tm.tm_mon < 1 || tm.tm_mon > 12 || tm.tm_mday < 1 || tm.tm_mday > 31 || tm.tm_hour > 23 ||
+      tm.tm_min > 59 || tm.tm_sec > 60)
+    return std::nullopt;
+  std::string rest = text.substr(19);
+  int64_t fraction = 0;
+  if (!rest.empty() && rest[0] == '.') {
+    size_t digits = 1;
+    int64_t scale = 100000000;
+    while (digits < rest.size() && std::isdigit(static_cast<unsigned char>(rest[digits]))) {
+      fraction += (rest[digits] - '0') * scale;
+      scale /= 10;
+      ++digits;
+    }
+    if (digits == 1 || digits > 10) return std::nullopt;
+    rest = rest.substr(digits);
+  }
+  tm.tm_year -= 1900;
+  tm.tm_mon -= 1;
+  int64_t seconds;
+  if (rest == "Z") {
+    seconds = timegm(&tm);
+  } else if (rest.empty()) {
+    tm.tm_isdst = -1;
+    seconds = std::mktime(&tm);
+  } else {
+    int hours = 0, minutes = 0;
+    char sign = rest[0];
+    if ((sign != '+' && sign != '-') ||
+        std::sscanf(rest.c_str() + 1, "%2d:%2d%n", &hours, &minutes, &consumed) != 2 ||
+        consumed != 5 || static_cast<size_t>(consumed) + 1 != rest.size() || hours > 23 ||
+        minutes > 59)
+      return std::nullopt;
+    seconds = timegm(&tm) - (sign == '+' ? 1 : -1) * (hours * 3600 + minutes * 60);
+  }
+  return seconds * 1000000000 + fraction;
+}
+
+std::string isoTimeOf(int64_t unixNs) {
+  std::time_t seconds = static_cast<std::time_t>(std::floor(unixNs / 1e9));
+  int millis = static_cast<int>((unixNs - seconds * 1000000000LL) / 1000000);
+  std::tm tm{};
+  gmtime_r(&seconds, &tm);
+  char text[64];
+  std::snprintf(text, sizeof text, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
+                tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, millis);
+  return text;
+}
+
+Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
+                                                      const std::string& camera,
+                                                      std::optional<int64_t> start,
+                                                      std::optional<int64_t> end) {
+  std::error_code error;
+  if (!fs::is_directory(folder, error))
+    return unexpected("no recordings folder " + folder.string());
+  ExportSelection selection;
+  RecordingIndex index(folder);
+  if (!fs::exists(index.path())) {
+    // As at the recorder's start-up: every file read back.
+    size_t added = index.reconcile(inspectSegment);
+    selection.notes.push_back("no " + std::string(RecordingIndex::kFileName) + ": rebuilt from " +
+                              std::to_string(added) + " files");
+  }
+  std::set<std::string> cameras, indexed;
+  for (const auto& entry : index.entries()) {
+    cameras.insert(entry.camera);
+    indexed.insert(entry.file);
+    if (entry.camera != camera) continue;
+    auto begins = parseIsoTime(entry.startUtc);
+    if (!begins) continue;
+    auto lasts = static_cast<int64_t>(entry.durationSeconds * 1e9);
+    if ((end && *begins > *end) || (start && *begins + lasts < *start)) continue;
+    selection.segments.push_back({folder / entry.file, *begins, lasts, entry.frames});
+  }
+  // A file of the camera the index lacks is still being written (the
+  // recorder indexes each as it closes).
+  for (const auto& file : fs::directory_iterator(folder, error)) {
+    auto name = parseSegmentName(file.path().filename().string());
+    if (name && name->camera == camera && !indexed.count(file.path().filename().string()))
+      selection.notes.push_back(file.path().filename().string() +
+                                " is still being written: not exported");
+  }
+  if (!cameras.count(camera)) {
+    std::string known;
+    for (const auto& name : cameras) known += (known.empty() ? "" : ", ") + name;
+    return unexpected("no camera " + camera + " in " + folder.string() +
+                      (known.empty() ? " (no finished segments)" : " (there are: " + known + ")"));
+  }
+  if (selection.segments.empty())
+    return unexpected("camera " + camera + " has no frame in that range");
+  std::sort(selection.segments.begin(), selection.segments.end(),
+            [](const auto& a, const auto& b) { return a.startNs < b.startNs; });
+  return selection;
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,201 @@
+#include "export/exporter.h"
+
+#include <algorithm>
+#include <fstream>
+#include <memory>
+
+#include "export/mcap_export.h"
+#include "export/muxed_export.h"
+#include "export/segment_reader.h"
+
+namespace wircam::recorder {
+
+namespace fs = std::filesystem;
+
+std::optional<ExportFormat> exportFormatOf(const std::string& name) {
+  if (name == "mkv") return ExportFormat::kMkv;
+  if (name == "mp4") return ExportFormat::kMp4;
+  if (name == "mcap") return ExportFormat::kMcap;
+  return std::nullopt;
+}
+
+namespace {
+
+struct TimedLine {
+  int64_t utcNs;
+  nlohmann::json json;
+};
+
+// A segment's sidecar lines at their UTC (its start plus their "pts"), in
+// time order; lines that do not parse are left out.
+std::vector<TimedLine> linesOf(const ExportSegment& segment) {
+  std::vector<TimedLine> lines;
+  for (const auto& text : sidecarLines(segment.video)) {
+    auto json = nlohmann::json::parse(text, nullptr, false);
+    if (!json.is_object()) continue;
+    int64_t pts = json.value("pts", int64_t{0});
+    lines.push_back({segment.startNs + std::max<int64_t>(pts, 0), std::move(json)});
+  }
+  std::stable_sort(lines.begin(), lines.end(),
+                   [](const auto& a, const auto& b) { return a.utcNs < b.utcNs; });
+  return lines;
+}
+
+// Feeds the sink in time order and keeps the timeline: from 0 at the first
+// frame, each frame after the one before.
+class Timeline {
+ public:
+  Timeline(ExportSink& sink, std::ofstream& jsonl, const ExportRequest& request)
+      : sink_(sink), jsonl_(jsonl), request_(request) {}
+
+  bool inRange(int64_t utcNs) const {
+    return (!request_.start || utcNs >= *request_.start) &&
+           (!request_.end || utcNs <= *request_.end);
+  }
+
+  std::optional<std::string> frame(GstBuffer* buffer, int64_t utcNs, bool key, GstCaps* caps) {
+    if (!origin_) {
+      if (auto problem = sink_.start(caps)) return problem;
+      origin_ = utcNs;
+      report.firstUtcNs = utcNs;
+    }
+    int64_t pts = std::max(utcNs - *origin_, lastFrame_ + 1000);  // rising, if by a microsecond
+    if (lastFrame_ < 0) pts = 0;
+    lastFrame_ = pts;
+    report.lastUtcNs = utcNs;
+    ++report.frames;
+    return sink_.frame(buffer, pts, utcNs, key);
+  }
+
+  std::optional<std::string> line(TimedLine& line) {
+    if (!origin_) return std::nullopt;  // lines before the first frame wait for it
+    int64_t pts = std::max<int64_t>(line.utcNs - *origin_, 0);
+    line.json["pts"] = pts;
+    jsonl_ << line.json.dump() << '\n';
+    ++report.lines;
+    return sink_.line(line.json, pts, line.utcNs);
+  }
+
+  bool started() const { return origin_.has_value(); }
+  ExportReport report;
+
+ private:
+  ExportSink& sink_;
+  std::ofstream& jsonl_;
+  const ExportRequest& request_;
+  std::optional<int64_t> origin_;
+  int64_t lastFrame_ = -1;
+};
+
+// The frames of one segment and its lines, merged by time.
+std::optional<std::string> exportSegment(const ExportSegment& segment, Timeline& timeline,
+                                         GstCaps*& caps, bool h264, std::vector<std::string>& notes,
+                                         const std::function<void()>& onFrame) {
+  std::string name = segment.video.filename().string();
+  auto reader = SegmentReader::open(segment.video);
+  if (!reader) {
+    notes.push_back(name + ": " + reader.error() + ": skipped");
+    return std::nullopt;
+  }
+  auto lines = linesOf(segment);
+  // Lines from before the segment's first frame (its login) wait for it.
+  std::vector<TimedLine> waiting;
+  size_t nextLine = 0;
+  uint64_t frames = 0;
+  while (true) {
+    auto frame = (*reader)->next();
+    if (!frame) {
+      notes.push_back(name + ": broken off after " + std::to_string(frames) + " frames (" +
+                      frame.error() + "): the rest skipped");
+      break;
+    }
+    if (!*frame) break;
+    if (frames++ == 0 && caps && !gst_caps_is_equal(caps, (*reader)->caps())) {
+      notes.push_back(
+          name + ": its frames differ from the first segment's (" +
+          std::string(gst_structure_get_name(gst_caps_get_structure((*reader)->caps(), 0))) +
+          "): skipped");
+      return std::nullopt;
+    }
+    int64_t utc = segment.startNs + (*frame)->ptsNs;
+    for (; nextLine < lines.size() && lines[nextLine].utcNs <= utc; ++nextLine)
+      if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
+    if (!timeline.inRange(utc)) continue;
+    // H.264 begins on a key frame: the ones before it could not be decoded.
+    if (!timeline.started() && h264 && !(*frame)->key) continue;
+    if (!caps) caps = gst_caps_ref((*reader)->caps());
+    if (auto problem = timeline.frame((*frame)->buffer, utc, (*frame)->key, caps)) return problem;
+    onFrame();
+    for (auto& line : waiting)
+      if (auto problem = timeline.line(line)) return problem;
+    waiting.clear();
+  }
+  // The lines after the last frame, up to the segment's end.
+  if (timeline.started()) {
+    for (; nextLine < lines.size(); ++nextLine)
+      if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
+    for (auto& line : waiting)
+      if (auto problem = timeline.line(line)) return problem;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Expected<ExportReport, std::string> exportRange(const ExportRequest& request,
+                                                const ExportProgress& progress) {
+  auto selection = selectSegments(request.recordings, request.camera, request.start, request.end);
+  if (!selection) return unexpected(selection.error());
+  // mp4mux takes H.264 and not JPEG: known from the first segment.
+  bool h264 = false;
+  {
+    auto first = SegmentReader::open(selection->segments.front().video);
+    if (first && (*first)->next() && (*first)->caps())
+      h264 = std::string(gst_structure_get_name(gst_caps_get_structure((*first)->caps(), 0))) ==
+             "video/x-h264";
+  }
+  if (request.format == ExportFormat::kMp4 && !h264)
+    return unexpected(
+        "--format mp4 needs H.264 recordings: GStreamer's mp4mux cannot carry the camera's JPEG "
+        "frames as they are (use mkv or mcap to keep them untouched)");
+
+  std::unique_ptr<ExportSink> sink;
+  if (request.format == ExportFormat::kMcap)
+    sink = std::make_unique<McapExport>(request.out.string(), request.camera);
+  else
+    sink = std::make_unique<MuxedExport>(request.out.string(),
+                                         request.format == ExportFormat::kMp4 ? "mp4" : "mkv");
+  fs::path jsonlPath = fs::path(request.out).replace_extension(".jsonl");
+  std::ofstream jsonl(jsonlPath);
+  if (!jsonl) return unexpected("cannot write " + jsonlPath.string());
+
+  Timeline timeline(*sink, jsonl, request);
+  uint64_t total = 0, done = 0;
+  for (const auto& segment : selection->segments) total += segment.frames;
+  GstCaps* caps = nullptr;
+  std::optional<std::string> problem;
+  for (const auto& segment : selection->segments) {
+    problem = exportSegment(segment, timeline, caps, h264, selection->notes, [&] {
+      if (progress && ++done % 50 == 0) progress(done, total);
+    });
+    if (problem) break;
+    ++timeline.report.segments;
+  }
+  if (caps) gst_caps_unref(caps);
+  if (!problem && !timeline.started())
+    problem = "camera " + request.camera + " has no frame in that range";
+  if (!problem) problem = timeline.started() ? sink->finish() : std::nullopt;
+  sink.reset();
+  jsonl.close();
+  if (problem) {
+    std::error_code ignored;
+    fs::remove(request.out, ignored);
+    fs::remove(jsonlPath, ignored);
+    return unexpected(*problem);
+  }
+  if (progress) progress(total, total);
+  timeline.report.notes = std::move(selection->notes);
+  return timeline.report;
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,43 @@
+// One camera's time range, from its recorded segments into one file: the
+// frames untouched on one timeline from 0 (an outage stays a gap), the
+// sidecars' lines merged at their times, and the same lines, re-based, in a
+// .jsonl beside the file.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/expected.h"
+#include "export/export_range.h"
+
+namespace wircam::recorder {
+
+enum class ExportFormat { kMkv, kMp4, kMcap };
+std::optional<ExportFormat> exportFormatOf(const std::string& name);  // "mkv", "mp4", "mcap"
+
+struct ExportRequest {
+  std::filesystem::path recordings;
+  std::string camera;
+  std::optional<int64_t> start, end;  // UTC ns; open-ended without
+  ExportFormat format = ExportFormat::kMkv;
+  std::filesystem::path out;
+};
+
+struct ExportReport {
+  uint64_t frames = 0, lines = 0, segments = 0;
+  int64_t firstUtcNs = 0, lastUtcNs = 0;
+  std::vector<std::string> notes;  // segments skipped or left out, and why
+};
+
+// Frames done of about how many.
+using ExportProgress = std::function<void(uint64_t done, uint64_t total)>;
+
+// Errors: an unknown camera, no frame in the range, a file that cannot be
+// written (then nothing is left at `out`).
+Expected<ExportReport, std::string> exportRange(const ExportRequest& request,
+                                                const ExportProgress& progress = {});
+
+}  // namespace wircam::recorder

@@ -1,0 +1,121 @@
+// wirc-export: one camera's recordings over a time range as one file.
+//   wirc-export --recordings DIR --camera NAME [--start ISO8601] [--end ISO8601]
+//               --format mkv|mp4|mcap --out FILE
+#include <getopt.h>
+#include <gst/gst.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+#include "export/exporter.h"
+
+namespace {
+
+using namespace wircam::recorder;
+
+const char* kUsage =
+    R"(Usage: wirc-export --recordings DIR --camera NAME [--start ISO8601] [--end ISO8601] --format mkv|mp4|mcap --out FILE
+
+Writes one camera's recorded segments between two times as one file, the
+frames untouched (JPEG stays JPEG, H.264 stays H.264), on one timeline from
+0 at the first frame (an outage stays a gap), with the sidecars' telemetry
+merged: as the "telemetry" text track (mkv, mp4) or on MCAP channels, and
+re-based in FILE's .jsonl beside it.
+
+  --recordings DIR   a wirc-recorder --out folder (its index.json; rebuilt
+                     from the files when missing)
+  --camera NAME      the stream, as in the file names: <device>-cam<N>
+  --start, --end     UTC times, e.g. 2026-11-24T14:59:35Z or with an offset
+                     (+01:00); without a zone, local time. Default: all
+  --format           mkv | mp4 (H.264 recordings) | mcap (Foxglove, Lichtblick:
+                     /NAME/image, /NAME/tags, /NAME/telemetry, /NAME/log)
+  --out FILE         the file to write (replaced)
+
+Segments still being written are left out, and a broken one is skipped:
+both are said. Exit 0 when written, 1 when there is nothing to export or it
+cannot be written, 2 for a wrong command line.
+)";
+
+int usageError(const std::string& problem) {
+  std::fprintf(stderr, "wirc-export: %s\n(wirc-export --help for the options)\n", problem.c_str());
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  gst_init(&argc, &argv);
+  static const option options[] = {{"recordings", required_argument, nullptr, 'r'},
+                                   {"camera", required_argument, nullptr, 'c'},
+                                   {"start", required_argument, nullptr, 's'},
+                                   {"end", required_argument, nullptr, 'e'},
+                                   {"format", required_argument, nullptr, 'f'},
+                                   {"out", required_argument, nullptr, 'o'},
+                                   {"help", no_argument, nullptr, 'h'},
+                                   {nullptr, 0, nullptr, 0}};
+  ExportRequest request;
+  bool formatGiven = false;
+  int opt;
+  while ((opt = getopt_long(argc, argv, "h", options, nullptr)) != -1) {
+    switch (opt) {
+      case 'r':
+        request.recordings = optarg;
+        break;
+      case 'c':
+        request.camera = optarg;
+        break;
+      case 's':
+      case 'e': {
+        auto time = parseIsoTime(optarg);
+        if (!time)
+          return usageError(std::string("--") + (opt == 's' ? "start" : "end") + " '" + optarg +
+                            "' is not an ISO 8601 time like 2026-11-24T14:59:35Z");
+        (opt == 's' ? request.start : request.end) = *time;
+        break;
+      }
+      case 'f': {
+        auto format = exportFormatOf(optarg);
+        if (!format) return usageError(std::string("--format '") + optarg + "': mkv, mp4 or mcap");
+        request.format = *format;
+        formatGiven = true;
+        break;
+      }
+      case 'o':
+        request.out = optarg;
+        break;
+      case 'h':
+        std::fputs(kUsage, stdout);
+        return 0;
+      default:
+        return usageError("unknown option");
+    }
+  }
+  if (optind < argc) return usageError(std::string("unexpected argument '") + argv[optind] + "'");
+  if (request.recordings.empty()) return usageError("--recordings DIR is needed");
+  if (request.camera.empty()) return usageError("--camera NAME is needed");
+  if (!formatGiven) return usageError("--format mkv|mp4|mcap is needed");
+  if (request.out.empty()) return usageError("--out FILE is needed");
+  if (request.start && request.end && *request.end < *request.start)
+    return usageError("--end is before --start");
+
+  bool terminal = isatty(STDERR_FILENO);
+  auto report = exportRange(request, [terminal](uint64_t done, uint64_t total) {
+    if (!terminal || total == 0) return;
+    std::fprintf(stderr, "\rwirc-export: %llu of %llu frames (%d%%)",
+                 static_cast<unsigned long long>(done), static_cast<unsigned long long>(total),
+                 static_cast<int>(100 * done / total));
+  });
+  if (terminal) std::fputc('\n', stderr);
+  if (!report) {
+    std::fprintf(stderr, "wirc-export: %s\n", report.error().c_str());
+    return 1;
+  }
+  for (const auto& note : report->notes) std::fprintf(stderr, "wirc-export: %s\n", note.c_str());
+  std::printf("wirc-export: %s: %llu frames from %llu segments, %llu telemetry lines, %s to %s\n",
+              request.out.c_str(), static_cast<unsigned long long>(report->frames),
+              static_cast<unsigned long long>(report->segments),
+              static_cast<unsigned long long>(report->lines), isoTimeOf(report->firstUtcNs).c_str(),
+              isoTimeOf(report->lastUtcNs).c_str());
+  return 0;
+}

@@ -1,0 +1,39 @@
+// An export into MCAP for robotics viewers (Foxglove, Lichtblick), on four
+// channels per camera STREAM:
+//   /STREAM/image      foxglove.CompressedImage, the camera's JPEG or H.264 bytes
+//   /STREAM/tags       foxglove.ImageAnnotations: each detected tag's outline and id
+//   /STREAM/telemetry  every sidecar line, as it is (a JSON schema)
+//   /STREAM/log        foxglove.Log: the session's events
+// Messages are JSON with JSON schemas (the images' bytes in base64): the
+// encoding Foxglove reads without generated code, readable by any JSON
+// tool; zstd chunk compression takes back most of base64's third.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "export/export_sink.h"
+#include "export/mcap_writer.h"
+
+namespace wircam::recorder {
+
+class McapExport : public ExportSink {
+ public:
+  McapExport(std::string path, std::string stream);
+
+  std::optional<std::string> start(GstCaps* caps) override;
+  std::optional<std::string> frame(GstBuffer* buffer, int64_t ptsNs, int64_t utcNs,
+                                   bool key) override;
+  std::optional<std::string> line(const nlohmann::json& line, int64_t ptsNs,
+                                  int64_t utcNs) override;
+  std::optional<std::string> finish() override;
+
+ private:
+  void write(uint16_t channel, int64_t utcNs, const nlohmann::json& message);
+
+  std::string path_, stream_, format_;
+  std::unique_ptr<McapWriter> writer_;
+  uint16_t image_ = 0, tags_ = 0, telemetry_ = 0, log_ = 0;
+};
+
+}  // namespace wircam::recorder

@@ -1,0 +1,91 @@
+#include "export/segment_reader.h"
+
+#include <gst/app/gstappsink.h>
+
+#include <fstream>
+#include <utility>
+
+namespace wircam::recorder {
+
+SegmentFrame::SegmentFrame(SegmentFrame&& other) noexcept
+    : buffer(std::exchange(other.buffer, nullptr)), ptsNs(other.ptsNs), key(other.key) {}
+
+SegmentFrame& SegmentFrame::operator=(SegmentFrame&& other) noexcept {
+  std::swap(buffer, other.buffer);
+  ptsNs = other.ptsNs;
+  key = other.key;
+  return *this;
+}
+
+SegmentFrame::~SegmentFrame() {
+  if (buffer) gst_buffer_unref(buffer);
+}
+
+Expected<std::unique_ptr<SegmentReader>, std::string> SegmentReader::open(
+    const std::filesystem::path& video) {
+  std::unique_ptr<SegmentReader> reader(new SegmentReader);
+  bool mp4 = video.extension() == ".mp4";
+  // The video track only (caps pick it); the text track stays unlinked.
+  gchar* location = g_strescape(video.c_str(), nullptr);
+  std::string description = std::string("filesrc location=\"") + location + "\" ! " +
+                            (mp4 ? "qtdemux" : "matroskademux") +
+                            " ! appsink name=frames sync=false max-buffers=8 "
+                            "caps=\"image/jpeg;video/x-h264\"";
+  g_free(location);
+  GError* error = nullptr;
+  reader->pipeline_ = gst_parse_launch(description.c_str(), &error);
+  if (error) {
+    std::string message = error->message;
+    g_error_free(error);
+    return unexpected("cannot read " + video.string() + ": " + message);
+  }
+  reader->sink_ = gst_bin_get_by_name(GST_BIN(reader->pipeline_), "frames");
+  if (gst_element_set_state(reader->pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE)
+    return unexpected("cannot read " + video.string());
+  return reader;
+}
+
+SegmentReader::~SegmentReader() {
+  if (pipeline_) gst_element_set_state(pipeline_, GST_STATE_NULL);
+  if (sink_) gst_object_unref(sink_);
+  if (pipeline_) gst_object_unref(pipeline_);
+  if (caps_) gst_caps_unref(caps_);
+}
+
+Expected<std::optional<SegmentFrame>, std::string> SegmentReader::next() {
+  GstSample* sample = gst_app_sink_pull_sample(GST_APP_SINK(sink_));
+  if (!sample) {
+    // The end, or an error that ended it.
+    GstBus* bus = gst_element_get_bus(pipeline_);
+    GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
+    gst_object_unref(bus);
+    if (!message) return std::optional<SegmentFrame>();
+    GError* error = nullptr;
+    gst_message_parse_error(message, &error, nullptr);
+    std::string text = error ? error->message : "unreadable";
+    if (error) g_error_free(error);
+    gst_message_unref(message);
+    return unexpected(text);
+  }
+  if (!caps_) caps_ = gst_caps_ref(gst_sample_get_caps(sample));
+  SegmentFrame frame;
+  frame.buffer = gst_buffer_ref(gst_sample_get_buffer(sample));
+  GstSegment* segment = gst_sample_get_segment(sample);
+  GstClockTime pts = GST_BUFFER_PTS(frame.buffer);
+  GstClockTime time =
+      segment ? gst_segment_to_stream_time(segment, GST_FORMAT_TIME, pts) : GST_CLOCK_TIME_NONE;
+  frame.ptsNs = GST_CLOCK_TIME_IS_VALID(time) ? static_cast<int64_t>(time) : 0;
+  frame.key = !GST_BUFFER_FLAG_IS_SET(frame.buffer, GST_BUFFER_FLAG_DELTA_UNIT);
+  gst_sample_unref(sample);
+  return std::optional<SegmentFrame>(std::move(frame));
+}
+
+std::vector<std::string> sidecarLines(const std::filesystem::path& video) {
+  std::ifstream in(std::filesystem::path(video).replace_extension(".jsonl"));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) lines.push_back(std::move(line));
+  return lines;
+}
+
+}  // namespace wircam::recorder

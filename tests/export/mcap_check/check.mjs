@@ -1,0 +1,92 @@
+// Reads an MCAP file with readers written by others and prints what it
+// found, as JSON, for the export tests to compare with the recordings:
+//   node check.mjs FILE.mcap
+// - @mcap/core's McapIndexedReader (chunk indexes, summary, CRCs) and
+//   McapStreamReader (every record in order, the data section's CRC);
+// - every message validated against Foxglove's own JSON schema for its
+//   type (@foxglove/schemas), with ajv;
+// - a read from the middle (startTime), which the chunk index serves.
+import { readFile } from "node:fs/promises";
+import { createHash } from "node:crypto";
+import { McapIndexedReader, McapStreamReader } from "@mcap/core";
+import * as foxglove from "@foxglove/schemas/jsonschema.js";
+import Ajv from "ajv";
+import { decompress } from "fzstd";
+
+const bytes = new Uint8Array(await readFile(process.argv[2]));
+const decompressHandlers = { zstd: (data) => decompress(data) };
+const readable = {
+  size: async () => BigInt(bytes.length),
+  read: async (offset, size) => bytes.subarray(Number(offset), Number(offset + size)),
+};
+const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+
+const ajv = new Ajv({ strict: false });
+const foxgloveSchemas = {
+  "foxglove.CompressedImage": foxglove.CompressedImage,
+  "foxglove.ImageAnnotations": foxglove.ImageAnnotations,
+  "foxglove.Log": foxglove.Log,
+};
+const validators = new Map();
+for (const [id, channel] of reader.channelsById) {
+  const schema = reader.schemasById.get(channel.schemaId);
+  const ours = JSON.parse(new TextDecoder().decode(schema.data));
+  validators.set(id, {
+    topic: channel.topic,
+    name: schema.name,
+    ours: ajv.compile(ours),
+    theirs: foxgloveSchemas[schema.name] ? ajv.compile(foxgloveSchemas[schema.name]) : null,
+  });
+}
+
+const result = { topics: {}, images: [], invalid: [], chunks: reader.chunkIndexes.length };
+result.compression = [...new Set(reader.chunkIndexes.map((c) => c.compression))];
+result.statistics = reader.statistics
+  ? { messages: Number(reader.statistics.messageCount), chunks: reader.statistics.chunkCount }
+  : null;
+let last = -1n;
+result.ordered = true;
+for await (const message of reader.readMessages()) {
+  const v = validators.get(message.channelId);
+  result.topics[v.topic] = (result.topics[v.topic] ?? 0) + 1;
+  if (message.logTime < last) result.ordered = false;
+  last = message.logTime;
+  const json = JSON.parse(new TextDecoder().decode(message.data));
+  for (const [who, check] of [["ours", v.ours], ["foxglove", v.theirs]]) {
+    if (check && !check(json) && result.invalid.length < 5)
+      result.invalid.push({ topic: v.topic, who, errors: check.errors });
+  }
+  if (v.name === "foxglove.CompressedImage") {
+    const data = Buffer.from(json.data, "base64");
+    result.images.push({
+      logTime: message.logTime.toString(),
+      md5: createHash("md5").update(data).digest("hex"),
+      format: json.format,
+    });
+  }
+}
+
+// Seeking: from the middle of the images, the reader starts there.
+if (result.images.length > 2) {
+  const middle = BigInt(result.images[Math.floor(result.images.length / 2)].logTime);
+  let first = null;
+  let count = 0;
+  for await (const message of reader.readMessages({ startTime: middle })) {
+    if (first === null) first = message.logTime;
+    ++count;
+  }
+  result.seek = { from: middle.toString(), first: first?.toString(), messages: count };
+}
+
+// Straight through, every record, with the CRCs checked.
+const stream = new McapStreamReader({ validateCrcs: true, decompressHandlers });
+stream.append(bytes);
+let records = 0;
+try {
+  for (let record; (record = stream.nextRecord()); ) ++records;
+  result.streamRecords = records;
+  result.streamDone = stream.done();
+} catch (error) {
+  result.streamError = String(error);
+}
+console.log(JSON.stringify(result));
