@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "record/recording_index.h"
@@ -68,6 +70,25 @@ std::string isoTimeOf(int64_t unixNs) {
   return text;
 }
 
+namespace {
+
+// A segment's first frame to the millisecond, from its sidecar: a line's
+// UTC less its time in the file (a rebuilt index knows only its name's
+// second).
+std::optional<int64_t> startFromSidecar(const fs::path& video) {
+  std::ifstream in(fs::path(video).replace_extension(".jsonl"));
+  for (std::string text; std::getline(in, text);) {
+    auto line = nlohmann::json::parse(text, nullptr, false);
+    if (!line.is_object() || line.value("pts", int64_t{0}) <= 0 || !line["utc"].is_string())
+      continue;
+    auto utc = parseIsoTime(line["utc"].get<std::string>());
+    if (utc) return *utc - line["pts"].get<int64_t>();
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
                                                       const std::string& camera,
                                                       std::optional<int64_t> start,
@@ -83,24 +104,28 @@ Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
     selection.notes.push_back("no " + std::string(RecordingIndex::kFileName) + ": rebuilt from " +
                               std::to_string(added) + " files");
   }
+  bool rebuilt = !selection.notes.empty();
   std::set<std::string> cameras, indexed;
   for (const auto& entry : index.entries()) {
     cameras.insert(entry.camera);
     indexed.insert(entry.file);
     if (entry.camera != camera) continue;
-    auto begins = parseIsoTime(entry.startUtc);
+    auto begins = rebuilt ? startFromSidecar(folder / entry.file) : std::nullopt;
+    if (!begins) begins = parseIsoTime(entry.startUtc);
     if (!begins) continue;
     auto lasts = static_cast<int64_t>(entry.durationSeconds * 1e9);
     if ((end && *begins > *end) || (start && *begins + lasts < *start)) continue;
     selection.segments.push_back({folder / entry.file, *begins, lasts, entry.frames});
   }
   // A file of the camera the index lacks is still being written (the
-  // recorder indexes each as it closes).
+  // recorder indexes each as it closes), or, when the index was rebuilt
+  // just now, unreadable.
   for (const auto& file : fs::directory_iterator(folder, error)) {
     auto name = parseSegmentName(file.path().filename().string());
     if (name && name->camera == camera && !indexed.count(file.path().filename().string()))
       selection.notes.push_back(file.path().filename().string() +
-                                " is still being written: not exported");
+                                (rebuilt ? " holds no readable frame: skipped"
+                                         : " is still being written: not exported"));
   }
   if (!cameras.count(camera)) {
     std::string known;

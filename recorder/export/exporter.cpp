@@ -59,8 +59,10 @@ class Timeline {
       origin_ = utcNs;
       report.firstUtcNs = utcNs;
     }
-    int64_t pts = std::max(utcNs - *origin_, lastFrame_ + 1000);  // rising, if by a microsecond
-    if (lastFrame_ < 0) pts = 0;
+    // Rising by a frame at least: a segment's start from a rebuilt index
+    // may be known to its name's second only, and players count in frames.
+    int64_t pts = lastFrame_ < 0 ? 0 : std::max(utcNs - *origin_, lastFrame_ + step_);
+    if (lastFrame_ >= 0) step_ = std::clamp<int64_t>(pts - lastFrame_, 1000000, 1000000000);
     lastFrame_ = pts;
     report.lastUtcNs = utcNs;
     ++report.frames;
@@ -85,6 +87,7 @@ class Timeline {
   const ExportRequest& request_;
   std::optional<int64_t> origin_;
   int64_t lastFrame_ = -1;
+  int64_t step_ = 1000000000 / 15;  // the frames' last interval
 };
 
 // The frames of one segment and its lines, merged by time.

@@ -1,0 +1,270 @@
+// wirc-export on a real recording: the simulator streams, the recorder cuts
+// segments and lives through an outage, and the export is read back by
+// others' readers (ffprobe, ffmpeg, GStreamer's demuxers, and for MCAP
+// @mcap/core with Foxglove's schemas under node).
+#include <gst/app/gstappsink.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "camera_checks.h"
+#include "recorder_process.h"
+#include "simulated_device.h"
+#include "wait_for.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+
+struct Ran {
+  int code;
+  std::string output;
+};
+
+Ran run(const std::string& command) {
+  std::string output;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  char chunk[4096];
+  while (size_t n = fread(chunk, 1, sizeof chunk, pipe)) output.append(chunk, n);
+  int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+// The MD5 of each video frame's bytes, in file order.
+std::vector<std::string> frameDigests(const fs::path& file) {
+  std::string description = "filesrc location=\"" + file.string() + "\" ! " +
+                            (file.extension() == ".mp4" ? "qtdemux" : "matroskademux") +
+                            " ! appsink name=sink sync=false caps=\"image/jpeg;video/x-h264\"";
+  GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
+  GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  std::vector<std::string> digests;
+  while (GstSample* sample = gst_app_sink_pull_sample(GST_APP_SINK(sink))) {
+    GstMapInfo map;
+    GstBuffer* buffer = gst_sample_get_buffer(sample);
+    gst_buffer_map(buffer, &map, GST_MAP_READ);
+    gchar* md5 = g_compute_checksum_for_data(G_CHECKSUM_MD5, map.data, map.size);
+    digests.emplace_back(md5);
+    g_free(md5);
+    gst_buffer_unmap(buffer, &map);
+    gst_sample_unref(sample);
+  }
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(sink);
+  gst_object_unref(pipeline);
+  return digests;
+}
+
+std::vector<double> packetTimes(const fs::path& file) {
+  std::istringstream csv(run("ffprobe -v error -select_streams v:0 -show_entries packet=pts_time "
+                             "-of csv=p=0 '" +
+                             file.string() + "'")
+                             .output);
+  std::vector<double> times;
+  for (std::string line; std::getline(csv, line);) times.push_back(std::stod(line));
+  return times;
+}
+
+std::string exportCommand(const fs::path& recordings, const std::string& camera,
+                          const std::string& rest) {
+  return std::string(WIRC_EXPORT) + " --recordings '" + recordings.string() + "' --camera " +
+         camera + " " + rest;
+}
+
+// One recording for every test: segments of 2 s, and an outage between.
+class Export : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    auto device = startSequenceDevice();
+    uint16_t port = device->port();
+    recorder_ = new RecorderProcess(port, {"--segment", "2"});
+    camera_ = new std::string(cameraName(port));
+    ASSERT_TRUE(waitFor([] { return recorder_->files(".mkv").size() >= 2; }, milliseconds(15000)))
+        << recorder_->log();
+    device.reset();
+    ASSERT_TRUE(recorder_->waitForText("retrying in 400 ms", milliseconds(10000)))
+        << recorder_->log();
+    device = startSequenceDevice(port);
+    ASSERT_TRUE(waitFor([] { return recorder_->files(".mkv").size() >= 4; }, milliseconds(15000)))
+        << recorder_->log();
+    recorder_->signal(SIGINT);
+    ASSERT_EQ(recorder_->wait(), 0) << recorder_->log();
+  }
+  static void TearDownTestSuite() {
+    delete recorder_;
+    delete camera_;
+  }
+
+  static nlohmann::json segments() {
+    return nlohmann::json::parse(std::ifstream(recorder_->out() / "index.json"))["segments"];
+  }
+  static fs::path output(const std::string& name) { return recorder_->out().parent_path() / name; }
+  // Every frame of the recording, in order.
+  static std::vector<std::string> recordedDigests(size_t from = 0, size_t to = SIZE_MAX) {
+    std::vector<std::string> all;
+    auto files = recorder_->files(".mkv");
+    for (size_t i = from; i < std::min(to, files.size()); ++i)
+      for (auto& d : frameDigests(files[i])) all.push_back(d);
+    return all;
+  }
+
+  static RecorderProcess* recorder_;
+  static std::string* camera_;
+};
+RecorderProcess* Export::recorder_ = nullptr;
+std::string* Export::camera_ = nullptr;
+
+TEST_F(Export, AllOfItAsMatroskaIsEveryFrameUntouchedOnOneTimelineWithTheOutageAsAGap) {
+  fs::path out = output("all.mkv");
+  auto ran =
+      run(exportCommand(recorder_->out(), *camera_, "--format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.code, 0) << ran.output;
+  uint64_t indexed = 0;
+  for (const auto& segment : segments()) indexed += segment["frames"].get<uint64_t>();
+  EXPECT_NE(ran.output.find(std::to_string(indexed) + " frames from"), std::string::npos)
+      << ran.output;
+  EXPECT_EQ(frameDigests(out), recordedDigests());
+  EXPECT_EQ(frameDigests(out).size(), indexed);
+  auto times = packetTimes(out);
+  ASSERT_FALSE(times.empty());
+  EXPECT_EQ(times.front(), 0);
+  double widest = 0;
+  for (size_t i = 1; i < times.size(); ++i) {
+    EXPECT_GT(times[i], times[i - 1]) << i;
+    widest = std::max(widest, times[i] - times[i - 1]);
+  }
+  EXPECT_GT(widest, 0.4);  // the outage (the device off, the login's backoff)
+  EXPECT_EQ(run("ffmpeg -v error -i '" + out.string() + "' -f null -").output, "");
+  // The telemetry: a named text track, and the same lines re-based beside.
+  EXPECT_EQ(run("ffprobe -v error -select_streams s:0 -show_entries "
+                "stream_disposition=default:stream_tags=title -of csv=p=0 '" +
+                out.string() + "'")
+                .output,
+            "0,telemetry\n");
+  auto track = contentsOf(out).telemetry;
+  std::ifstream jsonl(fs::path(out).replace_extension(".jsonl"));
+  std::vector<nlohmann::json> lines;
+  for (std::string line; std::getline(jsonl, line);) lines.push_back(nlohmann::json::parse(line));
+  EXPECT_EQ(lines.size(), track.size());
+  size_t sidecarLines = 0;
+  for (const auto& video : recorder_->files(".mkv")) {
+    std::ifstream sidecar(fs::path(video).replace_extension(".jsonl"));
+    for (std::string line; std::getline(sidecar, line);) ++sidecarLines;
+  }
+  EXPECT_EQ(lines.size(), sidecarLines);
+  bool loggedIn = false;
+  for (const auto& line : lines) {
+    EXPECT_GE(line["pts"].get<int64_t>(), 0) << line;
+    EXPECT_LE(line["pts"].get<double>() / 1e9, times.back() + 0.5) << line;
+    loggedIn |= line.dump().find("logged in") != std::string::npos;
+  }
+  EXPECT_TRUE(loggedIn);
+}
+
+TEST_F(Export, ARangeHoldsTheFramesOfTheSegmentsInIt) {
+  auto index = segments();
+  ASSERT_GE(index.size(), 4u);
+  // From the second segment's first frame to just before the fourth's.
+  std::string start = index[1]["start_utc"];
+  std::string fourth = index[3]["start_utc"];
+  // 1 ms before: "....123Z" → "....122Z" (the recorder writes milliseconds).
+  int ms = std::stoi(fourth.substr(20, 3));
+  ASSERT_GT(ms, 0) << "a start on a whole second: the test would need a borrow";
+  char end[32];
+  std::snprintf(end, sizeof end, "%s%03dZ", fourth.substr(0, 20).c_str(), ms - 1);
+  fs::path out = output("range.mkv");
+  auto ran = run(exportCommand(
+      recorder_->out(), *camera_,
+      "--start " + start + " --end " + end + " --format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.code, 0) << ran.output;
+  EXPECT_EQ(frameDigests(out), recordedDigests(1, 3));
+  EXPECT_EQ(frameDigests(out).size(),
+            index[1]["frames"].get<size_t>() + index[2]["frames"].get<size_t>());
+}
+
+TEST_F(Export, McapIsReadByMcapCoreWithEveryMessageValidAgainstFoxglovesSchemas) {
+  fs::path out = output("all.mcap");
+  auto ran =
+      run(exportCommand(recorder_->out(), *camera_, "--format mcap --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.code, 0) << ran.output;
+  auto checked = run("node '" MCAP_CHECK_DIR "/check.mjs' '" + out.string() + "'");
+  ASSERT_EQ(checked.code, 0)
+      << checked.output << "\n(run tools/run-tests, which installs the checker's npm packages)";
+  auto result = nlohmann::json::parse(checked.output);
+  EXPECT_EQ(result["invalid"], nlohmann::json::array()) << result["invalid"];
+  EXPECT_FALSE(result.contains("streamError")) << result["streamError"];
+  EXPECT_TRUE(result["streamDone"].get<bool>());
+  EXPECT_TRUE(result["ordered"].get<bool>());
+  std::string topic = "/" + *camera_;
+  auto recorded = recordedDigests();
+  EXPECT_EQ(result["topics"][topic + "/image"], recorded.size());
+  EXPECT_GT(result["topics"][topic + "/telemetry"].get<int>(), 3);
+  EXPECT_GE(result["topics"][topic + "/log"].get<int>(), 2);  // two logins at least
+  std::vector<std::string> images;
+  for (const auto& image : result["images"]) {
+    images.push_back(image["md5"]);
+    EXPECT_EQ(image["format"], "jpeg");
+  }
+  EXPECT_EQ(images, recorded);
+  // Seekable: chunks in the index, and a read from the middle starts there.
+  EXPECT_GE(result["chunks"].get<int>(), 2);
+  auto seek = result["seek"];
+  EXPECT_GE(std::stoull(seek["first"].get<std::string>()),
+            std::stoull(seek["from"].get<std::string>()));
+  EXPECT_LT(seek["messages"].get<size_t>(), result["statistics"]["messages"].get<size_t>());
+}
+
+TEST_F(Export, SaysWhyWhenThereIsNothingToExport) {
+  fs::path out = output("none.mkv");
+  auto unknown = run(
+      exportCommand(recorder_->out(), "nosuch-cam0", "--format mkv --out '" + out.string() + "'"));
+  EXPECT_EQ(unknown.code, 1);
+  EXPECT_NE(unknown.output.find("no camera nosuch-cam0"), std::string::npos) << unknown.output;
+  EXPECT_NE(unknown.output.find(*camera_), std::string::npos) << unknown.output;  // those there are
+  auto before =
+      run(exportCommand(recorder_->out(), *camera_,
+                        "--end 2001-01-01T00:00:00Z --format mkv --out '" + out.string() + "'"));
+  EXPECT_EQ(before.code, 1);
+  EXPECT_NE(before.output.find("no frame in that range"), std::string::npos) << before.output;
+  EXPECT_FALSE(fs::exists(out));
+  auto malformed = run(exportCommand(
+      recorder_->out(), *camera_, "--start yesterday --format mkv --out '" + out.string() + "'"));
+  EXPECT_EQ(malformed.code, 2);
+  EXPECT_NE(malformed.output.find("--start 'yesterday' is not an ISO 8601 time"), std::string::npos)
+      << malformed.output;
+  auto mp4 =
+      run(exportCommand(recorder_->out(), *camera_, "--format mp4 --out '" + out.string() + "'"));
+  EXPECT_EQ(mp4.code, 1);
+  EXPECT_NE(mp4.output.find("mp4 needs H.264 recordings"), std::string::npos) << mp4.output;
+}
+
+TEST_F(Export, ADeletedIndexIsRebuiltAndABrokenSegmentSkippedWithAWord) {
+  fs::path copy = output("copy");
+  fs::remove_all(copy);
+  fs::copy(recorder_->out(), copy);
+  fs::remove(copy / "index.json");
+  auto files = recorder_->files(".mkv");
+  // The second segment cut off after 3000 bytes: its first frames or none.
+  fs::resize_file(copy / files[1].filename(), 3000);
+  fs::path out = output("rebuilt.mkv");
+  auto ran = run(exportCommand(copy, *camera_, "--format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.code, 0) << ran.output;
+  EXPECT_NE(ran.output.find("no index.json: rebuilt from"), std::string::npos) << ran.output;
+  auto exported = frameDigests(out);
+  auto whole = recordedDigests();
+  size_t lost = frameDigests(files[1]).size();
+  // Every frame of the other segments, and at most the readable start of the broken one.
+  EXPECT_GE(exported.size(), whole.size() - lost);
+  EXPECT_LT(exported.size(), whole.size());
+  EXPECT_EQ(run("ffmpeg -v error -i '" + out.string() + "' -f null -").output, "");
+}
+
+}  // namespace
