@@ -85,10 +85,10 @@ file and exits 0.
   -h, --help             this text
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
-(out, segment, segment-size, format, codec, bitrate, telemetry-track, detect, follow, max-bytes,
-min-free, status, stall-timeout, http, http-token, http-idle-timeout, rtsp, periods, failsafe, marvelmind,
-beacon, mqtt, mqtt-prefix, mqtt-detections-rate, on-segment-closed,
-hook-timeout), and one [device NAME] group per vehicle with host, port, cameras
+(out, segment, segment-size, format, codec, bitrate, telemetry-track, detect,
+follow, max-bytes, min-free, status, stall-timeout, http, http-token,
+http-idle-timeout, rtsp, periods, failsafe, marvelmind, beacon, mqtt,
+mqtt-prefix, mqtt-detections-rate, on-segment-closed, hook-timeout), and one [device NAME] group per vehicle with host, port, cameras
 (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as on the command
 line), marvelmind and beacon:
 
@@ -107,9 +107,10 @@ time of their first frame, each starting at 0 on a key frame; a segment also
 ends where the device was lost. Beside each, <same name>.jsonl with one JSON
 object per event: {"pts": ns on the segment's timeline, "utc": "...Z", "type":
 "stats"|"detections"|"control"|"session"|"vehicle"|"position"|"position-stale",
-...}; the same objects are
-the file's text track "telemetry" (unless --telemetry-track off). DIR/index.json lists the finished segments
-(camera, file, start_utc, duration_s, frames, bytes).
+...}; the same objects are the file's text track "telemetry" (unless
+--telemetry-track off). DIR/index.json lists the finished segments (camera,
+file, start_utc, duration_s, frames, bytes); wirc-export makes one file of a
+time range of them.
 
 MQTT topics (PREFIX/STREAM, STREAM as in the file names):
   PREFIX/available          online/offline, retained; offline is the last will

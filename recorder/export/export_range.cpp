@@ -4,10 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "export/segment_reader.h"
 #include "record/recording_index.h"
 #include "record/segment_inspector.h"
 
@@ -76,8 +76,7 @@ namespace {
 // UTC less its time in the file (a rebuilt index knows only its name's
 // second).
 std::optional<int64_t> startFromSidecar(const fs::path& video) {
-  std::ifstream in(fs::path(video).replace_extension(".jsonl"));
-  for (std::string text; std::getline(in, text);) {
+  for (const auto& text : sidecarLines(video)) {
     auto line = nlohmann::json::parse(text, nullptr, false);
     if (!line.is_object() || line.value("pts", int64_t{0}) <= 0 || !line["utc"].is_string())
       continue;

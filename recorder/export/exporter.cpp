@@ -92,7 +92,7 @@ class Timeline {
 
 // The frames of one segment and its lines, merged by time.
 std::optional<std::string> exportSegment(const ExportSegment& segment, Timeline& timeline,
-                                         GstCaps*& caps, bool h264, std::vector<std::string>& notes,
+                                         GstCaps*& caps, std::vector<std::string>& notes,
                                          const std::function<void()>& onFrame) {
   std::string name = segment.video.filename().string();
   auto reader = SegmentReader::open(segment.video);
@@ -124,8 +124,9 @@ std::optional<std::string> exportSegment(const ExportSegment& segment, Timeline&
     for (; nextLine < lines.size() && lines[nextLine].utcNs <= utc; ++nextLine)
       if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
     if (!timeline.inRange(utc)) continue;
-    // H.264 begins on a key frame: the ones before it could not be decoded.
-    if (!timeline.started() && h264 && !(*frame)->key) continue;
+    // H.264 begins on a key frame: the ones before it could not be decoded
+    // (every JPEG frame is one).
+    if (!timeline.started() && !(*frame)->key) continue;
     if (!caps) caps = gst_caps_ref((*reader)->caps());
     if (auto problem = timeline.frame((*frame)->buffer, utc, (*frame)->key, caps)) return problem;
     onFrame();
@@ -149,19 +150,6 @@ Expected<ExportReport, std::string> exportRange(const ExportRequest& request,
                                                 const ExportProgress& progress) {
   auto selection = selectSegments(request.recordings, request.camera, request.start, request.end);
   if (!selection) return unexpected(selection.error());
-  // mp4mux takes H.264 and not JPEG: known from the first segment.
-  bool h264 = false;
-  {
-    auto first = SegmentReader::open(selection->segments.front().video);
-    if (first && (*first)->next() && (*first)->caps())
-      h264 = std::string(gst_structure_get_name(gst_caps_get_structure((*first)->caps(), 0))) ==
-             "video/x-h264";
-  }
-  if (request.format == ExportFormat::kMp4 && !h264)
-    return unexpected(
-        "--format mp4 needs H.264 recordings: GStreamer's mp4mux cannot carry the camera's JPEG "
-        "frames as they are (use mkv or mcap to keep them untouched)");
-
   std::unique_ptr<ExportSink> sink;
   if (request.format == ExportFormat::kMcap)
     sink = std::make_unique<McapExport>(request.out.string(), request.camera);
@@ -178,7 +166,7 @@ Expected<ExportReport, std::string> exportRange(const ExportRequest& request,
   GstCaps* caps = nullptr;
   std::optional<std::string> problem;
   for (const auto& segment : selection->segments) {
-    problem = exportSegment(segment, timeline, caps, h264, selection->notes, [&] {
+    problem = exportSegment(segment, timeline, caps, selection->notes, [&] {
       if (progress && ++done % 50 == 0) progress(done, total);
     });
     if (problem) break;

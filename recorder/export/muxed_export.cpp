@@ -22,13 +22,16 @@ MuxedExport::~MuxedExport() {
 
 std::optional<std::string> MuxedExport::start(GstCaps* caps) {
   bool mkv = container_ == "mkv";
+  if (!mkv && gst_structure_has_name(gst_caps_get_structure(caps, 0), "image/jpeg"))
+    return "--format mp4 needs H.264 recordings: GStreamer's mp4mux cannot carry the camera's "
+           "JPEG frames as they are (use mkv or mcap to keep them untouched)";
   // The text track is named as in the recordings (in Matroska a
   // placeholder, rewritten when the file is done: telemetry_track_flags.h).
   gchar* location = g_strescape(path_.c_str(), nullptr);
   std::string description =
       std::string("appsrc name=video format=time block=true max-bytes=8000000 ! mux.video_%u ") +
       (mkv ? "matroskamux" : "mp4mux") + " name=mux ! filesink location=\"" + location +
-      "\" appsrc name=text format=time caps=\"text/x-raw,format=(string)utf8\" ! taginject "
+      "\" appsrc name=text format=time caps=\"text/x-raw,format=(string)utf8\" ! taginject name=title "
       "tags=\"title=" +
       std::string(mkv ? kTelemetryTrackPlaceholder : kTelemetryTrackName) + "\" ! mux.subtitle_%u";
   g_free(location);
@@ -43,7 +46,12 @@ std::optional<std::string> MuxedExport::start(GstCaps* caps) {
   video_ = gst_bin_get_by_name(GST_BIN(pipeline_), "video");
   text_ = gst_bin_get_by_name(GST_BIN(pipeline_), "text");
   gst_app_src_set_caps(GST_APP_SRC(video_), caps);
-  GstPad* textOut = gst_element_get_static_pad(text_, "src");
+  // Gaps become what the muxer wants after taginject, which sends the
+  // track's title with the first buffer it sees: a GAP event would pass it
+  // by, and the title could miss the file's header.
+  GstElement* title = gst_bin_get_by_name(GST_BIN(pipeline_), "title");
+  GstPad* textOut = gst_element_get_static_pad(title, "src");
+  gst_object_unref(title);
   gst_pad_add_probe(textOut, GST_PAD_PROBE_TYPE_BUFFER, onText, this, nullptr);
   gst_object_unref(textOut);
   if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE)

@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <string>
 
+#include "shell_command.h"
+
 namespace wircam::testing {
 
 inline GstElement* launch(const std::string& description) {
@@ -50,17 +52,6 @@ inline std::string firstErrorOf(const std::string& description, std::chrono::mil
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(pipeline);
   return error;
-}
-
-// What a shell command prints (stdout and stderr), as a user would see it.
-inline std::string commandOutput(const std::string& command) {
-  std::string output;
-  if (FILE* pipe = popen((command + " 2>&1").c_str(), "r")) {
-    char chunk[4096];
-    while (size_t n = fread(chunk, 1, sizeof chunk, pipe)) output.append(chunk, n);
-    pclose(pipe);
-  }
-  return output;
 }
 
 }  // namespace wircam::testing

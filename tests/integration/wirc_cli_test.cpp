@@ -11,6 +11,7 @@
 #include "marvelmind_dashboard.h"
 #include "misbehaving_peers.h"
 #include "rcoip/rcoip_receiver.h"
+#include "shell_command.h"
 #include "wait_for.h"
 #include "wirc/device.h"
 #include "wirc/transmitter_session.h"
@@ -19,21 +20,11 @@ namespace wircam::wirc {
 namespace {
 
 using std::chrono::milliseconds;
+using testing::CommandRun;
+using testing::runCommand;
 
-struct Run {
-  int exitCode;
-  std::string output;  // stdout and stderr
-};
-
-Run wircCli(const std::string& arguments) {
-  std::string command = std::string(WIRCAM_BIN_DIR) + "/wirc-cli " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  Run run{-1, ""};
-  std::array<char, 256> chunk;
-  while (size_t n = fread(chunk.data(), 1, chunk.size(), pipe)) run.output.append(chunk.data(), n);
-  int status = pclose(pipe);
-  run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+CommandRun wircCli(const std::string& arguments) {
+  return runCommand(std::string(WIRCAM_BIN_DIR) + "/wirc-cli " + arguments);
 }
 
 TEST(WircCli, RequestControlExitsOneWithTheReasonWhenTheDeviceDenies) {

@@ -13,6 +13,7 @@
 
 #include "camera_checks.h"
 #include "recorder_process.h"
+#include "shell_command.h"
 #include "simulated_device.h"
 #include "wait_for.h"
 
@@ -22,21 +23,6 @@ namespace fs = std::filesystem;
 using namespace wircam;
 using namespace wircam::testing;
 using std::chrono::milliseconds;
-
-struct Ran {
-  int code;
-  std::string output;
-};
-
-Ran run(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return {-1, "popen failed"};
-  char chunk[4096];
-  while (size_t n = fread(chunk, 1, sizeof chunk, pipe)) output.append(chunk, n);
-  int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
 
 // The MD5 of each video frame's bytes, in file order.
 std::vector<std::string> frameDigests(const fs::path& file) {
@@ -64,10 +50,11 @@ std::vector<std::string> frameDigests(const fs::path& file) {
 }
 
 std::vector<double> packetTimes(const fs::path& file) {
-  std::istringstream csv(run("ffprobe -v error -select_streams v:0 -show_entries packet=pts_time "
-                             "-of csv=p=0 '" +
-                             file.string() + "'")
-                             .output);
+  std::istringstream csv(
+      runCommand("ffprobe -v error -select_streams v:0 -show_entries packet=pts_time "
+                 "-of csv=p=0 '" +
+                 file.string() + "'")
+          .output);
   std::vector<double> times;
   for (std::string line; std::getline(csv, line);) times.push_back(std::stod(line));
   return times;
@@ -124,9 +111,9 @@ std::string* Export::camera_ = nullptr;
 
 TEST_F(Export, AllOfItAsMatroskaIsEveryFrameUntouchedOnOneTimelineWithTheOutageAsAGap) {
   fs::path out = output("all.mkv");
-  auto ran =
-      run(exportCommand(recorder_->out(), *camera_, "--format mkv --out '" + out.string() + "'"));
-  ASSERT_EQ(ran.code, 0) << ran.output;
+  auto ran = runCommand(
+      exportCommand(recorder_->out(), *camera_, "--format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
   uint64_t indexed = 0;
   for (const auto& segment : segments()) indexed += segment["frames"].get<uint64_t>();
   EXPECT_NE(ran.output.find(std::to_string(indexed) + " frames from"), std::string::npos)
@@ -142,11 +129,11 @@ TEST_F(Export, AllOfItAsMatroskaIsEveryFrameUntouchedOnOneTimelineWithTheOutageA
     widest = std::max(widest, times[i] - times[i - 1]);
   }
   EXPECT_GT(widest, 0.4);  // the outage (the device off, the login's backoff)
-  EXPECT_EQ(run("ffmpeg -v error -i '" + out.string() + "' -f null -").output, "");
+  EXPECT_EQ(runCommand("ffmpeg -v error -i '" + out.string() + "' -f null -").output, "");
   // The telemetry: a named text track, and the same lines re-based beside.
-  EXPECT_EQ(run("ffprobe -v error -select_streams s:0 -show_entries "
-                "stream_disposition=default:stream_tags=title -of csv=p=0 '" +
-                out.string() + "'")
+  EXPECT_EQ(runCommand("ffprobe -v error -select_streams s:0 -show_entries "
+                       "stream_disposition=default:stream_tags=title -of csv=p=0 '" +
+                       out.string() + "'")
                 .output,
             "0,telemetry\n");
   auto track = contentsOf(out).telemetry;
@@ -181,10 +168,10 @@ TEST_F(Export, ARangeHoldsTheFramesOfTheSegmentsInIt) {
   char end[32];
   std::snprintf(end, sizeof end, "%s%03dZ", fourth.substr(0, 20).c_str(), ms - 1);
   fs::path out = output("range.mkv");
-  auto ran = run(exportCommand(
+  auto ran = runCommand(exportCommand(
       recorder_->out(), *camera_,
       "--start " + start + " --end " + end + " --format mkv --out '" + out.string() + "'"));
-  ASSERT_EQ(ran.code, 0) << ran.output;
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
   EXPECT_EQ(frameDigests(out), recordedDigests(1, 3));
   EXPECT_EQ(frameDigests(out).size(),
             index[1]["frames"].get<size_t>() + index[2]["frames"].get<size_t>());
@@ -192,11 +179,11 @@ TEST_F(Export, ARangeHoldsTheFramesOfTheSegmentsInIt) {
 
 TEST_F(Export, McapIsReadByMcapCoreWithEveryMessageValidAgainstFoxglovesSchemas) {
   fs::path out = output("all.mcap");
-  auto ran =
-      run(exportCommand(recorder_->out(), *camera_, "--format mcap --out '" + out.string() + "'"));
-  ASSERT_EQ(ran.code, 0) << ran.output;
-  auto checked = run("node '" MCAP_CHECK_DIR "/check.mjs' '" + out.string() + "'");
-  ASSERT_EQ(checked.code, 0)
+  auto ran = runCommand(
+      exportCommand(recorder_->out(), *camera_, "--format mcap --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
+  auto checked = runCommand("node '" MCAP_CHECK_DIR "/check.mjs' '" + out.string() + "'");
+  ASSERT_EQ(checked.exitCode, 0)
       << checked.output << "\n(run tools/run-tests, which installs the checker's npm packages)";
   auto result = nlohmann::json::parse(checked.output);
   EXPECT_EQ(result["invalid"], nlohmann::json::array()) << result["invalid"];
@@ -224,25 +211,25 @@ TEST_F(Export, McapIsReadByMcapCoreWithEveryMessageValidAgainstFoxglovesSchemas)
 
 TEST_F(Export, SaysWhyWhenThereIsNothingToExport) {
   fs::path out = output("none.mkv");
-  auto unknown = run(
+  auto unknown = runCommand(
       exportCommand(recorder_->out(), "nosuch-cam0", "--format mkv --out '" + out.string() + "'"));
-  EXPECT_EQ(unknown.code, 1);
+  EXPECT_EQ(unknown.exitCode, 1);
   EXPECT_NE(unknown.output.find("no camera nosuch-cam0"), std::string::npos) << unknown.output;
   EXPECT_NE(unknown.output.find(*camera_), std::string::npos) << unknown.output;  // those there are
-  auto before =
-      run(exportCommand(recorder_->out(), *camera_,
-                        "--end 2001-01-01T00:00:00Z --format mkv --out '" + out.string() + "'"));
-  EXPECT_EQ(before.code, 1);
+  auto before = runCommand(
+      exportCommand(recorder_->out(), *camera_,
+                    "--end 2001-01-01T00:00:00Z --format mkv --out '" + out.string() + "'"));
+  EXPECT_EQ(before.exitCode, 1);
   EXPECT_NE(before.output.find("no frame in that range"), std::string::npos) << before.output;
   EXPECT_FALSE(fs::exists(out));
-  auto malformed = run(exportCommand(
+  auto malformed = runCommand(exportCommand(
       recorder_->out(), *camera_, "--start yesterday --format mkv --out '" + out.string() + "'"));
-  EXPECT_EQ(malformed.code, 2);
+  EXPECT_EQ(malformed.exitCode, 2);
   EXPECT_NE(malformed.output.find("--start 'yesterday' is not an ISO 8601 time"), std::string::npos)
       << malformed.output;
-  auto mp4 =
-      run(exportCommand(recorder_->out(), *camera_, "--format mp4 --out '" + out.string() + "'"));
-  EXPECT_EQ(mp4.code, 1);
+  auto mp4 = runCommand(
+      exportCommand(recorder_->out(), *camera_, "--format mp4 --out '" + out.string() + "'"));
+  EXPECT_EQ(mp4.exitCode, 1);
   EXPECT_NE(mp4.output.find("mp4 needs H.264 recordings"), std::string::npos) << mp4.output;
 }
 
@@ -255,8 +242,8 @@ TEST_F(Export, ADeletedIndexIsRebuiltAndABrokenSegmentSkippedWithAWord) {
   // The second segment cut off after 3000 bytes: its first frames or none.
   fs::resize_file(copy / files[1].filename(), 3000);
   fs::path out = output("rebuilt.mkv");
-  auto ran = run(exportCommand(copy, *camera_, "--format mkv --out '" + out.string() + "'"));
-  ASSERT_EQ(ran.code, 0) << ran.output;
+  auto ran = runCommand(exportCommand(copy, *camera_, "--format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
   EXPECT_NE(ran.output.find("no index.json: rebuilt from"), std::string::npos) << ran.output;
   auto exported = frameDigests(out);
   auto whole = recordedDigests();
@@ -264,7 +251,7 @@ TEST_F(Export, ADeletedIndexIsRebuiltAndABrokenSegmentSkippedWithAWord) {
   // Every frame of the other segments, and at most the readable start of the broken one.
   EXPECT_GE(exported.size(), whole.size() - lost);
   EXPECT_LT(exported.size(), whole.size());
-  EXPECT_EQ(run("ffmpeg -v error -i '" + out.string() + "' -f null -").output, "");
+  EXPECT_EQ(runCommand("ffmpeg -v error -i '" + out.string() + "' -f null -").output, "");
 }
 
 }  // namespace

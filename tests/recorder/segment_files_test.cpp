@@ -17,6 +17,7 @@
 #include "camera_checks.h"
 #include "http_fetch.h"
 #include "recorder_process.h"
+#include "shell_command.h"
 #include "simulated_device.h"
 #include "wait_for.h"
 
@@ -27,16 +28,6 @@ using namespace wircam;
 using namespace wircam::testing;
 using std::chrono::milliseconds;
 
-std::string run(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return "popen failed";
-  char chunk[4096];
-  while (size_t n = fread(chunk, 1, sizeof chunk, pipe)) output.append(chunk, n);
-  pclose(pipe);
-  return output;
-}
-
 struct ProbedFrame {
   bool key;
   double pts;
@@ -45,9 +36,9 @@ struct ProbedFrame {
 // The video frames as ffprobe decodes them, in presentation order.
 std::vector<ProbedFrame> probeFrames(const fs::path& file) {
   std::istringstream csv(
-      run("ffprobe -v error -select_streams v:0 -show_frames -show_entries "
-          "frame=key_frame,pts_time -of csv=p=0 '" +
-          file.string() + "'"));
+      commandOutput("ffprobe -v error -select_streams v:0 -show_frames -show_entries "
+                    "frame=key_frame,pts_time -of csv=p=0 '" +
+                    file.string() + "'"));
   std::vector<ProbedFrame> frames;
   for (std::string line; std::getline(csv, line);) {
     int key = 0;
@@ -58,14 +49,16 @@ std::vector<ProbedFrame> probeFrames(const fs::path& file) {
 }
 
 double probeDuration(const fs::path& file) {
-  return std::stod("0" + run("ffprobe -v error -show_entries format=duration -of csv=p=0 '" +
-                             file.string() + "'"));
+  return std::stod("0" +
+                   commandOutput("ffprobe -v error -show_entries format=duration -of csv=p=0 '" +
+                                 file.string() + "'"));
 }
 
 int probePackets(const fs::path& file) {
-  return std::stoi("0" + run("ffprobe -v error -select_streams v:0 -count_packets -show_entries "
-                             "stream=nb_read_packets -of csv=p=0 '" +
-                             file.string() + "'"));
+  return std::stoi(
+      "0" + commandOutput("ffprobe -v error -select_streams v:0 -count_packets -show_entries "
+                          "stream=nb_read_packets -of csv=p=0 '" +
+                          file.string() + "'"));
 }
 
 // "rover-cam0-20261122T143205Z.mkv" → seconds since the epoch.
@@ -114,7 +107,7 @@ TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
     EXPECT_LT(frames.front().pts, 0.1);
     // Every packet decodes to a frame, without a word from the decoder.
     EXPECT_EQ(static_cast<int>(frames.size()), probePackets(video));
-    EXPECT_EQ(run("ffmpeg -v error -i '" + video.string() + "' -f null -"), "");
+    EXPECT_EQ(commandOutput("ffmpeg -v error -i '" + video.string() + "' -f null -"), "");
     double duration = probeDuration(video);
     if (i + 1 < videos.size()) {
       EXPECT_NEAR(duration, 3.0, 1.0);  // the last ends when the recording does
@@ -125,9 +118,9 @@ TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
     EXPECT_NEAR(static_cast<double>(*named), static_cast<double>(expectedStart), 2.0);
     expectedStart = *named + static_cast<std::time_t>(duration + 0.5);
     // The telemetry track is named, and players do not show it by default.
-    EXPECT_EQ(run("ffprobe -v error -select_streams s:0 -show_entries "
-                  "stream_disposition=default,forced:stream_tags=title -of csv=p=0 '" +
-                  video.string() + "'"),
+    EXPECT_EQ(commandOutput("ffprobe -v error -select_streams s:0 -show_entries "
+                            "stream_disposition=default,forced:stream_tags=title -of csv=p=0 '" +
+                            video.string() + "'"),
               std::string(container) == "mkv" ? "0,0,telemetry\n" : "0,0\n");
     // Its sidecar is on its own timeline, every line within the file.
     auto lines = sidecarOf(video);
@@ -164,10 +157,10 @@ TEST(SegmentFilesSidecarOnly, WithTheTelemetryTrackOffAFileIsItsFramesAndTheSide
   ASSERT_EQ(index["segments"].size(), videos.size()) << index;
   for (const auto& video : videos) {
     SCOPED_TRACE(video.filename().string());
-    EXPECT_EQ(run("ffprobe -v error -show_entries stream=codec_type -of csv=p=0 '" +
-                  video.string() + "'"),
+    EXPECT_EQ(commandOutput("ffprobe -v error -show_entries stream=codec_type -of csv=p=0 '" +
+                            video.string() + "'"),
               "video\n");
-    EXPECT_EQ(run("ffmpeg -v error -i '" + video.string() + "' -f null -"), "");
+    EXPECT_EQ(commandOutput("ffmpeg -v error -i '" + video.string() + "' -f null -"), "");
     auto frames = probeFrames(video);
     ASSERT_GT(frames.size(), 10u);
     EXPECT_TRUE(frames.front().key);
