@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "camera_checks.h"
 #include "headless_chromium.h"
 #include "http_fetch.h"
 #include "recorder_process.h"
@@ -182,7 +183,9 @@ TEST(WircRecorderHttp, LiveViewShowsTheCameraWithTheTagOverlayInChromium) {
     GTEST_SKIP() << "chromium is not installed (tools/install-deps test installs it)";
   LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11"});
   ASSERT_FALSE(live.url.empty()) << live.recorder->log();
-  std::this_thread::sleep_for(milliseconds(2000));  // detections have come
+  // Two seconds of frames, and with them detections.
+  ASSERT_TRUE(waitFor([&] { return framesOf(live.url, live.camera()) >= 30; }, milliseconds(15000)))
+      << live.recorder->log();
   auto shot = live.recorder->out().parent_path() / "live-view.png";
   ASSERT_TRUE(screenshot(live.url, shot, 800, 600));
   auto picture = readPng(shot);
@@ -248,7 +251,8 @@ TEST(WircRecorderHttp, TheCameraCardSaysLiveThenOfflineWhenTheDeviceStops) {
     GTEST_SKIP() << "chromium is not installed (tools/install-deps test installs it)";
   LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11", "--follow"});
   ASSERT_FALSE(live.url.empty()) << live.recorder->log();
-  std::this_thread::sleep_for(milliseconds(2000));
+  ASSERT_TRUE(waitFor([&] { return framesOf(live.url, live.camera()) >= 30; }, milliseconds(15000)))
+      << live.recorder->log();
   // Kept beside the build for people to look at.
   auto liveShot = fs::path(WIRCAM_SCREENSHOT_DIR) / "card-live.png";
   ASSERT_TRUE(screenshot(live.url, liveShot, 800, 700));

@@ -150,8 +150,15 @@ TEST(RecorderPositions, StatusCarriesTheLatestAndTheMapDrawsTheTrail) {
   RecorderProcess recorder(car.device->port(), args);
   auto url = recorder.waitForLog("http://", 10s);
   ASSERT_TRUE(url) << recorder.log();
-  std::this_thread::sleep_for(2s);
-  auto status = nlohmann::json::parse(fetch(*url + "api/status").body);
+  // Until the first position has come through.
+  nlohmann::json status;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        status = nlohmann::json::parse(fetch(*url + "api/status").body, nullptr, false);
+        return status.is_object() && status["streams"][0]["position"].is_object();
+      },
+      10s))
+      << recorder.log();
   auto position = status["streams"][0]["position"];
   ASSERT_TRUE(position.is_object()) << status.dump();
   EXPECT_EQ(position["beacon"], 5);
