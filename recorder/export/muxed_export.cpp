@@ -31,7 +31,8 @@ std::optional<std::string> MuxedExport::start(GstCaps* caps) {
   std::string description =
       std::string("appsrc name=video format=time block=true max-bytes=8000000 ! mux.video_%u ") +
       (mkv ? "matroskamux" : "mp4mux") + " name=mux ! filesink location=\"" + location +
-      "\" appsrc name=text format=time caps=\"text/x-raw,format=(string)utf8\" ! taginject name=title "
+      "\" appsrc name=text format=time caps=\"text/x-raw,format=(string)utf8\" ! taginject "
+      "name=title "
       "tags=\"title=" +
       std::string(mkv ? kTelemetryTrackPlaceholder : kTelemetryTrackName) + "\" ! mux.subtitle_%u";
   g_free(location);
