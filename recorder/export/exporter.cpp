@@ -53,9 +53,11 @@ class Timeline {
            (!request_.end || utcNs <= *request_.end);
   }
 
-  std::optional<std::string> frame(GstBuffer* buffer, int64_t utcNs, bool key, GstCaps* caps) {
+  std::optional<ExportError> frame(GstBuffer* buffer, int64_t utcNs, bool key, GstCaps* caps) {
     if (!origin_) {
-      if (auto problem = sink_.start(caps)) return problem;
+      // The format cannot hold these frames (JPEG in MP4), or its muxer is missing.
+      if (auto problem = sink_.start(caps))
+        return ExportError{ExportError::Kind::kUnsupported, *problem};
       origin_ = utcNs;
       report.firstUtcNs = utcNs;
     }
@@ -66,22 +68,27 @@ class Timeline {
     lastFrame_ = pts;
     report.lastUtcNs = utcNs;
     ++report.frames;
-    return sink_.frame(buffer, pts, utcNs, key);
+    return failed(sink_.frame(buffer, pts, utcNs, key));
   }
 
-  std::optional<std::string> line(TimedLine& line) {
+  std::optional<ExportError> line(TimedLine& line) {
     if (!origin_) return std::nullopt;  // lines before the first frame wait for it
     int64_t pts = std::max<int64_t>(line.utcNs - *origin_, 0);
     line.json["pts"] = pts;
     jsonl_ << line.json.dump() << '\n';
     ++report.lines;
-    return sink_.line(line.json, pts, line.utcNs);
+    return failed(sink_.line(line.json, pts, line.utcNs));
   }
 
   bool started() const { return origin_.has_value(); }
   ExportReport report;
 
  private:
+  static std::optional<ExportError> failed(std::optional<std::string> problem) {
+    if (!problem) return std::nullopt;
+    return ExportError{ExportError::Kind::kFailed, *problem};
+  }
+
   ExportSink& sink_;
   std::ofstream& jsonl_;
   const ExportRequest& request_;
@@ -91,9 +98,9 @@ class Timeline {
 };
 
 // The frames of one segment and its lines, merged by time.
-std::optional<std::string> exportSegment(const ExportSegment& segment, Timeline& timeline,
+std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline& timeline,
                                          GstCaps*& caps, std::vector<std::string>& notes,
-                                         const std::function<void()>& onFrame) {
+                                         const std::function<bool()>& onFrame) {
   std::string name = segment.video.filename().string();
   auto reader = SegmentReader::open(segment.video);
   if (!reader) {
@@ -129,7 +136,7 @@ std::optional<std::string> exportSegment(const ExportSegment& segment, Timeline&
     if (!timeline.started() && !(*frame)->key) continue;
     if (!caps) caps = gst_caps_ref((*reader)->caps());
     if (auto problem = timeline.frame((*frame)->buffer, utc, (*frame)->key, caps)) return problem;
-    onFrame();
+    if (!onFrame()) return std::nullopt;  // stopped: the caller knows
     for (auto& line : waiting)
       if (auto problem = timeline.line(line)) return problem;
     waiting.clear();
@@ -146,10 +153,11 @@ std::optional<std::string> exportSegment(const ExportSegment& segment, Timeline&
 
 }  // namespace
 
-Expected<ExportReport, std::string> exportRange(const ExportRequest& request,
+Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
                                                 const ExportProgress& progress) {
+  using Kind = ExportError::Kind;
   auto selection = selectSegments(request.recordings, request.camera, request.start, request.end);
-  if (!selection) return unexpected(selection.error());
+  if (!selection) return unexpected(ExportError{Kind::kNothing, selection.error()});
   std::unique_ptr<ExportSink> sink;
   if (request.format == ExportFormat::kMcap)
     sink = std::make_unique<McapExport>(request.out.string(), request.camera);
@@ -158,24 +166,29 @@ Expected<ExportReport, std::string> exportRange(const ExportRequest& request,
                                          request.format == ExportFormat::kMp4 ? "mp4" : "mkv");
   fs::path jsonlPath = fs::path(request.out).replace_extension(".jsonl");
   std::ofstream jsonl(jsonlPath);
-  if (!jsonl) return unexpected("cannot write " + jsonlPath.string());
+  if (!jsonl) return unexpected(ExportError{Kind::kFailed, "cannot write " + jsonlPath.string()});
 
   Timeline timeline(*sink, jsonl, request);
   uint64_t total = 0, done = 0;
   for (const auto& segment : selection->segments) total += segment.frames;
   GstCaps* caps = nullptr;
-  std::optional<std::string> problem;
+  std::optional<ExportError> problem;
   for (const auto& segment : selection->segments) {
+    bool stopped = false;
     problem = exportSegment(segment, timeline, caps, selection->notes, [&] {
-      if (progress && ++done % 50 == 0) progress(done, total);
+      if (progress && ++done % 50 == 0 && !progress(done, total)) stopped = true;
+      return !stopped;
     });
+    if (stopped) problem = ExportError{Kind::kCancelled, "the export was stopped"};
     if (problem) break;
     ++timeline.report.segments;
   }
   if (caps) gst_caps_unref(caps);
   if (!problem && !timeline.started())
-    problem = "camera " + request.camera + " has no frame in that range";
-  if (!problem) problem = timeline.started() ? sink->finish() : std::nullopt;
+    problem =
+        ExportError{Kind::kNothing, "camera " + request.camera + " has no frame in that range"};
+  if (!problem && timeline.started())
+    if (auto failed = sink->finish()) problem = ExportError{Kind::kFailed, *failed};
   sink.reset();
   jsonl.close();
   if (problem) {

@@ -32,12 +32,22 @@ struct ExportReport {
   std::vector<std::string> notes;  // segments skipped or left out, and why
 };
 
-// Frames done of about how many.
-using ExportProgress = std::function<void(uint64_t done, uint64_t total)>;
+// Frames done of about how many; false stops the export (a client gone).
+using ExportProgress = std::function<bool(uint64_t done, uint64_t total)>;
 
-// Errors: an unknown camera, no frame in the range, a file that cannot be
-// written (then nothing is left at `out`).
-Expected<ExportReport, std::string> exportRange(const ExportRequest& request,
+struct ExportError {
+  enum class Kind {
+    kNothing,      // an unknown camera, no frame in the range
+    kUnsupported,  // the format cannot hold the camera's frames (JPEG in MP4)
+    kFailed,       // the file could not be written
+    kCancelled,    // the progress said stop
+  };
+  Kind kind;
+  std::string message;
+};
+
+// On an error nothing is left at `out`.
+Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
                                                 const ExportProgress& progress = {});
 
 }  // namespace wircam::recorder

@@ -101,14 +101,15 @@ int main(int argc, char** argv) {
 
   bool terminal = isatty(STDERR_FILENO);
   auto report = exportRange(request, [terminal](uint64_t done, uint64_t total) {
-    if (!terminal || total == 0) return;
+    if (!terminal || total == 0) return true;
     std::fprintf(stderr, "\rwirc-export: %llu of %llu frames (%d%%)",
                  static_cast<unsigned long long>(done), static_cast<unsigned long long>(total),
                  static_cast<int>(100 * done / total));
+    return true;
   });
   if (terminal) std::fputc('\n', stderr);
   if (!report) {
-    std::fprintf(stderr, "wirc-export: %s\n", report.error().c_str());
+    std::fprintf(stderr, "wirc-export: %s\n", report.error().message.c_str());
     return 1;
   }
   for (const auto& note : report->notes) std::fprintf(stderr, "wirc-export: %s\n", note.c_str());

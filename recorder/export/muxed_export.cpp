@@ -23,7 +23,7 @@ MuxedExport::~MuxedExport() {
 std::optional<std::string> MuxedExport::start(GstCaps* caps) {
   bool mkv = container_ == "mkv";
   if (!mkv && gst_structure_has_name(gst_caps_get_structure(caps, 0), "image/jpeg"))
-    return "--format mp4 needs H.264 recordings: GStreamer's mp4mux cannot carry the camera's "
+    return "mp4 needs H.264 recordings: GStreamer's mp4mux cannot carry the camera's "
            "JPEG frames as they are (use mkv or mcap to keep them untouched)";
   // The text track is named as in the recordings (in Matroska a
   // placeholder, rewritten when the file is done: telemetry_track_flags.h).

@@ -23,6 +23,7 @@ struct Route {
     CameraCommand,   // POST /api/cameras/NAME/{follow,target,request-control}
     Drive,           // GET /api/cameras/NAME/drive: the drive mode's WebSocket
     Playback,        // GET /play/FILE.mjpg?from=SECONDS: a recording replayed as MJPEG
+    Export,          // GET /api/export?camera=&start=&end=&format=: a range as one file
     ApiNotFound,     // any other /api/ path: 404 with JSON
     NotFound
   };

@@ -67,6 +67,7 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     return unexpected("--http: cannot listen on port " + std::to_string(address.port) + ": " +
                       connections.error());
   self->connections_ = std::move(*connections);
+  self->exports_ = std::make_unique<ExportDownloads>(self->content_.recordingsFolder);
   self->url_ =
       "http://" + address.listenHost() + ":" + std::to_string(self->connections_->port()) + "/";
 
@@ -141,6 +142,7 @@ HttpServer::~HttpServer() {
   for (auto& feed : feeds_) release(feed->clients);
   release(eventClients_);
   release(playbackClients_);
+  exports_.reset();       // before libsoup frees the messages it answers
   driveSockets_.clear();  // each sends neutral and closes
   if (server_) {
     soup_server_disconnect(server_);
@@ -233,6 +235,8 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       return self->serveRecordingIndex(message);
     case Route::Kind::Playback:
       return self->servePlayback(message, route.name, query);
+    case Route::Kind::Export:
+      return self->exports_->serve(message, query);
     case Route::Kind::Drive:
       // Left unanswered when allowed: libsoup then upgrades it (onWebSocket).
       return self->refuseDriveUnlessAllowed(message, route.name);
@@ -243,7 +247,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                               "no such endpoint; /api/status, /api/events, /api/cameras, "
                               "/api/cameras/NAME/snapshot.jpg, /api/cameras/NAME/follow, "
                               "/api/cameras/NAME/target, /api/cameras/NAME/request-control, "
-                              "/api/cameras/NAME/drive, /api/recordings");
+                              "/api/cameras/NAME/drive, /api/recordings, /api/export");
     case Route::Kind::NotFound:
       return respondError(
           message, SOUP_STATUS_NOT_FOUND,

@@ -22,6 +22,7 @@
 #include "common/expected.h"
 #include "fleet/fleet_command.h"
 #include "http/drive_socket.h"
+#include "http/export_downloads.h"
 #include "http/http_connections.h"
 #include "http/http_routes.h"
 
@@ -121,6 +122,7 @@ class HttpServer {
   std::vector<std::unique_ptr<Client>> playbackClients_;  // each with its replay
   std::vector<std::unique_ptr<DriveSocket>> driveSockets_;
   std::unique_ptr<HttpConnections> connections_;
+  std::unique_ptr<ExportDownloads> exports_;
   // Frames queued for the main loop check it: the server may be gone.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

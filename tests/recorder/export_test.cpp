@@ -2,7 +2,6 @@
 // segments and lives through an outage, and the export is read back by
 // others' readers (ffprobe, ffmpeg, GStreamer's demuxers, and for MCAP
 // @mcap/core with Foxglove's schemas under node).
-#include <gst/app/gstappsink.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -23,31 +22,6 @@ namespace fs = std::filesystem;
 using namespace wircam;
 using namespace wircam::testing;
 using std::chrono::milliseconds;
-
-// The MD5 of each video frame's bytes, in file order.
-std::vector<std::string> frameDigests(const fs::path& file) {
-  std::string description = "filesrc location=\"" + file.string() + "\" ! " +
-                            (file.extension() == ".mp4" ? "qtdemux" : "matroskademux") +
-                            " ! appsink name=sink sync=false caps=\"image/jpeg;video/x-h264\"";
-  GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
-  GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
-  gst_element_set_state(pipeline, GST_STATE_PLAYING);
-  std::vector<std::string> digests;
-  while (GstSample* sample = gst_app_sink_pull_sample(GST_APP_SINK(sink))) {
-    GstMapInfo map;
-    GstBuffer* buffer = gst_sample_get_buffer(sample);
-    gst_buffer_map(buffer, &map, GST_MAP_READ);
-    gchar* md5 = g_compute_checksum_for_data(G_CHECKSUM_MD5, map.data, map.size);
-    digests.emplace_back(md5);
-    g_free(md5);
-    gst_buffer_unmap(buffer, &map);
-    gst_sample_unref(sample);
-  }
-  gst_element_set_state(pipeline, GST_STATE_NULL);
-  gst_object_unref(sink);
-  gst_object_unref(pipeline);
-  return digests;
-}
 
 std::vector<double> packetTimes(const fs::path& file) {
   std::istringstream csv(

@@ -19,6 +19,14 @@ Response fetch(const std::string& url, const char* method, const Headers& header
   const char* authenticate =
       soup_message_headers_get_one(soup_message_get_response_headers(message), "WWW-Authenticate");
   response.authenticate = authenticate ? authenticate : "";
+  SoupMessageHeadersIter headerIter;
+  soup_message_headers_iter_init(&headerIter, soup_message_get_response_headers(message));
+  const char *name, *value;
+  while (soup_message_headers_iter_next(&headerIter, &name, &value)) {
+    gchar* lower = g_ascii_strdown(name, -1);
+    response.headers[lower] = value;
+    g_free(lower);
+  }
   if (body) {
     gsize size = 0;
     auto* data = static_cast<const char*>(g_bytes_get_data(body, &size));

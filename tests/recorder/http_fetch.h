@@ -3,6 +3,7 @@
 
 #include <glib.h>
 
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,7 +14,8 @@ struct Response {
   guint status = 0;
   std::string contentType;
   std::string body;
-  std::string authenticate;  // the WWW-Authenticate header
+  std::string authenticate;                    // the WWW-Authenticate header
+  std::map<std::string, std::string> headers;  // every response header, by its name in lower case
 };
 
 using Headers = std::vector<std::pair<std::string, std::string>>;

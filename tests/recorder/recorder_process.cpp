@@ -1,5 +1,6 @@
 #include "recorder_process.h"
 
+#include <gst/app/gstappsink.h>
 #include <gst/pbutils/pbutils.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -196,6 +197,31 @@ void onPadAdded(GstElement*, GstPad* pad, gpointer data) {
 }
 
 }  // namespace
+
+std::vector<std::string> frameDigests(const fs::path& file) {
+  std::string description = "filesrc location=\"" + file.string() + "\" ! " +
+                            (file.extension() == ".mp4" ? "qtdemux" : "matroskademux") +
+                            " ! appsink name=sink sync=false caps=\"image/jpeg;video/x-h264\"";
+  GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
+  GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  std::vector<std::string> digests;
+  // A file that does not demux ends the frames (a wait, not a hang).
+  while (GstSample* sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), 10 * GST_SECOND)) {
+    GstMapInfo map;
+    GstBuffer* buffer = gst_sample_get_buffer(sample);
+    gst_buffer_map(buffer, &map, GST_MAP_READ);
+    gchar* md5 = g_compute_checksum_for_data(G_CHECKSUM_MD5, map.data, map.size);
+    digests.emplace_back(md5);
+    g_free(md5);
+    gst_buffer_unmap(buffer, &map);
+    gst_sample_unref(sample);
+  }
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(sink);
+  gst_object_unref(pipeline);
+  return digests;
+}
 
 Contents contentsOf(const fs::path& file) {
   const char* demuxer = file.extension() == ".mp4" ? "qtdemux" : "matroskademux";

@@ -66,4 +66,8 @@ struct Contents {
 };
 Contents contentsOf(const std::filesystem::path& file);
 
+// The MD5 of each video frame's bytes (JPEG or H.264), in file order
+// (Matroska or MP4).
+std::vector<std::string> frameDigests(const std::filesystem::path& file);
+
 }  // namespace wircam::testing

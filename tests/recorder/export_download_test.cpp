@@ -1,0 +1,144 @@
+// GET /api/export on a recorder that is still recording: the file comes
+// whole through a real HTTP client, holds exactly the finished segments'
+// frames, says what it left out, and leaves nothing behind.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "camera_checks.h"
+#include "http_fetch.h"
+#include "recorder_process.h"
+#include "shell_command.h"
+#include "simulated_device.h"
+#include "wait_for.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+
+// A live recorder with 2 s segments and the web server, for every test.
+class ExportDownload : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    device_ = startSequenceDevice().release();
+    recorder_ = new RecorderProcess(
+        device_->port(), {"--segment", "2", "--http", "127.0.0.1:0", "--duration", "90"});
+    url_ = new std::string(recorder_->waitForLog("http://", milliseconds(10000)).value_or(""));
+    camera_ = new std::string(cameraName(device_->port()));
+    ASSERT_TRUE(waitFor(
+        [] { return indexedFrames(recorder_->out(), *camera_) > 0 && segments().size() >= 2; },
+        milliseconds(15000)))
+        << recorder_->log();
+  }
+  static void TearDownTestSuite() {
+    delete recorder_;
+    delete device_;
+    delete url_;
+    delete camera_;
+  }
+
+  static nlohmann::json segments() {
+    std::ifstream index(recorder_->out() / "index.json");
+    auto json = nlohmann::json::parse(index, nullptr, false);
+    return json.is_object() ? json.value("segments", nlohmann::json::array())
+                            : nlohmann::json::array();
+  }
+  static std::string exportUrl(const std::string& query) { return *url_ + "api/export?" + query; }
+  // The body, kept as a file to read back.
+  static fs::path saved(const Response& response, const std::string& name) {
+    fs::path file = recorder_->out().parent_path() / name;
+    std::ofstream(file, std::ios::binary) << response.body;
+    return file;
+  }
+
+  static wirc::Device* device_;
+  static RecorderProcess* recorder_;
+  static std::string* url_;
+  static std::string* camera_;
+};
+wirc::Device* ExportDownload::device_ = nullptr;
+RecorderProcess* ExportDownload::recorder_ = nullptr;
+std::string* ExportDownload::url_ = nullptr;
+std::string* ExportDownload::camera_ = nullptr;
+
+TEST_F(ExportDownload, AllOfItIsTheFinishedSegmentsFramesUntouchedAsAFileToSave) {
+  auto response = fetch(exportUrl("camera=" + *camera_ + "&format=mkv"));
+  ASSERT_EQ(response.status, 200u) << response.body.substr(0, 300);
+  EXPECT_EQ(response.contentType, "video/x-matroska");
+  auto disposition = response.headers["content-disposition"];
+  EXPECT_EQ(disposition.find("attachment; filename=\"" + *camera_ + "_"), 0u) << disposition;
+  EXPECT_TRUE(disposition.ends_with(".mkv\"")) << disposition;
+  // The segment being written is left out, and the client is told.
+  EXPECT_NE(response.headers["x-export-notes"].find("is still being written: not exported"),
+            std::string::npos)
+      << response.headers["x-export-notes"];
+
+  fs::path file = saved(response, "download.mkv");
+  auto exported = frameDigests(file);
+  ASSERT_FALSE(exported.empty());
+  EXPECT_EQ(std::to_string(exported.size()), response.headers["x-export-frames"]);
+  // Whole finished segments, from the first: every frame, byte for byte.
+  std::vector<std::string> recorded;
+  for (const auto& segment : segments()) {
+    if (recorded.size() >= exported.size()) break;
+    for (auto& digest : frameDigests(recorder_->out() / segment["file"].get<std::string>()))
+      recorded.push_back(digest);
+  }
+  EXPECT_EQ(exported, recorded);
+  EXPECT_EQ(runCommand("ffmpeg -v error -i '" + file.string() + "' -f null -").output, "");
+}
+
+TEST_F(ExportDownload, ARangeWithAnOffsetAsTypedInTheAddressBarComesAsMcap) {
+  auto first = segments().at(0);
+  // "+00:00" unescaped: a query's '+' reads as a space, and is given back.
+  std::string start = first["start_utc"].get<std::string>();
+  ASSERT_TRUE(start.ends_with("Z")) << start;
+  start = start.substr(0, start.size() - 1) + "+00:00";
+  auto response =
+      fetch(exportUrl("camera=" + *camera_ + "&start=" + start + "&end=" + start + "&format=mcap"));
+  ASSERT_EQ(response.status, 200u) << response.body.substr(0, 300);
+  EXPECT_EQ(response.body.substr(0, 8), std::string("\x89MCAP0\r\n", 8));
+  EXPECT_EQ(response.body.substr(response.body.size() - 8), std::string("\x89MCAP0\r\n", 8));
+  EXPECT_EQ(response.headers["x-export-frames"], "1");
+  EXPECT_TRUE(response.headers["content-disposition"].ends_with(".mcap\""));
+}
+
+TEST_F(ExportDownload, WrongRequestsAreAnsweredInJson) {
+  auto expectError = [](const std::string& query, guint status, const std::string& says) {
+    auto response = fetch(exportUrl(query));
+    EXPECT_EQ(response.status, status) << query;
+    EXPECT_EQ(response.contentType, "application/json") << query;
+    auto json = nlohmann::json::parse(response.body, nullptr, false);
+    ASSERT_TRUE(json.is_object()) << response.body;
+    EXPECT_NE(json.value("error", "").find(says), std::string::npos) << response.body;
+  };
+  expectError("camera=nobody-cam9&format=mkv", 404, "no camera nobody-cam9");
+  expectError("camera=" + *camera_ + "&format=avi", 400, "format= is mkv, mp4 or mcap");
+  expectError("format=mkv", 400, "camera= is needed");
+  expectError("camera=" + *camera_ + "&format=mkv&start=yesterday", 400,
+              "start= 'yesterday' is not an ISO 8601 time");
+  expectError(
+      "camera=" + *camera_ + "&format=mkv&start=2026-01-02T00:00:00Z&end=2026-01-01T00:00:00Z", 400,
+      "end= is before start=");
+  expectError(
+      "camera=" + *camera_ + "&format=mkv&start=2001-01-01T00:00:00Z&end=2001-01-01T00:01:00Z", 404,
+      "has no frame in that range");
+  // JPEG recordings cannot go into MP4 (its muxer takes no JPEG): said, not written.
+  expectError("camera=" + *camera_ + "&format=mp4", 415, "mp4 needs H.264 recordings");
+}
+
+TEST_F(ExportDownload, NothingIsLeftBehindOnceTheFileIsSent) {
+  auto response = fetch(exportUrl("camera=" + *camera_ + "&format=mkv"));
+  ASSERT_EQ(response.status, 200u);
+  fs::path scratch = recorder_->out() / ".exports";
+  EXPECT_TRUE(waitFor([&] { return fs::is_empty(scratch); }, milliseconds(5000)));
+  // Not a recording either: the list does not show the folder.
+  auto list = nlohmann::json::parse(fetch(*url_ + "recordings").body);
+  for (const auto& file : list) EXPECT_FALSE(file["name"].get<std::string>().starts_with("."));
+}
+
+}  // namespace
