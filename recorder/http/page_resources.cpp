@@ -33,6 +33,7 @@ std::string liveViewPage(const std::string& initialState) {
   };
   put("STYLE", pageFile("live_view.css"));
   put("PLAYER_SCRIPT", pageFile("player.js"));
+  put("DAY_TIMELINE_SCRIPT", pageFile("day_timeline.js"));
   put("CONTROL_SCRIPT", pageFile("control.js"));
   put("PAGE_SCRIPT", pageFile("live_view.js"));
   put("INITIAL_STATE", initialState);

@@ -43,6 +43,8 @@ class DevToolsPage {
   bool setCookie(const std::string& name, const std::string& value, const std::string& url);
   void key(const char* type, const std::string& key);  // type: keyDown or keyUp
   void click(double x, double y);
+  // The left button pressed at one point, moved and released at another.
+  void drag(double fromX, double fromY, double toX, double toY);
   bool screenshot(const std::filesystem::path& png);
   // Stops the page's scripts where they are; the socket stays open.
   void pauseScripts();

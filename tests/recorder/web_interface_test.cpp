@@ -16,6 +16,7 @@
 #include "headless_chromium.h"
 #include "http_fetch.h"
 #include "recorder_process.h"
+#include "signed_in_page.h"
 #include "simulated_device.h"
 #include "wait_for.h"
 
@@ -26,65 +27,7 @@ using namespace wircam::testing;
 using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
 
-constexpr const char* kToken = "0123456789abcdef0123456789abcdef";
 constexpr size_t kSteering = 0, kThrottle = 1;
-
-std::filesystem::path shotPath(const std::string& name) {
-  return std::filesystem::path(WIRCAM_SCREENSHOT_DIR) / name;
-}
-
-// The follow scene, kept here so the test can see where the car is.
-struct FollowedCar {
-  std::shared_ptr<sim::FollowScene> scene;
-  std::unique_ptr<wirc::Device> device;
-  FollowedCar() {
-    auto created = sim::FollowScene::create({});
-    EXPECT_TRUE(created.has_value());
-    scene = std::shared_ptr<sim::FollowScene>(std::move(*created));
-    auto started = wirc::Device::start({.port = 0, .fragmentSize = 8000}, scene);
-    EXPECT_TRUE(started.has_value());
-    device = std::move(*started);
-  }
-};
-
-// A recorder with the web server and the token, and a browser signed in.
-struct SignedInPage {
-  RecorderProcess recorder;
-  std::string url;
-  std::unique_ptr<DevToolsPage> page;
-  SignedInPage(uint16_t port, std::vector<std::string> extra, const std::string& profile,
-               bool withToken = true)
-      : recorder(port, withArgs(extra, withToken)) {
-    auto found = recorder.waitForLog("http://", milliseconds(10000));
-    EXPECT_TRUE(found) << recorder.log();
-    url = found.value_or("");
-    page = DevToolsPage::launch(shotPath(profile), 900, 1400);
-    EXPECT_TRUE(page);
-    if (!page) return;
-    if (withToken) {
-      EXPECT_TRUE(page->setCookie("wircam_token", kToken, url));
-    }
-    EXPECT_TRUE(page->navigate(url));
-  }
-  static std::vector<std::string> withArgs(std::vector<std::string> extra, bool withToken) {
-    extra.insert(extra.end(), {"--http", "127.0.0.1:0", "--duration", "120"});
-    if (withToken) extra.insert(extra.end(), {"--http-token", kToken});
-    return extra;
-  }
-  // The centre of the first element `selector` names, in page pixels.
-  std::pair<double, double> centreOf(const std::string& selector) {
-    auto box = page->evaluate("(() => { const r = document.querySelector('" + selector +
-                              "').getBoundingClientRect(); return [r.x + r.width / 2, "
-                              "r.y + r.height / 2]; })()");
-    if (!box.is_array()) return {0, 0};
-    return {box[0].get<double>(), box[1].get<double>()};
-  }
-  void clickOn(const std::string& selector) {
-    page->evaluate("document.querySelector('" + selector + "').scrollIntoView({block: 'center'})");
-    auto [x, y] = centreOf(selector);
-    page->click(x, y);
-  }
-};
 
 double shownPosition(DevToolsPage& page) {
   auto text = page.evaluate("document.getElementById('playback-time').textContent");

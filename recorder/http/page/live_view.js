@@ -167,15 +167,16 @@ async function refreshStatus() {
 }
 
 // The finished segments from the recording index, by camera and by day
-// (local time), newest first: start, duration, size, frames, download,
-// delete (which the server allows only with the access token).
+// (local time), newest first: the day's timeline, then each segment's start,
+// duration, size, frames, download, delete (which the server allows only
+// with the access token).
 async function refresh() {
   const segments = await (await fetch("/api/recordings")).json();
   const groups = new Map();
   for (const segment of segments.reverse()) {
     const start = new Date(segment.start_utc);
     const key = `${segment.camera} · ${start.toLocaleDateString()}`;
-    if (!groups.has(key)) groups.set(key, []);
+    if (!groups.has(key)) groups.set(key, Object.assign([], { camera: segment.camera }));
     groups.get(key).push({ ...segment, start });
   }
   const box = document.getElementById("recordings");
@@ -209,7 +210,7 @@ async function refresh() {
       remove.addEventListener("click", () => deleteSegment(segment.file));
       row.insertCell().appendChild(remove);
     }
-    box.append(heading, table);
+    box.append(heading, dayTimelineOf(title, list.camera, list), table);
   }
 }
 

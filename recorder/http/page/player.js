@@ -1,4 +1,19 @@
-const player = { file: "", duration: 0, position: 0, abort: null, lines: [], objectUrl: "" };
+// `following`: the segments that play on after this one (a day's timeline).
+const player = { file: "", duration: 0, position: 0, abort: null, lines: [], objectUrl: "",
+                 following: [] };
+
+// A sidecar's text (JSON Lines) as objects; a line that does not parse is left out.
+const parseJsonLines = text => text.split("\n").filter(l => l).flatMap(l => {
+  try { return [JSON.parse(l)]; } catch (e) { return []; }
+});
+const sidecarUrl = segment => segment.url.replace(/\.(mkv|mp4)$/, ".jsonl");
+
+// The end of a segment: on to the next one of the day, if any.
+function playedToTheEnd() {
+  if (player.following.length)
+    return openPlayer(player.following[0], 0, player.following.slice(1));
+  document.getElementById("playback-time").textContent += "  (end)";
+}
 
 function indexOfBytes(bytes, pattern, from) {
   outer: for (let i = from; i + pattern.length <= bytes.length; ++i) {
@@ -66,15 +81,18 @@ async function playFrom(seconds) {
       player.objectUrl = url;
       showPosition(position);
     });
-    if (player.abort === abort) document.getElementById("playback-time").textContent += "  (end)";
+    if (player.abort === abort) playedToTheEnd();
   } catch (e) {
     if (e.name !== "AbortError") document.getElementById("playback-time").textContent = e.message;
   }
 }
 
-async function openPlayer(segment) {
+// Plays `segment` from `from` seconds, then `following`.
+async function openPlayer(segment, from = 0, following = []) {
   const box = document.getElementById("player");
+  const continuing = !box.hidden && player.following[0] === segment;
   box.hidden = false;
+  player.following = following;
   player.file = segment.file;
   player.duration = segment.duration_s;
   player.position = 0;
@@ -88,19 +106,15 @@ async function openPlayer(segment) {
   if (mp4) {
     video.src = segment.url;
     video.ontimeupdate = () => showPosition(video.currentTime);
+    video.onended = playedToTheEnd;
   } else {
     video.removeAttribute("src");
   }
-  box.scrollIntoView();
-  const sidecar = segment.url.replace(/\.(mkv|mp4)$/, ".jsonl");
-  const response = await fetch(sidecar);
-  if (response.ok) {
-    player.lines = (await response.text()).split("\n").filter(l => l).flatMap(l => {
-      try { return [JSON.parse(l)]; } catch (e) { return []; }
-    });
-  }
+  if (!continuing) box.scrollIntoView();
+  const response = await fetch(sidecarUrl(segment));
+  if (response.ok) player.lines = parseJsonLines(await response.text());
   drawTimeline();
-  playFrom(0);
+  playFrom(from);
 }
 
 function closePlayer() {
@@ -108,6 +122,7 @@ function closePlayer() {
   document.getElementById("playback-video").pause();
   document.getElementById("player").hidden = true;
   player.file = "";
+  player.following = [];
 }
 
 // The timeline's rows (top, height) and its margins, in CSS pixels.

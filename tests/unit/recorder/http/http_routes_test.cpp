@@ -43,6 +43,8 @@ TEST(HttpRoutes, TheTokenComesAsBearerOrCookie) {
 TEST(HttpRoutes, NamesTheCameraAndRecordingApi) {
   EXPECT_EQ(routeOf("/api/cameras").kind, Kind::Cameras);
   EXPECT_EQ(routeOf("/api/recordings").kind, Kind::RecordingIndex);
+  EXPECT_EQ(routeOf("/api/export").kind, Kind::Export);
+  EXPECT_EQ(routeOf("/api/export/x").kind, Kind::ApiNotFound);
   auto snapshot = routeOf("/api/cameras/rover-cam0/snapshot.jpg");
   EXPECT_EQ(snapshot.kind, Kind::Snapshot);
   EXPECT_EQ(snapshot.name, "rover-cam0");

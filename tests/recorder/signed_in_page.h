@@ -1,0 +1,46 @@
+// A wirc-recorder with its web server (and by default the access token)
+// and Debian's chromium signed in to it, recording a simulated car, for the
+// tests that use the page as its users do. Screenshots go under the build
+// tree.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "devtools_page.h"
+#include "follow_scene.h"
+#include "recorder_process.h"
+#include "wirc/device.h"
+
+namespace wircam::testing {
+
+// The simulator's follow scene (a car and its AprilTag target) on a device
+// on an ephemeral port, the scene kept so a test can see where the car is.
+struct FollowedCar {
+  std::shared_ptr<sim::FollowScene> scene;
+  std::unique_ptr<wirc::Device> device;
+  FollowedCar();
+};
+
+inline constexpr const char* kToken = "0123456789abcdef0123456789abcdef";
+
+// build/tests/recorder/NAME
+std::filesystem::path shotPath(const std::string& name);
+
+struct SignedInPage {
+  RecorderProcess recorder;
+  std::string url;  // "http://127.0.0.1:PORT/"
+  std::unique_ptr<DevToolsPage> page;
+  // Records from 127.0.0.1:port with `extra`; `profile` names chromium's
+  // profile folder.
+  SignedInPage(uint16_t port, std::vector<std::string> extra, const std::string& profile,
+               bool withToken = true);
+  // The centre of the first element `selector` names, in page pixels.
+  std::pair<double, double> centreOf(const std::string& selector);
+  void clickOn(const std::string& selector);
+};
+
+}  // namespace wircam::testing
