@@ -1,0 +1,121 @@
+// Export throughput and memory: one recording made for the run
+//   wirc-sim --frames DIR (720p JPEGs) → wirc-recorder --segment 5
+// and then all of it joined into one file, three ways, side by side:
+//   wirc-export --format mkv, wirc-export --format mcap, and the stock way,
+//   ffmpeg -f concat -c copy of the same segments.
+// MB/s is the segments' bytes over the wall time (the median of 3 runs);
+// peak memory comes from wait4().
+// Usage: bench_export [SECONDS] [FPS]   (default 20 s at 60 fps)
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "child_process.h"
+#include "synthetic_jpeg.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using wircam::bench::spawn;
+using wircam::bench::waitForUsage;
+
+struct Run {
+  double seconds = 0;
+  long maxRssKb = 0;
+};
+
+// The median of three runs of `command` (by time), and its peak memory.
+Run measure(const std::string& command) {
+  std::vector<Run> runs;
+  for (int i = 0; i < 3; ++i) {
+    auto start = std::chrono::steady_clock::now();
+    auto usage = waitForUsage(spawn(command));
+    runs.push_back({std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                    usage.maxRssKb});
+  }
+  std::sort(runs.begin(), runs.end(), [](auto& a, auto& b) { return a.seconds < b.seconds; });
+  return runs[1];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double seconds = argc > 1 ? std::atof(argv[1]) : 20;
+  int fps = argc > 2 ? std::atoi(argv[2]) : 60;
+  fs::path bin = fs::canonical("/proc/self/exe").parent_path();
+  fs::path work = fs::temp_directory_path() / ("wircam-bench-export-" + std::to_string(getpid()));
+  fs::create_directories(work / "frames");
+  for (int i = 0; i < 30; ++i) {
+    auto jpeg = wircam::bench::syntheticJpeg(1280, 720, i, 85);
+    std::ofstream(work / "frames" / (std::to_string(100 + i) + ".jpg"), std::ios::binary)
+        .write(reinterpret_cast<const char*>(jpeg.data()),
+               static_cast<std::streamsize>(jpeg.size()));
+  }
+
+  // The recording.
+  int port = 24000 + getpid() % 20000;
+  pid_t sim = spawn((bin / "wirc-sim").string() + " --port " + std::to_string(port) + " --fps " +
+                    std::to_string(fps) + " --frames " + (work / "frames").string() +
+                    " --duration " + std::to_string(seconds + 3));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  pid_t recorder = spawn(
+      (bin / "wirc-recorder").string() + " --device 127.0.0.1:" + std::to_string(port) + " --out " +
+      (work / "rec").string() + " --segment 5 --duration " + std::to_string(seconds));
+  waitForUsage(recorder);
+  waitForUsage(sim);
+
+  auto index = nlohmann::json::parse(std::ifstream(work / "rec" / "index.json"), nullptr, false);
+  if (!index.is_object() || index["segments"].empty()) {
+    std::fprintf(stderr, "bench_export: the recording failed (no segments in %s)\n",
+                 (work / "rec").c_str());
+    return 1;
+  }
+  std::string camera = index["segments"][0]["camera"];
+  uint64_t bytes = 0, frames = 0;
+  std::ofstream list(work / "concat.txt");
+  for (const auto& segment : index["segments"]) {
+    bytes += segment["bytes"].get<uint64_t>();
+    frames += segment["frames"].get<uint64_t>();
+    list << "file '" << (work / "rec" / segment["file"].get<std::string>()).string() << "'\n";
+  }
+  list.close();
+  double megabytes = static_cast<double>(bytes) / 1e6;
+  std::printf("recording: %zu segments, %llu frames of 1280x720 JPEG, %.1f MB\n",
+              index["segments"].size(), static_cast<unsigned long long>(frames), megabytes);
+
+  std::string exporter = (bin / "wirc-export").string() + " --recordings " +
+                         (work / "rec").string() + " --camera " + camera;
+  struct Way {
+    const char* name;
+    std::string command;
+  };
+  std::vector<Way> ways = {
+      {"ffmpeg -f concat -c copy (mkv)", "ffmpeg -v error -y -f concat -safe 0 -i " +
+                                             (work / "concat.txt").string() + " -c copy " +
+                                             (work / "ffmpeg.mkv").string()},
+      {"wirc-export --format mkv",
+       exporter + " --format mkv --out " + (work / "export.mkv").string()},
+      {"wirc-export --format mcap",
+       exporter + " --format mcap --out " + (work / "export.mcap").string()},
+  };
+  std::printf("%-32s | %8s | %8s | %8s | %s\n", "way", "MB/s", "seconds", "peak MB",
+              "× ffmpeg's MB/s");
+  double stock = 0;
+  for (const auto& way : ways) {
+    auto run = measure(way.command);
+    double rate = megabytes / run.seconds;
+    if (stock == 0) stock = rate;
+    std::printf("%-32s | %8.1f | %8.2f | %8.1f | %.2f\n", way.name, rate, run.seconds,
+                static_cast<double>(run.maxRssKb) / 1024, rate / stock);
+  }
+  fs::remove_all(work);
+  return 0;
+}
