@@ -41,6 +41,20 @@ std::vector<TimedLine> linesOf(const ExportSegment& segment) {
   return lines;
 }
 
+// Whether one segment's frames can follow another's in one file: the same
+// codec, size and codec data. The frame rate is left out: the MP4 demuxer
+// guesses it from each file's sample durations, which vary a little.
+bool sameFrames(GstCaps* a, GstCaps* b) {
+  GstCaps* first = gst_caps_copy(a);
+  GstCaps* second = gst_caps_copy(b);
+  for (GstCaps* caps : {first, second})
+    gst_structure_remove_field(gst_caps_get_structure(caps, 0), "framerate");
+  bool same = gst_caps_is_equal(first, second);
+  gst_caps_unref(first);
+  gst_caps_unref(second);
+  return same;
+}
+
 // Feeds the sink in time order and keeps the timeline: from 0 at the first
 // frame, each frame after the one before.
 class Timeline {
@@ -120,7 +134,7 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
       break;
     }
     if (!*frame) break;
-    if (frames++ == 0 && caps && !gst_caps_is_equal(caps, (*reader)->caps())) {
+    if (frames++ == 0 && caps && !sameFrames(caps, (*reader)->caps())) {
       notes.push_back(
           name + ": its frames differ from the first segment's (" +
           std::string(gst_structure_get_name(gst_caps_get_structure((*reader)->caps(), 0))) +

@@ -80,6 +80,7 @@ class McapWriter {
   std::vector<Channel> channels_;
   // The open chunk: its records, and per channel (time, offset in it).
   std::string chunk_;
+  std::string packed_;  // chunk_ compressed
   uint64_t chunkStart_ = UINT64_MAX, chunkEnd_ = 0;
   std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunkMessages_;
   std::vector<ChunkIndex> chunkIndexes_;

@@ -13,6 +13,7 @@ MuxedExport::MuxedExport(std::string path, std::string container)
     : path_(std::move(path)), container_(std::move(container)) {}
 
 MuxedExport::~MuxedExport() {
+  if (pending_) gst_buffer_unref(pending_);
   if (!pipeline_) return;
   gst_element_set_state(pipeline_, GST_STATE_NULL);
   gst_object_unref(video_);
@@ -76,10 +77,19 @@ std::optional<std::string> MuxedExport::frame(GstBuffer* buffer, int64_t ptsNs, 
     gst_app_src_push_buffer(GST_APP_SRC(text_), gap);
     textPts_ = ptsNs;
   }
+  if (pending_)
+    if (auto problem = pushPending(ptsNs - pendingPts_)) return problem;
   // Its bytes shared, not copied; its times its own on the new timeline.
-  GstBuffer* out = gst_buffer_copy(buffer);
-  GST_BUFFER_PTS(out) = GST_BUFFER_DTS(out) = static_cast<GstClockTime>(ptsNs);
-  GST_BUFFER_DURATION(out) = GST_CLOCK_TIME_NONE;
+  pending_ = gst_buffer_copy(buffer);
+  pendingPts_ = ptsNs;
+  GST_BUFFER_PTS(pending_) = GST_BUFFER_DTS(pending_) = static_cast<GstClockTime>(ptsNs);
+  return std::nullopt;
+}
+
+std::optional<std::string> MuxedExport::pushPending(int64_t durationNs) {
+  lastDuration_ = durationNs;
+  GST_BUFFER_DURATION(pending_) = static_cast<GstClockTime>(durationNs);
+  GstBuffer* out = std::exchange(pending_, nullptr);
   if (gst_app_src_push_buffer(GST_APP_SRC(video_), out) != GST_FLOW_OK)
     return failure().value_or("the muxer stopped taking frames");
   return std::nullopt;
@@ -96,6 +106,8 @@ std::optional<std::string> MuxedExport::line(const nlohmann::json& line, int64_t
 }
 
 std::optional<std::string> MuxedExport::finish() {
+  if (pending_)
+    if (auto problem = pushPending(lastDuration_)) return problem;
   gst_app_src_end_of_stream(GST_APP_SRC(video_));
   gst_app_src_end_of_stream(GST_APP_SRC(text_));
   GstBus* bus = gst_element_get_bus(pipeline_);

@@ -32,6 +32,11 @@ class MuxedExport : public ExportSink {
   GstElement* video_ = nullptr;  // the appsrcs
   GstElement* text_ = nullptr;
   int64_t textPts_ = -1;  // the newest text buffer's time
+  // Each frame waits for the next, which gives it its duration: the last
+  // one's is the interval before it (MP4 readers drop a frame that has none).
+  std::optional<std::string> pushPending(int64_t durationNs);
+  GstBuffer* pending_ = nullptr;
+  int64_t pendingPts_ = 0, lastDuration_ = GST_SECOND / 15;
 };
 
 }  // namespace wircam::recorder

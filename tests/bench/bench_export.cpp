@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,12 +33,17 @@ struct Run {
   long maxRssKb = 0;
 };
 
-// The median of three runs of `command` (by time), and its peak memory.
-Run measure(const std::string& command) {
+// The median of three runs of `command` (by time), and its peak memory;
+// nothing if a run fails.
+std::optional<Run> measure(const std::string& command) {
   std::vector<Run> runs;
   for (int i = 0; i < 3; ++i) {
     auto start = std::chrono::steady_clock::now();
     auto usage = waitForUsage(spawn(command));
+    if (usage.exitCode != 0) {
+      std::fprintf(stderr, "bench_export: exit %d from %s\n", usage.exitCode, command.c_str());
+      return std::nullopt;
+    }
     runs.push_back({std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
                     usage.maxRssKb});
   }
@@ -111,11 +117,12 @@ int main(int argc, char** argv) {
   double stock = 0;
   for (const auto& way : ways) {
     auto run = measure(way.command);
-    double rate = megabytes / run.seconds;
+    if (!run) return 1;
+    double rate = megabytes / run->seconds;
     if (stock == 0) stock = rate;
-    std::printf("%-32s | %8.1f | %8.2f | %8.1f | %.2f\n", way.name, rate, run.seconds,
-                static_cast<double>(run.maxRssKb) / 1024, rate / stock);
+    std::printf("%-32s | %8.1f | %8.2f | %8.1f | %.2f\n", way.name, rate, run->seconds,
+                static_cast<double>(run->maxRssKb) / 1024, rate / stock);
   }
-  fs::remove_all(work);
+  if (!getenv("KEEP")) fs::remove_all(work);
   return 0;
 }

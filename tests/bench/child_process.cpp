@@ -29,7 +29,7 @@ Usage waitForUsage(pid_t pid) {
   wait4(pid, &status, 0, &usage);
   return {static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
               static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6,
-          usage.ru_maxrss};
+          usage.ru_maxrss, WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status)};
 }
 
 }  // namespace wircam::bench

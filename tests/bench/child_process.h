@@ -14,10 +14,12 @@ pid_t spawn(const std::string& command, const std::string& output = "/dev/null")
 // Signals the whole group and waits for its leader.
 void stopGroup(pid_t pid, int signal);
 
-// Waits for a child and says what it used: CPU (user + system) and peak memory.
+// Waits for a child and says what it used: CPU (user + system) and peak
+// memory, and how it ended.
 struct Usage {
   double cpuSeconds = 0;
   long maxRssKb = 0;
+  int exitCode = 0;  // 128 + the signal that ended it
 };
 Usage waitForUsage(pid_t pid);
 

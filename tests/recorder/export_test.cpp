@@ -229,3 +229,49 @@ TEST_F(Export, ADeletedIndexIsRebuiltAndABrokenSegmentSkippedWithAWord) {
 }
 
 }  // namespace
+
+// H.264 stays H.264: a recording transcoded by the recorder (--codec h264,
+// MP4 segments) exports to MP4, Matroska and MCAP with its frames as they
+// were stored, starting on a key frame.
+TEST(ExportH264, EveryFormatCarriesTheRecordedH264Untouched) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(
+      device->port(), {"--segment", "2", "--duration", "7", "--codec", "h264", "--format", "mp4"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  std::vector<std::string> recorded;
+  for (const auto& file : recorder.files(".mp4"))
+    for (auto& digest : frameDigests(file)) recorded.push_back(digest);
+  ASSERT_GT(recorded.size(), 60u);
+  std::string camera = cameraName(device->port());
+  for (const char* format : {"mp4", "mkv"}) {
+    fs::path out = recorder.out().parent_path() / (std::string("h264.") + format);
+    auto ran = runCommand(
+        exportCommand(recorder.out(), camera,
+                      std::string("--format ") + format + " --out '" + out.string() + "'"));
+    ASSERT_EQ(ran.exitCode, 0) << ran.output;
+    EXPECT_EQ(frameDigests(out), recorded) << format;
+    EXPECT_EQ(runCommand("ffmpeg -v error -i '" + out.string() + "' -f null -").output, "")
+        << format;
+    EXPECT_EQ(runCommand("ffprobe -v error -select_streams v:0 -show_entries stream=codec_name "
+                         "-of csv=p=0 '" +
+                         out.string() + "'")
+                  .output,
+              "h264\n")
+        << format;
+  }
+  fs::path mcap = recorder.out().parent_path() / "h264.mcap";
+  ASSERT_EQ(runCommand(exportCommand(recorder.out(), camera,
+                                     "--format mcap --out '" + mcap.string() + "'"))
+                .exitCode,
+            0);
+  auto checked = runCommand("node '" MCAP_CHECK_DIR "/check.mjs' '" + mcap.string() + "'");
+  ASSERT_EQ(checked.exitCode, 0) << checked.output;
+  auto result = nlohmann::json::parse(checked.output);
+  EXPECT_EQ(result["invalid"], nlohmann::json::array()) << result["invalid"];
+  std::vector<std::string> images;
+  for (const auto& image : result["images"]) {
+    images.push_back(image["md5"]);
+    EXPECT_EQ(image["format"], "h264");
+  }
+  EXPECT_EQ(images, recorded);
+}
