@@ -1,6 +1,7 @@
-// GET /api/export on a recorder that is still recording: the file comes
-// whole through a real HTTP client, holds exactly the finished segments'
-// frames, says what it left out, and leaves nothing behind.
+// GET /api/export on a recorder that is still recording (the simulated car
+// following its tag): the file comes whole through a real HTTP client,
+// holds exactly the finished segments' frames, says what it left out, and
+// leaves nothing behind; as MCAP its detections are image annotations.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -10,7 +11,7 @@
 #include "http_fetch.h"
 #include "recorder_process.h"
 #include "shell_command.h"
-#include "simulated_device.h"
+#include "signed_in_page.h"
 #include "wait_for.h"
 
 namespace {
@@ -24,11 +25,12 @@ using std::chrono::milliseconds;
 class ExportDownload : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    device_ = startSequenceDevice().release();
+    car_ = new FollowedCar;
     recorder_ = new RecorderProcess(
-        device_->port(), {"--segment", "2", "--http", "127.0.0.1:0", "--duration", "90"});
+        car_->device->port(),
+        {"--detect", "tag36h11", "--segment", "2", "--http", "127.0.0.1:0", "--duration", "90"});
     url_ = new std::string(recorder_->waitForLog("http://", milliseconds(10000)).value_or(""));
-    camera_ = new std::string(cameraName(device_->port()));
+    camera_ = new std::string(cameraName(car_->device->port()));
     ASSERT_TRUE(waitFor(
         [] { return indexedFrames(recorder_->out(), *camera_) > 0 && segments().size() >= 2; },
         milliseconds(15000)))
@@ -36,7 +38,7 @@ class ExportDownload : public ::testing::Test {
   }
   static void TearDownTestSuite() {
     delete recorder_;
-    delete device_;
+    delete car_;
     delete url_;
     delete camera_;
   }
@@ -55,12 +57,12 @@ class ExportDownload : public ::testing::Test {
     return file;
   }
 
-  static wirc::Device* device_;
+  static FollowedCar* car_;
   static RecorderProcess* recorder_;
   static std::string* url_;
   static std::string* camera_;
 };
-wirc::Device* ExportDownload::device_ = nullptr;
+FollowedCar* ExportDownload::car_ = nullptr;
 RecorderProcess* ExportDownload::recorder_ = nullptr;
 std::string* ExportDownload::url_ = nullptr;
 std::string* ExportDownload::camera_ = nullptr;
@@ -92,19 +94,32 @@ TEST_F(ExportDownload, AllOfItIsTheFinishedSegmentsFramesUntouchedAsAFileToSave)
   EXPECT_EQ(runCommand("ffmpeg -v error -i '" + file.string() + "' -f null -").output, "");
 }
 
-TEST_F(ExportDownload, ARangeWithAnOffsetAsTypedInTheAddressBarComesAsMcap) {
+TEST_F(ExportDownload, ARangeWithAnOffsetAsTypedInTheAddressBarComesAsMcapWithTheTags) {
   auto first = segments().at(0);
   // "+00:00" unescaped: a query's '+' reads as a space, and is given back.
   std::string start = first["start_utc"].get<std::string>();
   ASSERT_TRUE(start.ends_with("Z")) << start;
   start = start.substr(0, start.size() - 1) + "+00:00";
-  auto response =
+  auto single =
       fetch(exportUrl("camera=" + *camera_ + "&start=" + start + "&end=" + start + "&format=mcap"));
-  ASSERT_EQ(response.status, 200u) << response.body.substr(0, 300);
-  EXPECT_EQ(response.body.substr(0, 8), std::string("\x89MCAP0\r\n", 8));
-  EXPECT_EQ(response.body.substr(response.body.size() - 8), std::string("\x89MCAP0\r\n", 8));
-  EXPECT_EQ(response.headers["x-export-frames"], "1");
-  EXPECT_TRUE(response.headers["content-disposition"].ends_with(".mcap\""));
+  ASSERT_EQ(single.status, 200u) << single.body.substr(0, 300);
+  EXPECT_EQ(single.headers["x-export-frames"], "1");
+  EXPECT_TRUE(single.headers["content-disposition"].ends_with(".mcap\""));
+
+  // The first segment, read by @mcap/core: the frames with a tag have their
+  // outlines on /tags, valid against Foxglove's schema.
+  std::string end = segments().at(1)["start_utc"];
+  auto segment =
+      fetch(exportUrl("camera=" + *camera_ + "&start=" + start + "&end=" + end + "&format=mcap"));
+  ASSERT_EQ(segment.status, 200u) << segment.body.substr(0, 300);
+  fs::path file = saved(segment, "download.mcap");
+  auto checked = runCommand("node '" MCAP_CHECK_DIR "/check.mjs' '" + file.string() + "'");
+  ASSERT_EQ(checked.exitCode, 0) << checked.output;
+  auto result = nlohmann::json::parse(checked.output);
+  EXPECT_EQ(result["invalid"], nlohmann::json::array()) << result["invalid"];
+  EXPECT_GT(result["topics"]["/" + *camera_ + "/tags"].get<int>(), 5) << result["topics"];
+  EXPECT_EQ(std::to_string(result["topics"]["/" + *camera_ + "/image"].get<int>()),
+            segment.headers["x-export-frames"]);
 }
 
 TEST_F(ExportDownload, WrongRequestsAreAnsweredInJson) {
