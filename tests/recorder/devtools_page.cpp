@@ -226,26 +226,21 @@ void DevToolsPage::click(double x, double y) {
 }
 
 void DevToolsPage::drag(double fromX, double fromY, double toX, double toY) {
-  call("Input.dispatchMouseEvent", {{"type", "mousePressed"},
-                                    {"x", fromX},
-                                    {"y", fromY},
-                                    {"button", "left"},
-                                    {"buttons", 1},
-                                    {"clickCount", 1}});
+  auto mouse = [this](const char* type, double x, double y, int buttons) {
+    call("Input.dispatchMouseEvent", {{"type", type},
+                                      {"x", x},
+                                      {"y", y},
+                                      {"button", "left"},
+                                      {"buttons", buttons},
+                                      {"clickCount", 1}});
+  };
+  mouse("mousePressed", fromX, fromY, 1);
   // In steps, as a hand moves: each one a pointermove on the way.
   constexpr int kSteps = 8;
   for (int step = 1; step <= kSteps; ++step)
-    call("Input.dispatchMouseEvent", {{"type", "mouseMoved"},
-                                      {"x", fromX + (toX - fromX) * step / kSteps},
-                                      {"y", fromY + (toY - fromY) * step / kSteps},
-                                      {"button", "left"},
-                                      {"buttons", 1}});
-  call("Input.dispatchMouseEvent", {{"type", "mouseReleased"},
-                                    {"x", toX},
-                                    {"y", toY},
-                                    {"button", "left"},
-                                    {"buttons", 0},
-                                    {"clickCount", 1}});
+    mouse("mouseMoved", fromX + (toX - fromX) * step / kSteps,
+          fromY + (toY - fromY) * step / kSteps, 1);
+  mouse("mouseReleased", toX, toY, 0);
 }
 
 bool DevToolsPage::screenshot(const std::filesystem::path& png) {

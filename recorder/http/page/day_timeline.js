@@ -58,18 +58,8 @@ class DayTimeline {
   }
 
   draw() {
-    const canvas = this.canvas, scale = window.devicePixelRatio || 1;
-    const width = canvas.clientWidth;
-    canvas.width = width * scale;
-    canvas.height = dayHeight * scale;
-    const g = canvas.getContext("2d");
-    g.scale(scale, scale);
-    g.fillStyle = "#0d0f12";
-    g.fillRect(0, 0, width, dayHeight);
-    g.font = "11px sans-serif";
-    g.fillStyle = "#889";
-    for (const [name, [top, rowHeight]] of Object.entries(dayRows))
-      g.fillText(name, 4, top + rowHeight / 2 + 4);
+    const width = this.canvas.clientWidth;
+    const g = timelineCanvas(this.canvas, dayHeight, dayRows);
     const [top, rowHeight] = dayRows.segments;
     this.segments.forEach((segment, i) => {
       const next = this.segments[i + 1];

@@ -131,23 +131,30 @@ const timelineRows = { battery: [4, 30], tags: [38, 10], commands: [54, 10],
 const timelineLeft = 70, timelineRight = 8;
 const timelineSpan = canvas => canvas.clientWidth - timelineLeft - timelineRight;
 
-// Each telemetry line at its time in the segment (pts, ns).
-function drawTimeline() {
-  const canvas = document.getElementById("timeline");
+// A timeline's canvas at the screen's resolution, cleared, its rows
+// ({name: [top, height]}) labelled on the left; its 2D context.
+function timelineCanvas(canvas, height, rows) {
   const scale = window.devicePixelRatio || 1;
-  const width = canvas.clientWidth, height = 104;
-  canvas.width = width * scale;
+  canvas.width = canvas.clientWidth * scale;
   canvas.height = height * scale;
   const g = canvas.getContext("2d");
   g.scale(scale, scale);
   g.fillStyle = "#0d0f12";
-  g.fillRect(0, 0, width, height);
-  const span = timelineSpan(canvas);
-  const x = seconds => timelineLeft + Math.min(1, seconds / (player.duration || 1)) * span;
+  g.fillRect(0, 0, canvas.clientWidth, height);
   g.font = "11px sans-serif";
   g.fillStyle = "#889";
-  for (const [name, [top, rowHeight]] of Object.entries(timelineRows))
+  for (const [name, [top, rowHeight]] of Object.entries(rows))
     g.fillText(name, 4, top + rowHeight / 2 + 4);
+  return g;
+}
+
+// Each telemetry line at its time in the segment (pts, ns).
+function drawTimeline() {
+  const canvas = document.getElementById("timeline");
+  const width = canvas.clientWidth, height = 104;
+  const g = timelineCanvas(canvas, height, timelineRows);
+  const span = timelineSpan(canvas);
+  const x = seconds => timelineLeft + Math.min(1, seconds / (player.duration || 1)) * span;
   const at = line => (line.pts || 0) / 1e9;
   const tick = (line, row, colour) => {
     const [top, rowHeight] = timelineRows[row];
