@@ -1,15 +1,19 @@
 #include "http/export_downloads.h"
 
+#include <sys/socket.h>
+
 #include <algorithm>
 #include <atomic>
 #include <fstream>
 #include <optional>
 #include <thread>
+#include <utility>
 
 #include "common/printable_text.h"
 #include "export/export_range.h"
 #include "export/exporter.h"
 #include "http/http_responses.h"
+#include "log_line.h"
 
 namespace wircam::recorder {
 
@@ -86,7 +90,10 @@ struct ExportDownloads::Download {
   std::atomic<bool> stop{false};
   std::optional<Expected<ExportReport, ExportError>> result;  // the worker's, read after it posts
   std::thread worker;
+  GSocket* socket = nullptr;  // the client's, borrowed: looked at while exporting
+  guint clientCheck = 0;
   std::ifstream file;
+  bool sentAll = false;
   // The result on its way to the main loop checks it: the download may be gone.
   std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
@@ -95,15 +102,32 @@ struct ExportDownloads::Download {
     std::vector<char> block(kBlockBytes);
     file.read(block.data(), static_cast<std::streamsize>(block.size()));
     auto* body = soup_server_message_get_response_body(message);
-    if (file.gcount() > 0)
+    if (file.gcount() > 0) {
       soup_message_body_append(body, SOUP_MEMORY_COPY, block.data(),
                                static_cast<gsize>(file.gcount()));
-    else
+    } else {
       soup_message_body_complete(body);
+      sentAll = true;
+    }
     soup_server_message_unpause(message);
   }
 
+  // The recorder's log says how each export ended.
+  void logEnd() const {
+    std::string what = "export of " + request.camera + " (" + extensionOf(request.format) + ")";
+    if (!result) {
+      logLine(what + ": the client left before it began");
+    } else if (!*result) {
+      bool stopped = result->error().kind == ExportError::Kind::kCancelled;
+      logLine(what + (stopped ? ": stopped, the client left" : ": " + result->error().message));
+    } else {
+      logLine(what + (sentAll ? ": " + std::to_string((*result)->frames) + " frames sent"
+                              : ": the client left before the end"));
+    }
+  }
+
   ~Download() {
+    if (clientCheck) g_source_remove(clientCheck);
     stop = true;
     if (worker.joinable()) worker.join();
     if (message) {
@@ -118,8 +142,10 @@ struct ExportDownloads::Download {
   }
 };
 
-ExportDownloads::ExportDownloads(fs::path recordings)
-    : recordings_(std::move(recordings)), scratch_(recordings_ / ".exports") {
+ExportDownloads::ExportDownloads(fs::path recordings, SocketOf socketOf)
+    : recordings_(std::move(recordings)),
+      scratch_(recordings_ / ".exports"),
+      socketOf_(std::move(socketOf)) {
   std::error_code ignored;
   fs::remove_all(scratch_, ignored);
 }
@@ -173,6 +199,7 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
       g_signal_connect(message, "finished", G_CALLBACK(+[](SoupServerMessage*, gpointer data) {
                          auto* d = static_cast<Download*>(data);
                          d->message = nullptr;  // libsoup is done with it
+                         d->logEnd();
                          d->owner->forget(d);
                        }),
                        download);
@@ -180,6 +207,8 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
   // requests) would answer it; the real one is set when the export is done.
   soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
   soup_server_message_pause(message);
+  download->socket = socketOf_ ? socketOf_(message) : nullptr;
+  if (download->socket) download->clientCheck = g_timeout_add(500, checkClient, download);
   download->worker = std::thread([this, download, alive = std::weak_ptr<bool>(download->alive)] {
     download->result = exportRange(
         download->request, [download](uint64_t, uint64_t) { return !download->stop.load(); });
@@ -200,7 +229,24 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
   downloads_.push_back(std::move(request));
 }
 
+gboolean ExportDownloads::checkClient(gpointer data) {
+  auto* download = static_cast<Download*>(data);
+  // Readable with nothing to read: the client closed its end. (Bytes there
+  // are a next request, sent ahead: the client is still there.)
+  GIOCondition ready = g_socket_condition_check(
+      download->socket, static_cast<GIOCondition>(G_IO_IN | G_IO_HUP | G_IO_ERR));
+  char byte;
+  bool gone = (ready & (G_IO_HUP | G_IO_ERR)) ||
+              ((ready & G_IO_IN) &&
+               recv(g_socket_get_fd(download->socket), &byte, 1, MSG_PEEK | MSG_DONTWAIT) == 0);
+  if (!gone) return G_SOURCE_CONTINUE;
+  download->stop = true;
+  download->clientCheck = 0;
+  return G_SOURCE_REMOVE;
+}
+
 void ExportDownloads::exported(Download* download) {
+  if (download->clientCheck) g_source_remove(std::exchange(download->clientCheck, 0));
   download->worker.join();
   SoupServerMessage* message = download->message;
   auto& result = *download->result;

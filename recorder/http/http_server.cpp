@@ -67,7 +67,11 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     return unexpected("--http: cannot listen on port " + std::to_string(address.port) + ": " +
                       connections.error());
   self->connections_ = std::move(*connections);
-  self->exports_ = std::make_unique<ExportDownloads>(self->content_.recordingsFolder);
+  self->exports_ = std::make_unique<ExportDownloads>(
+      self->content_.recordingsFolder,
+      [connections = self->connections_.get()](SoupServerMessage* message) {
+        return connections->socketOf(message);
+      });
   self->url_ =
       "http://" + address.listenHost() + ":" + std::to_string(self->connections_->port()) + "/";
 

@@ -157,3 +157,35 @@ TEST_F(ExportDownload, NothingIsLeftBehindOnceTheFileIsSent) {
 }
 
 }  // namespace
+
+TEST_F(ExportDownload, AClientThatLeavesLeavesNothingBehind) {
+  // The request sent, the connection closed before the answer.
+  GUri* uri = g_uri_parse(url_->c_str(), G_URI_FLAGS_NONE, nullptr);
+  ASSERT_TRUE(uri);
+  GSocketClient* client = g_socket_client_new();
+  GSocketConnection* connection = g_socket_client_connect_to_host(
+      client, "127.0.0.1", static_cast<guint16>(g_uri_get_port(uri)), nullptr, nullptr);
+  g_uri_unref(uri);
+  ASSERT_TRUE(connection);
+  std::string request =
+      "GET /api/export?camera=" + *camera_ + "&format=mcap HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+  EXPECT_TRUE(g_output_stream_write_all(g_io_stream_get_output_stream(G_IO_STREAM(connection)),
+                                        request.data(), request.size(), nullptr, nullptr, nullptr));
+  g_io_stream_close(G_IO_STREAM(connection), nullptr, nullptr);
+  g_object_unref(connection);
+  g_object_unref(client);
+
+  // Stopped, or written and not sent: either way said, and the file gone.
+  EXPECT_TRUE(waitFor(
+      [] {
+        auto log = recorder_->log();
+        return log.find("export of " + *camera_ + " (mcap): stopped, the client left") !=
+                   std::string::npos ||
+               log.find("export of " + *camera_ + " (mcap): the client left before") !=
+                   std::string::npos;
+      },
+      milliseconds(10000)))
+      << recorder_->log();
+  EXPECT_TRUE(fs::is_empty(recorder_->out() / ".exports"));
+  EXPECT_EQ(fetch(*url_ + "api/status").status, 200u);
+}
