@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <memory>
 
 #include "fleet/mqtt_url.h"
@@ -78,6 +79,38 @@ Expected<DeviceTarget, std::string> deviceTarget(const std::string& argument) {
     return unexpected("--device needs a host, as in 192.168.1.1 or 127.0.0.1:1984");
   target.label = target.host + (target.port == 1984 ? "" : "-" + std::to_string(target.port));
   return target;
+}
+
+// "steering-kp=1.25,max-throttle=0.5" → " steering-kp=1.25 max-throttle=0.5"
+// for wirccontrol: the follower's gains and limits, each within the
+// element's range (nothing else reaches the pipeline's description).
+Expected<std::string, std::string> followTuning(const char* value) {
+  static const std::map<std::string, std::pair<double, double>> kTunable = {
+      {"steering-kp", {0, 100}},        {"steering-ki", {0, 100}}, {"steering-kd", {0, 100}},
+      {"throttle-kp", {0, 100}},        {"throttle-ki", {0, 100}}, {"throttle-kd", {0, 100}},
+      {"target-distance", {0.05, 100}}, {"max-throttle", {0, 1}}};
+  auto decimal = [](double v) {
+    char digits[G_ASCII_DTOSTR_BUF_SIZE];
+    return std::string(g_ascii_dtostr(digits, sizeof digits, v));
+  };
+  std::string tuning;
+  std::unique_ptr<gchar*, decltype(&g_strfreev)> pairs(g_strsplit(value, ",", -1), g_strfreev);
+  for (gchar** pair = pairs.get(); *pair; ++pair) {
+    std::string text = *pair;
+    auto equals = text.find('=');
+    auto range = kTunable.find(text.substr(0, equals));
+    if (range == kTunable.end())
+      return unexpected("'" + text.substr(0, equals) +
+                        "' is not one of steering-kp, steering-ki, steering-kd, throttle-kp, "
+                        "throttle-ki, throttle-kd, target-distance, max-throttle");
+    auto given =
+        equals == std::string::npos ? std::nullopt : number(text.substr(equals + 1).c_str());
+    auto [low, high] = range->second;
+    if (!given || *given < low || *given > high)
+      return unexpected(range->first + " takes a number in " + decimal(low) + ".." + decimal(high));
+    tuning += " " + range->first + "=" + decimal(*given);
+  }
+  return tuning;
 }
 
 // Applies one option given by its long name (from the command line or the
@@ -211,6 +244,10 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     o.detectFamily = value;
   } else if (name == "follow") {
     o.follow = std::string(value) != "false" && std::string(value) != "0";
+  } else if (name == "follow-tuning") {
+    auto tuning = followTuning(value);
+    if (!tuning) return tuning.error();
+    o.followTuning = *tuning;
   } else if (name == "duration") {
     auto seconds = number(value);
     if (!seconds || *seconds <= 0) return "seconds > 0";
@@ -342,6 +379,7 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"http-token", required_argument, nullptr, kValue},
                                    {"detect", required_argument, nullptr, kValue},
                                    {"follow", no_argument, nullptr, kValue},
+                                   {"follow-tuning", required_argument, nullptr, kValue},
                                    {"duration", required_argument, nullptr, kValue},
                                    {"status", required_argument, nullptr, kValue},
                                    {"max-bytes", required_argument, nullptr, kValue},
@@ -390,6 +428,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   if (optind < argc) return unexpected(std::string("unexpected argument '") + argv[optind] + "'");
   if (o.outDir.empty()) return unexpected("--out DIR (or out= in the config) is needed");
   if (o.follow && o.detectFamily.empty()) return unexpected("--follow needs --detect FAMILY");
+  if (!o.followTuning.empty() && !o.follow)
+    return unexpected("--follow-tuning tunes the follower: it needs --follow");
   if (o.container == Container::kMp4 && o.codec == Codec::kJpeg)
     return unexpected(
         "--format mp4 needs --codec h264: GStreamer's mp4mux cannot carry the camera's JPEG "

@@ -71,6 +71,9 @@ struct RecorderOptions {
   unsigned h264Kbps = 2000;
   std::string detectFamily;  // empty: no detection
   bool follow = false;       // needs detectFamily
+  // The follower's tuning, as wirccontrol properties: " steering-kp=1.25 ..."
+  // (checked names and numbers), appended to its element.
+  std::string followTuning;
   std::optional<double> duration;
   double statusSeconds = 1;
   double stallSeconds = 5;  // logged in without a frame this long: no-video, restarted

@@ -34,6 +34,11 @@ file and exits 0.
                          frame (for many cameras on a small machine)
   --detect FAMILY        find AprilTags (e.g. tag36h11); detections go to telemetry
   --follow               steer the vehicle after the largest tag (needs --detect)
+  --follow-tuning K=V[,K=V...]
+                         the follower's gains and limits (wirccontrol's
+                         properties): steering-kp, -ki, -kd, throttle-kp, -ki,
+                         -kd, target-distance, max-throttle; e.g. tried on a
+                         replayed drive (wirc-sim --replay)
   --marvelmind HOST[:PORT]
                          a Marvelmind dashboard (port default 49200) to ask
                          where the vehicle is; with --beacon

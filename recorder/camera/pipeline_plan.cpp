@@ -133,7 +133,8 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
              ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=" +
              stream.detector + " quad-decimate=1 family=" + options.detectFamily;
         if (!stream.controller.empty())
-          d += " ! wirccontrol name=" + stream.controller + controlOf(device);
+          d +=
+              " ! wirccontrol name=" + stream.controller + controlOf(device) + options.followTuning;
         d += " ! fakesink sync=false async=false ";
       }
       if (!stream.liveSink.empty()) {

@@ -48,6 +48,15 @@ Commands:
                                stdin; print one JSON object per message
   encode [--raw]               read JSON objects (one per line) on stdin; print
                                each message as hex (or raw bytes with --raw)
+  compare-commands RECORDED.jsonl REPLAYED.jsonl [--json]
+                               a recorded drive's commands (the recorder's sidecar,
+                               its "control" lines) against those its replay drew
+                               (wirc-sim --replay --commands-out), frame by frame:
+                               the frames compared, mean and max |Δ| of steering
+                               and throttle (µs), how far each steers from
+                               neutral, the frames where one steers left and the
+                               other right (±10 µs is straight ahead), and the
+                               longest run of them; --json: one JSON object
 
 RCOIP and BTEMP vehicles (--protocol rcoip|btemp; port default 9048, 16980):
   drive --protocol P --host H --port N --steering US --throttle US --duration S
@@ -128,6 +137,7 @@ Options parse(int argc, char** argv) {
     kSteering,
     kThrottle,
     kRaw,
+    kJson,
     kToPort,
     kDestination,
     kData,
@@ -162,6 +172,7 @@ Options parse(int argc, char** argv) {
                                    {"steering", required_argument, nullptr, kSteering},
                                    {"throttle", required_argument, nullptr, kThrottle},
                                    {"raw", no_argument, nullptr, kRaw},
+                                   {"json", no_argument, nullptr, kJson},
                                    {"to-port", required_argument, nullptr, kToPort},
                                    {"destination", required_argument, nullptr, kDestination},
                                    {"data", required_argument, nullptr, kData},
@@ -249,6 +260,9 @@ Options parse(int argc, char** argv) {
         break;
       case kThrottle:
         o.throttle = static_cast<int>(integer(optarg, "--throttle", 800, 2200));
+        break;
+      case kJson:
+        o.json = true;
         break;
       case kRaw:
         o.raw = true;

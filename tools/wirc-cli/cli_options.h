@@ -28,7 +28,7 @@ struct Options {
 
   // Command-specific.
   std::optional<std::string> periods, failsafe, ssid, out, country, destination, data, md5;
-  bool passwordStdin = false, station = false, raw = false;
+  bool passwordStdin = false, station = false, raw = false, json = false;
   int camera = 0, channel = 1;
   std::optional<int> frames;
   std::optional<uint16_t> toPort;

@@ -3,9 +3,11 @@
 // positions have their own (cousin_commands, positions_command).
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <string>
 
 #include "cli_options.h"
+#include "command_comparison.h"
 #include "cousin_commands.h"
 #include "positions_command.h"
 #include "wirc_commands.h"
@@ -19,6 +21,26 @@ struct Command {
   int (*run)(const Options&);
   int arguments = -1;  // positional arguments it takes; -1: not checked
 };
+
+// compare-commands RECORDED REPLAYED: exit 1 when a file cannot be read.
+int compareCommandFiles(const Options& o) {
+  std::ifstream recordedFile(o.positional[0]), replayedFile(o.positional[1]);
+  if (!recordedFile) usageError("cannot read " + o.positional[0]);
+  if (!replayedFile) usageError("cannot read " + o.positional[1]);
+  auto recorded = recordedCommands(recordedFile);
+  auto replayed = replayedCommands(replayedFile);
+  if (!recorded || !replayed) {
+    bool first = !recorded;
+    std::fprintf(stderr, "wirc-cli: %s: %s\n", o.positional[first ? 0 : 1].c_str(),
+                 (first ? recorded.error() : replayed.error()).c_str());
+    return 1;
+  }
+  auto comparison = compareCommands(*recorded, *replayed);
+  std::fputs(o.json ? (comparisonJson(comparison).dump() + "\n").c_str()
+                    : comparisonText(comparison).c_str(),
+             stdout);
+  return 0;
+}
 
 // A WiRC device's commands.
 constexpr Command kWircCommands[] = {
@@ -35,6 +57,7 @@ constexpr Command kWircCommands[] = {
     {"drive", drive},
     {"decode", decode},
     {"encode", encode},
+    {"compare-commands", compareCommandFiles, 2},
 };
 
 int positions(Options& o) {

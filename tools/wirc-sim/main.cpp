@@ -1,7 +1,9 @@
 // wirc-sim: a complete WiRC device on this machine, for tests, demos and
 // benchmarks. See --help.
 #include <getopt.h>
+#include <gst/gst.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -16,6 +18,7 @@
 #include "jpeg_sequence_scene.h"
 #include "marvelmind/position_client.h"
 #include "marvelmind_dashboard.h"
+#include "replay/replay_scene.h"
 #include "vehicle_control.h"
 #include "wirc/device.h"
 
@@ -51,6 +54,18 @@ Scene:
                        static: the car stays put, the target still moves
   --frames DIR         stream the .jpg/.jpeg files of DIR in name order,
                        byte for byte, looping (instead of a rendered scene)
+  --replay PATH        replay a recorded drive as the live camera: PATH is a
+                       wirc-recorder segment (.mkv of JPEG) or its folder (the
+                       segments in index order); each frame byte for byte at
+                       its recorded time, outages as outages (a pause over
+                       10 s shortened to 10 s), the battery from the sidecars.
+                       Stops at the end with a summary
+  --camera NAME        the camera to replay from a folder holding several
+  --speed X            replay X times as fast (default 1)
+  --loop               replay again from the start at the end
+  --commands-out FILE  write every PCD received with the frame on screen as
+                       it came: JSON lines {"frame", "pts", "segment",
+                       "channels", "arrival_ms"} (wirc-cli compare-commands)
   --family NAME        tag family (default tag36h11)
   --tags ID[,ID...]    tag ids; the first rides on the target (default 0)
   --tag-size M         tag edge (black border) in metres (default 0.16)
@@ -119,6 +134,11 @@ enum Option {
   kDuration,
   kScene,
   kFrames,
+  kReplay,
+  kCamera,
+  kSpeed,
+  kLoop,
+  kCommandsOut,
   kFamily,
   kTags,
   kTagSize,
@@ -168,6 +188,11 @@ const option kOptions[] = {
     {"duration", required_argument, nullptr, kDuration},
     {"scene", required_argument, nullptr, kScene},
     {"frames", required_argument, nullptr, kFrames},
+    {"replay", required_argument, nullptr, kReplay},
+    {"camera", required_argument, nullptr, kCamera},
+    {"speed", required_argument, nullptr, kSpeed},
+    {"loop", no_argument, nullptr, kLoop},
+    {"commands-out", required_argument, nullptr, kCommandsOut},
     {"family", required_argument, nullptr, kFamily},
     {"tags", required_argument, nullptr, kTags},
     {"tag-size", required_argument, nullptr, kTagSize},
@@ -266,7 +291,11 @@ std::string timestamp() {
 int main(int argc, char** argv) {
   wirc::DeviceConfig device;
   sim::FollowSceneConfig scene;
-  std::optional<std::string> framesDir, truthPath;
+  std::optional<std::string> framesDir, truthPath, replayPath;
+  struct {
+    std::string camera;
+    sim::ReplayScene::Options options;
+  } replay;
   std::optional<double> duration;
   std::string control = "wirc";
   std::optional<uint16_t> controlPort;
@@ -332,6 +361,21 @@ int main(int argc, char** argv) {
         break;
       case kFrames:
         framesDir = optarg;
+        break;
+      case kReplay:
+        replayPath = optarg;
+        break;
+      case kCamera:
+        replay.camera = optarg;
+        break;
+      case kSpeed:
+        replay.options.speed = number(optarg, "speed", 0.01, 100);
+        break;
+      case kLoop:
+        replay.options.loop = true;
+        break;
+      case kCommandsOut:
+        replay.options.commandsOut = optarg;
         break;
       case kFamily:
         scene.family = optarg;
@@ -461,9 +505,43 @@ int main(int argc, char** argv) {
   if (device.name.size() > wirc::kNameWidth) usageError("--name is at most 64 characters");
   if (dashboard && !dashboardPort) usageError("the --marvelmind-* options need --marvelmind PORT");
 
+  if (framesDir && replayPath) usageError("--frames and --replay: one scene at a time");
+  if (!replayPath && (!replay.camera.empty() || replay.options.loop || replay.options.speed != 1 ||
+                      !replay.options.commandsOut.empty()))
+    usageError("--camera, --speed, --loop and --commands-out go with --replay");
+
+  // Signals are taken synchronously below; block them before any thread
+  // starts. SIGUSR1: the replay has ended.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGUSR1);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  auto logger = [](const std::string& line) {
+    std::fprintf(stderr, "%s wirc-sim: %s\n", timestamp().c_str(), line.c_str());
+  };
+
   std::shared_ptr<wirc::DeviceScene> deviceScene;
   sim::FollowScene* follow = nullptr;
-  if (framesDir) {
+  sim::ReplayScene* replayed = nullptr;
+  if (replayPath) {
+    gst_init(&argc, &argv);
+    auto drive = sim::RecordedDrive::open(*replayPath, replay.camera);
+    if (!drive) {
+      std::fprintf(stderr, "wirc-sim: %s\n", drive.error().c_str());
+      return 1;
+    }
+    replay.options.log = logger;
+    replay.options.ended = [] { kill(getpid(), SIGUSR1); };
+    auto created = sim::ReplayScene::create(std::move(*drive), replay.options);
+    if (!created) {
+      std::fprintf(stderr, "wirc-sim: %s\n", created.error().c_str());
+      return 1;
+    }
+    replayed = created->get();
+    deviceScene = std::move(*created);
+  } else if (framesDir) {
     auto frames = sim::JpegSequenceScene::loadFolder(*framesDir);
     if (!frames) usageError(frames.error());
     deviceScene = std::make_shared<sim::JpegSequenceScene>(std::move(*frames));
@@ -477,16 +555,6 @@ int main(int argc, char** argv) {
     deviceScene = std::move(*created);
   }
 
-  // Signals are taken synchronously below; block them before any thread starts.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-
-  auto logger = [](const std::string& line) {
-    std::fprintf(stderr, "%s wirc-sim: %s\n", timestamp().c_str(), line.c_str());
-  };
   auto vehicle = sim::startVehicleControl(control, device.bindAddress, controlPort, logger);
   if (!vehicle) {
     std::fprintf(stderr, "wirc-sim: %s\n", vehicle.error().c_str());
@@ -533,7 +601,11 @@ int main(int argc, char** argv) {
   positions.reset();
 
   auto stats = sim->stats();
-  std::printf("wirc-sim summary:%s\n", caught > 0 ? " (stopped by signal)" : "");
+  const char* ending = caught == SIGUSR1 ? " (the replay ended)"
+                       : caught > 0      ? " (stopped by signal)"
+                                         : "";
+  std::printf("wirc-sim summary:%s\n", ending);
+  if (replayed) std::printf("  %s\n", replayed->summary().c_str());
   std::printf("  frames sent        %llu (%llu datagrams)\n",
               static_cast<unsigned long long>(stats.framesSent),
               static_cast<unsigned long long>(stats.datagramsSent));

@@ -143,10 +143,12 @@ void Device::Impl::runTimers(DeviceClock::time_point now) {
   }
   if (now >= nextFrame_) {
     tickFrame(now);
-    auto period =
-        duration_cast<DeviceClock::duration>(std::chrono::duration<double>(1.0 / config_.fps));
-    nextFrame_ += period;
-    if (nextFrame_ <= now) nextFrame_ = now + period;  // skip ticks we were too slow for
+    auto period = scene_ ? scene_->frameInterval() : std::nullopt;
+    if (!period)
+      period =
+          duration_cast<DeviceClock::duration>(std::chrono::duration<double>(1.0 / config_.fps));
+    nextFrame_ += *period;
+    if (nextFrame_ <= now) nextFrame_ = now + *period;  // skip ticks we were too slow for
   }
 }
 
@@ -160,7 +162,7 @@ void Device::Impl::tickFrame(DeviceClock::time_point now) {
                                           batteryMillivolts_ - seconds * (0.2 + 4.0 * throttle));
   }
   lastTick_ = now;
-  if (!scene_) return;
+  if (!scene_ || (streams_.empty() && scene_->waitsForViewer())) return;
   scene_->advance(now, config_.carControl ? config_.carControl(now) : localOutputs_);
   for (int camera = 0; camera < config_.cameras; ++camera) {
     std::vector<uint8_t> jpeg;
@@ -179,7 +181,8 @@ void Device::Impl::tickFrame(DeviceClock::time_point now) {
 
 void Device::Impl::sendStatus() {
   Psd psd;
-  psd.batteryMillivolts = static_cast<uint16_t>(batteryMillivolts_);
+  auto known = scene_ ? scene_->batteryMillivolts() : std::nullopt;
+  psd.batteryMillivolts = known.value_or(static_cast<uint16_t>(batteryMillivolts_));
   psd.analogMillivolts = 1650;
   // The digital inputs read back the digital outputs ch9..ch12, as if wired
   // together: a transmitter can see its own PCD take effect.
@@ -269,6 +272,7 @@ void Device::Impl::readPcd(DeviceClock::time_point now) {
   if (localOutputs_.failsafe) log("PCD received: leaving failsafe");
   localOutputs_.pulses = std::get<Pcd>(*message).values;
   localOutputs_.failsafe = false;
+  if (scene_) scene_->pcdReceived(now, localOutputs_.pulses);
 }
 
 void Device::Impl::enterFailsafe(const std::string& why) {

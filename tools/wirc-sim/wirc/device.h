@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "common/expected.h"
@@ -34,6 +35,17 @@ class DeviceScene {
   virtual void advance(DeviceClock::time_point now, const ChannelOutputs& outputs) = 0;
   // The current picture of `camera` as a JPEG file.
   virtual std::vector<uint8_t> renderJpeg(int camera) = 0;
+  // A scene with a timing of its own (a replayed recording): how long until
+  // the next frame after the one just shown. Nothing: the device's --fps.
+  virtual std::optional<DeviceClock::duration> frameInterval() { return std::nullopt; }
+  // The battery the scene knows (a recording's), instead of the device's
+  // own drain model.
+  virtual std::optional<uint16_t> batteryMillivolts() { return std::nullopt; }
+  // A scene that is watched rather than lived (a replay) stands still until
+  // a stream is started, so that its first frame is the first one seen.
+  virtual bool waitsForViewer() const { return false; }
+  // A valid PCD from the controller arrived at `at`.
+  virtual void pcdReceived(DeviceClock::time_point /*at*/, const ChannelValues& /*values*/) {}
 };
 
 struct DeviceConfig {

@@ -57,6 +57,28 @@ TEST(RecorderOptions, TheTelemetryTrackIsOnUnlessTurnedOff) {
   EXPECT_EQ(neither.error(), "--telemetry-track: on or off");
 }
 
+TEST(RecorderOptions, FollowTuningTakesTheFollowersGainsWithinTheirRanges) {
+  auto options = parse({"--out", "x", "--detect", "tag36h11", "--follow", "--follow-tuning",
+                        "steering-kp=1.25,max-throttle=0.5"});
+  ASSERT_TRUE(options.has_value()) << options.error();
+  EXPECT_EQ(options->followTuning, " steering-kp=1.25 max-throttle=0.5");
+  auto unknown = parse({"--out", "x", "--detect", "tag36h11", "--follow", "--follow-tuning",
+                        "host=evil ! filesink location=/etc/passwd"});
+  ASSERT_FALSE(unknown.has_value());
+  EXPECT_NE(unknown.error().find("'host' is not one of steering-kp"), std::string::npos)
+      << unknown.error();
+  auto outside = parse(
+      {"--out", "x", "--detect", "tag36h11", "--follow", "--follow-tuning", "max-throttle=2"});
+  ASSERT_FALSE(outside.has_value());
+  EXPECT_EQ(outside.error(), "--follow-tuning: max-throttle takes a number in 0..1");
+  auto injected = parse({"--out", "x", "--detect", "tag36h11", "--follow", "--follow-tuning",
+                         "steering-kp=1 ! fakesink"});
+  EXPECT_FALSE(injected.has_value());
+  auto alone = parse({"--out", "x", "--follow-tuning", "steering-kp=1"});
+  ASSERT_FALSE(alone.has_value());
+  EXPECT_NE(alone.error().find("needs --follow"), std::string::npos) << alone.error();
+}
+
 TEST(RecorderOptions, RefusesNumbersNoFieldCanHold) {
   // Found by fuzz_recorder_input: these used to reach a cast that is undefined.
   EXPECT_FALSE(parse({"--out", "x", "--max-bytes", "1e120"}).has_value());

@@ -1,0 +1,162 @@
+#include "replay/recorded_drive.h"
+
+#include <gst/gst.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "export/export_range.h"
+#include "export/segment_reader.h"
+#include "record/recording_index.h"
+
+namespace wircam::sim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr uint16_t kFullBatteryMv = 8400;
+
+// The cameras whose segments are in `folder`, from the file names.
+std::set<std::string> camerasIn(const fs::path& folder) {
+  std::set<std::string> cameras;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(folder, error))
+    if (auto name = recorder::parseSegmentName(entry.path().filename().string()))
+      cameras.insert(name->camera);
+  return cameras;
+}
+
+bool isJpeg(GstCaps* caps) {
+  return caps && gst_structure_has_name(gst_caps_get_structure(caps, 0), "image/jpeg");
+}
+
+std::string mediaTypeOf(GstCaps* caps) {
+  return caps ? gst_structure_get_name(gst_caps_get_structure(caps, 0)) : "nothing";
+}
+
+}  // namespace
+
+RecordedDrive::~RecordedDrive() = default;
+
+Expected<std::unique_ptr<RecordedDrive>, std::string> RecordedDrive::open(
+    const fs::path& path, const std::string& camera) {
+  std::unique_ptr<RecordedDrive> drive(new RecordedDrive);
+  std::error_code error;
+  if (fs::is_regular_file(path, error)) {
+    // One file on its own timeline: its frames' times are its pts.
+    auto name = recorder::parseSegmentName(path.filename().string());
+    drive->camera_ = name ? name->camera : path.stem().string();
+    drive->segments_.push_back({path, 0});
+  } else if (fs::is_directory(path, error)) {
+    drive->camera_ = camera;
+    if (camera.empty()) {
+      auto cameras = camerasIn(path);
+      if (cameras.empty()) return unexpected("no recordings in " + path.string());
+      if (cameras.size() > 1) {
+        std::string names;
+        for (const auto& name : cameras) names += (names.empty() ? "" : ", ") + name;
+        return unexpected(path.string() + " holds several cameras (" + names +
+                          "): choose one with --camera");
+      }
+      drive->camera_ = *cameras.begin();
+    }
+    auto selection = recorder::selectSegments(path, drive->camera_, std::nullopt, std::nullopt);
+    if (!selection) return unexpected(selection.error());
+    for (const auto& segment : selection->segments)
+      drive->segments_.push_back({segment.video, segment.startNs});
+    drive->notes_ = std::move(selection->notes);
+  } else {
+    return unexpected("no such file or folder: " + path.string());
+  }
+  // The WiRC protocol carries JPEG: an H.264 recording cannot be replayed.
+  auto first = recorder::SegmentReader::open(drive->segments_.front().video);
+  if (!first) return unexpected(first.error());
+  auto frame = (*first)->next();
+  if (!frame || !*frame)
+    return unexpected(drive->segments_.front().video.string() + " holds no readable frame");
+  if (!isJpeg((*first)->caps()))
+    return unexpected(drive->segments_.front().video.filename().string() + " holds " +
+                      mediaTypeOf((*first)->caps()) +
+                      ": the WiRC protocol carries JPEG frames, so only recordings made with "
+                      "--codec jpeg (the default) can be replayed");
+  drive->readBattery();
+  return drive;
+}
+
+void RecordedDrive::readBattery() {
+  for (const auto& segment : segments_)
+    for (const auto& text : recorder::sidecarLines(segment.video)) {
+      auto line = nlohmann::json::parse(text, nullptr, false);
+      if (!line.is_object() || !line.contains("battery-v") || !line["battery-v"].is_number())
+        continue;
+      double volts = line["battery-v"];
+      if (volts < 0 || volts > 60) continue;
+      battery_.emplace_back(segment.startNs + line.value("pts", int64_t{0}),
+                            static_cast<uint16_t>(std::lround(volts * 1000)));
+    }
+  std::stable_sort(battery_.begin(), battery_.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (battery_.empty())
+    notes_.push_back("no battery reports in the sidecars: the status says a full 8.4 V");
+}
+
+uint16_t RecordedDrive::batteryMillivoltsAt(int64_t timeNs) const {
+  auto after = std::upper_bound(battery_.begin(), battery_.end(), timeNs,
+                                [](int64_t t, const auto& report) { return t < report.first; });
+  if (after == battery_.begin()) return battery_.empty() ? kFullBatteryMv : after->second;
+  return std::prev(after)->second;
+}
+
+std::optional<RecordedDrive::Frame> RecordedDrive::next() {
+  while (current_ < segments_.size()) {
+    const auto& segment = segments_[current_];
+    std::string name = segment.video.filename().string();
+    if (!reader_) {
+      auto opened = recorder::SegmentReader::open(segment.video);
+      if (!opened) {
+        notes_.push_back(name + ": " + opened.error() + ": skipped");
+        ++current_;
+        continue;
+      }
+      reader_ = std::move(*opened);
+      framesInSegment_ = 0;
+    }
+    auto frame = reader_->next();
+    if (frame && *frame && !isJpeg(reader_->caps())) {
+      notes_.push_back(name + " holds " + mediaTypeOf(reader_->caps()) + ": skipped");
+      frame = std::optional<recorder::SegmentFrame>();
+    }
+    if (!frame)
+      notes_.push_back(name + ": broken off after " + std::to_string(framesInSegment_) +
+                       " frames (" + frame.error() + ")");
+    if (!frame || !*frame) {
+      reader_.reset();
+      ++current_;
+      continue;
+    }
+    ++framesInSegment_;
+    Frame out;
+    GstMapInfo map;
+    if (gst_buffer_map((*frame)->buffer, &map, GST_MAP_READ)) {
+      out.jpeg.assign(map.data, map.data + map.size);
+      gst_buffer_unmap((*frame)->buffer, &map);
+    }
+    out.ptsNs = (*frame)->ptsNs;
+    out.timeNs = segment.startNs + out.ptsNs;
+    out.segment = name;
+    return out;
+  }
+  return std::nullopt;
+}
+
+void RecordedDrive::rewind() {
+  reader_.reset();
+  current_ = 0;
+}
+
+std::vector<std::string> RecordedDrive::takeNotes() { return std::exchange(notes_, {}); }
+
+}  // namespace wircam::sim
