@@ -1,0 +1,228 @@
+// A recorded drive replayed as a live vehicle (the simulator's device with
+// the replay scene, as wirc-sim --replay runs them) into wirc-recorder
+// --follow: the frames arrive byte for byte at their recorded intervals,
+// the follower commands what it commanded on the drive, a halved steering
+// gain steers less, and wirc-cli compare-commands says so.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <atomic>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "camera_checks.h"
+#include "recorder_process.h"
+#include "replay/replay_scene.h"
+#include "shell_command.h"
+#include "signed_in_page.h"
+#include "wait_for.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using namespace wircam::testing;
+using std::chrono::milliseconds;
+
+const std::vector<std::string> kFollow = {"--detect", "tag36h11", "--follow"};
+
+// The recording's one segment, and its sidecar.
+fs::path segmentOf(const RecorderProcess& recorder) { return recorder.files(".mkv").at(0); }
+fs::path sidecarOf(const RecorderProcess& recorder) {
+  return fs::path(segmentOf(recorder)).replace_extension(".jsonl");
+}
+
+// The recording replayed into a recorder following with `extra`, until the
+// replay's end; the recorder's files and the commands it sent.
+struct ReplayRun {
+  std::unique_ptr<RecorderProcess> recorder;
+  fs::path commands;
+  std::string summary;
+};
+
+ReplayRun replay(const fs::path& recording, std::vector<std::string> extra,
+                 const std::string& tag) {
+  ReplayRun run;
+  auto drive = sim::RecordedDrive::open(recording);
+  EXPECT_TRUE(drive.has_value()) << drive.error();
+  if (!drive) return run;
+  run.commands = recording.parent_path() / ("commands-" + tag + ".jsonl");
+  auto ended = std::make_shared<std::atomic<bool>>(false);
+  auto scene = sim::ReplayScene::create(std::move(*drive), {.commandsOut = run.commands.string(),
+                                                            .ended = [ended] { *ended = true; }});
+  EXPECT_TRUE(scene.has_value());
+  if (!scene) return run;
+  sim::ReplayScene* replayed = scene->get();
+  auto device = wirc::Device::start({.port = 0}, std::move(*scene));
+  EXPECT_TRUE(device.has_value());
+  if (!device) return run;
+  extra.insert(extra.end(), kFollow.begin(), kFollow.end());
+  extra.insert(extra.end(), {"--duration", "60"});
+  run.recorder = std::make_unique<RecorderProcess>((*device)->port(), extra);
+  EXPECT_TRUE(waitFor([&] { return ended->load(); }, milliseconds(40000))) << run.recorder->log();
+  run.recorder->signal(SIGINT);
+  EXPECT_EQ(run.recorder->wait(), 0) << run.recorder->log();
+  (*device)->stop();
+  run.summary = replayed->summary();
+  return run;
+}
+
+nlohmann::json compare(const fs::path& recorded, const fs::path& replayed) {
+  auto ran = runCommand(std::string(WIRC_CLI) + " compare-commands '" + recorded.string() + "' '" +
+                        replayed.string() + "' --json");
+  EXPECT_EQ(ran.exitCode, 0) << ran.output;
+  // In the test's output, for the README's figures.
+  ::testing::Test::RecordProperty("compare-commands " + replayed.stem().string(), ran.output);
+  return nlohmann::json::parse(ran.output, nullptr, false);
+}
+
+// 10 s of the follow scene recorded with --follow, replayed once with the
+// same settings; for every test.
+class Replay : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    car_ = new FollowedCar;
+    original_ = new RecorderProcess(car_->device->port(), {"--detect", "tag36h11", "--follow",
+                                                           "--segment", "60", "--duration", "10"});
+    ASSERT_EQ(original_->wait(), 0) << original_->log();
+    same_ = new ReplayRun(replay(segmentOf(*original_), {}, "same"));
+  }
+  static void TearDownTestSuite() {
+    delete same_;
+    delete original_;
+    delete car_;
+  }
+  static FollowedCar* car_;
+  static RecorderProcess* original_;
+  static ReplayRun* same_;
+};
+FollowedCar* Replay::car_ = nullptr;
+RecorderProcess* Replay::original_ = nullptr;
+ReplayRun* Replay::same_ = nullptr;
+
+TEST_F(Replay, EveryFrameArrivesByteForByteAtItsRecordedInterval) {
+  ASSERT_TRUE(same_->recorder);
+  auto recorded = frameDigests(segmentOf(*original_));
+  auto replayed = frameDigests(segmentOf(*same_->recorder));
+  ASSERT_GT(recorded.size(), 100u);
+  EXPECT_EQ(replayed, recorded);
+  EXPECT_NE(same_->summary.find("replayed " + std::to_string(recorded.size()) + " frames"),
+            std::string::npos)
+      << same_->summary;
+  // Both files keep whole milliseconds; the receiver stamps arrivals.
+  auto before = contentsOf(segmentOf(*original_)).framePts;
+  auto after = contentsOf(segmentOf(*same_->recorder)).framePts;
+  ASSERT_EQ(before.size(), after.size());
+  size_t within = 0;
+  for (size_t i = 1; i < before.size(); ++i) {
+    auto recordedInterval = static_cast<int64_t>(before[i] - before[i - 1]);
+    auto replayedInterval = static_cast<int64_t>(after[i] - after[i - 1]);
+    within += std::llabs(recordedInterval - replayedInterval) <= 2 * GST_MSECOND;
+  }
+  EXPECT_GE(within, (before.size() - 1) * 95 / 100) << within << " of " << before.size() - 1;
+}
+
+TEST_F(Replay, TheSameFollowerCommandsTheSameDirectionAndSaysSo) {
+  ASSERT_TRUE(same_->recorder);
+  auto result = compare(sidecarOf(*original_), same_->commands);
+  ASSERT_TRUE(result.is_object());
+  auto frames = result["frames"].get<uint64_t>();
+  EXPECT_GT(frames, 100u);
+  EXPECT_LE(result["direction_disagreements"].get<uint64_t>() * 100, frames * 2) << result;
+  // The human form says the same.
+  auto text = runCommand(std::string(WIRC_CLI) + " compare-commands '" +
+                         sidecarOf(*original_).string() + "' '" + same_->commands.string() + "'");
+  EXPECT_NE(text.output.find("frames compared          " + std::to_string(frames)),
+            std::string::npos)
+      << text.output;
+}
+
+TEST_F(Replay, AHalvedSteeringGainSteersLess) {
+  auto halved =
+      replay(segmentOf(*original_),
+             {"--follow-tuning", "steering-kp=1.25,steering-ki=0.3,steering-kd=0.05"}, "halved");
+  ASSERT_TRUE(halved.recorder);
+  auto result = compare(sidecarOf(*original_), halved.commands);
+  ASSERT_TRUE(result.is_object());
+  double recorded = result["steering_from_neutral_us"]["recorded"];
+  double replayed = result["steering_from_neutral_us"]["replayed"];
+  EXPECT_GT(recorded, 10) << result;  // the car did steer
+  EXPECT_LT(replayed, 0.75 * recorded) << result;
+  EXPECT_GT(replayed, 0.25 * recorded) << result;
+}
+
+TEST_F(Replay, WhatCannotBeReplayedIsSaidAndABrokenFileIsPlayedAsFarAsItIsWhole) {
+  fs::path folder = original_->out().parent_path() / "mixed";
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  std::string file = segmentOf(*original_).filename().string();
+  std::string camera = cameraName(car_->device->port());
+  std::string time = file.substr(camera.size());  // "-20261124T....mkv"
+  fs::copy(segmentOf(*original_), folder / ("roverA-cam0" + time));
+  fs::copy(segmentOf(*original_), folder / ("roverB-cam0" + time));
+  auto mixed = sim::RecordedDrive::open(folder);
+  ASSERT_FALSE(mixed.has_value());
+  EXPECT_NE(mixed.error().find("several cameras (roverA-cam0, roverB-cam0): choose one with "
+                               "--camera"),
+            std::string::npos)
+      << mixed.error();
+  auto chosen = sim::RecordedDrive::open(folder, "roverB-cam0");
+  ASSERT_TRUE(chosen.has_value()) << chosen.error();
+  EXPECT_EQ((*chosen)->camera(), "roverB-cam0");
+
+  // Cut in the middle: the frames before the cut, then said.
+  fs::path cut = folder / ("cut-cam0" + time);
+  fs::copy(segmentOf(*original_), cut);
+  fs::resize_file(cut, fs::file_size(cut) / 2);
+  auto broken = sim::RecordedDrive::open(cut);
+  ASSERT_TRUE(broken.has_value()) << broken.error();
+  size_t frames = 0;
+  while ((*broken)->next()) ++frames;
+  EXPECT_GT(frames, 10u);
+  EXPECT_LT(frames, frameDigests(segmentOf(*original_)).size());
+  // Without a sidecar the battery stays full, and that is said.
+  auto notes = (*broken)->takeNotes();
+  EXPECT_NE(std::find_if(notes.begin(), notes.end(),
+                         [](const auto& n) { return n.find("full 8.4 V") != std::string::npos; }),
+            notes.end());
+  EXPECT_EQ((*broken)->batteryMillivoltsAt(0), 8400);
+
+  // H.264 cannot go over the WiRC protocol.
+  fs::path h264 = folder / ("h264-cam0" + time);
+  std::string description =
+      "videotestsrc num-buffers=10 ! x264enc ! h264parse ! matroskamux ! "
+      "filesink location=\"" +
+      h264.string() + "\"";
+  GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
+  ASSERT_TRUE(pipeline);
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  GstBus* bus = gst_element_get_bus(pipeline);
+  gst_message_unref(gst_bus_timed_pop_filtered(
+      bus, GST_CLOCK_TIME_NONE, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR)));
+  gst_object_unref(bus);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+  auto refused = sim::RecordedDrive::open(h264);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_NE(refused.error().find("video/x-h264: the WiRC protocol carries JPEG"), std::string::npos)
+      << refused.error();
+}
+
+TEST_F(Replay, TheBatteryIsTheRecordedOne) {
+  auto drive = sim::RecordedDrive::open(segmentOf(*original_));
+  ASSERT_TRUE(drive.has_value());
+  // The simulated car's battery drains as it drives: the replay's status
+  // says what the sidecar said at that moment, not a model's guess.
+  std::ifstream sidecar(sidecarOf(*original_));
+  int checked = 0;
+  for (std::string text; std::getline(sidecar, text);) {
+    auto line = nlohmann::json::parse(text);
+    if (!line.contains("battery-v")) continue;
+    EXPECT_EQ((*drive)->batteryMillivoltsAt(line["pts"].get<int64_t>()),
+              std::lround(line["battery-v"].get<double>() * 1000));
+    ++checked;
+  }
+  EXPECT_GT(checked, 5);
+}
+
+}  // namespace
