@@ -242,6 +242,68 @@ TEST_F(Replay, WhatCannotBeReplayedIsSaidAndABrokenFileIsPlayedAsFarAsItIsWhole)
       << refused.error();
 }
 
+// The scene as the device drives it: a tick, the frame, the time to the next.
+struct Tick {
+  bool frame;
+  std::chrono::nanoseconds interval;
+};
+Tick tick(sim::ReplayScene& scene) {
+  scene.advance(wirc::DeviceClock::now(), {});
+  return {!scene.renderJpeg(0).empty(),
+          std::chrono::duration_cast<std::chrono::nanoseconds>(*scene.frameInterval())};
+}
+
+TEST_F(Replay, AnOutageStaysAnOutageAndALongPauseIsShortened) {
+  // One camera's three segments: 15 s apart (an outage of about 5 s after
+  // the first), then an hour later (a pause, not an outage).
+  fs::path folder = original_->out().parent_path() / "outages";
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  for (const char* time : {"20261124T100000Z", "20261124T100015Z", "20261124T110000Z"})
+    fs::copy(segmentOf(*original_), folder / ("gap-cam0-" + std::string(time) + ".mkv"));
+  auto drive = sim::RecordedDrive::open(folder);
+  ASSERT_TRUE(drive.has_value()) << drive.error();
+  std::vector<std::string> said;
+  auto scene = sim::ReplayScene::create(
+      std::move(*drive), {.log = [&](const std::string& line) { said.push_back(line); }});
+  ASSERT_TRUE(scene.has_value());
+  size_t frames = frameDigests(segmentOf(*original_)).size();
+  std::vector<std::chrono::nanoseconds> boundaries;
+  for (size_t i = 0; i < 3 * frames; ++i) {
+    auto t = tick(**scene);
+    ASSERT_TRUE(t.frame) << i;
+    if (i % frames == frames - 1 && i + 1 < 3 * frames) boundaries.push_back(t.interval);
+    if (i % frames != frames - 1) {
+      EXPECT_LT(t.interval, std::chrono::milliseconds(200)) << i;
+    }
+  }
+  ASSERT_EQ(boundaries.size(), 2u);
+  EXPECT_GT(boundaries[0], std::chrono::seconds(4));
+  EXPECT_LT(boundaries[0], std::chrono::seconds(6));
+  EXPECT_EQ(boundaries[1], sim::ReplayScene::kMaxGap);
+  EXPECT_NE(std::find_if(said.begin(), said.end(),
+                         [](const auto& l) { return l.find("replayed as 10 s") != l.npos; }),
+            said.end());
+  EXPECT_FALSE(tick(**scene).frame);  // the end
+}
+
+TEST_F(Replay, LoopStartsAgainAndSpeedShortensEveryInterval) {
+  auto drive = sim::RecordedDrive::open(segmentOf(*original_));
+  ASSERT_TRUE(drive.has_value());
+  auto scene = sim::ReplayScene::create(std::move(*drive), {.speed = 2, .loop = true});
+  ASSERT_TRUE(scene.has_value());
+  auto pts = contentsOf(segmentOf(*original_)).framePts;
+  for (size_t i = 0; i < pts.size() + 5; ++i) {
+    auto t = tick(**scene);
+    ASSERT_TRUE(t.frame) << i;
+    size_t at = i % pts.size();
+    if (at + 1 < pts.size()) {
+      EXPECT_EQ(t.interval.count(), static_cast<int64_t>(pts[at + 1] - pts[at]) / 2) << i;
+    }
+  }
+  EXPECT_NE((*scene)->summary().find(", 2 times"), std::string::npos) << (*scene)->summary();
+}
+
 TEST_F(Replay, TheBatteryIsTheRecordedOne) {
   auto drive = sim::RecordedDrive::open(segmentOf(*original_));
   ASSERT_TRUE(drive.has_value());
