@@ -147,6 +147,7 @@ std::optional<RecordedDrive::Frame> RecordedDrive::next() {
     out.ptsNs = (*frame)->ptsNs;
     out.timeNs = segment.startNs + out.ptsNs;
     out.segment = name;
+    out.index = framesRead_++;
     return out;
   }
   return std::nullopt;
@@ -155,6 +156,7 @@ std::optional<RecordedDrive::Frame> RecordedDrive::next() {
 void RecordedDrive::rewind() {
   reader_.reset();
   current_ = 0;
+  framesRead_ = 0;
 }
 
 std::vector<std::string> RecordedDrive::takeNotes() { return std::exchange(notes_, {}); }

@@ -26,6 +26,7 @@ class RecordedDrive {
     int64_t timeNs = 0;  // on the drive's timeline: a folder's UTC, a file's own
     int64_t ptsNs = 0;   // in its segment, as its sidecar's lines count
     std::string segment;
+    uint64_t index = 0;  // in the drive, from 0
   };
 
   // `path`: a segment (.mkv of JPEG) or a folder of them; `camera` (as in
@@ -65,7 +66,7 @@ class RecordedDrive {
   std::vector<Segment> segments_;
   size_t current_ = 0;
   std::unique_ptr<recorder::SegmentReader> reader_;
-  uint64_t framesInSegment_ = 0;
+  uint64_t framesInSegment_ = 0, framesRead_ = 0;
   std::vector<std::pair<int64_t, uint16_t>> battery_;  // (time, mV), in time order
   std::vector<std::string> notes_;
 };

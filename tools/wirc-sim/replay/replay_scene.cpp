@@ -46,9 +46,7 @@ void ReplayScene::sayNotes() {
 
 void ReplayScene::advance(wirc::DeviceClock::time_point now, const wirc::ChannelOutputs&) {
   if (!started_) started_ = now;
-  bool first = !shown_;
   shown_ = std::move(coming_);
-  if (shown_) frameIndex_ = first ? 0 : frameIndex_ + 1;
   coming_ = drive_->next();
   if (!coming_ && shown_ && options_.loop) {
     drive_->rewind();
@@ -90,7 +88,7 @@ std::optional<uint16_t> ReplayScene::batteryMillivolts() {
 void ReplayScene::pcdReceived(wirc::DeviceClock::time_point at, const wirc::ChannelValues& values) {
   if (!commands_ || !shown_ || !started_) return;
   nlohmann::json line = {
-      {"frame", frameIndex_},
+      {"frame", shown_->index},
       {"pts", shown_->ptsNs},
       {"segment", shown_->segment},
       {"channels", values},

@@ -54,7 +54,6 @@ class ReplayScene : public wirc::DeviceScene {
   Options options_;
   std::FILE* commands_ = nullptr;
   std::optional<RecordedDrive::Frame> shown_, coming_;
-  uint64_t frameIndex_ = 0;  // of the frame shown, from 0
   uint64_t framesShown_ = 0, commandsWritten_ = 0, loops_ = 0;
   bool endSaid_ = false;
   std::optional<wirc::DeviceClock::time_point> started_;
