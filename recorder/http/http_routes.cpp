@@ -1,5 +1,9 @@
 #include "http/http_routes.h"
 
+#include <glib.h>
+
+#include <string>
+
 namespace wircam::recorder {
 
 namespace {
@@ -65,12 +69,25 @@ bool sameSecret(std::string_view given, std::string_view token) {
 
 }  // namespace
 
+// "Basic base64(user:password)" with the token as the password, whatever
+// the user name: what VLC, OpenCV and Home Assistant send from a URL's
+// user:password@.
+bool basicCarries(std::string_view credentials, std::string_view token) {
+  std::string encoded(credentials);
+  gsize size = 0;
+  guchar* decoded = g_base64_decode(encoded.c_str(), &size);
+  std::string pair(reinterpret_cast<const char*>(decoded), size);
+  g_free(decoded);
+  auto colon = pair.find(':');
+  return colon != std::string::npos && sameSecret(std::string_view(pair).substr(colon + 1), token);
+}
+
 bool carriesToken(const char* authorization, const char* cookie, std::string_view token) {
   if (token.empty()) return true;
-  constexpr std::string_view kBearer = "Bearer ";
-  if (authorization && std::string_view(authorization).starts_with(kBearer) &&
-      sameSecret(std::string_view(authorization).substr(kBearer.size()), token))
-    return true;
+  constexpr std::string_view kBearer = "Bearer ", kBasic = "Basic ";
+  std::string_view given = authorization ? authorization : "";
+  if (given.starts_with(kBearer) && sameSecret(given.substr(kBearer.size()), token)) return true;
+  if (given.starts_with(kBasic) && basicCarries(given.substr(kBasic.size()), token)) return true;
   if (!cookie) return false;
   // "a=1; wircam_token=T; b=2"
   std::string_view cookies = cookie;

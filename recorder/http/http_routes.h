@@ -35,9 +35,10 @@ struct Route {
 // `path` as libsoup hands it over (percent-decoded).
 Route routeOf(std::string_view path);
 
-// Whether a request carries the access token, as "Authorization: Bearer T"
-// or the "wircam_token" cookie (either header may be null). Compared in
-// constant time.
+// Whether a request carries the access token, as "Authorization: Bearer T",
+// as the password of "Authorization: Basic" (any user name), or the
+// "wircam_token" cookie (either header may be null). Compared in constant
+// time.
 bool carriesToken(const char* authorization, const char* cookie, std::string_view token);
 
 // A recording may be served by this name: a plain file name (no folder, not

@@ -194,8 +194,11 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
     if (route.kind == Route::Kind::Page)
       return respond(message, SOUP_STATUS_UNAUTHORIZED, "text/html; charset=utf-8",
                      pageFile("login.html"));
-    soup_message_headers_replace(soup_server_message_get_response_headers(message),
-                                 "WWW-Authenticate", "Bearer realm=\"wirc-recorder\"");
+    // Basic first: clients that know only it (VLC, OpenCV, Home Assistant)
+    // ask for the user name and password, any name and the token.
+    auto* headers = soup_server_message_get_response_headers(message);
+    soup_message_headers_append(headers, "WWW-Authenticate", "Basic realm=\"wirc-recorder\"");
+    soup_message_headers_append(headers, "WWW-Authenticate", "Bearer realm=\"wirc-recorder\"");
     return respondJsonError(message, SOUP_STATUS_UNAUTHORIZED,
                             "needs the access token: Authorization: Bearer T, or sign in at "
                             "/login");

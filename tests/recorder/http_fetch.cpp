@@ -17,7 +17,7 @@ Response fetch(const std::string& url, const char* method, const Headers& header
       soup_message_headers_get_content_type(soup_message_get_response_headers(message), nullptr);
   response.contentType = type ? type : "";
   const char* authenticate =
-      soup_message_headers_get_one(soup_message_get_response_headers(message), "WWW-Authenticate");
+      soup_message_headers_get_list(soup_message_get_response_headers(message), "WWW-Authenticate");
   response.authenticate = authenticate ? authenticate : "";
   SoupMessageHeadersIter headerIter;
   soup_message_headers_iter_init(&headerIter, soup_message_get_response_headers(message));

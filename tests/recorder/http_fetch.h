@@ -14,7 +14,7 @@ struct Response {
   guint status = 0;
   std::string contentType;
   std::string body;
-  std::string authenticate;                    // the WWW-Authenticate header
+  std::string authenticate;                    // the WWW-Authenticate headers, joined by ", "
   std::map<std::string, std::string> headers;  // every response header, by its name in lower case
 };
 

@@ -9,6 +9,7 @@
 
 #include "http_fetch.h"
 #include "recorder_process.h"
+#include "shell_command.h"
 #include "simulated_device.h"
 #include "wait_for.h"
 
@@ -33,7 +34,8 @@ TEST(WircRecorderHttpToken, EveryRequestNeedsTheTokenAsBearerOrCookie) {
     auto refused = fetch(*url + path);
     EXPECT_EQ(refused.status, 401u) << path;
     EXPECT_EQ(refused.contentType, "application/json") << path;
-    EXPECT_EQ(refused.authenticate, "Bearer realm=\"wirc-recorder\"") << path;
+    EXPECT_EQ(refused.authenticate, "Basic realm=\"wirc-recorder\", Bearer realm=\"wirc-recorder\"")
+        << path;
     auto wrong = fetch(*url + path, "GET", {{"Authorization", "Bearer 0123456789abcdef"}});
     EXPECT_EQ(wrong.status, 401u) << path;
   }
@@ -51,6 +53,36 @@ TEST(WircRecorderHttpToken, EveryRequestNeedsTheTokenAsBearerOrCookie) {
                       {{"Cookie", std::string("theme=dark; wircam_token=") + kToken + "; x=1"}});
   EXPECT_EQ(cookie.status, 200u);
   EXPECT_EQ(fetch(*url, "GET", {{"Cookie", std::string("wircam_token=") + kToken}}).status, 200u);
+}
+
+// What VLC, OpenCV and Home Assistant send for http://user:TOKEN@host/...:
+// Basic credentials, any user name, the token as the password.
+TEST(WircRecorderHttpToken, ClientsWithCredentialsInTheUrlGetTheLiveStream) {
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess recorder(device->port(),
+                           {"--http", "127.0.0.1:0", "--http-token", kToken, "--duration", "30"});
+  auto url = recorder.waitForLog("http://", milliseconds(10000));
+  ASSERT_TRUE(url) << recorder.log();
+  std::string camera = "127.0.0.1-" + std::to_string(device->port()) + "-cam0";
+  auto withCredentials = [&](const std::string& password) {
+    std::string live =
+        "http://viewer:" + password + "@" + url->substr(7) + "live/" + camera + ".mjpg";
+    return runCommand("timeout 20 gst-launch-1.0 -q souphttpsrc location='" + live +
+                      "' ! multipartdemux ! jpegdec ! fakesink num-buffers=5");
+  };
+  auto played = withCredentials(kToken);
+  EXPECT_EQ(played.exitCode, 0) << played.output;
+  auto refused = withCredentials("0123456789abcdef0123456789abcdeX");
+  EXPECT_NE(refused.exitCode, 0) << refused.output;
+  EXPECT_NE(refused.output.find("Unauthorized"), std::string::npos) << refused.output;
+  // A script's Basic header works on the API too.
+  std::string pair = std::string("script:") + kToken;
+  gchar* basic = g_base64_encode(reinterpret_cast<const guchar*>(pair.data()), pair.size());
+  EXPECT_EQ(
+      fetch(*url + "api/cameras", "GET", {{"Authorization", std::string("Basic ") + basic}}).status,
+      200u);
+  g_free(basic);
 }
 
 TEST(WircRecorderHttpToken, WithoutATokenTheServerStaysOnThisMachine) {

@@ -33,6 +33,12 @@ TEST(HttpRoutes, TheTokenComesAsBearerOrCookie) {
   EXPECT_FALSE(carriesToken("Bearer 0123456789abcde", nullptr, token));
   EXPECT_FALSE(carriesToken("Bearer 0123456789abcdef0", nullptr, token));
   EXPECT_FALSE(carriesToken("Basic 0123456789abcdef", nullptr, token));
+  // Basic: the token as the password, any user name ("u:0123456789abcdef").
+  EXPECT_TRUE(carriesToken("Basic dTowMTIzNDU2Nzg5YWJjZGVm", nullptr, token));
+  EXPECT_TRUE(carriesToken("Basic OjAxMjM0NTY3ODlhYmNkZWY=", nullptr, token));   // no user
+  EXPECT_FALSE(carriesToken("Basic dTowMTIzNDU2Nzg5YWJjZGU=", nullptr, token));  // one short
+  EXPECT_FALSE(carriesToken("Basic MDEyMzQ1Njc4OWFiY2RlZg==", nullptr, token));  // no colon
+  EXPECT_FALSE(carriesToken("Basic !!!", nullptr, token));
   EXPECT_TRUE(carriesToken(nullptr, "a=1; wircam_token=0123456789abcdef; b=2", token));
   EXPECT_TRUE(carriesToken(nullptr, "wircam_token=0123456789abcdef", token));
   EXPECT_FALSE(carriesToken(nullptr, "xwircam_token=0123456789abcdef", token));
