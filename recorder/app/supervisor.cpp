@@ -105,6 +105,7 @@ std::optional<std::string> Supervisor::startServers() {
     content.recordingsFolder = options_.outDir;
     content.token = options_.httpToken;
     content.status = [this] { return status(); };
+    content.metrics = [this] { return metrics(); };
     content.trails = [this] { return trails(); };
     content.cameraStates = [this] {
       nlohmann::json cameras = nlohmann::json::array();
@@ -146,6 +147,8 @@ std::optional<std::string> Supervisor::startServers() {
         options_.onSegmentClosed,
         std::chrono::seconds(static_cast<int64_t>(options_.hookTimeoutSeconds)),
         [this](const std::string& name, const nlohmann::json& hookEvent) {
+          std::string type = hookEvent.value("type", "");
+          if (type == "hook-failed" || type == "hook-gave-up") ++recorded_[name].hookFailures;
           if (Camera* c = cameraNamed(name)) event(*c, hookEvent);
         });
   }
@@ -189,6 +192,10 @@ void Supervisor::segmentClosed(Camera& camera, const std::string& file,
               .durationSeconds = planned.durationSeconds(),
               .frames = planned.frames,
               .bytes = std::filesystem::file_size(file, error)});
+  auto& totals = recorded_[camera.name()];
+  ++totals.segmentsClosed;
+  totals.frames += planned.frames;
+  totals.bytes += std::filesystem::file_size(file, error);
   auto sidecar = TelemetryLog::pathFor(file);
   event(camera, {{"type", "segment-closed"},
                  {"file", name},
@@ -365,6 +372,22 @@ nlohmann::json Supervisor::status() const {
                       {"connects", mqtt.connects}};
   }
   return result;
+}
+
+std::string Supervisor::metrics() const {
+  RecorderMetrics m;
+  m.version = WIRCAM_VERSION;
+  for (const auto& c : cameras_) m.cameras.push_back(c->report());
+  m.recorded = recorded_;
+  m.diskFreeBytes = disk_.free();
+  m.httpConnections = http_ ? http_->openConnections() : 0;
+  if (fleet_) {
+    auto mqtt = fleet_->stats();
+    m.mqttConnected = fleet_->connected();
+    m.mqttPublished = mqtt.published;
+    m.mqttDropped = mqtt.dropped;
+  }
+  return prometheusText(m);
 }
 
 nlohmann::json Supervisor::trails() const {

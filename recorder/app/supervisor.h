@@ -8,6 +8,7 @@
 
 #include <gst/gst.h>
 
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -25,6 +26,7 @@
 #include "record/recording_index.h"
 #include "record/retention.h"
 #include "record/segment_hook.h"
+#include "status/prometheus_metrics.h"
 
 namespace wircam::recorder {
 
@@ -68,6 +70,7 @@ class Supervisor : CameraObserver {
   void guardDisk();
   std::string rtspOf(const Camera& camera) const;
   nlohmann::json status() const;
+  std::string metrics() const;  // GET /metrics
   nlohmann::json trails() const;
   std::vector<std::string> openSegments() const;
   Camera* cameraNamed(const std::string& name);
@@ -76,6 +79,7 @@ class Supervisor : CameraObserver {
   Retention retention_;
   DiskGuard disk_;
   RecordingIndex index_;
+  std::map<std::string, RecordedTotals> recorded_;  // by camera, since the start
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Camera>> cameras_;
   CommandDispatcher commands_;

@@ -24,6 +24,7 @@ struct Route {
     Drive,           // GET /api/cameras/NAME/drive: the drive mode's WebSocket
     Playback,        // GET /play/FILE.mjpg?from=SECONDS: a recording replayed as MJPEG
     Export,          // GET /api/export?camera=&start=&end=&format=: a range as one file
+    Metrics,         // GET /metrics: Prometheus's text format
     ApiNotFound,     // any other /api/ path: 404 with JSON
     NotFound
   };

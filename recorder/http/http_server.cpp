@@ -244,6 +244,11 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       return self->servePlayback(message, route.name, query);
     case Route::Kind::Export:
       return self->exports_->serve(message, query);
+    case Route::Kind::Metrics:
+      if (!self->content_.metrics)
+        return respondError(message, SOUP_STATUS_NOT_FOUND, "no metrics");
+      return respond(message, SOUP_STATUS_OK, "text/plain; version=0.0.4; charset=utf-8",
+                     self->content_.metrics());
     case Route::Kind::Drive:
       // Left unanswered when allowed: libsoup then upgrades it (onWebSocket).
       return self->refuseDriveUnlessAllowed(message, route.name);
@@ -259,7 +264,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       return respondError(
           message, SOUP_STATUS_NOT_FOUND,
           "not found; try /, /api/status, /api/events, /api/cameras, /api/recordings, "
-          "/live/CAMERA.mjpg or /recordings");
+          "/live/CAMERA.mjpg, /recordings or /metrics");
   }
 }
 

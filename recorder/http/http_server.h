@@ -38,6 +38,8 @@ class HttpServer {
     std::vector<Camera> cameras;
     std::string recordingsFolder;
     std::function<nlohmann::json()> status;  // called on the main thread
+    // GET /metrics: the Prometheus text (main thread).
+    std::function<std::string()> metrics;
     // /api/cameras: [{name, state, fps, has_control, following}, ...]
     std::function<nlohmann::json()> cameraStates;
     // /api/recordings: the recording index's entries (url added here)
@@ -76,6 +78,9 @@ class HttpServer {
 
   // "http://HOST:PORT/", with the port the system picked for port 0.
   const std::string& url() const { return url_; }
+
+  // Connections open now (counted from accept to close).
+  size_t openConnections() const { return connections_->open(); }
 
   // Sends one camera's detections to every open page (main thread).
   void publishDetections(const std::string& camera, const nlohmann::json& detections);
