@@ -10,6 +10,7 @@
 
 #include "fleet/mqtt_url.h"
 #include "marvelmind/position_client.h"
+#include "record/retention.h"
 #include "wirc/channel_list.h"
 
 namespace wircam::recorder {
@@ -260,6 +261,10 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto bytes = size(value);
     if (!bytes) return "a size like 500M or 20G";
     (name == "max-bytes" ? o.maxBytes : o.minFree) = *bytes;
+  } else if (name == "max-age" || name == "keep-events") {
+    auto duration = parseDuration(value);
+    if (!duration || duration->count() == 0) return "a duration like 7d, 12h, 30m or 90s";
+    (name == "max-age" ? o.maxAge : o.keepEvents) = *duration;
   } else if (name == "periods" || name == "failsafe") {
     auto channels = wirc::parseChannelList(value);
     if (!channels) return channels.error();
@@ -384,6 +389,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"status", required_argument, nullptr, kValue},
                                    {"max-bytes", required_argument, nullptr, kValue},
                                    {"min-free", required_argument, nullptr, kValue},
+                                   {"max-age", required_argument, nullptr, kValue},
+                                   {"keep-events", required_argument, nullptr, kValue},
                                    {"periods", required_argument, nullptr, kValue},
                                    {"failsafe", required_argument, nullptr, kValue},
                                    {"marvelmind", required_argument, nullptr, kValue},
@@ -428,6 +435,10 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   if (optind < argc) return unexpected(std::string("unexpected argument '") + argv[optind] + "'");
   if (o.outDir.empty()) return unexpected("--out DIR (or out= in the config) is needed");
   if (o.follow && o.detectFamily.empty()) return unexpected("--follow needs --detect FAMILY");
+  if (o.keepEvents.count() > 0 && o.keepEvents <= o.maxAge)
+    return unexpected(
+        "--keep-events keeps segments with events longer than --max-age: give "
+        "--max-age and a longer --keep-events");
   if (!o.followTuning.empty() && !o.follow)
     return unexpected("--follow-tuning tunes the follower: it needs --follow");
   if (o.container == Container::kMp4 && o.codec == Codec::kJpeg)

@@ -1,6 +1,7 @@
 // What wirc-recorder was asked to do, read from its command line.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -79,10 +80,12 @@ struct RecorderOptions {
   double stallSeconds = 5;  // logged in without a frame this long: no-video, restarted
   uint64_t maxBytes = 0;    // retention: 0 = unlimited
   uint64_t minFree = 0;
-  std::optional<ServerAddress> http;  // unset: no web server
-  std::optional<ServerAddress> rtsp;  // unset: no RTSP server
-  double httpIdleSeconds = 10;        // a connection silent this long is closed
-  std::string httpToken;              // empty: this machine only, no authentication
+  std::chrono::seconds maxAge{0};      // retention by age: 0 = none
+  std::chrono::seconds keepEvents{0};  // segments with tags or commands kept this long
+  std::optional<ServerAddress> http;   // unset: no web server
+  std::optional<ServerAddress> rtsp;   // unset: no RTSP server
+  double httpIdleSeconds = 10;         // a connection silent this long is closed
+  std::string httpToken;               // empty: this machine only, no authentication
   // What the login tells the device (CCFG, FCFG), as channel lists; only the
   // first transmitter's login configures it. Unset: wircsrc's defaults.
   std::optional<std::string> periods;

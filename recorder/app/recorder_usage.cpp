@@ -61,6 +61,11 @@ file and exits 0.
                          deleting the oldest finished segments
   --min-free SIZE        delete the oldest finished segments while the disk
                          has less than SIZE free
+  --max-age DURATION     delete finished segments older than DURATION (e.g. 7d,
+                         12h, 30m; their last write counts), looked at every
+                         minute
+  --keep-events DURATION keep the segments whose telemetry shows tags seen or
+                         commands sent this long instead of --max-age (longer)
   --http [HOST]:PORT     web server: live view, playback, control and drive
                          mode at /, status at /api/status, cameras at
                          /api/cameras, recordings at /api/recordings (e.g.
@@ -91,7 +96,7 @@ file and exits 0.
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, telemetry-track, detect,
-follow, max-bytes, min-free, status, stall-timeout, http, http-token,
+follow, max-bytes, min-free, max-age, keep-events, status, stall-timeout, http, http-token,
 http-idle-timeout, rtsp, periods, failsafe, marvelmind, beacon, mqtt,
 mqtt-prefix, mqtt-detections-rate, on-segment-closed, hook-timeout), and one [device NAME] group per vehicle with host, port, cameras
 (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as on the command

@@ -47,7 +47,12 @@ constexpr int kHookDrainSeconds = 15;
 
 Supervisor::Supervisor(RecorderOptions options)
     : options_(std::move(options)),
-      retention_(options_.outDir, {options_.maxBytes, options_.minFree}, logLine),
+      retention_(options_.outDir,
+                 {.maxBytes = options_.maxBytes,
+                  .minFree = options_.minFree,
+                  .maxAge = options_.maxAge,
+                  .keepEvents = options_.keepEvents},
+                 logLine),
       disk_(options_.outDir),
       index_(options_.outDir),
       commands_([this](const std::string& name) { return cameraNamed(name); },
@@ -205,6 +210,10 @@ void Supervisor::segmentClosed(Camera& camera, const std::string& file,
                  {"duration_s", planned.durationSeconds()},
                  {"frames", planned.frames}});
   if (hook_) hook_->segmentClosed(camera.name(), file, sidecar);
+  enforceRetention();
+}
+
+void Supervisor::enforceRetention() {
   auto open = openSegments();
   updateIndex(retention_.enforce({open.begin(), open.end()}));
 }
@@ -363,6 +372,11 @@ nlohmann::json Supervisor::status() const {
   nlohmann::json result = {{"out", options_.outDir},
                            {"free_bytes", disk_.free()},
                            {"stopping", stopping_},
+                           {"retention",
+                            {{"max_bytes", options_.maxBytes},
+                             {"min_free", options_.minFree},
+                             {"max_age_s", options_.maxAge.count()},
+                             {"keep_events_s", options_.keepEvents.count()}}},
                            {"streams", streams}};
   if (fleet_) {
     auto mqtt = fleet_->stats();
@@ -423,6 +437,18 @@ int Supervisor::run() {
           return G_SOURCE_CONTINUE;
         },
         this));
+  // Segments age whether or not any camera closes one: --max-age is looked
+  // at now and every minute.
+  if (options_.maxAge.count() > 0) {
+    enforceRetention();
+    timers_.push_back(g_timeout_add_seconds(
+        60,
+        [](gpointer self) -> gboolean {
+          static_cast<Supervisor*>(self)->enforceRetention();
+          return G_SOURCE_CONTINUE;
+        },
+        this));
+  }
   for (auto& c : cameras_)
     if (!c->start()) return kExitError;
   g_main_loop_run(loop_);

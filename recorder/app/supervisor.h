@@ -66,6 +66,7 @@ class Supervisor : CameraObserver {
   // DELETE /api/recordings/FILE: the HTTP status and reason when it cannot.
   std::optional<std::pair<guint, std::string>> deleteSegment(const std::string& file);
   void updateIndex(const std::vector<std::string>& deleted);
+  void enforceRetention();  // and the index after it
   void printStatus();
   void guardDisk();
   std::string rtspOf(const Camera& camera) const;

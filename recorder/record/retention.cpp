@@ -1,7 +1,12 @@
 #include "record/retention.h"
 
+#include <glib.h>
+
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "record/disk_guard.h"
@@ -32,7 +37,45 @@ std::error_code removeSegment(const fs::path& video) {
   return error;
 }
 
-std::vector<std::string> Retention::enforce(const std::set<std::string>& open) {
+std::optional<std::chrono::seconds> parseDuration(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  char* end = nullptr;
+  double value = g_ascii_strtod(text.c_str(), &end);
+  std::string unit(end);
+  static const std::map<std::string, double> kUnits = {{"", 1},     {"s", 1},     {"m", 60},
+                                                       {"h", 3600}, {"d", 86400}, {"w", 7 * 86400}};
+  auto scale = kUnits.find(unit);
+  if (end == text.c_str() || scale == kUnits.end() || !std::isfinite(value) || value < 0 ||
+      value * scale->second > 100.0 * 365 * 86400)
+    return std::nullopt;
+  return std::chrono::seconds(static_cast<int64_t>(std::llround(value * scale->second)));
+}
+
+bool segmentHasEvents(const fs::path& video) {
+  std::ifstream sidecar(TelemetryLog::pathFor(video.string()));
+  for (std::string text; std::getline(sidecar, text);) {
+    auto line = nlohmann::json::parse(text, nullptr, false);
+    if (!line.is_object()) continue;
+    std::string type = line.value("type", "");
+    if (type == "detections" && line.contains("detections") && line["detections"].is_array() &&
+        !line["detections"].empty())
+      return true;
+    if (type == "control" &&
+        (line.value("steering-pulse", 1500) != 1500 || line.value("throttle-pulse", 1500) != 1500))
+      return true;
+    if (type == "drive" || type == "command") return true;
+  }
+  return false;
+}
+
+bool Retention::hasEvents(const fs::path& video) {
+  auto known = events_.find(video.string());
+  if (known != events_.end()) return known->second;
+  return events_[video.string()] = segmentHasEvents(video);
+}
+
+std::vector<std::string> Retention::enforce(const std::set<std::string>& open,
+                                            std::chrono::system_clock::time_point now) {
   std::vector<std::string> deleted;
   if (!active()) return deleted;
   std::vector<Segment> segments;
@@ -50,15 +93,27 @@ std::vector<std::string> Retention::enforce(const std::set<std::string>& open) {
   }
   std::sort(segments.begin(), segments.end(),
             [](const Segment& a, const Segment& b) { return a.written < b.written; });
+  auto remove = [&](const Segment& segment, const std::string& why) {
+    removeSegment(segment.video);
+    events_.erase(segment.video.string());
+    total -= segment.bytes;
+    deleted.push_back(segment.video.string());
+    logger_("deleted " + segment.video.filename().string() + " (" + why + ")");
+  };
+  if (limits_.maxAge.count() > 0) {
+    std::erase_if(segments, [&](const Segment& segment) {
+      auto age = now - std::chrono::file_clock::to_sys(segment.written);
+      if (age <= limits_.maxAge) return false;
+      bool kept = age <= limits_.keepEvents && hasEvents(segment.video);
+      if (!kept) remove(segment, "older than --max-age");
+      return !kept;
+    });
+  }
   for (const auto& segment : segments) {
     bool overSize = limits_.maxBytes > 0 && total > limits_.maxBytes;
     bool underFree = limits_.minFree > 0 && freeBytes(folder_) < limits_.minFree;
     if (!overSize && !underFree) break;
-    removeSegment(segment.video);
-    total -= segment.bytes;
-    deleted.push_back(segment.video.string());
-    logger_("deleted " + segment.video.filename().string() +
-            (overSize ? " (over --max-bytes)" : " (under --min-free)"));
+    remove(segment, overSize ? "over --max-bytes" : "under --min-free");
   }
   return deleted;
 }

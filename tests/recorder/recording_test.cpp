@@ -9,6 +9,7 @@
 #include <set>
 #include <thread>
 
+#include "http_fetch.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
 #include "wait_for.h"
@@ -206,6 +207,51 @@ TEST(WircRecorder, DeletesTheOldestSegmentsToStayUnderMaxBytes) {
     EXPECT_EQ(index["segments"][i]["file"], videos[i].filename().string());
   for (const auto& video : videos)
     EXPECT_TRUE(fs::exists(fs::path(video).replace_extension(".jsonl")));
+}
+
+TEST(WircRecorder, DeletesSegmentsOlderThanMaxAgeButKeepsThoseWithEventsLonger) {
+  auto device = startSequenceDevice();
+  RecorderProcess first(device->port(), {"--segment", "1", "--duration", "2.5"});
+  ASSERT_EQ(first.wait(), 0) << first.log();
+  auto made = first.files(".mkv");
+  ASSERT_FALSE(made.empty());
+  // Back-dated copies in the folder of a second run: a quiet one and one
+  // with a tag seen, both ten days old, and a recent one.
+  fs::path out = first.out().parent_path() / "aged";
+  fs::create_directories(out);
+  std::string camera = "127.0.0.1-" + std::to_string(device->port()) + "-cam0";
+  auto place = [&](const std::string& time, int daysAgo, const std::string& extraLine) {
+    fs::path video = out / (camera + "-" + time + ".mkv");
+    fs::copy(made.front(), video);
+    fs::copy(fs::path(made.front()).replace_extension(".jsonl"),
+             fs::path(video).replace_extension(".jsonl"));
+    std::ofstream(fs::path(video).replace_extension(".jsonl"), std::ios::app) << extraLine;
+    fs::last_write_time(video, fs::file_time_type::clock::now() - std::chrono::hours(24 * daysAgo));
+    return video;
+  };
+  auto quiet = place("20261101T000000Z", 10, "");
+  auto tagged = place("20261101T000100Z", 10,
+                      R"({"type":"detections","detections":[{"id":0}],"pts":1000})"
+                      "\n");
+  auto recent = place("20261101T000200Z", 0, "");
+  RecorderProcess second(
+      0, {"--device", "127.0.0.1:" + std::to_string(device->port()), "--out", out.string(),
+          "--max-age", "1d", "--keep-events", "30d", "--http", "127.0.0.1:0", "--duration", "30"});
+  auto url = second.waitForLog("http://", milliseconds(10000));
+  ASSERT_TRUE(url) << second.log();
+  EXPECT_TRUE(second.waitForText("deleted " + quiet.filename().string() + " (older than --max-age)",
+                                 milliseconds(10000)))
+      << second.log();
+  EXPECT_FALSE(fs::exists(quiet));
+  EXPECT_TRUE(fs::exists(tagged));
+  EXPECT_TRUE(fs::exists(recent));
+  auto status = nlohmann::json::parse(fetch(*url + "api/status").body);
+  EXPECT_EQ(status["retention"]["max_age_s"], 86400);
+  EXPECT_EQ(status["retention"]["keep_events_s"], 30 * 86400);
+  second.signal(SIGINT);
+  EXPECT_EQ(second.wait(), 0) << second.log();
+  auto index = nlohmann::json::parse(std::ifstream(out / "index.json"));
+  for (const auto& entry : index["segments"]) EXPECT_NE(entry["file"], quiet.filename().string());
 }
 
 TEST(WircRecorder, TakesItsDevicesFromAConfigFile) {

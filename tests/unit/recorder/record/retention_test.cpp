@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -54,6 +55,65 @@ TEST_F(RetentionTest, WithoutLimitsNothingIsDeleted) {
   EXPECT_FALSE(retention.active());
   EXPECT_TRUE(retention.enforce({}).empty());
   EXPECT_TRUE(fs::exists(kept));
+}
+
+TEST_F(RetentionTest, SegmentsOlderThanTheMaxAgeGoUnlessTheirEventsKeepThemLonger) {
+  using std::chrono::hours;
+  std::vector<std::string> logged;
+  Retention retention(folder_, {.maxAge = hours(24), .keepEvents = hours(24 * 7)},
+                      [&](const std::string& l) { logged.push_back(l); });
+  auto young = segment("young.mkv", 100, 0);
+  auto quiet = segment("quiet.mkv", 100, 0);
+  auto tagged = segment("tagged.mkv", 100, 0);
+  auto steered = segment("steered.mkv", 100, 0);
+  auto ancient = segment("ancient.mkv", 100, 0);
+  auto open = segment("open.mkv", 100, 0);
+  auto sidecar = [](const std::string& video, const std::string& lines) {
+    std::ofstream(fs::path(video).replace_extension(".jsonl")) << lines;
+  };
+  sidecar(quiet, R"({"type":"detections","detections":[],"pts":0})"
+                 "\n"
+                 R"({"type":"control","steering-pulse":1500,"throttle-pulse":1500,"pts":0})"
+                 "\n");
+  sidecar(tagged, R"({"type":"detections","detections":[{"id":3}],"pts":0})"
+                  "\n");
+  sidecar(steered, R"({"type":"control","steering-pulse":1620,"throttle-pulse":1500,"pts":0})"
+                   "\n");
+  sidecar(ancient, R"({"type":"detections","detections":[{"id":3}],"pts":0})"
+                   "\n");
+  // Time is a parameter: "now" is three days after they were written, and
+  // the ancient one was written ten days before that.
+  auto written = fs::file_time_type::clock::now();
+  for (const auto& video : {young, quiet, tagged, steered, open})
+    fs::last_write_time(video, written);
+  fs::last_write_time(ancient, written - hours(24 * 10));
+  fs::last_write_time(young, written + hours(24 * 3));
+  auto now = std::chrono::file_clock::to_sys(written) + hours(24 * 3);
+  auto deleted = retention.enforce({open}, now);
+  std::sort(deleted.begin(), deleted.end());
+  EXPECT_EQ(deleted, (std::vector<std::string>{ancient, quiet}));
+  for (const auto& kept : {young, tagged, steered, open}) EXPECT_TRUE(fs::exists(kept)) << kept;
+  ASSERT_EQ(logged.size(), 2u);
+  EXPECT_NE(logged[0].find("older than --max-age"), std::string::npos);
+  // A week later the ones kept for their events go too, and the young one
+  // (a quiet day old by then); never the open one.
+  deleted = retention.enforce({open}, now + hours(24 * 7));
+  std::sort(deleted.begin(), deleted.end());
+  EXPECT_EQ(deleted, (std::vector<std::string>{steered, tagged, young}));
+  EXPECT_TRUE(fs::exists(open));
+}
+
+TEST(RetentionDuration, ReadsDaysHoursMinutesAndSeconds) {
+  using std::chrono::seconds;
+  EXPECT_EQ(parseDuration("7d"), seconds(7 * 86400));
+  EXPECT_EQ(parseDuration("12h"), seconds(12 * 3600));
+  EXPECT_EQ(parseDuration("30m"), seconds(1800));
+  EXPECT_EQ(parseDuration("90s"), seconds(90));
+  EXPECT_EQ(parseDuration("90"), seconds(90));
+  EXPECT_EQ(parseDuration("1.5h"), seconds(5400));
+  EXPECT_EQ(parseDuration("2w"), seconds(14 * 86400));
+  for (const char* bad : {"", "d", "7 days", "-1d", "7y", "1e300d", "nan", "7dd"})
+    EXPECT_FALSE(parseDuration(bad).has_value()) << bad;
 }
 
 TEST(DiskGuard, KeepsAMebibyteAndFourSecondsOfWriting) {
