@@ -227,6 +227,8 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto address = parseServerAddress(value);
     if (!address) return "[HOST]:PORT, as in :8080 or 127.0.0.1:8080";
     (name == "http" ? o.http : o.rtsp) = *address;
+  } else if (name == "http-cert" || name == "http-key") {
+    (name == "http-cert" ? o.httpCert : o.httpKey) = value;
   } else if (name == "http-token") {
     std::string token = value;
     if (token.size() < 16 || token.find_first_of(" ;,\"\\") != std::string::npos)
@@ -382,6 +384,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"http-idle-timeout", required_argument, nullptr, kValue},
                                    {"stall-timeout", required_argument, nullptr, kValue},
                                    {"http-token", required_argument, nullptr, kValue},
+                                   {"http-cert", required_argument, nullptr, kValue},
+                                   {"http-key", required_argument, nullptr, kValue},
                                    {"detect", required_argument, nullptr, kValue},
                                    {"follow", no_argument, nullptr, kValue},
                                    {"follow-tuning", required_argument, nullptr, kValue},
@@ -435,6 +439,9 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   if (optind < argc) return unexpected(std::string("unexpected argument '") + argv[optind] + "'");
   if (o.outDir.empty()) return unexpected("--out DIR (or out= in the config) is needed");
   if (o.follow && o.detectFamily.empty()) return unexpected("--follow needs --detect FAMILY");
+  if (o.httpCert.empty() != o.httpKey.empty())
+    return unexpected("--http-cert and --http-key go together: the certificate and its key");
+  if (!o.httpCert.empty() && !o.http) return unexpected("--http-cert needs --http [HOST]:PORT");
   if (o.keepEvents.count() > 0 && o.keepEvents <= o.maxAge)
     return unexpected(
         "--keep-events keeps segments with events longer than --max-age: give "

@@ -86,6 +86,8 @@ struct RecorderOptions {
   std::optional<ServerAddress> rtsp;   // unset: no RTSP server
   double httpIdleSeconds = 10;         // a connection silent this long is closed
   std::string httpToken;               // empty: this machine only, no authentication
+  // HTTPS: the server's certificate and key (PEM files), both or neither.
+  std::string httpCert, httpKey;
   // What the login tells the device (CCFG, FCFG), as channel lists; only the
   // first transmitter's login configures it. Unset: wircsrc's defaults.
   std::optional<std::string> periods;

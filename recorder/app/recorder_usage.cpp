@@ -74,6 +74,10 @@ file and exits 0.
   --http-token T         every request needs "Authorization: Bearer T" or the
                          cookie the page's /login sets (16 characters at least);
                          control, driving and deleting need it always
+  --http-cert FILE --http-key FILE
+                         serve HTTPS with this certificate and key (PEM): the
+                         page, API, streams and drive WebSocket over TLS (the
+                         token then never travels in clear)
   --http-idle-timeout S  close an HTTP connection with no request in progress (silent,
                          idle, or still sending its headers) for S seconds (default 10)
   --mqtt mqtt://[USER:PASS@]HOST[:PORT]
@@ -96,11 +100,12 @@ file and exits 0.
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, telemetry-track, detect,
-follow, max-bytes, min-free, max-age, keep-events, status, stall-timeout, http, http-token,
-http-idle-timeout, rtsp, periods, failsafe, marvelmind, beacon, mqtt,
-mqtt-prefix, mqtt-detections-rate, on-segment-closed, hook-timeout), and one [device NAME] group per vehicle with host, port, cameras
-(e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as on the command
-line), marvelmind and beacon:
+follow, follow-tuning, max-bytes, min-free, max-age, keep-events, status,
+stall-timeout, http, http-token, http-cert, http-key, http-idle-timeout, rtsp,
+periods, failsafe, marvelmind, beacon, mqtt, mqtt-prefix, mqtt-detections-rate,
+on-segment-closed, hook-timeout), and one [device NAME] group per vehicle with
+host, port, cameras (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as
+on the command line), marvelmind and beacon:
 
   [recorder]
   out=recordings

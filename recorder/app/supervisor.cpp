@@ -109,6 +109,8 @@ std::optional<std::string> Supervisor::startServers() {
     for (auto& c : cameras_) content.cameras.push_back({c->name(), c->frames()});
     content.recordingsFolder = options_.outDir;
     content.token = options_.httpToken;
+    content.certificateFile = options_.httpCert;
+    content.keyFile = options_.httpKey;
     content.status = [this] { return status(); };
     content.metrics = [this] { return metrics(); };
     content.trails = [this] { return trails(); };
@@ -134,6 +136,11 @@ std::optional<std::string> Supervisor::startServers() {
     if (!server) return server.error();
     http_ = std::move(*server);
     logLine("live view at " + http_->url());
+    std::string host = options_.http->listenHost();
+    if (!options_.httpToken.empty() && options_.httpCert.empty() && host != "127.0.0.1" &&
+        host != "localhost" && host != "::1")
+      logLine("the access token travels in clear over plain HTTP on " + host +
+              ": anyone on the network can read it; give --http-cert and --http-key for HTTPS");
   }
   if (options_.mqtt) {
     FleetPublisher::Settings settings{.url = *parseMqttUrl(*options_.mqtt),

@@ -43,8 +43,10 @@ HttpConnections::HttpConnections(SoupServer* server, ConnectionSlots::Limits lim
                  1000))) {}
 
 Expected<std::unique_ptr<HttpConnections>, std::string> HttpConnections::listen(
-    SoupServer* server, GSocketAddress* address, ConnectionSlots::Limits limits) {
+    SoupServer* server, GSocketAddress* address, ConnectionSlots::Limits limits,
+    GTlsCertificate* certificate) {
   std::unique_ptr<HttpConnections> self(new HttpConnections(server, limits));
+  if (certificate) self->certificate_ = G_TLS_CERTIFICATE(g_object_ref(certificate));
   self->service_ = g_socket_service_new();
   // GLib's default backlog (10) drops the SYNs of a burst of clients, who
   // then wait seconds to retry: let a whole cap's worth queue.
@@ -73,6 +75,7 @@ HttpConnections::~HttpConnections() {
   g_socket_service_stop(service_);
   g_socket_listener_close(G_SOCKET_LISTENER(service_));
   g_object_unref(service_);
+  g_clear_object(&certificate_);
 }
 
 gboolean HttpConnections::onIncoming(GSocketService*, GSocketConnection* connection, GObject*,
@@ -94,10 +97,19 @@ gboolean HttpConnections::onIncoming(GSocketService*, GSocketConnection* connect
                     new GoneWatch{self, endpoint, connection, self->alive_});
   GSocketAddress* local = g_socket_connection_get_local_address(connection, nullptr);
   GError* error = nullptr;
-  if (!soup_server_accept_iostream(self->server_, G_IO_STREAM(connection), local, remote, &error)) {
-    g_error_free(error);
-    g_io_stream_close(G_IO_STREAM(connection), nullptr, nullptr);
+  // HTTPS: libsoup gets the TLS stream over the connection (which it keeps
+  // alive: the slot is still the connection's). The handshake happens on
+  // the first read.
+  GIOStream* stream = G_IO_STREAM(g_object_ref(connection));
+  if (self->certificate_) {
+    GIOStream* tls = g_tls_server_connection_new(stream, self->certificate_, &error);
+    g_object_unref(stream);
+    stream = tls;
   }
+  if (!stream || !soup_server_accept_iostream(self->server_, stream, local, remote, &error))
+    g_io_stream_close(G_IO_STREAM(connection), nullptr, nullptr);
+  g_clear_error(&error);
+  g_clear_object(&stream);
   g_clear_object(&local);
   g_clear_object(&remote);
   return TRUE;

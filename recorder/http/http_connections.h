@@ -21,14 +21,19 @@ namespace wircam::recorder {
 
 class HttpConnections {
  public:
-  // Listens on `address` for `server`; the port bound comes with it.
+  // Listens on `address` for `server`; the port bound comes with it. With
+  // a certificate (and its key) every connection is TLS: the handshake
+  // first, then HTTP inside it; a client that speaks plain HTTP fails the
+  // handshake and is closed.
   static Expected<std::unique_ptr<HttpConnections>, std::string> listen(
-      SoupServer* server, GSocketAddress* address, ConnectionSlots::Limits limits);
+      SoupServer* server, GSocketAddress* address, ConnectionSlots::Limits limits,
+      GTlsCertificate* certificate = nullptr);
   ~HttpConnections();
   HttpConnections(const HttpConnections&) = delete;
   HttpConnections& operator=(const HttpConnections&) = delete;
 
   uint16_t port() const { return port_; }
+  bool tls() const { return certificate_ != nullptr; }
   // What libsoup tells of a message's request on one of these connections.
   void requestStarted(SoupServerMessage* message);
   void requestEnded(SoupServerMessage* message);
@@ -57,6 +62,7 @@ class HttpConnections {
   };
   const Accepted* find(SoupServerMessage* message) const;
   SoupServer* server_;
+  GTlsCertificate* certificate_ = nullptr;  // owned; null: plain HTTP
   ConnectionSlots slots_;
   GSocketService* service_ = nullptr;
   guint sweep_ = 0;

@@ -58,10 +58,25 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
   GSocketAddress* socket =
       g_inet_socket_address_new_from_string(address.listenHost().c_str(), address.port);
   if (!socket) return unexpected("--http: '" + address.host + "' is not an IP address");
+  GTlsCertificate* certificate = nullptr;
+  if (!self->content_.certificateFile.empty()) {
+    GError* error = nullptr;
+    certificate = g_tls_certificate_new_from_files(self->content_.certificateFile.c_str(),
+                                                   self->content_.keyFile.c_str(), &error);
+    if (!certificate) {
+      std::string text = error->message;
+      g_error_free(error);
+      g_object_unref(socket);
+      return unexpected("--http-cert " + self->content_.certificateFile + ", --http-key " +
+                        self->content_.keyFile + ": " + text);
+    }
+  }
   auto connections = HttpConnections::listen(self->server_, socket,
                                              {.maxOpen = kMaxConnections,
                                               .maxPerAddress = kMaxConnectionsPerAddress,
-                                              .idleTimeout = idleTimeout});
+                                              .idleTimeout = idleTimeout},
+                                             certificate);
+  g_clear_object(&certificate);
   g_object_unref(socket);
   if (!connections)
     return unexpected("--http: cannot listen on port " + std::to_string(address.port) + ": " +
@@ -72,8 +87,8 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
       [connections = self->connections_.get()](SoupServerMessage* message) {
         return connections->socketOf(message);
       });
-  self->url_ =
-      "http://" + address.listenHost() + ":" + std::to_string(self->connections_->port()) + "/";
+  self->url_ = std::string(self->connections_->tls() ? "https://" : "http://") +
+               address.listenHost() + ":" + std::to_string(self->connections_->port()) + "/";
 
   soup_server_add_early_handler(self->server_, nullptr, onHeaders, self.get(), nullptr);
   soup_server_add_handler(self->server_, nullptr, onRequest, self.get(), nullptr);
@@ -179,7 +194,9 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*,
   answer += "Content-Length: 0\r\nConnection: close\r\n\r\n";
   soup_message_body_set_accumulate(soup_server_message_get_request_body(message), FALSE);
   if (GSocket* socket = self->connections_->socketOf(message)) {
-    g_socket_send(socket, answer.data(), answer.size(), nullptr, nullptr);
+    // Over TLS a plain answer would be noise: the connection just closes.
+    if (!self->connections_->tls())
+      g_socket_send(socket, answer.data(), answer.size(), nullptr, nullptr);
     g_socket_shutdown(socket, TRUE, TRUE, nullptr);
   }
   soup_server_message_set_status(message, SOUP_STATUS_BAD_REQUEST, nullptr);

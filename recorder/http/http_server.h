@@ -45,6 +45,8 @@ class HttpServer {
     // /api/recordings: the recording index's entries (url added here)
     std::function<nlohmann::json()> recordings;
     std::string token;  // empty: no authentication (this machine only)
+    // HTTPS with this certificate and key (PEM files); empty: plain HTTP.
+    std::string certificateFile, keyFile;
     // Deletes a finished segment (video and sidecar) and its index entry;
     // the HTTP status and reason when it cannot.
     std::function<std::optional<std::pair<guint, std::string>>(const std::string& file)>
