@@ -278,6 +278,8 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto url = parseMqttUrl(value);
     if (!url) return url.error();
     o.mqtt = value;
+  } else if (name == "mqtt-cafile") {
+    o.mqttCaFile = value;
   } else if (name == "mqtt-prefix") {
     std::string prefix = value;
     if (prefix.empty() || prefix.find_first_of("+#") != std::string::npos ||
@@ -400,6 +402,7 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"marvelmind", required_argument, nullptr, kValue},
                                    {"mqtt", required_argument, nullptr, kValue},
                                    {"mqtt-prefix", required_argument, nullptr, kValue},
+                                   {"mqtt-cafile", required_argument, nullptr, kValue},
                                    {"mqtt-detections-rate", required_argument, nullptr, kValue},
                                    {"on-segment-closed", required_argument, nullptr, kValue},
                                    {"hook-timeout", required_argument, nullptr, kValue},
@@ -439,6 +442,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   if (optind < argc) return unexpected(std::string("unexpected argument '") + argv[optind] + "'");
   if (o.outDir.empty()) return unexpected("--out DIR (or out= in the config) is needed");
   if (o.follow && o.detectFamily.empty()) return unexpected("--follow needs --detect FAMILY");
+  if (!o.mqttCaFile.empty() && (!o.mqtt || !parseMqttUrl(*o.mqtt)->tls))
+    return unexpected("--mqtt-cafile is for a TLS broker: --mqtt mqtts://HOST[:PORT]");
   if (o.httpCert.empty() != o.httpKey.empty())
     return unexpected("--http-cert and --http-key go together: the certificate and its key");
   if (!o.httpCert.empty() && !o.http) return unexpected("--http-cert needs --http [HOST]:PORT");

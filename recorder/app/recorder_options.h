@@ -93,7 +93,8 @@ struct RecorderOptions {
   std::optional<std::string> periods;
   std::optional<std::string> failsafe;
   // Fleets: MQTT (unset: none) and the closed-segment hook (empty: none).
-  std::optional<std::string> mqtt;  // mqtt://[user:pass@]HOST[:PORT]
+  std::optional<std::string> mqtt;  // mqtt://[user:pass@]HOST[:PORT] or mqtts://
+  std::string mqttCaFile;           // mqtts://: the broker's CA (PEM)
   std::string mqttPrefix = "wircam";
   double mqttDetectionsRate = 0;             // per second and stream at most; 0 = every frame
   std::vector<std::string> onSegmentClosed;  // the command and its arguments

@@ -82,7 +82,10 @@ file and exits 0.
                          idle, or still sending its headers) for S seconds (default 10)
   --mqtt mqtt://[USER:PASS@]HOST[:PORT]
                          publish status, detections and events to an MQTT
-                         broker and take follow/target commands (below)
+                         broker and take follow/target commands (below);
+                         mqtts:// for TLS (port 8883 by default)
+  --mqtt-cafile FILE     mqtts://: the CA (PEM) that signed the broker's
+                         certificate (default: the system's CAs)
   --mqtt-prefix P        topic prefix (default wircam)
   --mqtt-detections-rate HZ
                          at most HZ detection messages per second and stream
@@ -102,10 +105,10 @@ Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, telemetry-track, detect,
 follow, follow-tuning, max-bytes, min-free, max-age, keep-events, status,
 stall-timeout, http, http-token, http-cert, http-key, http-idle-timeout, rtsp,
-periods, failsafe, marvelmind, beacon, mqtt, mqtt-prefix, mqtt-detections-rate,
-on-segment-closed, hook-timeout), and one [device NAME] group per vehicle with
-host, port, cameras (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as
-on the command line), marvelmind and beacon:
+periods, failsafe, marvelmind, beacon, mqtt, mqtt-cafile, mqtt-prefix,
+mqtt-detections-rate, on-segment-closed, hook-timeout), and one [device NAME]
+group per vehicle with host, port, cameras (e.g. 0;1), follow, control
+(rcoip://H:P or btemp://H:P, as on the command line), marvelmind and beacon:
 
   [recorder]
   out=recordings

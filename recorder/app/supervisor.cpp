@@ -146,6 +146,7 @@ std::optional<std::string> Supervisor::startServers() {
     FleetPublisher::Settings settings{.url = *parseMqttUrl(*options_.mqtt),
                                       .prefix = options_.mqttPrefix,
                                       .detectionsRate = options_.mqttDetectionsRate};
+    settings.url.caFile = options_.mqttCaFile;
     for (auto& c : cameras_) settings.streams.push_back(c->name());
     auto fleet = FleetPublisher::start(
         settings, [this](const FleetCommand& c) { commands_.apply(c, "MQTT"); });

@@ -40,6 +40,17 @@ Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttU
                                 url.password.empty() ? nullptr : url.password.c_str()) !=
           MOSQ_ERR_SUCCESS)
     return unexpected(std::string("the MQTT user name or password is not valid UTF-8"));
+  if (url.tls) {
+    // The broker's certificate is checked against the CA file (or the
+    // system's CAs) and its host name; a handshake that fails is said.
+    int rc =
+        url.caFile.empty()
+            ? mosquitto_tls_set(handle, nullptr, "/etc/ssl/certs", nullptr, nullptr, nullptr)
+            : mosquitto_tls_set(handle, url.caFile.c_str(), nullptr, nullptr, nullptr, nullptr);
+    if (rc != MOSQ_ERR_SUCCESS)
+      return unexpected("--mqtt-cafile " + url.caFile + ": " + mosquitto_strerror(rc) +
+                        " (a PEM file of the CA that signed the broker's certificate)");
+  }
   if (mosquitto_will_set(handle, will.topic.c_str(), static_cast<int>(will.payload.size()),
                          will.payload.data(), 1, true) != MOSQ_ERR_SUCCESS)
     return unexpected("cannot set the MQTT last will on '" + will.topic + "'");
@@ -81,6 +92,15 @@ bool MqttClient::reachable() {
   return error == 0;
 }
 
+std::string MqttClient::cannotConnect(int rc) const {
+  std::string where = "MQTT broker " + url_.host + ":" + std::to_string(url_.port) + ": ";
+  if (rc != MOSQ_ERR_TLS) return where + mosquitto_strerror(rc);
+  std::string ca = url_.caFile.empty() ? "the system's CAs" : "--mqtt-cafile " + url_.caFile;
+  return where + "the TLS handshake failed: the broker's certificate is not one " + ca +
+         " signed for " + url_.host +
+         ", or the broker does not speak TLS there; retrying with backoff, the recording goes on";
+}
+
 void MqttClient::waitBackoff() {
   std::unique_lock lock(mutex_);
   wake_.wait_for(lock, backoff_, [this] { return stopping_.load(); });
@@ -97,7 +117,7 @@ void MqttClient::run() {
       }
       int rc = mosquitto_connect(handle_, url_.host.c_str(), url_.port, kKeepaliveSeconds);
       if (rc != MOSQ_ERR_SUCCESS) {
-        report("MQTT broker " + url_.host + ": " + mosquitto_strerror(rc));
+        report(cannotConnect(rc));
         waitBackoff();
         continue;
       }
@@ -109,6 +129,8 @@ void MqttClient::run() {
       if (connected_.exchange(false))
         report("lost the MQTT broker " + url_.host + ":" + std::to_string(url_.port) + " (" +
                mosquitto_strerror(rc) + "); reconnecting with backoff");
+      else
+        report(cannotConnect(rc));  // the TLS handshake comes after mosquitto_connect
       waitBackoff();
     }
   }

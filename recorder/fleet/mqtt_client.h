@@ -70,6 +70,8 @@ class MqttClient {
   MqttClient(MqttUrl url, MqttWill will, mosquitto* handle, Handlers handlers);
   void run();
   bool reachable();
+  // Why a connection could not be made, in words (a TLS failure explained).
+  std::string cannotConnect(int rc) const;
   void waitBackoff();
   void report(const std::string& line);
   static void onConnect(mosquitto*, void* self, int rc);

@@ -26,11 +26,13 @@ std::string unescape(const std::string& text) {
 }  // namespace
 
 Expected<MqttUrl, std::string> parseMqttUrl(const std::string& text) {
-  const std::string scheme = "mqtt://";
-  if (text.rfind(scheme, 0) != 0)
-    return unexpected("'" + text + "' is not mqtt://[user:pass@]HOST[:PORT]");
-  std::string rest = text.substr(scheme.size());
+  const std::string plain = "mqtt://", secure = "mqtts://";
   MqttUrl url;
+  url.tls = text.rfind(secure, 0) == 0;
+  if (!url.tls && text.rfind(plain, 0) != 0)
+    return unexpected("'" + text + "' is not mqtt://[user:pass@]HOST[:PORT] (or mqtts://)");
+  if (url.tls) url.port = 8883;
+  std::string rest = text.substr((url.tls ? secure : plain).size());
   if (auto at = rest.rfind('@'); at != std::string::npos) {
     std::string credentials = rest.substr(0, at);
     rest = rest.substr(at + 1);

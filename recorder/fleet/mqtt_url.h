@@ -1,4 +1,5 @@
-// Where the recorder's MQTT broker is: mqtt://[user:pass@]HOST[:PORT].
+// Where the recorder's MQTT broker is: mqtt://[user:pass@]HOST[:PORT], or
+// mqtts:// for TLS (port 8883 by default).
 #pragma once
 
 #include <cstdint>
@@ -12,6 +13,10 @@ struct MqttUrl {
   std::string host;
   uint16_t port = 1883;
   std::string user, password;  // percent escapes undone ("%40" is "@")
+  bool tls = false;            // mqtts://
+  // The CA that signed the broker's certificate (PEM); empty: the
+  // system's CAs. mqtts:// only.
+  std::string caFile;
 };
 Expected<MqttUrl, std::string> parseMqttUrl(const std::string& text);
 

@@ -12,6 +12,7 @@
 #include "recorder_process.h"
 #include "shell_command.h"
 #include "simulated_device.h"
+#include "test_certificates.h"
 
 namespace {
 
@@ -20,21 +21,6 @@ using namespace wircam::testing;
 using std::chrono::milliseconds;
 
 constexpr const char* kToken = "0123456789abcdef0123456789abcdef";
-
-// A CA, and a certificate for 127.0.0.1 it signed, in `folder`.
-bool makeCertificates(const fs::path& folder) {
-  fs::create_directories(folder);
-  std::ofstream(folder / "san.ext") << "subjectAltName=IP:127.0.0.1\n";
-  std::string in = "cd '" + folder.string() + "' && ";
-  return runCommand(in +
-                    "openssl req -x509 -newkey rsa:2048 -nodes -keyout ca.key -out ca.pem "
-                    "-days 2 -subj '/CN=wircam test CA' && "
-                    "openssl req -newkey rsa:2048 -nodes -keyout server.key -out server.csr "
-                    "-subj '/CN=127.0.0.1' && "
-                    "openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial "
-                    "-out server.pem -days 2 -extfile san.ext")
-             .exitCode == 0;
-}
 
 // curl's exit code and what it printed: the body, then the HTTP status.
 CommandRun curl(const std::string& options, const std::string& url) {

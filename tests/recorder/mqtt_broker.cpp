@@ -24,7 +24,8 @@ uint16_t freePort() {
 
 }  // namespace
 
-MosquittoBroker::MosquittoBroker(const std::string& user, const std::string& password) {
+MosquittoBroker::MosquittoBroker(const std::string& user, const std::string& password,
+                                 const fs::path& tls) {
   static int count = 0;
   folder_ = fs::temp_directory_path() /
             ("wirc-mosquitto-" + std::to_string(getpid()) + "-" + std::to_string(++count));
@@ -42,9 +43,15 @@ MosquittoBroker::MosquittoBroker(const std::string& user, const std::string& pas
   // mosquitto binds it: then it exits, and another port is tried.
   for (int attempt = 0; attempt < 5 && !running(); ++attempt) {
     port_ = freePort();
-    std::ofstream(folder_ / "mosquitto.conf")
-        << "listener " << port_ << " 127.0.0.1\npersistence false\n"
-        << access;
+    std::ofstream config(folder_ / "mosquitto.conf");
+    config << "listener " << port_ << " 127.0.0.1\npersistence false\n" << access;
+    if (!tls.empty()) {
+      tlsPort_ = freePort();
+      config << "listener " << tlsPort_ << " 127.0.0.1\ncafile " << (tls / "ca.pem").string()
+             << "\ncertfile " << (tls / "server.pem").string() << "\nkeyfile "
+             << (tls / "server.key").string() << "\n";
+    }
+    config.close();
     start();
   }
 }

@@ -18,13 +18,17 @@ namespace wircam::testing {
 
 class MosquittoBroker {
  public:
-  // With a user, only that user with that password may connect.
-  explicit MosquittoBroker(const std::string& user = "", const std::string& password = "");
+  // With a user, only that user with that password may connect. With
+  // `tls` (a folder of makeCertificates()), a second listener speaks TLS
+  // with its server certificate, on tlsPort().
+  explicit MosquittoBroker(const std::string& user = "", const std::string& password = "",
+                           const std::filesystem::path& tls = {});
   ~MosquittoBroker();
   MosquittoBroker(const MosquittoBroker&) = delete;
   MosquittoBroker& operator=(const MosquittoBroker&) = delete;
 
   uint16_t port() const { return port_; }
+  uint16_t tlsPort() const { return tlsPort_; }
   std::string url(const std::string& credentials = "") const;
   bool running() const { return pid_ > 0; }
   void kill();   // SIGKILL: nothing said, nothing kept
@@ -32,7 +36,7 @@ class MosquittoBroker {
 
  private:
   std::filesystem::path folder_;
-  uint16_t port_ = 0;
+  uint16_t port_ = 0, tlsPort_ = 0;
   pid_t pid_ = -1;
 };
 

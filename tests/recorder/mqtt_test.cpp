@@ -10,6 +10,7 @@
 #include "mqtt_broker.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
+#include "test_certificates.h"
 #include "wait_for.h"
 #include "wirc/device.h"
 
@@ -288,6 +289,38 @@ TEST(RecorderMqtt, AHangingHookIsStoppedRetriedAndReportedWhileRecordingGoesOn) 
   EXPECT_TRUE(probe.waitFor(
       "wircam/" + streamOf(*device) + "/events",
       [](auto& m) { return parsed(m)["type"] == "hook-failed"; }, 3s));
+}
+
+}  // namespace
+
+namespace {
+
+// mqtts://: the recorder joins a TLS listener with the test's CA and
+// publishes over it; with a CA that did not sign the broker's certificate
+// it says why and records on.
+TEST(RecorderMqttTls, JoinsATlsBrokerWithItsCaAndRefusesAnotherCa) {
+  fs::path certificates = fs::temp_directory_path() / ("wirc-mqtts-" + std::to_string(getpid()));
+  fs::path stranger = certificates / "stranger";
+  ASSERT_TRUE(makeCertificates(certificates));
+  ASSERT_TRUE(makeCertificates(stranger));  // another CA altogether
+  MosquittoBroker broker("", "", certificates);
+  ASSERT_TRUE(broker.running());
+  MqttProbe probe(broker.port(), "wircam/#");
+  auto device = startSequenceDevice();
+  std::string tlsUrl = "mqtts://127.0.0.1:" + std::to_string(broker.tlsPort());
+  RecorderProcess trusted(device->port(), {"--mqtt", tlsUrl, "--mqtt-cafile",
+                                           (certificates / "ca.pem").string(), "--duration", "30"});
+  std::string stream = "127.0.0.1-" + std::to_string(device->port()) + "-cam0";
+  EXPECT_TRUE(probe.waitFor(
+      "wircam/" + stream + "/status", [](auto& m) { return parsed(m)["state"] == "live"; }, 10s))
+      << trusted.log();
+
+  RecorderProcess refused(device->port(),
+                          {"--mqtt", tlsUrl, "--mqtt-cafile", (stranger / "ca.pem").string(),
+                           "--segment", "1", "--duration", "30"});
+  EXPECT_TRUE(refused.waitForText("the TLS handshake failed", 10000ms)) << refused.log();
+  EXPECT_TRUE(waitFor([&] { return refused.files(".mkv").size() >= 2; }, 10000ms)) << "records on";
+  fs::remove_all(certificates);
 }
 
 }  // namespace

@@ -18,8 +18,14 @@ TEST(MqttUrl, ReadsHostPortAndEscapedCredentials) {
   ASSERT_TRUE(plain);
   EXPECT_EQ(plain->port, 1883);
   EXPECT_TRUE(plain->user.empty());
+  EXPECT_FALSE(plain->tls);
+  auto secure = parseMqttUrl("mqtts://broker.lab");
+  ASSERT_TRUE(secure);
+  EXPECT_TRUE(secure->tls);
+  EXPECT_EQ(secure->port, 8883);
+  EXPECT_EQ(parseMqttUrl("mqtts://u:p@broker.lab:9883")->port, 9883);
   for (const char* bad : {"10.0.0.2", "http://x", "mqtt://", "mqtt://x:0", "mqtt://x:99999",
-                          "mqtt://x:1883junk", "mqtt://a b"})
+                          "mqtt://x:1883junk", "mqtt://a b", "mqttss://x", "mqtts://"})
     EXPECT_FALSE(parseMqttUrl(bad)) << bad;
 }
 
