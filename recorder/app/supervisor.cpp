@@ -170,7 +170,7 @@ std::optional<std::string> Supervisor::startServers() {
     for (auto& c : cameras_)
       cameras.push_back(
           {"/" + c->plan().device + "/cam" + std::to_string(c->plan().camera), c->frames()});
-    auto server = RtspServer::start(*options_.rtsp, cameras);
+    auto server = RtspServer::start(*options_.rtsp, cameras, options_.httpToken);
     if (!server) return server.error();
     rtsp_ = std::move(*server);
     for (auto& camera : cameras) logLine("RTSP at " + rtsp_->url() + camera.path);

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "common/mutex.h"
+#include "http/rtsp_token_auth.h"
 
 namespace wircam::recorder {
 
@@ -28,7 +29,8 @@ constexpr char kMediaLaunch[] =
 }  // namespace
 
 Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const ServerAddress& address,
-                                                                     std::vector<Camera> cameras) {
+                                                                     std::vector<Camera> cameras,
+                                                                     const std::string& token) {
   std::unique_ptr<RtspServer> self(new RtspServer());
   self->server_ = gst_rtsp_server_new();
   gst_rtsp_server_set_address(self->server_, address.listenHost().c_str());
@@ -40,6 +42,10 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
     GstRTSPMediaFactory* factory = gst_rtsp_media_factory_new();
     gst_rtsp_media_factory_set_launch(factory, kMediaLaunch);
     gst_rtsp_media_factory_set_shared(factory, TRUE);
+    if (!token.empty())
+      gst_rtsp_media_factory_add_role(factory, kRtspViewerRole, GST_RTSP_PERM_MEDIA_FACTORY_ACCESS,
+                                      G_TYPE_BOOLEAN, TRUE, GST_RTSP_PERM_MEDIA_FACTORY_CONSTRUCT,
+                                      G_TYPE_BOOLEAN, TRUE, nullptr);
     g_signal_connect(factory, "media-configure", G_CALLBACK(onMediaConfigure), mount.get());
     gst_rtsp_mount_points_add_factory(mounts, camera.path.c_str(), factory);
     Mount* raw = mount.get();
@@ -58,6 +64,11 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
     self->mounts_.push_back(std::move(mount));
   }
   g_object_unref(mounts);
+  if (!token.empty()) {
+    GstRTSPAuth* auth = rtspTokenAuth(token);
+    gst_rtsp_server_set_auth(self->server_, auth);
+    g_object_unref(auth);
+  }
 
   GError* error = nullptr;
   GSource* source = gst_rtsp_server_create_source(self->server_, nullptr, &error);

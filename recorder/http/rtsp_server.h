@@ -24,8 +24,10 @@ class RtspServer {
     FrameTap* frames;  // borrowed; outlives the server
   };
 
+  // With a token every request needs it (rtsp_token_auth.h).
   static Expected<std::unique_ptr<RtspServer>, std::string> start(const ServerAddress& address,
-                                                                  std::vector<Camera> cameras);
+                                                                  std::vector<Camera> cameras,
+                                                                  const std::string& token = "");
   ~RtspServer();
 
   // "rtsp://HOST:PORT", the port the system picked for port 0.

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "recorder_process.h"
+#include "shell_command.h"
 #include "simulated_device.h"
 #include "wait_for.h"
 
@@ -46,6 +47,30 @@ TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
     EXPECT_EQ(frames, 15) << protocols;
     EXPECT_EQ(width, 352) << protocols;  // the scene's CIF frames, decoded
   }
+}
+
+// With --http-token the RTSP server asks for the same credentials: Basic,
+// the token as the password, any user name.
+TEST(WircRecorderRtsp, WithATokenOnlyAClientWithItPlays) {
+  constexpr const char* kToken = "0123456789abcdef0123456789abcdef";
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(), {"--rtsp", "127.0.0.1:0", "--http", "127.0.0.1:0",
+                                            "--http-token", kToken, "--duration", "60"});
+  auto url = recorder.waitForLog("rtsp://", milliseconds(10000));
+  ASSERT_TRUE(url) << recorder.log();
+  auto play = [&](const std::string& credentials) {
+    std::string location = "rtsp://" + credentials + url->substr(7);
+    return runCommand("timeout 20 gst-launch-1.0 -q rtspsrc location='" + location +
+                      "' protocols=tcp ! rtpjpegdepay ! jpegdec ! fakesink num-buffers=5 2>&1");
+  };
+  auto played = play(std::string("viewer:") + kToken + "@");
+  EXPECT_EQ(played.exitCode, 0) << played.output;
+  auto anonymous = play("");
+  EXPECT_NE(anonymous.exitCode, 0);
+  EXPECT_NE(anonymous.output.find("Unauthorized"), std::string::npos) << anonymous.output;
+  auto wrong = play("viewer:0123456789abcdef0123456789abcdeX@");
+  EXPECT_NE(wrong.exitCode, 0);
+  EXPECT_NE(wrong.output.find("Unauthorized"), std::string::npos) << wrong.output;
 }
 
 }  // namespace
