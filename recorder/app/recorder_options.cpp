@@ -278,6 +278,19 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto url = parseMqttUrl(value);
     if (!url) return url.error();
     o.mqtt = value;
+  } else if (name == "mqtt-discovery") {
+    // Alone (or =true in the config file): Home Assistant's own prefix.
+    std::string prefix = value;
+    if (prefix == "true") prefix = "homeassistant";
+    if (prefix == "false") return std::nullopt;
+    if (prefix.empty() || prefix.find_first_of("+# ") != std::string::npos ||
+        prefix.front() == '/' || prefix.back() == '/')
+      return "a topic prefix without + # or a leading or trailing /, like homeassistant";
+    o.mqttDiscovery = prefix;
+  } else if (name == "mqtt-snapshot-interval") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 0.5 || *seconds > 3600) return "seconds, 0.5..3600";
+    o.mqttSnapshotSeconds = *seconds;
   } else if (name == "mqtt-cafile") {
     o.mqttCaFile = value;
   } else if (name == "mqtt-prefix") {
@@ -403,6 +416,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"mqtt", required_argument, nullptr, kValue},
                                    {"mqtt-prefix", required_argument, nullptr, kValue},
                                    {"mqtt-cafile", required_argument, nullptr, kValue},
+                                   {"mqtt-discovery", optional_argument, nullptr, kValue},
+                                   {"mqtt-snapshot-interval", required_argument, nullptr, kValue},
                                    {"mqtt-detections-rate", required_argument, nullptr, kValue},
                                    {"on-segment-closed", required_argument, nullptr, kValue},
                                    {"hook-timeout", required_argument, nullptr, kValue},
@@ -442,6 +457,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   if (optind < argc) return unexpected(std::string("unexpected argument '") + argv[optind] + "'");
   if (o.outDir.empty()) return unexpected("--out DIR (or out= in the config) is needed");
   if (o.follow && o.detectFamily.empty()) return unexpected("--follow needs --detect FAMILY");
+  if (o.mqttDiscovery && !o.mqtt)
+    return unexpected("--mqtt-discovery publishes to the MQTT broker: it needs --mqtt URL");
   if (!o.mqttCaFile.empty() && (!o.mqtt || !parseMqttUrl(*o.mqtt)->tls))
     return unexpected("--mqtt-cafile is for a TLS broker: --mqtt mqtts://HOST[:PORT]");
   if (o.httpCert.empty() != o.httpKey.empty())

@@ -95,6 +95,9 @@ struct RecorderOptions {
   // Fleets: MQTT (unset: none) and the closed-segment hook (empty: none).
   std::optional<std::string> mqtt;  // mqtt://[user:pass@]HOST[:PORT] or mqtts://
   std::string mqttCaFile;           // mqtts://: the broker's CA (PEM)
+  // Home Assistant's discovery prefix (--mqtt-discovery), or none.
+  std::optional<std::string> mqttDiscovery;
+  double mqttSnapshotSeconds = 10;  // the camera entity's pictures
   std::string mqttPrefix = "wircam";
   double mqttDetectionsRate = 0;             // per second and stream at most; 0 = every frame
   std::vector<std::string> onSegmentClosed;  // the command and its arguments

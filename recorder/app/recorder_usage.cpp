@@ -87,6 +87,14 @@ file and exits 0.
   --mqtt-cafile FILE     mqtts://: the CA (PEM) that signed the broker's
                          certificate (default: the system's CAs)
   --mqtt-prefix P        topic prefix (default wircam)
+  --mqtt-discovery[=PREFIX]
+                         Home Assistant MQTT discovery (prefix default
+                         homeassistant): each camera a device with a camera
+                         (snapshots), a following switch, a target number,
+                         battery/fps/loss sensors and a connectivity sensor
+  --mqtt-snapshot-interval S
+                         the camera entity's snapshot every S seconds
+                         (default 10)
   --mqtt-detections-rate HZ
                          at most HZ detection messages per second and stream
                          (default 0: every frame with tags)
@@ -106,9 +114,10 @@ Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 follow, follow-tuning, max-bytes, min-free, max-age, keep-events, status,
 stall-timeout, http, http-token, http-cert, http-key, http-idle-timeout, rtsp,
 periods, failsafe, marvelmind, beacon, mqtt, mqtt-cafile, mqtt-prefix,
-mqtt-detections-rate, on-segment-closed, hook-timeout), and one [device NAME]
-group per vehicle with host, port, cameras (e.g. 0;1), follow, control
-(rcoip://H:P or btemp://H:P, as on the command line), marvelmind and beacon:
+mqtt-discovery, mqtt-snapshot-interval, mqtt-detections-rate,
+on-segment-closed, hook-timeout), and one [device NAME] group per vehicle with
+host, port, cameras (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as
+on the command line), marvelmind and beacon:
 
   [recorder]
   out=recordings

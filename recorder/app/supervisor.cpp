@@ -147,6 +147,10 @@ std::optional<std::string> Supervisor::startServers() {
                                       .prefix = options_.mqttPrefix,
                                       .detectionsRate = options_.mqttDetectionsRate};
     settings.url.caFile = options_.mqttCaFile;
+    if (options_.mqttDiscovery)
+      settings.discovery = DiscoveryNames{.discoveryPrefix = *options_.mqttDiscovery,
+                                          .topicPrefix = options_.mqttPrefix,
+                                          .version = WIRCAM_VERSION};
     for (auto& c : cameras_) settings.streams.push_back(c->name());
     auto fleet = FleetPublisher::start(
         settings, [this](const FleetCommand& c) { commands_.apply(c, "MQTT"); });
@@ -219,6 +223,19 @@ void Supervisor::segmentClosed(Camera& camera, const std::string& file,
                  {"frames", planned.frames}});
   if (hook_) hook_->segmentClosed(camera.name(), file, sidecar);
   enforceRetention();
+}
+
+void Supervisor::publishSnapshots() {
+  for (auto& c : cameras_) {
+    GstBuffer* jpeg = c->frames() ? c->frames()->latest() : nullptr;
+    if (!jpeg) continue;
+    GstMapInfo map;
+    if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
+      fleet_->snapshot(c->name(), std::string(reinterpret_cast<const char*>(map.data), map.size));
+      gst_buffer_unmap(jpeg, &map);
+    }
+    gst_buffer_unref(jpeg);
+  }
 }
 
 void Supervisor::enforceRetention() {
@@ -442,6 +459,15 @@ int Supervisor::run() {
         1,
         [](gpointer self) -> gboolean {
           static_cast<Supervisor*>(self)->publishFleetStatus();
+          return G_SOURCE_CONTINUE;
+        },
+        this));
+  // Home Assistant's camera entity: each camera's newest frame, retained.
+  if (fleet_ && options_.mqttDiscovery)
+    timers_.push_back(g_timeout_add(
+        static_cast<guint>(options_.mqttSnapshotSeconds * 1000),
+        [](gpointer self) -> gboolean {
+          static_cast<Supervisor*>(self)->publishSnapshots();
           return G_SOURCE_CONTINUE;
         },
         this));

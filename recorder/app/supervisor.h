@@ -67,6 +67,7 @@ class Supervisor : CameraObserver {
   std::optional<std::pair<guint, std::string>> deleteSegment(const std::string& file);
   void updateIndex(const std::vector<std::string>& deleted);
   void enforceRetention();  // and the index after it
+  void publishSnapshots();  // --mqtt-discovery's camera entity
   void printStatus();
   void guardDisk();
   std::string rtspOf(const Camera& camera) const;

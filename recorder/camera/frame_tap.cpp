@@ -17,7 +17,16 @@ void FrameTap::detach() {
   handler_ = 0;
 }
 
-FrameTap::~FrameTap() { detach(); }
+FrameTap::~FrameTap() {
+  detach();
+  MutexLock lock(mutex_);
+  gst_buffer_replace(&latest_, nullptr);
+}
+
+GstBuffer* FrameTap::latest() {
+  MutexLock lock(mutex_);
+  return latest_ ? gst_buffer_ref(latest_) : nullptr;
+}
 
 int FrameTap::listen(Listener listener) {
   MutexLock lock(mutex_);
@@ -36,6 +45,7 @@ GstFlowReturn FrameTap::onNewSample(GstElement* appsink, gpointer data) {
   if (!sample) return GST_FLOW_EOS;
   {
     MutexLock lock(self->mutex_);
+    gst_buffer_replace(&self->latest_, gst_sample_get_buffer(sample));
     for (auto& [id, listener] : self->listeners_) listener(sample);
   }
   gst_sample_unref(sample);

@@ -32,6 +32,8 @@ class FrameTap {
 
   int listen(Listener listener);
   void forget(int id);
+  // The newest frame (a reference to unref), or null before the first.
+  GstBuffer* latest();
 
  private:
   static GstFlowReturn onNewSample(GstElement* appsink, gpointer self);
@@ -41,6 +43,7 @@ class FrameTap {
   Mutex mutex_;
   std::map<int, Listener> listeners_ WIRCAM_GUARDED_BY(mutex_);
   int nextId_ WIRCAM_GUARDED_BY(mutex_) = 1;
+  GstBuffer* latest_ WIRCAM_GUARDED_BY(mutex_) = nullptr;
 };
 
 }  // namespace wircam::recorder

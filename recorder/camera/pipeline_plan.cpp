@@ -83,7 +83,8 @@ std::string PipelinePlan::description() const {
 PipelinePlan planPipeline(const RecorderOptions& options) {
   PipelinePlan plan;
   plan.transcoded = options.codec != Codec::kJpeg;
-  bool live = options.http || options.rtsp;
+  // The live branch feeds the web server, RTSP and the discovery snapshots.
+  bool live = options.http || options.rtsp || options.mqttDiscovery;
   size_t index = 0;
   for (const auto& device : options.devices) {
     bool controlled = false;

@@ -52,10 +52,31 @@ void FleetPublisher::republish(MqttClient& client) {
   }
   client.subscribe(settings_.prefix + "/+/follow/set");
   client.subscribe(settings_.prefix + "/+/target/set");
+  if (settings_.discovery) {
+    for (const auto& stream : settings_.streams)
+      for (const auto& [configTopic, config] : discoveryConfigs(*settings_.discovery, stream))
+        client.publish(configTopic, config, true, 1);
+    // Our earlier configs come back retained: those of cameras gone are cleared.
+    client.subscribe(discoverySubscription(*settings_.discovery));
+  }
+}
+
+// A retained config of this recorder for a camera it no longer has: an
+// empty retained message removes it from Home Assistant.
+bool FleetPublisher::clearedStaleConfig(const std::string& topicName, const std::string& payload) {
+  if (!settings_.discovery || !topicName.starts_with(settings_.discovery->discoveryPrefix + "/"))
+    return false;
+  if (!payload.empty() && isStaleConfig(*settings_.discovery, topicName, settings_.streams)) {
+    client_->publish(topicName, "", true, 1);
+    logLine("cleared the Home Assistant config " + printableText(topicName) +
+            " (a camera no longer here)");
+  }
+  return true;
 }
 
 void FleetPublisher::onMessage(const std::string& topicName, const std::string& payload,
                                bool retained) {
+  if (clearedStaleConfig(topicName, payload)) return;
   // PREFIX/STREAM/follow/set: the stream is the level after the prefix.
   std::string rest = topicName.substr(std::min(topicName.size(), settings_.prefix.size() + 1));
   auto slash = rest.find('/');
@@ -121,6 +142,10 @@ void FleetPublisher::detections(const std::string& stream, const nlohmann::json&
 
 void FleetPublisher::event(const std::string& stream, const nlohmann::json& event) {
   client_->publish(topic(stream, "events"), event.dump());
+}
+
+void FleetPublisher::snapshot(const std::string& stream, const std::string& jpeg) {
+  client_->publish(topic(stream, "snapshot"), jpeg, true);
 }
 
 }  // namespace wircam::recorder

@@ -1,7 +1,8 @@
 // The recorder's MQTT topics (see wirc-recorder --help): availability with a
 // last will, each stream's retained status (on change, at least every 5 s),
 // its detections (rate-limited) and events, and the follow/target commands
-// it takes. Everything here runs on the GLib main loop; commands arrive on
+// it takes; with discovery, Home Assistant's configs and the snapshots its
+// camera entity shows. Everything here runs on the GLib main loop; commands arrive on
 // the MQTT client's thread and are handed over to it.
 #pragma once
 
@@ -19,6 +20,7 @@
 
 #include "common/expected.h"
 #include "fleet/fleet_command.h"
+#include "fleet/home_assistant.h"
 #include "fleet/mqtt_client.h"
 
 namespace wircam::recorder {
@@ -32,6 +34,8 @@ class FleetPublisher {
     std::string prefix;
     double detectionsRate = 0;  // per second and stream; 0 = every frame
     std::vector<std::string> streams;
+    // Home Assistant's discovery (--mqtt-discovery), or none.
+    std::optional<DiscoveryNames> discovery;
   };
   // `apply` runs on the main loop for each valid live command.
   static Expected<std::unique_ptr<FleetPublisher>, std::string> start(
@@ -43,6 +47,8 @@ class FleetPublisher {
   void status(const std::string& stream, const nlohmann::json& status, bool force = false);
   void detections(const std::string& stream, const nlohmann::json& message, bool anyTags);
   void event(const std::string& stream, const nlohmann::json& event);
+  // A camera's newest frame (JPEG bytes), retained on PREFIX/STREAM/snapshot.
+  void snapshot(const std::string& stream, const std::string& jpeg);
   MqttClient::Stats stats() const { return client_->stats(); }
   bool connected() const { return client_->connected(); }
 
@@ -57,6 +63,8 @@ class FleetPublisher {
   std::string topic(const std::string& stream, const char* leaf) const;
   void onMessage(const std::string& topic, const std::string& payload, bool retained);
   void republish(MqttClient& client);
+  // Whether the message was a discovery config (cleared if stale).
+  bool clearedStaleConfig(const std::string& topic, const std::string& payload);
 
   const Settings settings_;
   const std::function<void(const FleetCommand&)> apply_;

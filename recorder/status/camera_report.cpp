@@ -78,6 +78,7 @@ nlohmann::json fleetStatusJson(const CameraReport& c) {
           {"battery_v", c.batteryMv / 1000.0},
           {"has_control", control.hasControl},
           {"following", control.following},
+          {"target", control.target},
           {"position", positionJson(c)}};
 }
 

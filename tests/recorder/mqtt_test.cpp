@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <cstring>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -321,6 +323,74 @@ TEST(RecorderMqttTls, JoinsATlsBrokerWithItsCaAndRefusesAnotherCa) {
   EXPECT_TRUE(refused.waitForText("the TLS handshake failed", 10000ms)) << refused.log();
   EXPECT_TRUE(waitFor([&] { return refused.files(".mkv").size() >= 2; }, 10000ms)) << "records on";
   fs::remove_all(certificates);
+}
+
+}  // namespace
+
+namespace {
+
+// --mqtt-discovery: Home Assistant's retained configs for the camera as one
+// device, each with a unique id and topics that work; a config left by a
+// camera no longer here is cleared.
+TEST(RecorderMqttDiscovery, HomeAssistantFindsTheCameraAndItsControlsWork) {
+  FollowedOverMqtt car;
+  ASSERT_TRUE(car.broker.running() && car.device);
+  MqttProbe assistant(car.broker.port(), "homeassistant/#");
+  // Left by an earlier run with a camera that is gone.
+  std::string stale = "homeassistant/sensor/wircam_wircam/rover-gone-cam0_battery/config";
+  assistant.publish(stale, R"({"unique_id":"wircam_rover-gone-cam0_battery"})", true);
+  car.recorder = std::make_unique<RecorderProcess>(
+      car.device->port(),
+      std::vector<std::string>{"--detect", "tag36h11", "--follow", "--mqtt", car.broker.url(),
+                               "--mqtt-discovery", "--mqtt-snapshot-interval", "1", "--duration",
+                               "60"});
+  ASSERT_TRUE(cameOnline(car.probe)) << car.recorder->log();
+  std::string id = car.stream;
+  for (char& c : id)
+    if (c == '.') c = '_';
+  std::map<std::string, Json> configs;
+  for (const char* entity : {"camera/camera", "switch/following", "number/target", "sensor/battery",
+                             "sensor/fps", "sensor/loss", "binary_sensor/connectivity"}) {
+    std::string component(entity, std::strchr(entity, '/'));
+    std::string key = std::strchr(entity, '/') + 1;
+    std::string topic =
+        "homeassistant/" + component + "/wircam_wircam/" + id + "_" + key + "/config";
+    ASSERT_TRUE(assistant.waitFor(
+        topic, [](auto& m) { return !m.payload.empty(); }, 10s))
+        << topic;
+    auto config = parsed(assistant.messages(topic).back());
+    ASSERT_TRUE(config.is_object()) << topic;
+    EXPECT_EQ(config["unique_id"], "wircam_" + id + "_" + key);
+    EXPECT_EQ(config["device"]["identifiers"][0], "wircam_" + id);
+    EXPECT_EQ(config["availability_topic"], "wircam/available");
+    configs[key] = config;
+  }
+  // Retained: Home Assistant started later finds them.
+  MqttProbe later(car.broker.port(), "homeassistant/switch/#");
+  EXPECT_TRUE(later.waitFor(
+      "homeassistant/switch/wircam_wircam/" + id + "_following/config",
+      [](auto& m) { return m.retained; }, 10s));
+  // The stale config is cleared with an empty retained message.
+  EXPECT_TRUE(assistant.waitFor(
+      stale, [](auto& m) { return m.payload.empty(); }, 10s));
+
+  // The camera entity's topic carries the camera's JPEG.
+  std::string snapshot = configs["camera"]["topic"];
+  EXPECT_TRUE(car.probe.waitFor(
+      snapshot,
+      [](auto& m) { return m.payload.size() > 1000 && m.payload.starts_with("\xFF\xD8"); }, 10s));
+  // The switch: its command topic turns following off, its state says so.
+  ASSERT_TRUE(car.probe.waitFor(
+      configs["following"]["state_topic"], [](auto& m) { return parsed(m)["following"] == true; },
+      10s));
+  car.probe.publish(configs["following"]["command_topic"], configs["following"]["payload_off"]);
+  EXPECT_TRUE(car.probe.waitFor(
+      configs["following"]["state_topic"], [](auto& m) { return parsed(m)["following"] == false; },
+      10s));
+  // The number: a target id in, the state's target out.
+  car.probe.publish(configs["target"]["command_topic"], "7");
+  EXPECT_TRUE(car.probe.waitFor(
+      configs["target"]["state_topic"], [](auto& m) { return parsed(m)["target"] == 7; }, 10s));
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
-// The MQTT URL and the commands taken over MQTT.
+// The MQTT URL, the commands taken over MQTT, and Home Assistant's discovery.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include "fleet/fleet_command.h"
+#include "fleet/home_assistant.h"
 #include "fleet/mqtt_url.h"
 
 namespace wircam::recorder {
@@ -45,6 +48,38 @@ TEST(FleetCommand, TakesOnOffAndTagIdsAndNamesWhatItRefuses) {
   for (const char* bad : {"", "-2", "7x", "1e3", "99999999999"})
     EXPECT_FALSE(parseFleetCommand("s", "target/set", bad)) << bad;
   EXPECT_FALSE(parseFleetCommand("s", "speed/set", "3"));
+}
+
+}  // namespace
+}  // namespace wircam::recorder
+
+namespace wircam::recorder {
+namespace {
+
+TEST(HomeAssistantDiscovery, EachCameraIsOneDeviceWithSevenEntitiesOnTheRecordersTopics) {
+  DiscoveryNames names{.discoveryPrefix = "homeassistant", .topicPrefix = "lab/a", .version = "1"};
+  auto configs = discoveryConfigs(names, "10.0.0.5-cam0");
+  ASSERT_EQ(configs.size(), 7u);
+  EXPECT_EQ(configs[1].first, "homeassistant/switch/wircam_lab_a/10_0_0_5-cam0_following/config");
+  auto following = nlohmann::json::parse(configs[1].second);
+  EXPECT_EQ(following["command_topic"], "lab/a/10.0.0.5-cam0/follow/set");
+  EXPECT_EQ(following["state_topic"], "lab/a/10.0.0.5-cam0/status");
+  EXPECT_EQ(following["availability_topic"], "lab/a/available");
+  EXPECT_EQ(following["device"]["identifiers"][0], "wircam_10_0_0_5-cam0");
+  EXPECT_EQ(discoverySubscription(names), "homeassistant/+/wircam_lab_a/+/config");
+}
+
+TEST(HomeAssistantDiscovery, OnlyThisRecordersConfigsOfCamerasItNoLongerHasAreStale) {
+  DiscoveryNames names{.discoveryPrefix = "homeassistant", .topicPrefix = "wircam"};
+  std::vector<std::string> streams = {"rover-cam0"};
+  EXPECT_FALSE(
+      isStaleConfig(names, "homeassistant/sensor/wircam_wircam/rover-cam0_fps/config", streams));
+  EXPECT_TRUE(
+      isStaleConfig(names, "homeassistant/sensor/wircam_wircam/rover-cam1_fps/config", streams));
+  EXPECT_FALSE(
+      isStaleConfig(names, "homeassistant/sensor/other_node/rover-cam1_fps/config", streams));
+  EXPECT_FALSE(
+      isStaleConfig(names, "elsewhere/sensor/wircam_wircam/rover-cam1_fps/config", streams));
 }
 
 }  // namespace
