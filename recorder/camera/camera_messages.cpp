@@ -167,6 +167,7 @@ void Camera::handleElementMessage(GstMessage* message) {
   if (bus::is<bus::Drive>(s)) {
     // Driving by hand from the page: each command, and the dead-man's neutral.
     line["type"] = "drive";
+    if (line.value("reason", "") == "dead-man") ++report_.deadManLapses;
     writeTelemetry(line, pipeline_->runningTime());
     return;
   }

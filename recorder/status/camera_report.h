@@ -30,9 +30,10 @@ struct CameraReport {
   int camera = 0;
   std::string state;  // connecting, live, no-video, offline
   int64_t stateSinceUnixMs = 0;
-  bool everLive = false;   // logged in at least once (else: waiting for the device)
-  std::string linkReason;  // why the link is not live, while it is not
-  unsigned restarts = 0;   // of its pipeline, after faults
+  bool everLive = false;       // logged in at least once (else: waiting for the device)
+  std::string linkReason;      // why the link is not live, while it is not
+  unsigned restarts = 0;       // of its pipeline, after faults
+  uint64_t deadManLapses = 0;  // drive mode: the page fell silent, the vehicle went to neutral
   // The source's figures, from its last wirc-stats.
   uint64_t frames = 0, incomplete = 0, bytes = 0;
   double fps = 0, kbps = 0;

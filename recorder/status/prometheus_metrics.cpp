@@ -107,6 +107,9 @@ std::string prometheusText(const RecorderMetrics& m) {
   out.family("wircam_camera_restarts_total", "counter",
              "Times the camera's pipeline was started again after a fault.");
   out.perCamera<uint64_t>(m.cameras, [](Report c) { return uint64_t{c.restarts}; });
+  out.family("wircam_drive_deadman_lapses_total", "counter",
+             "Times drive mode's dead-man put the vehicle at neutral (the page fell silent).");
+  out.perCamera<uint64_t>(m.cameras, [](Report c) { return c.deadManLapses; });
   out.family("wircam_frames_per_second", "gauge", "The camera's frame rate of late.");
   out.perCamera<double>(m.cameras, [](Report c) { return c.fps; });
   out.family("wircam_battery_volts", "gauge", "The vehicle's battery as its device last reported.");

@@ -156,6 +156,14 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
   EXPECT_LE(hung.count(), 250 + 100 + 100)
       << "neutral " << hung.count() << " ms after the page hung";
   std::cerr << "[ measured ] hung page → neutral in " << hung.count() << " ms\n";
+  // Counted for Prometheus.
+  std::string lapses = "wircam_drive_deadman_lapses_total{stream=\"127.0.0.1-" +
+                       std::to_string(car.device->port()) + "-cam0\"} 1";
+  EXPECT_TRUE(waitFor([&] {
+    return fetch(signedIn.url + "metrics", "GET",
+                 {{"Authorization", std::string("Bearer ") + kToken}})
+               .body.find(lapses) != std::string::npos;
+  }));
 
   // It comes back, drives again, and its tab is closed: neutral at once.
   page.call("Debugger.resume");
