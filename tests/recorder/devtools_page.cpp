@@ -49,7 +49,8 @@ std::string httpGet(SoupSession* session, const std::string& url, const char* me
 }  // namespace
 
 std::unique_ptr<DevToolsPage> DevToolsPage::launch(const std::filesystem::path& profile, int width,
-                                                   int height) {
+                                                   int height,
+                                                   const std::vector<std::string>& extraFlags) {
   std::unique_ptr<DevToolsPage> page(new DevToolsPage());
   page->profile_ = profile;
   std::error_code ignored;
@@ -57,6 +58,7 @@ std::unique_ptr<DevToolsPage> DevToolsPage::launch(const std::filesystem::path& 
   std::filesystem::create_directories(profile);
   std::vector<std::string> args = {"chromium"};
   for (auto& flag : chromiumFlags(profile, width, height)) args.push_back(flag);
+  args.insert(args.end(), extraFlags.begin(), extraFlags.end());
   // A hidden or idle tab must keep its timers at speed.
   args.insert(args.end(),
               {"--disable-background-timer-throttling", "--disable-renderer-backgrounding",

@@ -14,16 +14,18 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace wircam::testing {
 
 class DevToolsPage {
  public:
   // Starts chromium with a fresh profile in `profile` (removed at the end)
-  // and attaches to its first tab; nullptr (with the reason on stderr) if
-  // it cannot.
+  // and `extraFlags`, and attaches to its first tab; nullptr (with the
+  // reason on stderr) if it cannot.
   static std::unique_ptr<DevToolsPage> launch(const std::filesystem::path& profile, int width,
-                                              int height);
+                                              int height,
+                                              const std::vector<std::string>& extraFlags = {});
   ~DevToolsPage();
   DevToolsPage(const DevToolsPage&) = delete;
   DevToolsPage& operator=(const DevToolsPage&) = delete;

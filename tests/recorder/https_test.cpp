@@ -9,8 +9,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "devtools_page.h"
+#include "headless_chromium.h"
 #include "recorder_process.h"
 #include "shell_command.h"
+#include "signed_in_page.h"
 #include "simulated_device.h"
 #include "test_certificates.h"
 
@@ -56,6 +59,53 @@ TEST(WircRecorderHttps, TheApiIsServedOverTlsToClientsThatTrustTheCertificate) {
   EXPECT_NE(refused.exitCode, 0) << refused.output;
   // ...and the server serves the next client as before.
   EXPECT_TRUE(curl(trusted + bearer, *url + "api/status").output.ends_with("\n200"));
+  fs::remove_all(certificates);
+}
+
+// Chromium trusts the test's server key (--ignore-certificate-errors-spki-list,
+// the way to trust one certificate without a system CA store): the page,
+// the live picture and the drive WebSocket (wss://) all over TLS.
+TEST(WircRecorderHttps, ChromiumLoadsThePageSeesTheCameraAndDrivesOverTls) {
+  if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
+  fs::path certificates =
+      fs::temp_directory_path() / ("wirc-https-page-" + std::to_string(getpid()));
+  ASSERT_TRUE(makeCertificates(certificates));
+  auto spki = runCommand("cd '" + certificates.string() +
+                         "' && openssl x509 -in server.pem -pubkey -noout | openssl pkey -pubin "
+                         "-outform der | openssl dgst -sha256 -binary | base64");
+  ASSERT_EQ(spki.exitCode, 0) << spki.output;
+  std::string hash = spki.output.substr(0, spki.output.find('\n'));
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  RecorderProcess recorder(
+      car.device->port(),
+      {"--detect", "tag36h11", "--follow", "--http", "127.0.0.1:0", "--http-token", kToken,
+       "--http-cert", (certificates / "server.pem").string(), "--http-key",
+       (certificates / "server.key").string(), "--duration", "60"});
+  auto url = recorder.waitForLog("https://", milliseconds(10000));
+  ASSERT_TRUE(url) << recorder.log();
+  auto page = DevToolsPage::launch(shotPath("web-https"), 900, 1000,
+                                   {"--ignore-certificate-errors-spki-list=" + hash});
+  ASSERT_TRUE(page);
+  ASSERT_TRUE(page->setCookie("wircam_token", kToken, *url));
+  ASSERT_TRUE(page->navigate(*url));
+  EXPECT_EQ(page->evaluate("location.protocol"), "https:");
+  EXPECT_TRUE(
+      page->waitUntil("[...document.querySelectorAll('.view img')].some(i => "
+                      "i.naturalWidth === 352)",
+                      milliseconds(15000)))
+      << "the live picture over TLS";
+  std::string camera = "127.0.0.1-" + std::to_string(car.device->port()) + "-cam0";
+  auto answer = page->evaluate(
+      "new Promise(done => { const s = new WebSocket('wss://' + location.host + "
+      "'/api/cameras/" +
+      camera +
+      "/drive'); s.onopen = () => s.send(JSON.stringify({seq: 1, steering: 0, throttle: 0})); "
+      "s.onmessage = e => { done(e.data); s.close(); }; s.onerror = () => done('error'); })");
+  ASSERT_TRUE(answer.is_string()) << answer.dump();
+  auto ack = nlohmann::json::parse(answer.get<std::string>(), nullptr, false);
+  EXPECT_EQ(ack["ack"], 1) << answer.dump();
+  page->screenshot(shotPath("web-https.png"));
   fs::remove_all(certificates);
 }
 
