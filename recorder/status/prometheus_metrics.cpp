@@ -80,18 +80,25 @@ std::string prometheusText(const RecorderMetrics& m) {
       return it == m.recorded.end() ? 0 : it->second.*field;
     };
   };
-  out.family("wircam_frames_recorded_total", "counter",
-             "Frames in the segments closed since the recorder started.");
-  out.perCamera<uint64_t>(m.cameras, recorded(&RecordedTotals::frames));
-  out.family("wircam_segments_closed_total", "counter",
-             "Segments finished and indexed since the recorder started.");
-  out.perCamera<uint64_t>(m.cameras, recorded(&RecordedTotals::segmentsClosed));
-  out.family("wircam_recorded_bytes_total", "counter",
-             "Bytes of the segments closed since the recorder started.");
-  out.perCamera<uint64_t>(m.cameras, recorded(&RecordedTotals::bytes));
-  out.family("wircam_hook_failures_total", "counter",
-             "Runs of the --on-segment-closed hook that failed or timed out.");
-  out.perCamera<uint64_t>(m.cameras, recorded(&RecordedTotals::hookFailures));
+  const struct {
+    const char* name;
+    const char* help;
+    uint64_t RecordedTotals::*field;
+  } kRecordedCounters[] = {
+      {"wircam_frames_recorded_total", "Frames in the segments closed since the recorder started.",
+       &RecordedTotals::frames},
+      {"wircam_segments_closed_total", "Segments finished and indexed since the recorder started.",
+       &RecordedTotals::segmentsClosed},
+      {"wircam_recorded_bytes_total", "Bytes of the segments closed since the recorder started.",
+       &RecordedTotals::bytes},
+      {"wircam_hook_failures_total",
+       "Runs of the --on-segment-closed hook that failed or timed out.",
+       &RecordedTotals::hookFailures},
+  };
+  for (const auto& counter : kRecordedCounters) {
+    out.family(counter.name, "counter", counter.help);
+    out.perCamera<uint64_t>(m.cameras, recorded(counter.field));
+  }
 
   out.family("wircam_stream_up", "gauge", "1 while the camera's frames arrive (state live).");
   out.perCamera<uint64_t>(m.cameras, [](Report c) { return uint64_t{c.state == "live"}; });

@@ -20,14 +20,20 @@ using std::chrono::milliseconds;
 
 constexpr const char* kToken = "0123456789abcdef0123456789abcdef";
 
-TEST(WircRecorderHttpToken, EveryRequestNeedsTheTokenAsBearerOrCookie) {
-  auto device = startSequenceDevice();
-  ASSERT_TRUE(device);
-  RecorderProcess recorder(device->port(),
-                           {"--http", "127.0.0.1:0", "--http-token", kToken, "--duration", "30"});
-  auto url = recorder.waitForLog("http://", milliseconds(10000));
-  ASSERT_TRUE(url) << recorder.log();
+// A recorder of the sequence device with the web server and the token.
+struct TokenRecorder {
+  std::unique_ptr<wircam::wirc::Device> device = startSequenceDevice();
+  RecorderProcess recorder{device->port(),
+                           {"--http", "127.0.0.1:0", "--http-token", kToken, "--duration", "30"}};
+  std::optional<std::string> url = recorder.waitForLog("http://", milliseconds(10000));
   std::string camera = "127.0.0.1-" + std::to_string(device->port()) + "-cam0";
+};
+
+TEST(WircRecorderHttpToken, EveryRequestNeedsTheTokenAsBearerOrCookie) {
+  TokenRecorder served;
+  auto& url = served.url;
+  const auto& camera = served.camera;
+  ASSERT_TRUE(url) << served.recorder.log();
   for (const std::string& path : std::vector<std::string>{
            "api/status", "api/cameras", "api/recordings", "recordings", "live/" + camera + ".mjpg",
            "api/cameras/" + camera + "/snapshot.jpg", "api/events"}) {
@@ -58,13 +64,10 @@ TEST(WircRecorderHttpToken, EveryRequestNeedsTheTokenAsBearerOrCookie) {
 // What VLC, OpenCV and Home Assistant send for http://user:TOKEN@host/...:
 // Basic credentials, any user name, the token as the password.
 TEST(WircRecorderHttpToken, ClientsWithCredentialsInTheUrlGetTheLiveStream) {
-  auto device = startSequenceDevice();
-  ASSERT_TRUE(device);
-  RecorderProcess recorder(device->port(),
-                           {"--http", "127.0.0.1:0", "--http-token", kToken, "--duration", "30"});
-  auto url = recorder.waitForLog("http://", milliseconds(10000));
-  ASSERT_TRUE(url) << recorder.log();
-  std::string camera = "127.0.0.1-" + std::to_string(device->port()) + "-cam0";
+  TokenRecorder served;
+  auto& url = served.url;
+  const auto& camera = served.camera;
+  ASSERT_TRUE(url) << served.recorder.log();
   auto withCredentials = [&](const std::string& password) {
     std::string live =
         "http://viewer:" + password + "@" + url->substr(7) + "live/" + camera + ".mjpg";
