@@ -42,6 +42,7 @@ struct Session {
 struct Stats {
   static constexpr const char* kName = "wirc-stats";
   guint64 framesComplete = 0, framesIncomplete = 0, bytes = 0;
+  guint64 commandsSent = 0;  // PCD the vehicle link sent, keepalives included
   guint batteryMv = 0;
   bool statusStale = false;  // the device stopped reporting; batteryMv is its last word
   guint64 statusAgeMs = 0;
@@ -51,6 +52,7 @@ struct Stats {
     gst_structure_get_uint64(s, "frames-complete", &stats.framesComplete);
     gst_structure_get_uint64(s, "frames-incomplete", &stats.framesIncomplete);
     gst_structure_get_uint64(s, "bytes", &stats.bytes);
+    gst_structure_get_uint64(s, "commands-sent", &stats.commandsSent);
     gst_structure_get_uint(s, "battery-mv", &stats.batteryMv);
     gst_structure_get_boolean(s, "status-stale", &stale);
     gst_structure_get_uint64(s, "status-age-ms", &stats.statusAgeMs);

@@ -216,8 +216,10 @@ void postStats(GstWircSrc* self) {
                       G_TYPE_UINT64, static_cast<guint64>(age.count()), "status-stale",
                       G_TYPE_BOOLEAN, age > kStatusStaleAfter, nullptr);
   }
+  // Every PCD the link sent the vehicle, repeats (keepalives) included.
   gst_structure_set(stats, "input-rejected", G_TYPE_UINT64,
-                    static_cast<guint64>(session.inputRejected), nullptr);
+                    static_cast<guint64>(session.inputRejected), "commands-sent", G_TYPE_UINT64,
+                    static_cast<guint64>(session.commandsSent), nullptr);
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), stats));
 }
 

@@ -159,6 +159,7 @@ void Camera::tearDown() {
   earlierRuns_.frames += runCounts_.frames;
   earlierRuns_.incomplete += runCounts_.incomplete;
   earlierRuns_.bytes += runCounts_.bytes;
+  earlierRuns_.commandsSent += runCounts_.commandsSent;
   runCounts_ = {};
   if (stopping_) {
     ended_ = true;

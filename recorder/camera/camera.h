@@ -134,7 +134,7 @@ class Camera {
   CameraState state_ = CameraState::kConnecting;  // as last said
   bool everLive_ = false;                         // logged in at least once
   struct Counts {
-    uint64_t frames = 0, incomplete = 0, bytes = 0;
+    uint64_t frames = 0, incomplete = 0, bytes = 0, commandsSent = 0;
   };
   Counts earlierRuns_, runCounts_;  // the sources' counts: past pipelines', this one's
   std::optional<std::pair<bool, int>> carriedControl_;

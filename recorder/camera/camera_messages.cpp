@@ -75,10 +75,11 @@ void Camera::handleStats(const GstStructure* s, nlohmann::json line) {
   auto stats = bus::Stats::read(s);
   uint64_t frames = report_.frames, bytes = report_.bytes;
   // A new pipeline's source counts from 0: its counts add to the camera's.
-  runCounts_ = {stats.framesComplete, stats.framesIncomplete, stats.bytes};
+  runCounts_ = {stats.framesComplete, stats.framesIncomplete, stats.bytes, stats.commandsSent};
   report_.frames = earlierRuns_.frames + runCounts_.frames;
   report_.incomplete = earlierRuns_.incomplete + runCounts_.incomplete;
   report_.bytes = earlierRuns_.bytes + runCounts_.bytes;
+  report_.commandsSent = earlierRuns_.commandsSent + runCounts_.commandsSent;
   report_.batteryMv = stats.batteryMv;
   report_.statusStale = stats.statusStale;
   report_.statusAgeMs = stats.statusAgeMs;

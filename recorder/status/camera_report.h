@@ -36,6 +36,7 @@ struct CameraReport {
   uint64_t deadManLapses = 0;  // drive mode: the page fell silent, the vehicle went to neutral
   // The source's figures, from its last wirc-stats.
   uint64_t frames = 0, incomplete = 0, bytes = 0;
+  uint64_t commandsSent = 0;  // PCD to the WiRC vehicle, keepalives included
   double fps = 0, kbps = 0;
   unsigned batteryMv = 0;
   bool statusStale = false;  // the device stopped reporting; batteryMv is its last word

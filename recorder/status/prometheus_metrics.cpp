@@ -114,6 +114,9 @@ std::string prometheusText(const RecorderMetrics& m) {
   out.family("wircam_camera_restarts_total", "counter",
              "Times the camera's pipeline was started again after a fault.");
   out.perCamera<uint64_t>(m.cameras, [](Report c) { return uint64_t{c.restarts}; });
+  out.family("wircam_pcd_sent_total", "counter",
+             "Commands (PCD) the camera's link sent to the WiRC vehicle, keepalives included.");
+  out.perCamera<uint64_t>(m.cameras, [](Report c) { return c.commandsSent; });
   out.family("wircam_drive_deadman_lapses_total", "counter",
              "Times drive mode's dead-man put the vehicle at neutral (the page fell silent).");
   out.perCamera<uint64_t>(m.cameras, [](Report c) { return c.deadManLapses; });

@@ -47,6 +47,11 @@ TEST(RecorderMetrics, TheTextIsPrometheussAndNeedsTheToken) {
            "# TYPE wircam_frames_received_total counter", "wircam_disk_free_bytes ",
            "wircam_http_connections "})
     EXPECT_NE(metrics.body.find(line), std::string::npos) << line << "\n" << metrics.body;
+  // The link keeps the device's watchdog fed: PCD go out even without following.
+  std::string pcd = "wircam_pcd_sent_total{" + stream + "} ";
+  auto at = metrics.body.find(pcd);
+  ASSERT_NE(at, std::string::npos) << metrics.body;
+  EXPECT_GT(std::stoull(metrics.body.substr(at + pcd.size())), 5u);
   fs::path text = recorder.out().parent_path() / "metrics.txt";
   std::ofstream(text) << metrics.body;
   auto checked = runCommand("promtool check metrics < '" + text.string() + "'");

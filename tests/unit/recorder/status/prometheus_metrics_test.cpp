@@ -17,6 +17,7 @@ TEST(PrometheusMetrics, EachCameraIsAStreamLabelAndItsStateOneSeriesPerState) {
   steering.batteryMv = 7400;
   steering.control = ControlReport{.hasControl = true};
   steering.deadManLapses = 2;
+  steering.commandsSent = 300;
   CameraReport quiet;
   quiet.name = "odd\"name\\x";
   quiet.state = "offline";
@@ -36,6 +37,7 @@ TEST(PrometheusMetrics, EachCameraIsAStreamLabelAndItsStateOneSeriesPerState) {
            "wircam_battery_volts{stream=\"rover-cam0\"} 7.4\n",
            "wircam_has_control{stream=\"rover-cam0\"} 1\n",
            "wircam_drive_deadman_lapses_total{stream=\"rover-cam0\"} 2\n",
+           "wircam_pcd_sent_total{stream=\"rover-cam0\"} 300\n",
            "wircam_segments_closed_total{stream=\"odd\\\"name\\\\x\"} 0\n",
            "wircam_disk_free_bytes 1234\n",
        })
