@@ -79,14 +79,19 @@ TEST(WircRecorderHttpToken, ClientsWithCredentialsInTheUrlGetTheLiveStream) {
   auto refused = withCredentials("0123456789abcdef0123456789abcdeX");
   EXPECT_NE(refused.exitCode, 0) << refused.output;
   EXPECT_NE(refused.output.find("Unauthorized"), std::string::npos) << refused.output;
-  // Python's OpenCV (Debian's python3-opencv) opens the URL as it is.
-  std::string live =
-      "http://viewer:" + std::string(kToken) + "@" + url->substr(7) + "live/" + camera + ".mjpg";
-  auto opencv = runCommand(
-      "/usr/bin/python3 -c \"import cv2, sys; ok, frame = cv2.VideoCapture(sys.argv[1]).read(); "
-      "print(ok, frame.shape if ok else None)\" '" +
-      live + "' 2>/dev/null");
-  EXPECT_EQ(opencv.output, "True (288, 352, 3)\n") << opencv.output;
+  // Python's OpenCV (Debian's python3-opencv) opens the URL as it is, and
+  // not with a wrong password.
+  auto opencv = [&](const std::string& password) {
+    std::string live =
+        "http://viewer:" + password + "@" + url->substr(7) + "live/" + camera + ".mjpg";
+    return runCommand(
+               "/usr/bin/python3 -c \"import cv2, sys; ok, frame = "
+               "cv2.VideoCapture(sys.argv[1]).read(); print(ok, frame.shape if ok else None)\" '" +
+               live + "' 2>/dev/null")
+        .output;
+  };
+  EXPECT_EQ(opencv(kToken), "True (288, 352, 3)\n");
+  EXPECT_EQ(opencv("0123456789abcdef0123456789abcdeX"), "False None\n");
   // A script's Basic header works on the API too.
   std::string pair = std::string("script:") + kToken;
   gchar* basic = g_base64_encode(reinterpret_cast<const guchar*>(pair.data()), pair.size());
