@@ -92,8 +92,8 @@ TEST(WircRecorderHttpToken, ClientsWithCredentialsInTheUrlGetTheLiveStream) {
   };
   // (OpenCV prints its backend's warnings before the answer.)
   EXPECT_TRUE(opencv(kToken).ends_with("True (288, 352, 3)\n")) << opencv(kToken);
-  auto refused = opencv("0123456789abcdef0123456789abcdeX");
-  EXPECT_TRUE(refused.ends_with("False None\n")) << refused;
+  auto wrongPassword = opencv("0123456789abcdef0123456789abcdeX");
+  EXPECT_TRUE(wrongPassword.ends_with("False None\n")) << wrongPassword;
   // A script's Basic header works on the API too.
   std::string pair = std::string("script:") + kToken;
   gchar* basic = g_base64_encode(reinterpret_cast<const guchar*>(pair.data()), pair.size());
