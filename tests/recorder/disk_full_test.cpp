@@ -30,19 +30,22 @@ struct SmallDisk {
     fs::remove_all(mountPoint);
   }
 
-  // Runs the recorder with a tmpfs of `size` at mountPoint, then copies
-  // what it left into `saved` (the tmpfs goes with the namespace).
-  std::vector<std::string> wrapper(const char* size) const {
+  // Runs the recorder with a tmpfs of `size` at mountPoint (after `setup`,
+  // shell run in it), then copies what it left into `saved` (the tmpfs goes
+  // with the namespace).
+  std::vector<std::string> wrapper(const char* size, const std::string& setup = "true") const {
     return {"unshare",
             "--mount",
             "--map-root-user",
             "sh",
             "-c",
             "m=$1; s=$2; mkdir -p \"$m\" \"$s\" && mount -t tmpfs -o size=$0 wirc-test \"$m\" "
-            "|| exit 125; shift 2; \"$@\"; code=$?; cp -a \"$m\"/. \"$s\"/; exit $code",
+            "|| exit 125; (cd \"$m\" && eval \"$3\") || exit 126; shift 3; \"$@\"; code=$?; "
+            "cp -a \"$m\"/. \"$s\"/; exit $code",
             size,
             mountPoint.string(),
-            saved.string()};
+            saved.string(),
+            setup};
   }
 
   std::vector<fs::path> videos() const {
@@ -81,6 +84,30 @@ TEST(WircRecorderDiskFull, FinishesEverySegmentAndExitsThree) {
   }
   // Nothing that was recorded is lost: every frame delivered is in a file.
   EXPECT_GE(static_cast<uint64_t>(frames) + 3, device->stats().framesSent);
+}
+
+// A disk left full by an old segment: --max-age prunes it at start-up (a
+// removal needs no room), and the recording goes on.
+TEST(WircRecorderDiskFull, AnOldSegmentOnAFullDiskIsPrunedByAgeAndRecordingGoesOn) {
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  SmallDisk disk("wirc-disk-aged");
+  RecorderProcess recorder(
+      0,
+      {"--device", "127.0.0.1:" + std::to_string(device->port()), "--out", disk.mountPoint.string(),
+       "--max-age", "1d", "--duration", "3"},
+      disk.wrapper("2m",
+                   "dd if=/dev/zero of=old-cam0-20260101T000000Z.mkv bs=1k count=1900 "
+                   "2>/dev/null; touch -d '10 days ago' old-cam0-20260101T000000Z.mkv"));
+  int code = recorder.wait();
+  if (code == kNoNamespace) GTEST_SKIP() << "no mount namespace here: " << recorder.log();
+  EXPECT_EQ(code, 0) << recorder.log();
+  EXPECT_NE(recorder.log().find("deleted old-cam0-20260101T000000Z.mkv (older than --max-age)"),
+            std::string::npos)
+      << recorder.log();
+  auto videos = disk.videos();
+  ASSERT_EQ(videos.size(), 1u);
+  EXPECT_GT(contentsOf(videos[0]).frames, 10);
 }
 
 TEST(WircRecorderDiskFull, StopsAtOnceWhenThereIsNoRoomToStart) {
