@@ -112,12 +112,14 @@ struct ExportDownloads::Download {
     soup_server_message_unpause(message);
   }
 
-  // The recorder's log says how each export ended.
-  void logEnd() const {
+  // The response is over: the export stopped (if it still ran), and the
+  // recorder's log says how it ended.
+  void end() {
+    stop = true;
+    if (worker.joinable()) worker.join();  // the result is written then
     std::string what = "export of " + request.camera + " (" + extensionOf(request.format) + ")";
-    if (!result) {
-      logLine(what + ": the client left before it began");
-    } else if (!*result) {
+    if (!result) return;
+    if (!*result) {
       bool stopped = result->error().kind == ExportError::Kind::kCancelled;
       logLine(what + (stopped ? ": stopped, the client left" : ": " + result->error().message));
     } else {
@@ -199,7 +201,7 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
       g_signal_connect(message, "finished", G_CALLBACK(+[](SoupServerMessage*, gpointer data) {
                          auto* d = static_cast<Download*>(data);
                          d->message = nullptr;  // libsoup is done with it
-                         d->logEnd();
+                         d->end();
                          d->owner->forget(d);
                        }),
                        download);
