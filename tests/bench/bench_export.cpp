@@ -123,6 +123,6 @@ int main(int argc, char** argv) {
     std::printf("%-32s | %8.1f | %8.2f | %8.1f | %.2f\n", way.name, rate, run->seconds,
                 static_cast<double>(run->maxRssKb) / 1024, rate / stock);
   }
-  if (!getenv("KEEP")) fs::remove_all(work);
+  fs::remove_all(work);
   return 0;
 }
