@@ -19,6 +19,18 @@ std::optional<ExportFormat> exportFormatOf(const std::string& name) {
   return std::nullopt;
 }
 
+const char* exportFormatName(ExportFormat format) {
+  switch (format) {
+    case ExportFormat::kMkv:
+      return "mkv";
+    case ExportFormat::kMp4:
+      return "mp4";
+    case ExportFormat::kMcap:
+      return "mcap";
+  }
+  return "mkv";
+}
+
 namespace {
 
 struct TimedLine {
@@ -176,8 +188,7 @@ Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
   if (request.format == ExportFormat::kMcap)
     sink = std::make_unique<McapExport>(request.out.string(), request.camera);
   else
-    sink = std::make_unique<MuxedExport>(request.out.string(),
-                                         request.format == ExportFormat::kMp4 ? "mp4" : "mkv");
+    sink = std::make_unique<MuxedExport>(request.out.string(), exportFormatName(request.format));
   fs::path jsonlPath = fs::path(request.out).replace_extension(".jsonl");
   std::ofstream jsonl(jsonlPath);
   if (!jsonl) return unexpected(ExportError{Kind::kFailed, "cannot write " + jsonlPath.string()});

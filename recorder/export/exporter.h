@@ -17,6 +17,7 @@ namespace wircam::recorder {
 
 enum class ExportFormat { kMkv, kMp4, kMcap };
 std::optional<ExportFormat> exportFormatOf(const std::string& name);  // "mkv", "mp4", "mcap"
+const char* exportFormatName(ExportFormat format);                    // and back
 
 struct ExportRequest {
   std::filesystem::path recordings;

@@ -37,18 +37,6 @@ const char* contentTypeOf(ExportFormat format) {
   return "application/octet-stream";
 }
 
-const char* extensionOf(ExportFormat format) {
-  switch (format) {
-    case ExportFormat::kMkv:
-      return "mkv";
-    case ExportFormat::kMp4:
-      return "mp4";
-    case ExportFormat::kMcap:
-      return "mcap";
-  }
-  return "bin";
-}
-
 // "2026-11-24T14:59:35.467Z" → "20261124T145935Z", for a file name.
 std::string compactTime(int64_t unixNs) {
   std::string compact;
@@ -65,11 +53,7 @@ std::string downloadName(const std::string& camera, const ExportReport& report,
   std::string name;
   for (char c : camera) name += g_ascii_isalnum(c) || c == '-' || c == '.' ? c : '_';
   return name + "_" + compactTime(report.firstUtcNs) + "-" + compactTime(report.lastUtcNs) + "." +
-         extensionOf(format);
-}
-
-const char* queryValue(GHashTable* query, const char* name) {
-  return query ? static_cast<const char*>(g_hash_table_lookup(query, name)) : nullptr;
+         exportFormatName(format);
 }
 
 // A form-decoded query turns the '+' of "+01:00" into a space; no ISO 8601
@@ -99,13 +83,14 @@ struct ExportDownloads::Download {
 
   // The file's next block, or the body's end after its last.
   void sendNextBlock() {
-    std::vector<char> block(kBlockBytes);
-    file.read(block.data(), static_cast<std::streamsize>(block.size()));
+    // Read into memory the body then owns: no copy, freed once written.
+    auto* block = static_cast<char*>(g_malloc(kBlockBytes));
+    file.read(block, static_cast<std::streamsize>(kBlockBytes));
     auto* body = soup_server_message_get_response_body(message);
     if (file.gcount() > 0) {
-      soup_message_body_append(body, SOUP_MEMORY_COPY, block.data(),
-                               static_cast<gsize>(file.gcount()));
+      soup_message_body_append(body, SOUP_MEMORY_TAKE, block, static_cast<gsize>(file.gcount()));
     } else {
+      g_free(block);
       soup_message_body_complete(body);
       sentAll = true;
     }
@@ -117,7 +102,8 @@ struct ExportDownloads::Download {
   void end() {
     stop = true;
     if (worker.joinable()) worker.join();  // the result is written then
-    std::string what = "export of " + request.camera + " (" + extensionOf(request.format) + ")";
+    std::string what =
+        "export of " + request.camera + " (" + exportFormatName(request.format) + ")";
     if (!result) return;
     if (!*result) {
       bool stopped = result->error().kind == ExportError::Kind::kCancelled;
@@ -166,12 +152,13 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
   if (!format)
     return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
                             std::string("format= is mkv, mp4 or mcap") + kForm);
-  auto request = std::make_unique<Download>();
-  request->request.recordings = recordings_;
-  request->request.camera = camera;
-  request->request.format = *format;
-  for (auto [key, bound] :
-       {std::pair{"start", &request->request.start}, std::pair{"end", &request->request.end}}) {
+  auto owned = std::make_unique<Download>();
+  Download* download = owned.get();
+  auto& range = download->request;
+  range.recordings = recordings_;
+  range.camera = camera;
+  range.format = *format;
+  for (auto [key, bound] : {std::pair{"start", &range.start}, std::pair{"end", &range.end}}) {
     const char* text = queryValue(query, key);
     if (!text) continue;
     *bound = queryTime(text);
@@ -181,7 +168,6 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
                                   printableText(std::string(text).substr(0, 40)) +
                                   "' is not an ISO 8601 time like 2026-11-24T14:59:35Z");
   }
-  auto& range = request->request;
   if (range.start && range.end && *range.end < *range.start)
     return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "end= is before start=");
   if (recordings_.empty())
@@ -192,9 +178,8 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
         "already exporting " + std::to_string(kMaxAtOnce) + " ranges; try again when one is done");
   std::error_code error;
   fs::create_directories(scratch_, error);
-  range.out = scratch_ / (std::to_string(++serial_) + "." + extensionOf(*format));
+  range.out = scratch_ / (std::to_string(++serial_) + "." + exportFormatName(*format));
 
-  Download* download = request.get();
   download->message = message;
   download->owner = this;
   download->finishedHandler =
@@ -228,7 +213,7 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
         },
         new Done{this, download, alive}, [](gpointer data) { delete static_cast<Done*>(data); });
   });
-  downloads_.push_back(std::move(request));
+  downloads_.push_back(std::move(owned));
 }
 
 gboolean ExportDownloads::checkClient(gpointer data) {

@@ -23,7 +23,7 @@ void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GH
                             "POST /api/cameras/NAME/" + route.action);
   if (refusedWithoutToken(message, "controlling the vehicle")) return;
   auto lookup = [&](const char* key) -> std::string {
-    const char* value = query ? static_cast<const char*>(g_hash_table_lookup(query, key)) : nullptr;
+    const char* value = queryValue(query, key);
     return value ? value : "";
   };
   // The same commands as over MQTT, with their checks.

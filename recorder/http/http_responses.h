@@ -1,5 +1,6 @@
 // The web server's plain answers: a body with its type, and errors as text
-// or, for the API, as JSON that scripts can read.
+// or, for the API, as JSON that scripts can read; and a request's query
+// values.
 #pragma once
 
 #include <libsoup/soup.h>
@@ -8,6 +9,11 @@
 #include <string>
 
 namespace wircam::recorder {
+
+// A query parameter as libsoup decoded it, or null (also without a query).
+inline const char* queryValue(GHashTable* query, const char* name) {
+  return query ? static_cast<const char*>(g_hash_table_lookup(query, name)) : nullptr;
+}
 
 inline void respond(SoupServerMessage* message, guint status, const char* type,
                     const std::string& body) {

@@ -416,8 +416,7 @@ void HttpServer::servePlayback(SoupServerMessage* message, const std::string& na
         message, SOUP_STATUS_NOT_FOUND,
         "no Matroska recording named '" + name + "' (MP4 recordings play from /recordings/FILE)");
   double from = 0;
-  if (const char* text =
-          query ? static_cast<const char*>(g_hash_table_lookup(query, "from")) : nullptr) {
+  if (const char* text = queryValue(query, "from")) {
     char* end = nullptr;
     from = g_ascii_strtod(text, &end);
     if (end == text || *end != '\0' || !std::isfinite(from) || from < 0)
