@@ -68,12 +68,15 @@ file and exits 0.
                          commands sent this long instead of --max-age (longer)
   --http [HOST]:PORT     web server: live view, playback, control and drive
                          mode at /, status at /api/status, cameras at
-                         /api/cameras, recordings at /api/recordings (e.g.
-                         --http :8080). Without HOST it listens on 127.0.0.1
+                         /api/cameras, recordings at /api/recordings, a time
+                         range as one file at /api/export, Prometheus's
+                         metrics at /metrics (e.g. --http :8080). Without HOST it listens on 127.0.0.1
                          only; another HOST (e.g. 0.0.0.0) needs --http-token
-  --http-token T         every request needs "Authorization: Bearer T" or the
-                         cookie the page's /login sets (16 characters at least);
-                         control, driving and deleting need it always
+  --http-token T         every request needs "Authorization: Bearer T", Basic
+                         credentials with T as the password (any user name:
+                         http://viewer:T@host/...) or the cookie the page's
+                         /login sets (16 characters at least); RTSP asks for it
+                         too; control, driving and deleting need it always
   --http-cert FILE --http-key FILE
                          serve HTTPS with this certificate and key (PEM): the
                          page, API, streams and drive WebSocket over TLS (the
@@ -142,11 +145,12 @@ time range of them.
 MQTT topics (PREFIX/STREAM, STREAM as in the file names):
   PREFIX/available          online/offline, retained; offline is the last will
   PREFIX/STREAM/status      retained JSON: state, fps, loss, battery_v,
-                            has_control, following, position; on change and
-                            at least every 5 s
+                            has_control, following, target, position; on
+                            change and at least every 5 s
   PREFIX/STREAM/detections  JSON per frame with tags (and one when they go)
   PREFIX/STREAM/events      session events, {"type":"segment-closed",...},
                             hook failures
+  PREFIX/STREAM/snapshot    with --mqtt-discovery: the newest JPEG, retained
   PREFIX/STREAM/follow/set  ON or OFF (takes effect at once; OFF = neutral)
   PREFIX/STREAM/target/set  a tag id (-1: the largest)
 

@@ -203,16 +203,18 @@ void Supervisor::segmentClosed(Camera& camera, const std::string& file,
   markTelemetryTrack(file);
   std::error_code error;
   auto name = std::filesystem::path(file).filename().string();
+  uint64_t bytes = std::filesystem::file_size(file, error);
+  if (error) bytes = 0;
   index_.add({.camera = camera.name(),
               .file = name,
               .startUtc = SegmentPlanner::isoUtc(planned.startUnixMs),
               .durationSeconds = planned.durationSeconds(),
               .frames = planned.frames,
-              .bytes = std::filesystem::file_size(file, error)});
+              .bytes = bytes});
   auto& totals = recorded_[camera.name()];
   ++totals.segmentsClosed;
   totals.frames += planned.frames;
-  totals.bytes += std::filesystem::file_size(file, error);
+  totals.bytes += bytes;
   auto sidecar = TelemetryLog::pathFor(file);
   event(camera, {{"type", "segment-closed"},
                  {"file", name},
