@@ -44,6 +44,7 @@ std::string FleetPublisher::topic(const std::string& stream, const char* leaf) c
 // On the MQTT thread, at each connection: who we are, what we know, and
 // what we listen to.
 void FleetPublisher::republish(MqttClient& client) {
+  sessionClient_ = &client;
   client.publish(settings_.prefix + "/available", "online", true, 1);
   {
     std::lock_guard lock(retainedMutex_);
@@ -67,7 +68,7 @@ bool FleetPublisher::clearedStaleConfig(const std::string& topicName, const std:
   if (!settings_.discovery || !topicName.starts_with(settings_.discovery->discoveryPrefix + "/"))
     return false;
   if (!payload.empty() && isStaleConfig(*settings_.discovery, topicName, settings_.streams)) {
-    client_->publish(topicName, "", true, 1);
+    sessionClient_->publish(topicName, "", true, 1);
     logLine("cleared the Home Assistant config " + printableText(topicName) +
             " (a camera no longer here)");
   }

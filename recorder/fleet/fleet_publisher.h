@@ -69,6 +69,9 @@ class FleetPublisher {
   const Settings settings_;
   const std::function<void(const FleetCommand&)> apply_;
   std::unique_ptr<MqttClient> client_;
+  // The client as the MQTT thread knows it (from its first connection on):
+  // messages may come before start() has stored client_.
+  MqttClient* sessionClient_ = nullptr;
   std::map<std::string, StreamState> streams_;  // main loop only (the MQTT thread reads settings_)
   // The retained statuses, for a new connection (guarded: the MQTT thread reads it).
   std::mutex retainedMutex_;

@@ -125,14 +125,16 @@ std::optional<RecordedDrive::Frame> RecordedDrive::next() {
       framesInSegment_ = 0;
     }
     auto frame = reader_->next();
-    if (frame && *frame && !isJpeg(reader_->caps())) {
-      notes_.push_back(name + " holds " + mediaTypeOf(reader_->caps()) + ": skipped");
-      frame = std::optional<recorder::SegmentFrame>();
-    }
+    // The segment's end, a break in it, or frames the protocol cannot carry:
+    // on to the next segment (the last two said).
+    std::optional<std::string> skipped;
     if (!frame)
-      notes_.push_back(name + ": broken off after " + std::to_string(framesInSegment_) +
-                       " frames (" + frame.error() + ")");
-    if (!frame || !*frame) {
+      skipped = "broken off after " + std::to_string(framesInSegment_) + " frames (" +
+                frame.error() + ")";
+    else if (*frame && !isJpeg(reader_->caps()))
+      skipped = "holds " + mediaTypeOf(reader_->caps()) + ": skipped";
+    if (skipped) notes_.push_back(name + ": " + *skipped);
+    if (skipped || !*frame) {
       reader_.reset();
       ++current_;
       continue;
