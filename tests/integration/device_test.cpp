@@ -239,8 +239,7 @@ TEST(Device, IgnoresPcdOutOfRangeOrFromNoController) {
   ASSERT_TRUE(tx.login("driver", 1).has_value());
   Bytes body(24, 0);  // every channel 0 µs
   sendDatagram(udp->get(), SocketAddress::loopback(device->controlPort()), frameRaw(0x21, body));
-  std::this_thread::sleep_for(milliseconds(100));
-  EXPECT_EQ(device->stats().pcdRejected, 2u);
+  EXPECT_TRUE(testing::waitFor([&] { return device->stats().pcdRejected == 2; }));
   EXPECT_EQ(device->stats().pcdReceived, 0u);
 }
 
@@ -334,7 +333,7 @@ TEST(DeviceStream, DeliversEveryFrameByteForByteAndStopsOnEst) {
   EXPECT_EQ(got.stats.framesDropped(), 0u);
 
   s.tx->send(Est{.camera = 0});
-  std::this_thread::sleep_for(milliseconds(100));
+  ASSERT_TRUE(testing::waitFor([&] { return s.device->stats().activeStreams == 0; }));
   while (!receiveDatagram(s.video.get(), milliseconds(10)).empty()) {
   }
   EXPECT_TRUE(receiveDatagram(s.video.get(), milliseconds(300)).empty());

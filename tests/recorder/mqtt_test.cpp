@@ -221,7 +221,9 @@ TEST(RecorderMqtt, IgnoresRetainedJunkAndBadCommands) {
   // Left behind by some other tool: replayed to every new subscriber.
   car.probe.publish("wircam/" + car.stream + "/follow/set", "OFF", true);
   car.probe.publish("wircam/" + car.stream + "/target/set", "\x01\xff junk", true);
-  std::this_thread::sleep_for(200ms);
+  // Back to the probe itself: the broker holds them.
+  ASSERT_TRUE(car.probe.waitFor(
+      "wircam/" + car.stream + "/target/set", [](auto& m) { return !m.payload.empty(); }, 5s));
   ASSERT_TRUE(car.follow()) << car.recorder->log();
   car.probe.publish("wircam/" + car.stream + "/follow/set", "SIDEWAYS");
   car.probe.publish("wircam/" + car.stream + "/target/set", "7x");

@@ -54,7 +54,8 @@ TEST(WircRecorder, RecordsEveryFrameDeliveredInOrder) {
   auto device = startSequenceDevice();
   RecorderProcess recorder(device->port(), {"--segment", "2", "--duration", "5"});
   ASSERT_EQ(recorder.wait(), 0) << recorder.log();
-  std::this_thread::sleep_for(milliseconds(100));
+  // The device's count is final once the stream is stopped.
+  ASSERT_TRUE(waitFor([&] { return device->stats().activeStreams == 0; }, milliseconds(2000)));
   uint64_t sent = device->stats().framesSent;  // to this receiver, none lost on loopback
   int recorded = 0;
   constexpr GstClockTime kFramePeriod = GST_SECOND / 15;
