@@ -446,6 +446,11 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
       }
       case kValue: {
         std::string name = options[index].name;
+        // "--mqtt-discovery [PREFIX]": the prefix may follow as a word of
+        // its own (getopt takes an optional value only after "=").
+        if (options[index].has_arg == optional_argument && !optarg && optind < argc &&
+            argv[optind][0] != '-')
+          optarg = argv[optind++];
         if (auto problem = applyOption(o, name, optarg ? optarg : "true"))
           return unexpected("--" + name + ": " + *problem);
         break;

@@ -90,7 +90,7 @@ file and exits 0.
   --mqtt-cafile FILE     mqtts://: the CA (PEM) that signed the broker's
                          certificate (default: the system's CAs)
   --mqtt-prefix P        topic prefix (default wircam)
-  --mqtt-discovery[=PREFIX]
+  --mqtt-discovery [PREFIX]
                          Home Assistant MQTT discovery (prefix default
                          homeassistant): each camera a device with a camera
                          (snapshots), a following switch, a target number,

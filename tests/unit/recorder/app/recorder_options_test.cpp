@@ -79,6 +79,23 @@ TEST(RecorderOptions, FollowTuningTakesTheFollowersGainsWithinTheirRanges) {
   EXPECT_NE(alone.error().find("needs --follow"), std::string::npos) << alone.error();
 }
 
+TEST(RecorderOptions, MqttDiscoveryTakesItsPrefixAsTheNextWordOrAfterAnEqualsSign) {
+  const std::string mqtt = "mqtt://127.0.0.1";
+  auto alone = parse({"--out", "x", "--mqtt", mqtt, "--mqtt-discovery"});
+  ASSERT_TRUE(alone.has_value()) << alone.error();
+  EXPECT_EQ(*alone->mqttDiscovery, "homeassistant");
+  auto word = parse({"--mqtt-discovery", "ha2", "--out", "x", "--mqtt", mqtt});
+  ASSERT_TRUE(word.has_value()) << word.error();
+  EXPECT_EQ(*word->mqttDiscovery, "ha2");
+  auto equals = parse({"--out", "x", "--mqtt", mqtt, "--mqtt-discovery=ha3"});
+  ASSERT_TRUE(equals.has_value()) << equals.error();
+  EXPECT_EQ(*equals->mqttDiscovery, "ha3");
+  auto followed = parse({"--mqtt-discovery", "--out", "x", "--mqtt", mqtt});
+  ASSERT_TRUE(followed.has_value()) << followed.error();
+  EXPECT_EQ(*followed->mqttDiscovery, "homeassistant");
+  EXPECT_FALSE(parse({"--out", "x", "--mqtt-discovery"}).has_value());  // needs --mqtt
+}
+
 TEST(RecorderOptions, RefusesNumbersNoFieldCanHold) {
   // Found by fuzz_recorder_input: these used to reach a cast that is undefined.
   EXPECT_FALSE(parse({"--out", "x", "--max-bytes", "1e120"}).has_value());
