@@ -229,6 +229,23 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     (name == "http" ? o.http : o.rtsp) = *address;
   } else if (name == "http-cert" || name == "http-key") {
     (name == "http-cert" ? o.httpCert : o.httpKey) = value;
+  } else if (name == "webrtc") {
+    std::string on = value;
+    if (on != "on" && on != "off") return "on or off";
+    o.webrtc = on == "on";
+  } else if (name == "webrtc-stun") {
+    if (!g_str_has_prefix(value, "stun://") || !g_uri_is_valid(value, G_URI_FLAGS_NONE, nullptr))
+      return "a STUN server as stun://HOST:PORT";
+    o.webrtcStun = value;
+  } else if (name == "webrtc-turn") {
+    if ((!g_str_has_prefix(value, "turn://") && !g_str_has_prefix(value, "turns://")) ||
+        !g_uri_is_valid(value, G_URI_FLAGS_HAS_PASSWORD, nullptr))
+      return "a TURN server as turn://USER:PASSWORD@HOST:PORT (or turns://)";
+    o.webrtcTurn = value;
+  } else if (name == "webrtc-kbps") {
+    auto kbps = number(value);
+    if (!kbps || *kbps < 50 || *kbps > 20000) return "kbit/s, 50..20000";
+    o.webrtcKbps = static_cast<unsigned>(*kbps);
   } else if (name == "http-token") {
     std::string token = value;
     if (token.size() < 16 || token.find_first_of(" ;,\"\\") != std::string::npos)
@@ -401,6 +418,10 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"http-token", required_argument, nullptr, kValue},
                                    {"http-cert", required_argument, nullptr, kValue},
                                    {"http-key", required_argument, nullptr, kValue},
+                                   {"webrtc", required_argument, nullptr, kValue},
+                                   {"webrtc-stun", required_argument, nullptr, kValue},
+                                   {"webrtc-turn", required_argument, nullptr, kValue},
+                                   {"webrtc-kbps", required_argument, nullptr, kValue},
                                    {"detect", required_argument, nullptr, kValue},
                                    {"follow", no_argument, nullptr, kValue},
                                    {"follow-tuning", required_argument, nullptr, kValue},

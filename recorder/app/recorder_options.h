@@ -88,6 +88,11 @@ struct RecorderOptions {
   std::string httpToken;               // empty: this machine only, no authentication
   // HTTPS: the server's certificate and key (PEM files), both or neither.
   std::string httpCert, httpKey;
+  // The WebRTC live view beside MJPEG, with --http; its ICE servers (none:
+  // nothing outside is contacted) and each camera's VP8 rate.
+  bool webrtc = true;
+  std::string webrtcStun, webrtcTurn;
+  unsigned webrtcKbps = 600;
   // What the login tells the device (CCFG, FCFG), as channel lists; only the
   // first transmitter's login configures it. Unset: wircsrc's defaults.
   std::optional<std::string> periods;

@@ -83,6 +83,15 @@ file and exits 0.
                          token then never travels in clear)
   --http-idle-timeout S  close an HTTP connection with no request in progress (silent,
                          idle, or still sending its headers) for S seconds (default 10)
+  --webrtc on|off        the page's live view over WebRTC (VP8, about 1/3 of
+                         MJPEG's bitrate) with MJPEG as its fallback, and drive
+                         mode over a WebRTC data channel; WHEP at
+                         /api/cameras/NAME/whep (default on)
+  --webrtc-stun stun://HOST:PORT
+  --webrtc-turn turn://USER:PASSWORD@HOST:PORT
+                         ICE servers for viewers across networks (NAT); none
+                         by default, and none is ever contacted unless set
+  --webrtc-kbps N        each camera's VP8 bitrate for WebRTC (default 600)
   --mqtt mqtt://[USER:PASS@]HOST[:PORT]
                          publish status, detections and events to an MQTT
                          broker and take follow/target commands (below);
@@ -115,7 +124,8 @@ file and exits 0.
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, telemetry-track, detect,
 follow, follow-tuning, max-bytes, min-free, max-age, keep-events, status,
-stall-timeout, http, http-token, http-cert, http-key, http-idle-timeout, rtsp,
+stall-timeout, http, http-token, http-cert, http-key, http-idle-timeout, webrtc,
+webrtc-stun, webrtc-turn, webrtc-kbps, rtsp,
 periods, failsafe, marvelmind, beacon, mqtt, mqtt-cafile, mqtt-prefix,
 mqtt-discovery, mqtt-snapshot-interval, mqtt-detections-rate,
 on-segment-closed, hook-timeout), and one [device NAME] group per vehicle with

@@ -111,6 +111,9 @@ std::optional<std::string> Supervisor::startServers() {
     content.token = options_.httpToken;
     content.certificateFile = options_.httpCert;
     content.keyFile = options_.httpKey;
+    content.webrtc = options_.webrtc;
+    content.iceServers = {options_.webrtcStun, options_.webrtcTurn};
+    content.webrtcKbps = options_.webrtcKbps;
     content.status = [this] { return status(); };
     content.metrics = [this] { return metrics(); };
     content.trails = [this] { return trails(); };

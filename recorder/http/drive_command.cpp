@@ -39,4 +39,17 @@ Expected<DriveCommand, std::string> parseDriveCommand(std::string_view text) {
   return command;
 }
 
+std::string obeyDriveMessage(std::optional<std::string_view> text, const DriveFunction& drive) {
+  auto command = text ? parseDriveCommand(*text)
+                      : Expected<DriveCommand, std::string>(unexpected("not a text message"));
+  if (!command) {
+    // Whatever the page meant, the vehicle must not keep going on it.
+    drive(0, 0);
+    return nlohmann::json{{"error", command.error()}, {"neutral", true}}.dump();
+  }
+  auto obeyed = drive(command->steering, command->throttle);
+  if (!obeyed) return nlohmann::json{{"error", "this camera's vehicle cannot be driven"}}.dump();
+  return nlohmann::json{{"ack", command->seq}, {"obeyed", *obeyed}}.dump();
+}
+
 }  // namespace wircam::recorder

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -25,5 +27,14 @@ constexpr size_t kMaxDriveMessage = 256;
 // neutral): not JSON, not an object, a field missing or not a finite
 // number within -1..1, too long.
 Expected<DriveCommand, std::string> parseDriveCommand(std::string_view text);
+
+// Drives one camera's vehicle: whether it obeys (nullopt: it cannot be driven).
+using DriveFunction = std::function<std::optional<bool>(double steering, double throttle)>;
+
+// One message of a drive channel (the WebSocket or WebRTC's data channel;
+// nullopt: a binary one), obeyed: the reply, {"ack": seq, "obeyed": bool},
+// or {"error": ...} — with "neutral": true when the message was refused, as
+// the vehicle was then sent neutral.
+std::string obeyDriveMessage(std::optional<std::string_view> text, const DriveFunction& drive);
 
 }  // namespace wircam::recorder

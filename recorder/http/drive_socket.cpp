@@ -1,7 +1,5 @@
 #include "http/drive_socket.h"
 
-#include <nlohmann/json.hpp>
-
 #include "http/drive_command.h"
 
 namespace wircam::recorder {
@@ -36,21 +34,10 @@ void DriveSocket::onMessage(SoupWebsocketConnection*, gint type, GBytes* message
   auto* self = static_cast<DriveSocket*>(data);
   gsize size = 0;
   const char* bytes = static_cast<const char*>(g_bytes_get_data(message, &size));
-  auto command = type == SOUP_WEBSOCKET_DATA_TEXT
-                     ? parseDriveCommand(std::string_view(bytes, size))
-                     : Expected<DriveCommand, std::string>(unexpected("not a text message"));
-  if (!command) {
-    // Whatever the page meant, the vehicle must not keep going on it.
-    self->drive_(0, 0);
-    self->reply(nlohmann::json{{"error", command.error()}, {"neutral", true}}.dump());
-    return;
-  }
-  auto obeyed = self->drive_(command->steering, command->throttle);
-  if (!obeyed) {
-    self->reply(nlohmann::json{{"error", "this camera's vehicle cannot be driven"}}.dump());
-    return;
-  }
-  self->reply(nlohmann::json{{"ack", command->seq}, {"obeyed", *obeyed}}.dump());
+  auto text = type == SOUP_WEBSOCKET_DATA_TEXT
+                  ? std::optional<std::string_view>(std::string_view(bytes, size))
+                  : std::nullopt;
+  self->reply(obeyDriveMessage(text, self->drive_));
 }
 
 void DriveSocket::onClosed(SoupWebsocketConnection*, gpointer data) {

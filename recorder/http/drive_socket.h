@@ -12,12 +12,13 @@
 #include <optional>
 #include <string>
 
+#include "http/drive_command.h"
+
 namespace wircam::recorder {
 
 class DriveSocket {
  public:
-  // steering, throttle → whether the vehicle obeys (nullopt: it cannot be driven).
-  using Drive = std::function<std::optional<bool>(double steering, double throttle)>;
+  using Drive = DriveFunction;
 
   // Takes a reference on `connection`; `closed` is called (main loop) once
   // it has closed, after the vehicle was sent neutral.

@@ -38,6 +38,11 @@ Route routeOf(std::string_view path) {
       auto action = rest.substr(slash + 1);
       if (action == kSnapshot.substr(1)) return {Kind::Snapshot, camera};
       if (action == "drive") return {Kind::Drive, camera};
+      if (action == "whep") return {Kind::Whep, camera};
+      constexpr std::string_view kSession = "whep/";
+      if (action.starts_with(kSession) && action.size() > kSession.size() &&
+          action.find('/', kSession.size()) == std::string_view::npos)
+        return {Kind::WhepSession, camera, std::string(action.substr(kSession.size()))};
       if (action == "follow" || action == "target" || action == "request-control")
         return {Kind::CameraCommand, camera, std::string(action)};
     }

@@ -22,6 +22,8 @@ struct Route {
     RecordingEntry,  // /api/recordings/FILE (DELETE only)
     CameraCommand,   // POST /api/cameras/NAME/{follow,target,request-control}
     Drive,           // GET /api/cameras/NAME/drive: the drive mode's WebSocket
+    Whep,            // POST /api/cameras/NAME/whep: a WebRTC viewer's offer (WHEP)
+    WhepSession,     // DELETE /api/cameras/NAME/whep/SESSION: its end
     Playback,        // GET /play/FILE.mjpg?from=SECONDS: a recording replayed as MJPEG
     Export,          // GET /api/export?camera=&start=&end=&format=: a range as one file
     Metrics,         // GET /metrics: Prometheus's text format
@@ -30,7 +32,7 @@ struct Route {
   };
   Kind kind = Kind::NotFound;
   std::string name;    // the camera (Live, Snapshot, CameraCommand, Drive) or the file
-  std::string action;  // CameraCommand: follow, target or request-control
+  std::string action;  // CameraCommand: follow, target or request-control; WhepSession: its id
 };
 
 // `path` as libsoup hands it over (percent-decoded).

@@ -142,6 +142,23 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     });
     self->feeds_.push_back(std::move(feed));
   }
+  if (self->content_.webrtc) {
+    WebRtcService::Settings settings;
+    settings.servers = self->content_.iceServers;
+    settings.kbps = self->content_.webrtcKbps;
+    settings.idleTimeout = idleTimeout;
+    HttpServer* server = self.get();
+    settings.driveMessage = [server](const std::string& camera,
+                                     std::optional<std::string_view> text) {
+      return server->driveOverDataChannel(camera, text);
+    };
+    settings.neutral = [server](const std::string& camera) {
+      if (!server->content_.token.empty()) server->content_.drive(camera, 0, 0);
+    };
+    std::vector<WebRtcService::Camera> cameras;
+    for (const auto& camera : self->content_.cameras) cameras.push_back({camera.name, camera.frames});
+    self->webrtc_ = std::make_unique<WebRtcService>(std::move(cameras), std::move(settings));
+  }
   return self;
 }
 
@@ -162,6 +179,7 @@ HttpServer::~HttpServer() {
   release(eventClients_);
   release(playbackClients_);
   exports_.reset();       // before libsoup frees the messages it answers
+  webrtc_.reset();        // each viewer with a drive channel sends neutral
   driveSockets_.clear();  // each sends neutral and closes
   if (server_) {
     soup_server_disconnect(server_);
@@ -175,8 +193,8 @@ void HttpServer::onRequestEnded(SoupServer*, SoupServerMessage* message, gpointe
 
 // After the headers, before any body: only GET and HEAD are served, so a
 // body (however large it says it is) is refused unread.
-void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*, GHashTable*,
-                           gpointer data) {
+void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* path,
+                           GHashTable*, gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
   // Its connection is no longer idle: the request is answered, however long.
   self->connections_->requestStarted(message);
@@ -186,6 +204,13 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char*,
                  soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CHUNKED;
   bool known = method == "GET" || method == "HEAD" || method == "DELETE" || method == "POST";
   if (known && !hasBody) return;
+  // The one body taken: a WebRTC offer, its length given and bounded (read
+  // by libsoup into memory, so never more than kMaxOfferBytes).
+  goffset length = soup_message_headers_get_content_length(headers);
+  if (method == "POST" && routeOf(path).kind == Route::Kind::Whep &&
+      soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CONTENT_LENGTH &&
+      length <= static_cast<goffset>(kMaxOfferBytes))
+    return;
   // libsoup would read the whole body before answering: answer on the
   // socket now, and close it. Nothing of this request was written yet.
   std::string answer = !known
@@ -221,6 +246,8 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                             "/login");
   }
   std::string method = soup_server_message_get_method(message);
+  if (route.kind == Route::Kind::Whep || route.kind == Route::Kind::WhepSession)
+    return self->serveWhep(message, route);
   if (method == "DELETE") {
     if (route.kind != Route::Kind::Recording && route.kind != Route::Kind::RecordingEntry)
       return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
@@ -270,13 +297,16 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       // Left unanswered when allowed: libsoup then upgrades it (onWebSocket).
       return self->refuseDriveUnlessAllowed(message, route.name);
     case Route::Kind::CameraCommand:
+    case Route::Kind::Whep:
+    case Route::Kind::WhepSession:
       return;  // answered above
     case Route::Kind::ApiNotFound:
       return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
                               "no such endpoint; /api/status, /api/events, /api/cameras, "
                               "/api/cameras/NAME/snapshot.jpg, /api/cameras/NAME/follow, "
                               "/api/cameras/NAME/target, /api/cameras/NAME/request-control, "
-                              "/api/cameras/NAME/drive, /api/recordings, /api/export");
+                              "/api/cameras/NAME/drive, /api/cameras/NAME/whep, /api/recordings, "
+                              "/api/export");
     case Route::Kind::NotFound:
       return respondError(
           message, SOUP_STATUS_NOT_FOUND,

@@ -25,6 +25,7 @@
 #include "http/export_downloads.h"
 #include "http/http_connections.h"
 #include "http/http_routes.h"
+#include "webrtc/webrtc_service.h"
 
 namespace wircam::recorder {
 
@@ -60,6 +61,11 @@ class HttpServer {
     // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
     std::function<std::optional<bool>(const std::string& camera, double steering, double throttle)>
         drive;
+    // The WebRTC live view (WHEP at /api/cameras/NAME/whep), with these ICE
+    // servers and each camera's VP8 rate.
+    bool webrtc = false;
+    IceServers iceServers;
+    unsigned webrtcKbps = 600;
   };
 
   // Limits that keep hostile clients from holding the recorder's memory or
@@ -112,6 +118,13 @@ class HttpServer {
   // Answers with the reason when a drive-mode WebSocket may not open;
   // otherwise leaves the request to libsoup's upgrade.
   void refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera);
+  // WHEP: a viewer's offer answered (201, the answer and its session's
+  // Location), or a session ended.
+  void serveWhep(SoupServerMessage* message, const Route& route);
+  // The drive data channel's message for `camera`, obeyed as over the
+  // WebSocket (refused without the token): the reply.
+  std::string driveOverDataChannel(const std::string& camera,
+                                   std::optional<std::string_view> text);
   bool refusedWithoutToken(SoupServerMessage* message, const char* what);
   // Keeps `message` open as a stream of chunks in `clients`.
   void openStream(SoupServerMessage* message, const char* contentType,
@@ -130,6 +143,7 @@ class HttpServer {
   std::vector<std::unique_ptr<DriveSocket>> driveSockets_;
   std::unique_ptr<HttpConnections> connections_;
   std::unique_ptr<ExportDownloads> exports_;
+  std::unique_ptr<WebRtcService> webrtc_;  // with --webrtc on
   // Frames queued for the main loop check it: the server may be gone.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

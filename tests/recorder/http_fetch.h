@@ -20,6 +20,8 @@ struct Response {
 
 using Headers = std::vector<std::pair<std::string, std::string>>;
 
-Response fetch(const std::string& url, const char* method = "GET", const Headers& headers = {});
+// `body`, if any, goes with the Content-Type header given in `headers`.
+Response fetch(const std::string& url, const char* method = "GET", const Headers& headers = {},
+               const std::string& body = "");
 
 }  // namespace wircam::testing

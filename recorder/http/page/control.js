@@ -1,6 +1,6 @@
 const kDrivePeriodMs = 100;
 const keys = { ArrowUp: false, ArrowDown: false, ArrowLeft: false, ArrowRight: false };
-let driving = null;  // { name, socket, timer, seq, sent: Map(seq → time), view }
+let driving = null;  // { name, link, timer, seq, sent: Map(seq → time), view }
 
 function addControls(view, name) {
   const box = document.createElement("div");
@@ -63,25 +63,50 @@ function driveCommand() {
            throttle: Math.max(-1, Math.min(1, throttle)) };
 }
 
-function startDriving(view, name) {
+// Where drive commands go: the WebRTC peer connection's data channel when
+// the picture comes over WebRTC (unordered, no retransmits: a command never
+// waits behind a lost one), otherwise a WebSocket. Either way the same
+// messages, acks and dead-man.
+function driveLink(view, name) {
+  const channel = view.webrtc && view.webrtc.drive;
+  if (channel && channel.readyState === "open") {
+    const detach = new AbortController();
+    const link = { kind: "WebRTC data channel", open: true, send: text => channel.send(text),
+                   close: () => detach.abort() };
+    channel.addEventListener("message", event => link.onmessage(event),
+                             { signal: detach.signal });
+    channel.addEventListener("close", () => link.onclose(), { signal: detach.signal });
+    return link;
+  }
   const scheme = location.protocol === "https:" ? "wss:" : "ws:";
   const socket = new WebSocket(`${scheme}//${location.host}/api/cameras/` +
                                `${encodeURIComponent(name)}/drive`);
+  const link = { kind: "WebSocket", open: false, send: text => socket.send(text),
+                 close: () => socket.close() };
+  socket.onopen = () => { link.open = true; link.onopen(); };
+  socket.onmessage = event => link.onmessage(event);
+  socket.onclose = () => link.onclose();
+  return link;
+}
+
+function startDriving(view, name) {
+  const link = driveLink(view, name);
   const info = view.controls.querySelector(".drive-info");
-  driving = { name, socket, view, seq: 0, sent: new Map(), timer: 0 };
+  driving = { name, link, view, seq: 0, sent: new Map(), timer: 0 };
   view.controls.querySelector(".drive").classList.add("on");
   view.box.dataset.driving = "true";
+  view.box.dataset.driveLink = link.kind;
   info.textContent = "connecting…";
-  socket.onopen = () => {
-    info.textContent = "driving: arrow keys or gamepad";
+  link.onopen = () => {
+    info.textContent = `driving over ${link.kind}: arrow keys or gamepad`;
     // Every period, changed or not: the server's dead-man wants them.
     driving.timer = setInterval(() => {
       const command = { seq: ++driving.seq, ...driveCommand() };
       driving.sent.set(command.seq, performance.now());
-      socket.send(JSON.stringify(command));
+      link.send(JSON.stringify(command));
     }, kDrivePeriodMs);
   };
-  socket.onmessage = event => {
+  link.onmessage = event => {
     const answer = JSON.parse(event.data);
     if (answer.error) {
       info.textContent = answer.error;
@@ -90,22 +115,26 @@ function startDriving(view, name) {
     const sentAt = driving && driving.sent.get(answer.ack);
     if (sentAt === undefined) return;
     driving.sent.delete(answer.ack);
+    // Unordered: an old ack may come after a newer one; the older sends go.
+    for (const seq of driving.sent.keys()) if (seq < answer.ack) driving.sent.delete(seq);
     const roundTrip = performance.now() - sentAt;
     info.textContent = `round trip ${roundTrip.toFixed(0)} ms` +
         (answer.obeyed ? "" : " — the vehicle does not obey: request control");
     info.dataset.roundTripMs = roundTrip.toFixed(1);
   };
-  socket.onclose = () => { if (driving && driving.socket === socket) stopDriving("disconnected"); };
+  link.onclose = () => { if (driving && driving.link === link) stopDriving("disconnected"); };
+  if (link.open) link.onopen();
 }
 
 function stopDriving(why) {
   if (!driving) return;
-  const { socket, view, timer } = driving;
+  const { link, view, timer } = driving;
   driving = null;
   clearInterval(timer);
-  if (socket.readyState === WebSocket.OPEN)
-    socket.send(JSON.stringify({ steering: 0, throttle: 0 }));
-  socket.close();
+  if (link.open) {
+    try { link.send(JSON.stringify({ steering: 0, throttle: 0 })); } catch (e) { /* closed */ }
+  }
+  link.close();
   view.controls.querySelector(".drive").classList.remove("on");
   view.box.dataset.driving = "false";
   view.controls.querySelector(".drive-info").textContent = `not driving (${why})`;

@@ -6,11 +6,13 @@ function addCamera(camera) {
   const box = document.createElement("div");
   box.className = "camera";
   box.innerHTML = `<div class="head"><b></b><span class="badge"></span><span class="since">` +
-                  `</span></div><div class="view"><img alt="live"><svg></svg>` +
+                  `</span><span class="transport"></span></div><div class="view">` +
+                  `<img alt="live"><video muted autoplay playsinline hidden></video><svg></svg>` +
                   `<div class="placeholder"></div></div><div class="stats"></div>`;
   box.querySelector("b").textContent = camera.name;
   document.getElementById("cameras").appendChild(box);
-  views[camera.name] = { box, img: box.querySelector("img"), svg: box.querySelector("svg"),
+  views[camera.name] = { box, img: box.querySelector("img"), video: box.querySelector("video"),
+                         transport: box.querySelector(".transport"), svg: box.querySelector("svg"),
                          badge: box.querySelector(".badge"), since: box.querySelector(".since"),
                          placeholder: box.querySelector(".placeholder"),
                          stats: box.querySelector(".stats"),
@@ -43,10 +45,9 @@ function setState(view, state, sinceUtc) {
   if (view.state !== kind) {
     view.box.dataset.state = kind;
     if (kind === "live") {
-      const name = view.box.querySelector("b").textContent;
-      view.img.src = "/live/" + encodeURIComponent(name) + ".mjpg?t=" + Date.now();
+      startPicture(view, view.box.querySelector("b").textContent);
     } else {
-      view.img.removeAttribute("src");
+      stopPicture(view);
       view.svg.replaceChildren();
     }
     view.state = kind;
@@ -56,7 +57,9 @@ function setState(view, state, sinceUtc) {
 function showDetections(event) {
   const view = views[event.stream];
   if (!view || view.state !== "live") return;
-  const width = view.img.naturalWidth || view.width, height = view.img.naturalHeight || view.height;
+  const shown = view.webrtc ? { width: view.video.videoWidth, height: view.video.videoHeight }
+                            : { width: view.img.naturalWidth, height: view.img.naturalHeight };
+  const width = shown.width || view.width, height = shown.height || view.height;
   if (!width || !height) return;
   view.svg.setAttribute("viewBox", `0 0 ${width} ${height}`);
   view.svg.replaceChildren();

@@ -1,0 +1,61 @@
+#include "webrtc/camera_encoder.h"
+
+#include <gst/app/gstappsrc.h>
+
+namespace wircam::recorder {
+
+namespace {
+
+// Real time, no frames held back for look-ahead (lag-in-frames 0: one
+// frame in, one frame out), a key frame at least every 2 s at 15 fps so a
+// viewer whose request for one is lost still starts soon; browsers ask for
+// one (PLI) when they join, and the tee passes that up to the encoder.
+std::string description(unsigned kbps) {
+  return "appsrc name=frames is-live=true format=time do-timestamp=true leaky-type=downstream "
+         "max-buffers=2 ! tjpegdec ! videoconvert ! vp8enc deadline=1 cpu-used=8 lag-in-frames=0 "
+         "end-usage=cbr keyframe-max-dist=30 error-resilient=default target-bitrate=" +
+         std::to_string(kbps * 1000) + " ! tee name=viewers allow-not-linked=true";
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<CameraEncoder>, std::string> CameraEncoder::start(
+    FrameTap& frames, const std::string& camera, unsigned kbps) {
+  std::unique_ptr<CameraEncoder> self(new CameraEncoder());
+  GError* error = nullptr;
+  self->pipeline_ = gst_parse_launch(description(kbps).c_str(), &error);
+  if (!self->pipeline_) {
+    std::string text = error ? error->message : "unknown error";
+    g_clear_error(&error);
+    return unexpected("WebRTC encoder for " + camera + ": " + text);
+  }
+  gst_object_set_name(GST_OBJECT(self->pipeline_), ("webrtc-" + camera).c_str());
+  self->source_ = gst_bin_get_by_name(GST_BIN(self->pipeline_), "frames");
+  self->tee_ = gst_bin_get_by_name(GST_BIN(self->pipeline_), "viewers");
+  if (gst_element_set_state(self->pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE)
+    return unexpected("WebRTC encoder for " + camera + ": cannot start");
+  self->frames_ = &frames;
+  GstElement* source = self->source_;
+  // Called on the camera's streaming thread: a push into a leaky queue of
+  // two, so a slow encoder drops frames here and never holds the camera.
+  self->listener_ = frames.listen([source](GstSample* sample) {
+    GstCaps* caps = gst_sample_get_caps(sample);
+    GstCaps* current = gst_app_src_get_caps(GST_APP_SRC(source));
+    if (caps && (!current || !gst_caps_is_equal(current, caps)))
+      gst_app_src_set_caps(GST_APP_SRC(source), caps);
+    if (current) gst_caps_unref(current);
+    gst_app_src_push_buffer(GST_APP_SRC(source), gst_buffer_ref(gst_sample_get_buffer(sample)));
+  });
+  return self;
+}
+
+CameraEncoder::~CameraEncoder() {
+  // Once forget() returns, the camera's thread no longer pushes.
+  if (frames_) frames_->forget(listener_);
+  if (pipeline_) gst_element_set_state(pipeline_, GST_STATE_NULL);
+  if (source_) gst_object_unref(source_);
+  if (tee_) gst_object_unref(tee_);
+  if (pipeline_) gst_object_unref(pipeline_);
+}
+
+}  // namespace wircam::recorder

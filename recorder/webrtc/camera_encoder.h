@@ -1,0 +1,43 @@
+// One camera's frames encoded once for all of its WebRTC viewers: its JPEG
+// frames (from the camera's FrameTap) → tjpegdec → vp8enc, in real time and
+// without look-ahead, → a tee that each viewer branches off. A pipeline of
+// its own, apart from the camera's recording: it runs only while someone
+// watches, and a viewer's trouble never reaches the files.
+#pragma once
+
+#include <gst/gst.h>
+
+#include <memory>
+#include <string>
+
+#include "camera/frame_tap.h"
+#include "common/expected.h"
+
+namespace wircam::recorder {
+
+class CameraEncoder {
+ public:
+  // Starts encoding the frames `frames` hands over (borrowed; it outlives
+  // the encoder) at about `kbps`.
+  static Expected<std::unique_ptr<CameraEncoder>, std::string> start(FrameTap& frames,
+                                                                     const std::string& camera,
+                                                                     unsigned kbps);
+  ~CameraEncoder();  // stops listening, then the pipeline
+  CameraEncoder(const CameraEncoder&) = delete;
+  CameraEncoder& operator=(const CameraEncoder&) = delete;
+
+  // Where viewers' branches go, and the tee (video/x-vp8) they link to.
+  GstBin* pipeline() const { return GST_BIN(pipeline_); }
+  GstElement* tee() const { return tee_; }
+
+ private:
+  CameraEncoder() = default;
+
+  FrameTap* frames_ = nullptr;
+  int listener_ = 0;
+  GstElement* pipeline_ = nullptr;
+  GstElement* source_ = nullptr;  // appsrc
+  GstElement* tee_ = nullptr;
+};
+
+}  // namespace wircam::recorder

@@ -1,0 +1,164 @@
+#include "webrtc/webrtc_service.h"
+
+#include <gio/gio.h>
+
+#include "log_line.h"
+#include "webrtc/whep_sdp.h"
+
+namespace wircam::recorder {
+
+namespace {
+
+// The addresses of a TURN server ("turn://user:password@host:port"): a
+// viewer's relay candidates point there.
+std::set<std::string> turnAddresses(const std::string& url) {
+  std::set<std::string> addresses;
+  gchar* host = nullptr;
+  if (url.empty() || !g_uri_split(url.c_str(), G_URI_FLAGS_HAS_PASSWORD, nullptr, nullptr, &host,
+                                  nullptr, nullptr, nullptr, nullptr, nullptr) ||
+      !host)
+    return addresses;
+  GList* resolved =
+      g_resolver_lookup_by_name(g_resolver_get_default(), host, nullptr, nullptr);
+  for (GList* at = resolved; at; at = at->next) {
+    gchar* text = g_inet_address_to_string(G_INET_ADDRESS(at->data));
+    addresses.insert(text);
+    g_free(text);
+  }
+  g_resolver_free_addresses(resolved);
+  g_free(host);
+  return addresses;
+}
+
+}  // namespace
+
+WebRtcService::WebRtcService(std::vector<Camera> cameras, Settings settings)
+    : cameras_(std::move(cameras)),
+      settings_(std::move(settings)),
+      allowedHosts_(turnAddresses(settings_.servers.turn)) {
+  sweepTimer_ = g_timeout_add(
+      500,
+      [](gpointer self) -> gboolean {
+        static_cast<WebRtcService*>(self)->sweep(std::chrono::steady_clock::now());
+        return G_SOURCE_CONTINUE;
+      },
+      this);
+}
+
+WebRtcService::~WebRtcService() {
+  alive_.reset();
+  g_source_remove(sweepTimer_);
+  viewers_.clear();  // before their encoders
+  encoders_.clear();
+}
+
+FrameTap* WebRtcService::framesOf(const std::string& camera) const {
+  for (const auto& c : cameras_)
+    if (c.name == camera) return c.frames;
+  return nullptr;
+}
+
+void WebRtcService::offer(const std::string& camera, std::string_view sdp,
+                          const std::string& viewerAddress, Done done) {
+  FrameTap* frames = framesOf(camera);
+  if (!frames) return done(unexpected(Refusal{404, "no camera named '" + camera + "'"}));
+  if (viewers_.size() >= kMaxViewers)
+    return done(unexpected(Refusal{503, "already " + std::to_string(kMaxViewers) +
+                                            " WebRTC viewers; try again later, or "
+                                            "/live/CAMERA.mjpg"}));
+  auto allowed = allowedHosts_;
+  allowed.insert(viewerAddress);
+  auto offer = readViewerOffer(sdp, allowed);
+  if (!offer) return done(unexpected(Refusal{400, offer.error()}));
+  auto& encoder = encoders_[camera];
+  if (!encoder) {
+    auto started = CameraEncoder::start(*frames, camera, settings_.kbps);
+    if (!started) {
+      encoders_.erase(camera);
+      return done(unexpected(Refusal{500, started.error()}));
+    }
+    encoder = std::move(*started);
+  }
+  gchar* uuid = g_uuid_string_random();
+  std::string session = uuid;
+  g_free(uuid);
+  if (offer->droppedCandidates)
+    logLine("webrtc: " + camera + ": left out " +
+                           std::to_string(offer->droppedCandidates) +
+                           " ICE candidate(s) of the offer for other hosts than the viewer " +
+                           viewerAddress);
+  WebRtcViewer::Events events;
+  events.answered = [this, session, done](Expected<std::string, std::string> answer) {
+    if (!answer) {
+      removeLater(session);
+      return done(unexpected(Refusal{400, answer.error()}));
+    }
+    done(Answer{*answer, session});
+  };
+  events.ended = [this, session] { removeLater(session); };
+  events.driveMessage = [this, session, camera](std::optional<std::string_view> text) {
+    viewers_[session].driving = true;
+    return settings_.driveMessage(camera, text);
+  };
+  events.driveClosed = [this, camera] { settings_.neutral(camera); };
+  Viewer& viewer = viewers_[session];
+  viewer.camera = camera;
+  viewer.downSince = std::chrono::steady_clock::now();
+  viewer.peer = std::make_unique<WebRtcViewer>(*encoder, *offer, settings_.servers, events);
+  logLine("webrtc: " + camera + ": viewer " + viewerAddress + " (session " + session +
+                         "), " + std::to_string(viewers_.size()) + " now");
+}
+
+bool WebRtcService::end(const std::string& camera, const std::string& session) {
+  auto viewer = viewers_.find(session);
+  if (viewer == viewers_.end() || viewer->second.camera != camera) return false;
+  remove(session);
+  return true;
+}
+
+void WebRtcService::sweep(std::chrono::steady_clock::time_point now) {
+  std::vector<std::string> expired;
+  for (auto& [session, viewer] : viewers_) {
+    // Up: released when its browser has been silent that long (a closed
+    // tab, a lost network); not up yet: when it has not come up in time.
+    if (viewer.peer->state() == GST_WEBRTC_PEER_CONNECTION_STATE_CONNECTED) {
+      viewer.downSince.reset();
+      if (now - viewer.peer->lastHeard() > settings_.idleTimeout) expired.push_back(session);
+      continue;
+    }
+    if (!viewer.downSince) viewer.downSince = now;
+    if (now - *viewer.downSince > settings_.idleTimeout) expired.push_back(session);
+  }
+  for (const auto& session : expired) remove(session);
+}
+
+void WebRtcService::removeLater(const std::string& session) {
+  // Not from inside the viewer's own callback: on the main loop's next turn.
+  struct Removal {
+    std::weak_ptr<WebRtcService*> service;
+    std::string session;
+  };
+  g_idle_add_full(
+      G_PRIORITY_DEFAULT,
+      [](gpointer data) -> gboolean {
+        auto* removal = static_cast<Removal*>(data);
+        if (auto service = removal->service.lock()) (*service)->remove(removal->session);
+        return G_SOURCE_REMOVE;
+      },
+      new Removal{alive_, session}, [](gpointer data) { delete static_cast<Removal*>(data); });
+}
+
+void WebRtcService::remove(const std::string& session) {
+  auto viewer = viewers_.find(session);
+  if (viewer == viewers_.end()) return;
+  std::string camera = viewer->second.camera;
+  viewers_.erase(viewer);
+  logLine("webrtc: " + camera + ": viewer gone (session " + session + "), " +
+                         std::to_string(viewers_.size()) + " now");
+  // The encoder runs only while someone watches.
+  bool watched = false;
+  for (const auto& [id, other] : viewers_) watched = watched || other.camera == camera;
+  if (!watched) encoders_.erase(camera);
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,95 @@
+// The recorder's WebRTC live view: each camera encoded once while someone
+// watches it, its viewers (each a WHEP session), and their end: a DELETE of
+// the session, a connection that fails or closes, one that is not up within
+// the idle timeout (a viewer gone mid-negotiation), or one whose browser
+// sent no RTCP for that long (a closed tab, a lost network). At most
+// kMaxViewers at once, so memory and threads stay bounded.
+#pragma once
+
+#include <glib.h>
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "camera/frame_tap.h"
+#include "common/expected.h"
+#include "webrtc/camera_encoder.h"
+#include "webrtc/webrtc_viewer.h"
+
+namespace wircam::recorder {
+
+class WebRtcService {
+ public:
+  struct Camera {
+    std::string name;
+    FrameTap* frames;  // borrowed; outlives the service
+  };
+  struct Settings {
+    IceServers servers;
+    unsigned kbps = 600;  // each camera's VP8
+    std::chrono::milliseconds idleTimeout{10000};
+    // A drive data channel's message for `camera` → the reply (driving
+    // done, see drive_command.h); and the channel's end → neutral.
+    std::function<std::string(const std::string& camera, std::optional<std::string_view>)>
+        driveMessage;
+    std::function<void(const std::string& camera)> neutral;
+  };
+  // Each viewer is a webrtcbin with its own ICE, DTLS and SCTP threads.
+  static constexpr size_t kMaxViewers = 32;
+
+  WebRtcService(std::vector<Camera> cameras, Settings settings);
+  ~WebRtcService();
+  WebRtcService(const WebRtcService&) = delete;
+  WebRtcService& operator=(const WebRtcService&) = delete;
+
+  struct Answer {
+    std::string sdp;
+    std::string session;  // for the Location: /api/cameras/CAMERA/whep/SESSION
+  };
+  struct Refusal {
+    unsigned status;  // HTTP
+    std::string why;
+  };
+  using Done = std::function<void(Expected<Answer, Refusal>)>;
+  // A viewer's offer for `camera` from `viewerAddress` (the HTTP peer's IP:
+  // only candidates for it are kept). `done` is called once on the main
+  // loop, maybe before this returns.
+  void offer(const std::string& camera, std::string_view sdp, const std::string& viewerAddress,
+             Done done);
+  // Ends a session (WHEP's DELETE); false if there is none such.
+  bool end(const std::string& camera, const std::string& session);
+  size_t viewers() const { return viewers_.size(); }
+  size_t encoders() const { return encoders_.size(); }
+
+  // Releases the viewers not connected, or silent, for longer than the idle
+  // timeout at `now`; the service's own timer calls it twice a second.
+  void sweep(std::chrono::steady_clock::time_point now);
+
+ private:
+  struct Viewer {
+    std::string camera;
+    std::unique_ptr<WebRtcViewer> peer;
+    std::optional<std::chrono::steady_clock::time_point> downSince;  // not connected since
+    bool driving = false;
+  };
+  void remove(const std::string& session);
+  void removeLater(const std::string& session);
+  FrameTap* framesOf(const std::string& camera) const;
+
+  std::vector<Camera> cameras_;
+  Settings settings_;
+  std::set<std::string> allowedHosts_;  // the TURN server's, besides each viewer's own
+  std::map<std::string, std::unique_ptr<CameraEncoder>> encoders_;  // by camera
+  std::map<std::string, Viewer> viewers_;                           // by session
+  guint sweepTimer_ = 0;
+  std::shared_ptr<WebRtcService*> alive_ = std::make_shared<WebRtcService*>(this);
+};
+
+}  // namespace wircam::recorder

@@ -1,0 +1,124 @@
+#include "webrtc/whep_sdp.h"
+
+#include <glib.h>
+
+#include <memory>
+#include <sstream>
+
+namespace wircam::recorder {
+
+namespace {
+
+struct SdpDeleter {
+  void operator()(GstSDPMessage* message) const { gst_sdp_message_free(message); }
+};
+using SdpMessage = std::unique_ptr<GstSDPMessage, SdpDeleter>;
+
+SdpMessage parse(const std::string& text) {
+  GstSDPMessage* message = nullptr;
+  if (gst_sdp_message_new_from_text(text.c_str(), &message) != GST_SDP_OK) return nullptr;
+  return SdpMessage(message);
+}
+
+std::string asText(const GstSDPMessage* message) {
+  gchar* text = gst_sdp_message_as_text(message);
+  std::string result = text ? text : "";
+  g_free(text);
+  return result;
+}
+
+bool hasAttribute(const GstSDPMedia* media, const char* key) {
+  return gst_sdp_media_get_attribute_val(media, key) != nullptr;
+}
+
+// The payload type of "<pt> VP8/90000" among the m-line's rtpmaps, or -1.
+int vp8PayloadOf(const GstSDPMedia* media) {
+  for (guint i = 0;; ++i) {
+    const char* rtpmap = gst_sdp_media_get_attribute_val_n(media, "rtpmap", i);
+    if (!rtpmap) return -1;
+    int payload = -1;
+    char encoding[32] = {};
+    if (sscanf(rtpmap, "%d %31[^/]/90000", &payload, encoding) == 2 &&
+        g_ascii_strcasecmp(encoding, "VP8") == 0 && payload >= 0 && payload < 128)
+      return payload;
+  }
+}
+
+// "candidate:F C PROTO PRIO ADDRESS PORT typ T ...": the address.
+std::string candidateAddress(const char* value) {
+  std::istringstream words(value ? value : "");
+  std::string word;
+  for (int i = 0; i < 5 && words >> word; ++i) {
+  }
+  return word;
+}
+
+}  // namespace
+
+Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,
+                                                   const std::set<std::string>& allowedHosts) {
+  if (body.size() > kMaxOfferBytes)
+    return unexpected("the offer is " + std::to_string(body.size()) + " bytes; at most " +
+                      std::to_string(kMaxOfferBytes));
+  if (body.find('\0') != std::string_view::npos) return unexpected("the offer is not SDP text");
+  auto message = parse(std::string(body));
+  // GStreamer's parser takes almost anything: a version and an m-line show
+  // it is an SDP at all.
+  if (!message || !gst_sdp_message_get_version(message.get()) ||
+      gst_sdp_message_medias_len(message.get()) == 0)
+    return unexpected("the offer is not SDP (v=, o=, s=, t=, m= lines)");
+  unsigned medias = gst_sdp_message_medias_len(message.get());
+  if (medias > kMaxOfferMedia)
+    return unexpected("the offer has " + std::to_string(medias) + " m-lines; at most " +
+                      std::to_string(kMaxOfferMedia));
+  ViewerOffer offer;
+  bool video = false;
+  for (unsigned m = 0; m < medias; ++m) {
+    auto* media = const_cast<GstSDPMedia*>(gst_sdp_message_get_media(message.get(), m));
+    std::string kind = gst_sdp_media_get_media(media) ? gst_sdp_media_get_media(media) : "";
+    if (kind == "application") offer.dataChannel = true;
+    if (kind == "video" && !video && !hasAttribute(media, "sendonly") &&
+        !hasAttribute(media, "inactive") && gst_sdp_media_get_port(media) != 0) {
+      video = true;
+      offer.videoMedia = m;
+      offer.vp8Payload = vp8PayloadOf(media);
+    }
+    for (guint a = gst_sdp_media_attributes_len(media); a-- > 0;) {
+      const GstSDPAttribute* attribute = gst_sdp_media_get_attribute(media, a);
+      if (g_strcmp0(attribute->key, "candidate") != 0) continue;
+      if (allowedHosts.count(candidateAddress(attribute->value))) continue;
+      gst_sdp_media_remove_attribute(media, a);
+      ++offer.droppedCandidates;
+    }
+  }
+  if (!video) return unexpected("the offer has no video m-line that receives (recvonly)");
+  if (offer.vp8Payload < 0) return unexpected("the offer's video does not take VP8/90000");
+  offer.sdp = asText(message.get());
+  return offer;
+}
+
+std::string answerWithCandidates(const std::string& answer,
+                                 const std::vector<LocalCandidate>& candidates) {
+  auto message = parse(answer);
+  if (!message) return answer;
+  unsigned medias = gst_sdp_message_medias_len(message.get());
+  for (const auto& [index, text] : candidates) {
+    if (index >= medias) continue;
+    std::string value = text.starts_with("candidate:") ? text.substr(10) : text;
+    auto* media = const_cast<GstSDPMedia*>(gst_sdp_message_get_media(message.get(), index));
+    // webrtcbin may have put it in its description already.
+    bool present = false;
+    for (guint i = 0; const char* known = gst_sdp_media_get_attribute_val_n(media, "candidate", i);
+         ++i)
+      present = present || value == known;
+    if (!present) gst_sdp_media_add_attribute(media, "candidate", value.c_str());
+  }
+  for (unsigned m = 0; m < medias; ++m) {
+    auto* media = const_cast<GstSDPMedia*>(gst_sdp_message_get_media(message.get(), m));
+    if (!hasAttribute(media, "end-of-candidates"))
+      gst_sdp_media_add_attribute(media, "end-of-candidates", "");
+  }
+  return asText(message.get());
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,50 @@
+// The SDP of a WHEP exchange, checked and mended apart from any pipeline:
+// a viewer's offer is read with GStreamer's SDP parser and bounded, the
+// ICE candidates it names for hosts other than the viewer's own are taken
+// out (so the recorder never sends connectivity checks where a page points
+// it), and the answer gets the candidates the recorder gathered, as WHEP
+// without trickle ICE wants.
+#pragma once
+
+#include <gst/sdp/sdp.h>
+
+#include <set>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "common/expected.h"
+
+namespace wircam::recorder {
+
+// An offer is a few kilobytes; anything near this is hostile.
+constexpr size_t kMaxOfferBytes = 16 * 1024;
+// audio, video, data: a page offers at most these few.
+constexpr unsigned kMaxOfferMedia = 8;
+
+struct ViewerOffer {
+  std::string sdp;          // as it goes to webrtcbin: only the allowed candidates
+  unsigned videoMedia = 0;  // index of the video m-line that receives
+  int vp8Payload = 0;       // its payload type for VP8/90000
+  bool dataChannel = false;
+  unsigned droppedCandidates = 0;  // for another host, or a name
+};
+
+// The offer, or why it cannot be answered: too big, not SDP, no video the
+// viewer receives, no VP8. Candidates are kept only when their address is
+// one of `allowedHosts` (IP addresses as text: the viewer's own, and a
+// TURN server's).
+Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,
+                                                   const std::set<std::string>& allowedHosts);
+
+// A candidate webrtcbin gathered: the m-line it belongs to and its text
+// ("candidate:1 1 UDP 2015363327 10.0.0.2 41230 typ host").
+using LocalCandidate = std::pair<unsigned, std::string>;
+
+// `answer` with each candidate added to its m-line and end-of-candidates
+// on every m-line; `answer` unchanged if it does not parse.
+std::string answerWithCandidates(const std::string& answer,
+                                 const std::vector<LocalCandidate>& candidates);
+
+}  // namespace wircam::recorder
