@@ -145,6 +145,10 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
   if (self->content_.webrtc) {
     WebRtcService::Settings settings;
     settings.servers = self->content_.iceServers;
+    // Viewers reach the recorder where its web server listens, and no
+    // further: loopback by default; every interface for 0.0.0.0 or ::.
+    std::string host = address.listenHost();
+    if (host != "0.0.0.0" && host != "::") settings.servers.localAddresses = {host};
     settings.kbps = self->content_.webrtcKbps;
     settings.idleTimeout = idleTimeout;
     HttpServer* server = self.get();

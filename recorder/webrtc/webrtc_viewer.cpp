@@ -54,6 +54,15 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
   gst_util_set_object_arg(G_OBJECT(webrtc_), "bundle-policy", "max-bundle");
   if (!servers.stun.empty()) g_object_set(webrtc_, "stun-server", servers.stun.c_str(), nullptr);
   if (!servers.turn.empty()) g_object_set(webrtc_, "turn-server", servers.turn.c_str(), nullptr);
+  if (!servers.localAddresses.empty()) {
+    GstWebRTCICE* ice = nullptr;
+    g_object_get(webrtc_, "ice-agent", &ice, nullptr);
+    for (const auto& address : servers.localAddresses) {
+      gboolean added = FALSE;
+      g_signal_emit_by_name(ice, "add-local-ip-address", address.c_str(), &added);
+    }
+    gst_object_unref(ice);
+  }
   gst_bin_add_many(encoder_.pipeline(), queue_, payloader_, webrtc_, nullptr);
   gst_element_link(queue_, payloader_);
 

@@ -14,10 +14,16 @@ struct SdpDeleter {
 };
 using SdpMessage = std::unique_ptr<GstSDPMessage, SdpDeleter>;
 
+// GStreamer's parser takes almost anything: a version and an m-line show
+// it is an SDP at all.
 SdpMessage parse(const std::string& text) {
   GstSDPMessage* message = nullptr;
-  if (gst_sdp_message_new_from_text(text.c_str(), &message) != GST_SDP_OK) return nullptr;
-  return SdpMessage(message);
+  if (text.empty() || gst_sdp_message_new_from_text(text.c_str(), &message) != GST_SDP_OK)
+    return nullptr;
+  SdpMessage parsed(message);
+  if (!gst_sdp_message_get_version(message) || gst_sdp_message_medias_len(message) == 0)
+    return nullptr;
+  return parsed;
 }
 
 std::string asText(const GstSDPMessage* message) {
@@ -62,11 +68,7 @@ Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,
                       std::to_string(kMaxOfferBytes));
   if (body.find('\0') != std::string_view::npos) return unexpected("the offer is not SDP text");
   auto message = parse(std::string(body));
-  // GStreamer's parser takes almost anything: a version and an m-line show
-  // it is an SDP at all.
-  if (!message || !gst_sdp_message_get_version(message.get()) ||
-      gst_sdp_message_medias_len(message.get()) == 0)
-    return unexpected("the offer is not SDP (v=, o=, s=, t=, m= lines)");
+  if (!message) return unexpected("the offer is not SDP (v=, o=, s=, t=, m= lines)");
   unsigned medias = gst_sdp_message_medias_len(message.get());
   if (medias > kMaxOfferMedia)
     return unexpected("the offer has " + std::to_string(medias) + " m-lines; at most " +

@@ -193,4 +193,35 @@ TEST(WebRtcView, DriveModeGoesOverTheDataChannelAndAPageThatHangsOrGoesAwayStops
       << signedIn.recorder.log();
 }
 
+TEST(WebRtcView, JunkOnTheDataChannelIsAnsweredAndStopsTheCar) {
+  if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  SignedInPage signedIn(car.device->port(), {"--detect", "tag36h11", "--follow"}, "webrtc-junk");
+  ASSERT_TRUE(signedIn.page);
+  auto& page = *signedIn.page;
+  ASSERT_TRUE(page.waitUntil(
+      "document.querySelector('.camera[data-transport=webrtc]') && "
+      "Object.values(views)[0].webrtc.drive.readyState === 'open'",
+      milliseconds(15000)));
+  // The page's own channel, full ahead every 100 ms...
+  page.evaluate(
+      "window.probe = Object.values(views)[0].webrtc.drive; probe.onmessage = e => { "
+      "window.answer = JSON.parse(e.data); }; window.keep = setInterval(() => "
+      "probe.send(JSON.stringify({seq: 1, steering: 0, throttle: 1})), 100)");
+  ASSERT_TRUE(waitFor([&] { return car.device->outputs().pulses[kThrottle] > 1500; }));
+  ASSERT_TRUE(page.waitUntil("window.answer && window.answer.ack === 1"));
+  // ...then junk, text and binary: answered with the reason, and neutral at
+  // once (the dead-man would take 150 ms more at least).
+  page.evaluate("clearInterval(keep); probe.send('{\"steering\": \"hard left\"}')");
+  auto neutral = untilNeutral(*car.device);
+  EXPECT_LT(neutral.count(), 120) << "neutral " << neutral.count() << " ms after the junk";
+  ASSERT_TRUE(page.waitUntil("window.answer.error"));
+  EXPECT_EQ(page.evaluate("window.answer.error"), "'steering' is not a number");
+  EXPECT_EQ(page.evaluate("window.answer.neutral"), true);
+  page.evaluate("window.answer = null; probe.send(new Uint8Array([1, 2, 3]))");
+  ASSERT_TRUE(page.waitUntil("window.answer && window.answer.error"));
+  EXPECT_EQ(page.evaluate("window.answer.error"), "not a text message");
+}
+
 }  // namespace

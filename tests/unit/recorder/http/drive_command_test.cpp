@@ -39,5 +39,28 @@ TEST(DriveCommand, RefusesAnythingElseAndSaysWhy) {
   EXPECT_EQ(parseDriveCommand(padded).error(), "longer than 256 bytes");
 }
 
+// Whatever carries them (WebSocket or data channel), messages are obeyed,
+// refused with neutral, or told the vehicle cannot be driven.
+TEST(DriveCommand, AMessageIsObeyedOrRefusedWithNeutral) {
+  std::vector<std::pair<double, double>> sent;
+  std::optional<bool> obeys = true;
+  DriveFunction drive = [&](double steering, double throttle) {
+    sent.emplace_back(steering, throttle);
+    return obeys;
+  };
+  EXPECT_EQ(obeyDriveMessage(R"({"seq": 7, "steering": 0.5, "throttle": -1})", drive),
+            R"({"ack":7,"obeyed":true})");
+  EXPECT_EQ(sent.back(), std::make_pair(0.5, -1.0));
+  EXPECT_EQ(obeyDriveMessage("junk", drive), R"({"error":"not a JSON object","neutral":true})");
+  EXPECT_EQ(sent.back(), std::make_pair(0.0, 0.0));
+  sent.clear();
+  EXPECT_EQ(obeyDriveMessage(std::nullopt, drive),
+            R"({"error":"not a text message","neutral":true})");
+  EXPECT_EQ(sent, (std::vector<std::pair<double, double>>{{0.0, 0.0}}));
+  obeys = std::nullopt;
+  EXPECT_EQ(obeyDriveMessage(R"({"steering": 0, "throttle": 0})", drive),
+            R"({"error":"this camera's vehicle cannot be driven"})");
+}
+
 }  // namespace
 }  // namespace wircam::recorder

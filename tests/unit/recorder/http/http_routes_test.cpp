@@ -21,6 +21,15 @@ TEST(HttpRoutes, NamesEveryResource) {
   auto file = routeOf("/recordings/rover-cam0-000.mkv");
   EXPECT_EQ(file.kind, Kind::Recording);
   EXPECT_EQ(file.name, "rover-cam0-000.mkv");
+  auto whep = routeOf("/api/cameras/rover-cam0/whep");
+  EXPECT_EQ(whep.kind, Kind::Whep);
+  EXPECT_EQ(whep.name, "rover-cam0");
+  auto session = routeOf("/api/cameras/rover-cam0/whep/5d2f0f2c-1d4b");
+  EXPECT_EQ(session.kind, Kind::WhepSession);
+  EXPECT_EQ(session.name, "rover-cam0");
+  EXPECT_EQ(session.action, "5d2f0f2c-1d4b");
+  EXPECT_EQ(routeOf("/api/cameras/rover-cam0/whep/").kind, Kind::ApiNotFound);
+  EXPECT_EQ(routeOf("/api/cameras/rover-cam0/whep/a/b").kind, Kind::ApiNotFound);
   EXPECT_EQ(routeOf("/live/.mjpg").kind, Kind::NotFound);
   EXPECT_EQ(routeOf("/etc/passwd").kind, Kind::NotFound);
 }
