@@ -2,6 +2,8 @@
 
 #include <gst/app/gstappsrc.h>
 
+#include "log_line.h"
+
 namespace wircam::recorder {
 
 namespace {
@@ -30,6 +32,28 @@ Expected<std::unique_ptr<CameraEncoder>, std::string> CameraEncoder::start(
     return unexpected("WebRTC encoder for " + camera + ": " + text);
   }
   gst_object_set_name(GST_OBJECT(self->pipeline_), ("webrtc-" + camera).c_str());
+  // Nobody reads this pipeline's bus: it is kept flushing, and errors and
+  // warnings are logged on their way in.
+  GstBus* bus = gst_element_get_bus(self->pipeline_);
+  gst_bus_set_sync_handler(
+      bus,
+      [](GstBus*, GstMessage* message, gpointer name) {
+        if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR ||
+            GST_MESSAGE_TYPE(message) == GST_MESSAGE_WARNING) {
+          GError* problem = nullptr;
+          if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR)
+            gst_message_parse_error(message, &problem, nullptr);
+          else
+            gst_message_parse_warning(message, &problem, nullptr);
+          logLine("webrtc: " + *static_cast<std::string*>(name) + ": " +
+                  GST_OBJECT_NAME(GST_MESSAGE_SRC(message)) + ": " + problem->message);
+          g_error_free(problem);
+        }
+        return GST_BUS_PASS;
+      },
+      new std::string(camera), [](gpointer name) { delete static_cast<std::string*>(name); });
+  gst_bus_set_flushing(bus, TRUE);
+  gst_object_unref(bus);
   self->source_ = gst_bin_get_by_name(GST_BIN(self->pipeline_), "frames");
   self->tee_ = gst_bin_get_by_name(GST_BIN(self->pipeline_), "viewers");
   if (gst_element_set_state(self->pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE)
@@ -56,6 +80,12 @@ CameraEncoder::~CameraEncoder() {
   if (source_) gst_object_unref(source_);
   if (tee_) gst_object_unref(tee_);
   if (pipeline_) gst_object_unref(pipeline_);
+}
+
+void CameraEncoder::releaseMessages() {
+  GstBus* bus = gst_element_get_bus(pipeline_);
+  gst_bus_set_flushing(bus, TRUE);
+  gst_object_unref(bus);
 }
 
 }  // namespace wircam::recorder

@@ -29,6 +29,10 @@ class CameraEncoder {
   // Where viewers' branches go, and the tee (video/x-vp8) they link to.
   GstBin* pipeline() const { return GST_BIN(pipeline_); }
   GstElement* tee() const { return tee_; }
+  // Lets go of what the pipeline's messages still hold: a viewer's gone
+  // webrtcbin stays alive, with its threads and sockets, until they go
+  // (measured with GStreamer 1.22; a flushing bus alone does not do it).
+  void releaseMessages();
 
  private:
   CameraEncoder() = default;

@@ -1,6 +1,7 @@
 #include "webrtc/webrtc_service.h"
 
 #include <gio/gio.h>
+#include <malloc.h>
 
 #include "log_line.h"
 #include "webrtc/whep_sdp.h"
@@ -159,6 +160,9 @@ void WebRtcService::remove(const std::string& session) {
   bool watched = false;
   for (const auto& [id, other] : viewers_) watched = watched || other.camera == camera;
   if (!watched) encoders_.erase(camera);
+  // Each viewer's threads leave memory in glibc's per-thread arenas, kept
+  // for reuse; when nobody watches, it goes back to the system.
+  if (viewers_.empty()) malloc_trim(0);
 }
 
 }  // namespace wircam::recorder

@@ -129,6 +129,7 @@ void WebRtcViewer::negotiate(const std::string& offer) {
         delete answering;
       });
   g_signal_emit_by_name(webrtc_, "create-answer", nullptr, answered);
+  gst_promise_unref(answered);
   gatherTimer_ = g_timeout_add_seconds(
       kGatheringSeconds,
       [](gpointer self) -> gboolean {
@@ -287,9 +288,12 @@ WebRtcViewer::~WebRtcViewer() {
   gst_element_release_request_pad(encoder_.tee(), teePad_);
   gst_object_unref(teePad_);
   for (GstElement* element : {webrtc_, payloader_, queue_}) {
-    gst_element_set_state(element, GST_STATE_NULL);
+    gst_object_ref(element);
     gst_bin_remove(encoder_.pipeline(), element);
+    gst_element_set_state(element, GST_STATE_NULL);
+    gst_object_unref(element);
   }
+  encoder_.releaseMessages();
 }
 
 }  // namespace wircam::recorder
