@@ -68,7 +68,13 @@ Expected<std::unique_ptr<CameraEncoder>, std::string> CameraEncoder::start(
     if (caps && (!current || !gst_caps_is_equal(current, caps)))
       gst_app_src_set_caps(GST_APP_SRC(source), caps);
     if (current) gst_caps_unref(current);
-    gst_app_src_push_buffer(GST_APP_SRC(source), gst_buffer_ref(gst_sample_get_buffer(sample)));
+    // Its time is the camera pipeline's; here it gets this pipeline's
+    // (do-timestamp), or webrtcbin would hold it until the other clock's
+    // time came. A shallow copy: the JPEG's memory is shared.
+    GstBuffer* frame = gst_buffer_copy(gst_sample_get_buffer(sample));
+    GST_BUFFER_PTS(frame) = GST_BUFFER_DTS(frame) = GST_BUFFER_DURATION(frame) =
+        GST_CLOCK_TIME_NONE;
+    gst_app_src_push_buffer(GST_APP_SRC(source), frame);
   });
   return self;
 }

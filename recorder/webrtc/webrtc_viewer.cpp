@@ -109,6 +109,10 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
   GstPad* queued = gst_element_get_static_pad(queue_, "sink");
   gst_pad_link(teePad_, queued);
   gst_object_unref(queued);
+  // A branch added to a running pipeline has no latency configured until
+  // the pipeline works it out again (webrtcbin's RTP session needs it to
+  // time its packets).
+  gst_bin_recalculate_latency(encoder_.pipeline());
   negotiate(offer.sdp);
 }
 

@@ -103,7 +103,13 @@ TEST(WebRtcChurn, TwentyViewersComingAndGoingForAMinuteLeaveNothingBehind) {
       first = countOf(signedIn.recorder.pid());
     }
   }
-  long atEnd = residentKb(signedIn.recorder.pid());
+  // Back where it was once the last viewer's memory went back (the log
+  // line comes just before).
+  long atEnd = 0;
+  waitFor([&] {
+    atEnd = residentKb(signedIn.recorder.pid());
+    return atEnd - afterFirst < 8 * 1024;
+  });
   Counts last = countOf(signedIn.recorder.pid());
   // Every viewer's threads and sockets went with it (a leak would be 2 and
   // 16 a viewer); the browser keeps up to 6 HTTP connections open or not.

@@ -327,11 +327,25 @@ cv::Mat FollowScene::renderBgr() const {
   return image;
 }
 
+void FollowScene::drawClockStamp(cv::Mat& image) const {
+  auto now = std::chrono::duration_cast<std::chrono::milliseconds>(
+      std::chrono::system_clock::now().time_since_epoch());
+  auto stamp = static_cast<uint32_t>(now.count());
+  // Blocks big enough to survive JPEG and a video encoder at low rates.
+  int width = image.cols / kStampBits, height = std::max(16, image.rows / 16);
+  for (int bit = 0; bit < kStampBits; ++bit) {
+    bool one = (stamp >> (kStampBits - 1 - bit)) & 1;
+    cv::rectangle(image, cv::Rect(bit * width, 0, width, height),
+                  one ? cv::Scalar(255, 255, 255) : cv::Scalar(0, 0, 0), cv::FILLED);
+  }
+}
+
 std::vector<uint8_t> FollowScene::renderJpeg(int camera) {
   // Every camera looks forward: the simulated vehicle carries its cameras
   // side by side, which is what the multi-camera tests need.
   (void)camera;
   cv::Mat image = renderBgr();
+  if (config_.clockStamp) drawClockStamp(image);
   unsigned char* jpeg = nullptr;
   unsigned long size = 0;
   if (tjCompress2(encoder_.get(), image.data, image.cols, static_cast<int>(image.step), image.rows,

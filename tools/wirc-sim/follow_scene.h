@@ -42,7 +42,14 @@ struct FollowSceneConfig {
   double maxSteerRad = 0.5;
   double maxSpeed = 1.2;         // m/s at full throttle
   double throttleDeadband = 50;  // µs around neutral with no drive
+  // Each frame shows, as kStampBits black or white blocks across its top
+  // (most significant first), the wall clock's milliseconds since the epoch
+  // (modulo 2^32) when it was drawn: what a viewer compares its own clock
+  // with to measure latency (bench_live_latency).
+  bool clockStamp = false;
 };
+
+inline constexpr int kStampBits = 32;
 
 struct Pose2 {
   double x = 0;
@@ -87,6 +94,8 @@ class FollowScene : public wirc::DeviceScene {
   // Advances by an explicit time step; advance() uses wall-clock time.
   void step(double seconds, const wirc::ChannelOutputs& outputs);
   cv::Mat renderBgr() const;
+  // The wall clock's milliseconds across the top (config.clockStamp).
+  void drawClockStamp(cv::Mat& image) const;
 
   const Pose2& car() const { return car_; }
   // The car and the target as of the last step, for other threads (the

@@ -42,6 +42,7 @@ enum Option {
   kPcdTimeout,
   kDuration,
   kScene,
+  kClockStamp,
   kFrames,
   kReplay,
   kCamera,
@@ -96,6 +97,7 @@ const option kOptions[] = {
     {"pcd-timeout", required_argument, nullptr, kPcdTimeout},
     {"duration", required_argument, nullptr, kDuration},
     {"scene", required_argument, nullptr, kScene},
+    {"clock-stamp", no_argument, nullptr, kClockStamp},
     {"frames", required_argument, nullptr, kFrames},
     {"replay", required_argument, nullptr, kReplay},
     {"camera", required_argument, nullptr, kCamera},
@@ -267,6 +269,9 @@ int main(int argc, char** argv) {
           scene.carFixed = true;
         else if (std::string(optarg) != "follow")
           usageError("--scene is follow or static");
+        break;
+      case kClockStamp:
+        scene.clockStamp = true;
         break;
       case kFrames:
         framesDir = optarg;

@@ -28,6 +28,9 @@ Device:
 Scene:
   --scene follow|static  follow: the car drives by PCD (default);
                        static: the car stays put, the target still moves
+  --clock-stamp        draw the wall clock's milliseconds (mod 2^32) as 32
+                       black/white blocks across the top of each frame, most
+                       significant first, for latency measurements
   --frames DIR         stream the .jpg/.jpeg files of DIR in name order,
                        byte for byte, looping (instead of a rendered scene)
   --replay PATH        replay a recorded drive as the live camera: PATH is a
