@@ -160,7 +160,8 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
       if (!server->content_.token.empty()) server->content_.drive(camera, 0, 0);
     };
     std::vector<WebRtcService::Camera> cameras;
-    for (const auto& camera : self->content_.cameras) cameras.push_back({camera.name, camera.frames});
+    for (const auto& camera : self->content_.cameras)
+      cameras.push_back({camera.name, camera.frames});
     self->webrtc_ = std::make_unique<WebRtcService>(std::move(cameras), std::move(settings));
   }
   return self;
@@ -197,8 +198,8 @@ void HttpServer::onRequestEnded(SoupServer*, SoupServerMessage* message, gpointe
 
 // After the headers, before any body: only GET and HEAD are served, so a
 // body (however large it says it is) is refused unread.
-void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* path,
-                           GHashTable*, gpointer data) {
+void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
+                           gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
   // Its connection is no longer idle: the request is answered, however long.
   self->connections_->requestStarted(message);

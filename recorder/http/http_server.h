@@ -123,8 +123,7 @@ class HttpServer {
   void serveWhep(SoupServerMessage* message, const Route& route);
   // The drive data channel's message for `camera`, obeyed as over the
   // WebSocket (refused without the token): the reply.
-  std::string driveOverDataChannel(const std::string& camera,
-                                   std::optional<std::string_view> text);
+  std::string driveOverDataChannel(const std::string& camera, std::optional<std::string_view> text);
   bool refusedWithoutToken(SoupServerMessage* message, const char* what);
   // Keeps `message` open as a stream of chunks in `clients`.
   void openStream(SoupServerMessage* message, const char* contentType,

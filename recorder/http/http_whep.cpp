@@ -61,25 +61,24 @@ void HttpServer::serveWhep(SoupServerMessage* message, const Route& route) {
   soup_server_message_set_status(message, SOUP_STATUS_ACCEPTED, nullptr);
   soup_server_message_pause(message);
   std::string camera = route.name;
-  webrtc_->offer(
-      camera, offer, peerAddress(message),
-      [this, message, gone, finished, camera](
-          Expected<WebRtcService::Answer, WebRtcService::Refusal> answer) {
-        if (*gone) {
-          if (answer) webrtc_->end(camera, answer->session);
-          return;
-        }
-        g_signal_handler_disconnect(message, finished);
-        if (!answer) {
-          respondJsonError(message, answer.error().status, answer.error().why);
-        } else {
-          std::string location = "/api/cameras/" + camera + "/whep/" + answer->session;
-          soup_message_headers_replace(soup_server_message_get_response_headers(message),
-                                       "Location", location.c_str());
-          respond(message, SOUP_STATUS_CREATED, "application/sdp", answer->sdp);
-        }
-        soup_server_message_unpause(message);
-      });
+  webrtc_->offer(camera, offer, peerAddress(message),
+                 [this, message, gone, finished,
+                  camera](Expected<WebRtcService::Answer, WebRtcService::Refusal> answer) {
+                   if (*gone) {
+                     if (answer) webrtc_->end(camera, answer->session);
+                     return;
+                   }
+                   g_signal_handler_disconnect(message, finished);
+                   if (!answer) {
+                     respondJsonError(message, answer.error().status, answer.error().why);
+                   } else {
+                     std::string location = "/api/cameras/" + camera + "/whep/" + answer->session;
+                     soup_message_headers_replace(soup_server_message_get_response_headers(message),
+                                                  "Location", location.c_str());
+                     respond(message, SOUP_STATUS_CREATED, "application/sdp", answer->sdp);
+                   }
+                   soup_server_message_unpause(message);
+                 });
 }
 
 std::string HttpServer::driveOverDataChannel(const std::string& camera,

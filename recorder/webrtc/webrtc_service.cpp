@@ -15,12 +15,12 @@ namespace {
 std::set<std::string> turnAddresses(const std::string& url) {
   std::set<std::string> addresses;
   gchar* host = nullptr;
-  if (url.empty() || !g_uri_split(url.c_str(), G_URI_FLAGS_HAS_PASSWORD, nullptr, nullptr, &host,
-                                  nullptr, nullptr, nullptr, nullptr, nullptr) ||
+  if (url.empty() ||
+      !g_uri_split(url.c_str(), G_URI_FLAGS_HAS_PASSWORD, nullptr, nullptr, &host, nullptr, nullptr,
+                   nullptr, nullptr, nullptr) ||
       !host)
     return addresses;
-  GList* resolved =
-      g_resolver_lookup_by_name(g_resolver_get_default(), host, nullptr, nullptr);
+  GList* resolved = g_resolver_lookup_by_name(g_resolver_get_default(), host, nullptr, nullptr);
   for (GList* at = resolved; at; at = at->next) {
     gchar* text = g_inet_address_to_string(G_INET_ADDRESS(at->data));
     addresses.insert(text);
@@ -84,10 +84,8 @@ void WebRtcService::offer(const std::string& camera, std::string_view sdp,
   std::string session = uuid;
   g_free(uuid);
   if (offer->droppedCandidates)
-    logLine("webrtc: " + camera + ": left out " +
-                           std::to_string(offer->droppedCandidates) +
-                           " ICE candidate(s) of the offer for other hosts than the viewer " +
-                           viewerAddress);
+    logLine("webrtc: " + camera + ": left out " + std::to_string(offer->droppedCandidates) +
+            " ICE candidate(s) of the offer for other hosts than the viewer " + viewerAddress);
   WebRtcViewer::Events events;
   events.answered = [this, session, done](Expected<std::string, std::string> answer) {
     if (!answer) {
@@ -106,8 +104,8 @@ void WebRtcService::offer(const std::string& camera, std::string_view sdp,
   viewer.camera = camera;
   viewer.downSince = std::chrono::steady_clock::now();
   viewer.peer = std::make_unique<WebRtcViewer>(*encoder, *offer, settings_.servers, events);
-  logLine("webrtc: " + camera + ": viewer " + viewerAddress + " (session " + session +
-                         "), " + std::to_string(viewers_.size()) + " now");
+  logLine("webrtc: " + camera + ": viewer " + viewerAddress + " (session " + session + "), " +
+          std::to_string(viewers_.size()) + " now");
 }
 
 bool WebRtcService::end(const std::string& camera, const std::string& session) {
@@ -155,7 +153,7 @@ void WebRtcService::remove(const std::string& session) {
   std::string camera = viewer->second.camera;
   viewers_.erase(viewer);
   logLine("webrtc: " + camera + ": viewer gone (session " + session + "), " +
-                         std::to_string(viewers_.size()) + " now");
+          std::to_string(viewers_.size()) + " now");
   // The encoder runs only while someone watches.
   bool watched = false;
   for (const auto& [id, other] : viewers_) watched = watched || other.camera == camera;

@@ -92,8 +92,7 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
   };
   if ((rtpbin_ = gst_bin_get_by_name(GST_BIN(webrtc_), "rtpbin")))
     heardHandler_ = g_signal_connect_data(
-        rtpbin_, "on-ssrc-active",
-        G_CALLBACK(+[](GstElement*, guint, guint, gpointer heard) {
+        rtpbin_, "on-ssrc-active", G_CALLBACK(+[](GstElement*, guint, guint, gpointer heard) {
           static_cast<std::shared_ptr<std::atomic<int64_t>>*>(heard)->get()->store(
               std::chrono::steady_clock::now().time_since_epoch().count());
         }),
@@ -159,8 +158,8 @@ void WebRtcViewer::onAnswerCreated(GstPromise* promise, gpointer data) {
     if (gst_structure_get(reply, "error", G_TYPE_ERROR, &failure, nullptr)) {
       error = failure->message;
       g_error_free(failure);
-    } else if (gst_structure_get(reply, "answer", GST_TYPE_WEBRTC_SESSION_DESCRIPTION,
-                                 &description, nullptr)) {
+    } else if (gst_structure_get(reply, "answer", GST_TYPE_WEBRTC_SESSION_DESCRIPTION, &description,
+                                 nullptr)) {
       gchar* text = gst_sdp_message_as_text(description->sdp);
       answer = text;
       g_free(text);

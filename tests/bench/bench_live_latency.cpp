@@ -151,24 +151,25 @@ std::string webrtcLatency(const std::string& camera, double seconds) {
 // around it); the number that came up.
 std::string holdViewers(const std::string& kind, const std::string& camera, int viewers,
                         double seconds) {
-  std::string wait = "await new Promise(d => setTimeout(d, " + std::to_string(seconds * 1000) + "));";
+  std::string wait =
+      "await new Promise(d => setTimeout(d, " + std::to_string(seconds * 1000) + "));";
   if (kind == "mjpeg")
     return "(async () => { const imgs = Array.from({length: " + std::to_string(viewers) +
            "}, () => { const i = new Image(); i.src = '/live/" + camera +
            ".mjpg'; document.body.appendChild(i); return i; }); await new Promise(d => "
            "setTimeout(d, 1000)); window.holding = true; " +
-           wait + " const up = imgs.filter(i => i.naturalWidth).length; imgs.forEach(i => { "
-                  "i.src = ''; i.remove(); }); return up; })()";
+           wait +
+           " const up = imgs.filter(i => i.naturalWidth).length; imgs.forEach(i => { "
+           "i.src = ''; i.remove(); }); return up; })()";
   return "(async () => { const pcs = await Promise.all(Array.from({length: " +
          std::to_string(viewers) + "}, () => offerWhep('" + camera + "'))); " + wait +
          " for (const pc of pcs) await closeWhep(pc); return pcs.length; })()";
 }
 
 nlohmann::json run(DevToolsPage& page, const std::string& script, double seconds) {
-  auto reply = page.call(
-      "Runtime.evaluate",
-      {{"expression", script}, {"returnByValue", true}, {"awaitPromise", true}},
-      std::chrono::milliseconds(static_cast<int>(seconds * 1000) + 60000));
+  auto reply = page.call("Runtime.evaluate",
+                         {{"expression", script}, {"returnByValue", true}, {"awaitPromise", true}},
+                         std::chrono::milliseconds(static_cast<int>(seconds * 1000) + 60000));
   if (!reply.contains("result") || reply.contains("exceptionDetails")) {
     std::fprintf(stderr, "bench_live_latency: %s\n", reply.dump().substr(0, 400).c_str());
     return nullptr;
@@ -190,8 +191,8 @@ int main(int argc, char** argv) {
               "latency median/p90", "kbit/s", "recorder CPU %");
   for (const char* size : {"352x288", "1280x720"}) {
     uint16_t devicePort = freePort(), httpPort = freePort();
-    pid_t sim = spawn((bin / "wirc-sim").string() + " --clock-stamp --size " + size +
-                      " --port " + std::to_string(devicePort));
+    pid_t sim = spawn((bin / "wirc-sim").string() + " --clock-stamp --size " + size + " --port " +
+                      std::to_string(devicePort));
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     fs::remove_all(work / "rec");
     pid_t recorder = spawn((bin / "wirc-recorder").string() + " --device 127.0.0.1:" +
@@ -214,14 +215,14 @@ int main(int argc, char** argv) {
     };
     auto [idle, idleCpu] = cpuWhile("new Promise(d => setTimeout(() => d(0), " +
                                     std::to_string(seconds * 1000) + "))");
-    std::printf("%-8s | %-6s | %-7d | %-17s | %-8s | %5.1f (recording only)\n", size, "-", 0,
-                "-", "-", idleCpu);
+    std::printf("%-8s | %-6s | %-7d | %-17s | %-8s | %5.1f (recording only)\n", size, "-", 0, "-",
+                "-", idleCpu);
     for (const std::string kind : {"mjpeg", "webrtc"}) {
       auto [latency, cpu] = cpuWhile(kind == "mjpeg" ? mjpegLatency(camera, seconds)
                                                      : webrtcLatency(camera, seconds));
-      double kbps = kind == "mjpeg" ? run(*page, mjpegBitrate(camera, seconds), seconds)
-                                          .get<double>()
-                                    : latency.value("kbps", -1.0);
+      double kbps = kind == "mjpeg"
+                        ? run(*page, mjpegBitrate(camera, seconds), seconds).get<double>()
+                        : latency.value("kbps", -1.0);
       char shown[32];
       std::snprintf(shown, sizeof shown, "%d / %d ms", latency.value("median", -1),
                     latency.value("p90", -1));
@@ -230,8 +231,8 @@ int main(int argc, char** argv) {
                   latency.value("misread", 0));
       auto [held, heldCpu] = cpuWhile(holdViewers(kind, camera, 10, seconds));
       std::printf("%-8s | %-6s | %-7s | %-17s | %-8s | %5.1f\n", size, kind.c_str(),
-                  (std::to_string(held.is_number() ? held.get<int>() : 0) + " of 10").c_str(),
-                  "-", "-", heldCpu);
+                  (std::to_string(held.is_number() ? held.get<int>() : 0) + " of 10").c_str(), "-",
+                  "-", heldCpu);
     }
     std::fflush(stdout);
     page.reset();

@@ -82,8 +82,7 @@ struct WhepRecorder {
   }
   Response offer(const std::string& sdp, const char* type = "application/sdp") const {
     return fetch(whep(), "POST",
-                 {{"Authorization", std::string("Bearer ") + kToken}, {"Content-Type", type}},
-                 sdp);
+                 {{"Authorization", std::string("Bearer ") + kToken}, {"Content-Type", type}}, sdp);
   }
 };
 
@@ -93,9 +92,10 @@ TEST(WhepPeers, BadOffersAreRefusedWithTheReason) {
   auto malformed = whep.offer("v=0\r\nthis is not an offer\r\n");
   EXPECT_EQ(malformed.status, 400u);
   EXPECT_NE(malformed.body.find("not SDP"), std::string::npos) << malformed.body;
-  auto noVp8 = whep.offer("v=0\r\no=- 1 1 IN IP4 0.0.0.0\r\ns=-\r\nt=0 0\r\n"
-                          "m=video 9 UDP/TLS/RTP/SAVPF 100\r\na=recvonly\r\n"
-                          "a=rtpmap:100 H265/90000\r\n");
+  auto noVp8 = whep.offer(
+      "v=0\r\no=- 1 1 IN IP4 0.0.0.0\r\ns=-\r\nt=0 0\r\n"
+      "m=video 9 UDP/TLS/RTP/SAVPF 100\r\na=recvonly\r\n"
+      "a=rtpmap:100 H265/90000\r\n");
   EXPECT_EQ(noVp8.status, 400u);
   EXPECT_NE(noVp8.body.find("VP8"), std::string::npos) << noVp8.body;
   auto mistyped = whep.offer(offerWith(""), "text/plain");
@@ -109,10 +109,10 @@ TEST(WhepPeers, BadOffersAreRefusedWithTheReason) {
   EXPECT_EQ(anonymous.status, 401u);
   // An unknown camera, and a session that is not there.
   std::string other = whep.url + "api/cameras/nobody/whep";
-  auto unknown = fetch(other, "POST",
-                       {{"Authorization", std::string("Bearer ") + kToken},
-                        {"Content-Type", "application/sdp"}},
-                       offerWith(""));
+  auto unknown = fetch(
+      other, "POST",
+      {{"Authorization", std::string("Bearer ") + kToken}, {"Content-Type", "application/sdp"}},
+      offerWith(""));
   EXPECT_EQ(unknown.status, 404u);
   auto noSession = fetch(whep.whep() + "/no-such-session", "DELETE",
                          {{"Authorization", std::string("Bearer ") + kToken}});
@@ -131,11 +131,12 @@ TEST(WhepPeers, CandidatesForOtherHostsNeverGetAPacketAndAViewerThatNeverConnect
     return "a=candidate:" + std::to_string(id) + " 1 udp 2113937151 " + address + " " +
            std::to_string(port) + " typ host\r\n";
   };
-  auto answered = whep.offer(offerWith(candidate(1, "127.0.0.2", other.port()) +
-                                       candidate(2, "127.0.0.1", own.port())));
+  auto answered = whep.offer(
+      offerWith(candidate(1, "127.0.0.2", other.port()) + candidate(2, "127.0.0.1", own.port())));
   ASSERT_EQ(answered.status, 201u) << answered.body;
   EXPECT_EQ(answered.contentType, "application/sdp");
-  EXPECT_TRUE(answered.headers["location"].starts_with("/api/cameras/")) << answered.headers["location"];
+  EXPECT_TRUE(answered.headers["location"].starts_with("/api/cameras/"))
+      << answered.headers["location"];
   EXPECT_NE(answered.body.find("a=candidate:"), std::string::npos) << answered.body;
   EXPECT_NE(answered.body.find("a=end-of-candidates"), std::string::npos) << answered.body;
   auto answeredAt = Clock::now();
@@ -147,11 +148,11 @@ TEST(WhepPeers, CandidatesForOtherHostsNeverGetAPacketAndAViewerThatNeverConnect
   EXPECT_TRUE(whep.recorder.waitForText("left out 1 ICE candidate(s)", milliseconds(1000)));
   // The viewer never answers: its elements go within the idle timeout (and
   // the sweep's half second).
-  ASSERT_TRUE(whep.recorder.waitForText("viewer gone", milliseconds(10000)))
-      << whep.recorder.log();
+  ASSERT_TRUE(whep.recorder.waitForText("viewer gone", milliseconds(10000))) << whep.recorder.log();
   auto gone = std::chrono::duration_cast<milliseconds>(Clock::now() - answeredAt);
   EXPECT_LT(gone.count(), 1500 + 500 + 1000) << "let go after " << gone.count() << " ms";
-  std::cerr << "[ measured ] unconnected viewer let go " << gone.count() << " ms after its answer\n";
+  std::cerr << "[ measured ] unconnected viewer let go " << gone.count()
+            << " ms after its answer\n";
 }
 
 }  // namespace

@@ -114,10 +114,10 @@ TEST(WebRtcView, WithWebRtcOffInTheRecorderThePageShowsMjpeg) {
   ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-transport=mjpeg]')"));
   EXPECT_TRUE(page.waitUntil("document.querySelector('.view img').naturalWidth === 352"));
   // WHEP answers why, in JSON.
-  auto answer = fetch(signedIn.url + "api/cameras/" + cameraOf(car) + "/whep", "POST",
-                      {{"Authorization", std::string("Bearer ") + kToken},
-                       {"Content-Type", "application/sdp"}},
-                      "v=0\r\n");
+  auto answer = fetch(
+      signedIn.url + "api/cameras/" + cameraOf(car) + "/whep", "POST",
+      {{"Authorization", std::string("Bearer ") + kToken}, {"Content-Type", "application/sdp"}},
+      "v=0\r\n");
   EXPECT_EQ(answer.status, 404u);
   EXPECT_NE(answer.body.find("--webrtc off"), std::string::npos) << answer.body;
 }
@@ -145,10 +145,10 @@ TEST(WebRtcView, DriveModeGoesOverTheDataChannelAndAPageThatHangsOrGoesAwayStops
                         "webrtc-drive");
   ASSERT_TRUE(signedIn.page);
   auto& page = *signedIn.page;
-  ASSERT_TRUE(page.waitUntil(
-      "document.querySelector('.camera[data-transport=webrtc] button.drive') && "
-      "Object.values(views)[0].webrtc.drive.readyState === 'open'",
-      milliseconds(15000)))
+  ASSERT_TRUE(
+      page.waitUntil("document.querySelector('.camera[data-transport=webrtc] button.drive') && "
+                     "Object.values(views)[0].webrtc.drive.readyState === 'open'",
+                     milliseconds(15000)))
       << signedIn.recorder.log();
   signedIn.clickOn("button.drive");
   ASSERT_TRUE(
@@ -201,10 +201,10 @@ TEST(WebRtcView, JunkOnTheDataChannelIsAnsweredAndStopsTheCar) {
   SignedInPage signedIn(car.device->port(), {"--detect", "tag36h11", "--follow"}, "webrtc-junk");
   ASSERT_TRUE(signedIn.page);
   auto& page = *signedIn.page;
-  ASSERT_TRUE(page.waitUntil(
-      "document.querySelector('.camera[data-transport=webrtc]') && "
-      "Object.values(views)[0].webrtc.drive.readyState === 'open'",
-      milliseconds(15000)));
+  ASSERT_TRUE(
+      page.waitUntil("document.querySelector('.camera[data-transport=webrtc]') && "
+                     "Object.values(views)[0].webrtc.drive.readyState === 'open'",
+                     milliseconds(15000)));
   // The page's own channel, full ahead every 100 ms...
   page.evaluate(
       "window.probe = Object.values(views)[0].webrtc.drive; probe.onmessage = e => { "

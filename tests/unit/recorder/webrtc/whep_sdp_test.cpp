@@ -64,10 +64,10 @@ TEST(WhepSdp, TheAnswerCarriesEachCandidateOnceAndTheirEnd) {
       "v=0\r\no=- 1 2 IN IP4 0.0.0.0\r\ns=-\r\nt=0 0\r\nm=video 9 UDP/TLS/RTP/SAVPF 96\r\n"
       "c=IN IP4 0.0.0.0\r\na=mid:0\r\na=candidate:1 1 UDP 2015363327 10.0.0.2 41230 typ host\r\n"
       "m=application 9 UDP/DTLS/SCTP webrtc-datachannel\r\nc=IN IP4 0.0.0.0\r\na=mid:1\r\n";
-  auto mended = answerWithCandidates(
-      answer, {{0, "candidate:1 1 UDP 2015363327 10.0.0.2 41230 typ host"},
-               {0, "candidate:2 1 UDP 2015363583 10.0.0.3 41231 typ host"},
-               {7, "candidate:3 1 UDP 2015363583 10.0.0.4 41232 typ host"}});
+  auto mended =
+      answerWithCandidates(answer, {{0, "candidate:1 1 UDP 2015363327 10.0.0.2 41230 typ host"},
+                                    {0, "candidate:2 1 UDP 2015363583 10.0.0.3 41231 typ host"},
+                                    {7, "candidate:3 1 UDP 2015363583 10.0.0.4 41232 typ host"}});
   auto count = [&](const std::string& text) {
     size_t n = 0;
     for (auto at = mended.find(text); at != std::string::npos; at = mended.find(text, at + 1)) ++n;
