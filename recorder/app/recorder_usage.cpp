@@ -25,7 +25,8 @@ file and exits 0.
   --segment-size SIZE    also end a segment at SIZE (e.g. 100M)
   --format mkv|mp4       container (default mkv); mp4 needs --codec h264
   --codec jpeg|h264      jpeg: the camera's frames as they are (default);
-                         h264: transcoded with x264enc (gstreamer1.0-plugins-ugly)
+                         h264: transcoded with x264enc (gstreamer1.0-plugins-ugly),
+                         Main profile (WebRTC viewers get these frames as they are)
   --bitrate KBPS         H.264 bit rate (default 2000)
   --telemetry-track on|off
                          the telemetry as the file's text track too (default

@@ -106,7 +106,8 @@ Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
 std::optional<std::string> Supervisor::startServers() {
   if (options_.http) {
     HttpServer::Content content;
-    for (auto& c : cameras_) content.cameras.push_back({c->name(), c->frames()});
+    for (auto& c : cameras_)
+      content.cameras.push_back({c->name(), c->frames(), c->encodedFrames()});
     content.recordingsFolder = options_.outDir;
     content.token = options_.httpToken;
     content.certificateFile = options_.httpCert;

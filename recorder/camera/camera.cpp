@@ -28,7 +28,8 @@ Expected<std::unique_ptr<Camera>, std::string> Camera::create(StreamPlan plan, C
                                                               CameraHealth::Policy policy,
                                                               CameraObserver& observer) {
   std::unique_ptr<Camera> camera(new Camera(std::move(plan), std::move(files), policy, observer));
-  auto pipeline = CameraPipeline::build(camera->plan_, camera->files_, camera->frames());
+  auto pipeline = CameraPipeline::build(camera->plan_, camera->files_, camera->frames(),
+                                        camera->encodedFrames());
   if (!pipeline) return unexpected(pipeline.error());
   camera->pipeline_ = std::move(*pipeline);
   return camera;
@@ -176,7 +177,8 @@ void Camera::tearDown() {
 gboolean Camera::onRestart(gpointer data) {
   auto* self = static_cast<Camera*>(data);
   self->restartTimer_ = 0;
-  auto pipeline = CameraPipeline::build(self->plan_, self->files_, self->frames());
+  auto pipeline =
+      CameraPipeline::build(self->plan_, self->files_, self->frames(), self->encodedFrames());
   if (!pipeline) {
     logLine(self->name() + ": " + pipeline.error());
     return G_SOURCE_REMOVE;

@@ -78,6 +78,10 @@ class Camera {
   const StreamPlan& plan() const { return plan_; }
   const std::string& name() const { return plan_.name; }
   FrameTap* frames() { return plan_.liveSink.empty() ? nullptr : &frames_; }
+  // The recording's own H.264 frames (--codec h264, with live outputs), or null.
+  FrameTap* encodedFrames() {
+    return plan_.liveSink.empty() || !files_.transcoded ? nullptr : &encodedFrames_;
+  }
   // The wirccontrol of the running pipeline, or null (none, or restarting).
   GstElement* controller() const;
   CameraReport report() const;
@@ -121,6 +125,7 @@ class Camera {
   CameraObserver& observer_;
   CameraHealth health_;
   FrameTap frames_;
+  FrameTap encodedFrames_;
   std::unique_ptr<CameraPipeline> pipeline_;
   guint busWatch_ = 0;
   guint finishDeadline_ = 0, restartTimer_ = 0;

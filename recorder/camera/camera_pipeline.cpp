@@ -3,7 +3,7 @@
 namespace wircam::recorder {
 
 Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
-    const StreamPlan& plan, const CameraFiles& files, FrameTap* frames) {
+    const StreamPlan& plan, const CameraFiles& files, FrameTap* frames, FrameTap* encoded) {
   std::unique_ptr<CameraPipeline> camera(new CameraPipeline);
   GError* parseError = nullptr;
   camera->pipeline_ = gst_parse_launch(plan.description.c_str(), &parseError);
@@ -41,6 +41,12 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
     frames->attach(camera->element(plan.liveSink));
     camera->frames_ = frames;
   }
+  if (encoded && files.transcoded) {
+    GstPad* pad = gst_element_get_static_pad(camera->element(plan.videoTail), "src");
+    encoded->attachPad(pad);
+    gst_object_unref(pad);
+    camera->encoded_ = encoded;
+  }
   return camera;
 }
 
@@ -48,6 +54,7 @@ CameraPipeline::~CameraPipeline() {
   if (!pipeline_) return;
   gst_element_set_state(pipeline_, GST_STATE_NULL);
   if (frames_) frames_->detach();
+  if (encoded_) encoded_->detach();
   // The writer holds the elements' pads: before the pipeline goes.
   writer_.reset();
   telemetry_.reset();

@@ -31,10 +31,12 @@ struct CameraFiles {
 
 class CameraPipeline {
  public:
-  // `frames` (the camera's live tap, or null) is attached to its appsink.
+  // `frames` (the camera's live tap, or null) is attached to its appsink;
+  // `encoded` (or null) to its encoder's output, when it has one.
   static Expected<std::unique_ptr<CameraPipeline>, std::string> build(const StreamPlan& plan,
                                                                       const CameraFiles& files,
-                                                                      FrameTap* frames);
+                                                                      FrameTap* frames,
+                                                                      FrameTap* encoded);
   ~CameraPipeline();  // torn down (NULL) and released
   CameraPipeline(const CameraPipeline&) = delete;
   CameraPipeline& operator=(const CameraPipeline&) = delete;
@@ -57,6 +59,7 @@ class CameraPipeline {
 
   GstElement* pipeline_ = nullptr;
   FrameTap* frames_ = nullptr;
+  FrameTap* encoded_ = nullptr;
   std::unique_ptr<SegmentPlanner> planner_;
   std::unique_ptr<TelemetryTrack> track_;
   std::unique_ptr<TelemetryRouter> telemetry_;

@@ -11,10 +11,33 @@ void FrameTap::attach(GstElement* appsink) {
   handler_ = g_signal_connect(appsink_, "new-sample", G_CALLBACK(onNewSample), this);
 }
 
+void FrameTap::attachPad(GstPad* pad) {
+  detach();
+  pad_ = GST_PAD(gst_object_ref(pad));
+  probe_ = gst_pad_add_probe(
+      pad_, GST_PAD_PROBE_TYPE_BUFFER,
+      [](GstPad* tapped, GstPadProbeInfo* info, gpointer self) {
+        auto* tap = static_cast<FrameTap*>(self);
+        GstCaps* caps = gst_pad_get_current_caps(tapped);
+        GstSample* sample = gst_sample_new(GST_PAD_PROBE_INFO_BUFFER(info), caps, nullptr, nullptr);
+        if (caps) gst_caps_unref(caps);
+        tap->hand(sample);
+        gst_sample_unref(sample);
+        return GST_PAD_PROBE_OK;
+      },
+      this, nullptr);
+}
+
 void FrameTap::detach() {
   if (appsink_) g_signal_handler_disconnect(appsink_, handler_);
   appsink_ = nullptr;
   handler_ = 0;
+  if (pad_) {
+    gst_pad_remove_probe(pad_, probe_);
+    gst_object_unref(pad_);
+  }
+  pad_ = nullptr;
+  probe_ = 0;
 }
 
 FrameTap::~FrameTap() {
@@ -43,13 +66,15 @@ GstFlowReturn FrameTap::onNewSample(GstElement* appsink, gpointer data) {
   auto* self = static_cast<FrameTap*>(data);
   GstSample* sample = gst_app_sink_pull_sample(GST_APP_SINK(appsink));
   if (!sample) return GST_FLOW_EOS;
-  {
-    MutexLock lock(self->mutex_);
-    gst_buffer_replace(&self->latest_, gst_sample_get_buffer(sample));
-    for (auto& [id, listener] : self->listeners_) listener(sample);
-  }
+  self->hand(sample);
   gst_sample_unref(sample);
   return GST_FLOW_OK;
+}
+
+void FrameTap::hand(GstSample* sample) {
+  MutexLock lock(mutex_);
+  gst_buffer_replace(&latest_, gst_sample_get_buffer(sample));
+  for (auto& [id, listener] : listeners_) listener(sample);
 }
 
 }  // namespace wircam::recorder

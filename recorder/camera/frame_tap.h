@@ -1,5 +1,6 @@
 // The frames of one camera as they arrive (JPEG, untouched), handed to the
-// live outputs: the web server's MJPEG streams and the RTSP server. It
+// live outputs: the web server's MJPEG streams, the RTSP server and WebRTC;
+// or, for a recording encoded to H.264, its H.264 frames, for WebRTC. It
 // outlives the camera's pipelines: each run's appsink is attached in turn,
 // and the listeners stay.
 #pragma once
@@ -28,6 +29,9 @@ class FrameTap {
   // `appsink` is the live branch of the camera's running pipeline; borrowed
   // until detach(), which comes before the pipeline goes.
   void attach(GstElement* appsink);
+  // Or a pad of it: each buffer that passes is handed on, with the pad's
+  // caps, on the pad's thread (the recording's H.264, as it goes to the file).
+  void attachPad(GstPad* pad);
   void detach();
 
   int listen(Listener listener);
@@ -37,9 +41,12 @@ class FrameTap {
 
  private:
   static GstFlowReturn onNewSample(GstElement* appsink, gpointer self);
+  void hand(GstSample* sample);
 
   GstElement* appsink_ = nullptr;
   gulong handler_ = 0;
+  GstPad* pad_ = nullptr;
+  gulong probe_ = 0;
   Mutex mutex_;
   std::map<int, Listener> listeners_ WIRCAM_GUARDED_BY(mutex_);
   int nextId_ WIRCAM_GUARDED_BY(mutex_) = 1;

@@ -35,11 +35,13 @@ std::string encoder(const RecorderOptions& options, const std::string& tail) {
   // zerolatency: no B-frames and no look-ahead, so the live recording does
   // not lag. The recorder asks for a key frame at each cut and every 0.5 s
   // (SegmentWriter); key-int-max is only a backstop. The muxers take H.264
-  // as "avc" only, and the file is linked after the caps are settled.
+  // as "avc" only, and the file is linked after the caps are settled. Main
+  // profile: what browsers decode over WebRTC (Chromium and Safari offer
+  // it), so the live view passes the recording's frames on as they are.
   return "tjpegdec ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
          std::to_string(options.h264Kbps) +
          " key-int-max=60 ! h264parse ! capsfilter name=" + tail +
-         " caps=\"video/x-h264,stream-format=avc,alignment=au\" ";
+         " caps=\"video/x-h264,stream-format=avc,alignment=au,profile=main\" ";
 }
 
 // wirccontrol's properties for the vehicle the device's tags steer: the

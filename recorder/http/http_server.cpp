@@ -161,7 +161,7 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     };
     std::vector<WebRtcService::Camera> cameras;
     for (const auto& camera : self->content_.cameras)
-      cameras.push_back({camera.name, camera.frames});
+      cameras.push_back({camera.name, camera.frames, camera.encoded});
     self->webrtc_ = std::make_unique<WebRtcService>(std::move(cameras), std::move(settings));
   }
   return self;

@@ -33,7 +33,8 @@ class HttpServer {
  public:
   struct Camera {
     std::string name;
-    FrameTap* frames;  // borrowed; outlives the server
+    FrameTap* frames;             // borrowed; outlives the server
+    FrameTap* encoded = nullptr;  // the recording's H.264 (--codec h264), or null
   };
   struct Content {
     std::vector<Camera> cameras;

@@ -12,20 +12,27 @@ namespace {
 // frame in, one frame out), a key frame at least every 2 s at 15 fps so a
 // viewer whose request for one is lost still starts soon; browsers ask for
 // one (PLI) when they join, and the tee passes that up to the encoder.
-std::string description(unsigned kbps) {
-  return "appsrc name=frames is-live=true format=time do-timestamp=true leaky-type=downstream "
+// H.264 is passed on as the recording has it; its encoder makes a key frame
+// every 0.5 s (SegmentWriter), so a new viewer starts within that.
+std::string description(WebRtcVideo video, unsigned kbps) {
+  const std::string source =
+      "appsrc name=frames is-live=true format=time do-timestamp=true leaky-type=downstream ";
+  const std::string viewers = " ! tee name=viewers allow-not-linked=true";
+  if (video == WebRtcVideo::kH264) return source + "max-buffers=8" + viewers;
+  return source +
          "max-buffers=2 ! tjpegdec ! videoconvert ! vp8enc deadline=1 cpu-used=8 lag-in-frames=0 "
          "end-usage=cbr keyframe-max-dist=30 error-resilient=default target-bitrate=" +
-         std::to_string(kbps * 1000) + " ! tee name=viewers allow-not-linked=true";
+         std::to_string(kbps * 1000) + viewers;
 }
 
 }  // namespace
 
 Expected<std::unique_ptr<CameraEncoder>, std::string> CameraEncoder::start(
-    FrameTap& frames, const std::string& camera, unsigned kbps) {
+    FrameTap& frames, const std::string& camera, WebRtcVideo video, unsigned kbps) {
   std::unique_ptr<CameraEncoder> self(new CameraEncoder());
+  self->video_ = video;
   GError* error = nullptr;
-  self->pipeline_ = gst_parse_launch(description(kbps).c_str(), &error);
+  self->pipeline_ = gst_parse_launch(description(video, kbps).c_str(), &error);
   if (!self->pipeline_) {
     std::string text = error ? error->message : "unknown error";
     g_clear_error(&error);

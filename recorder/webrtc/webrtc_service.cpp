@@ -53,16 +53,16 @@ WebRtcService::~WebRtcService() {
   encoders_.clear();
 }
 
-FrameTap* WebRtcService::framesOf(const std::string& camera) const {
-  for (const auto& c : cameras_)
-    if (c.name == camera) return c.frames;
+const WebRtcService::Camera* WebRtcService::cameraNamed(const std::string& name) const {
+  for (const auto& camera : cameras_)
+    if (camera.name == name) return &camera;
   return nullptr;
 }
 
 void WebRtcService::offer(const std::string& camera, std::string_view sdp,
                           const std::string& viewerAddress, Done done) {
-  FrameTap* frames = framesOf(camera);
-  if (!frames) return done(unexpected(Refusal{404, "no camera named '" + camera + "'"}));
+  const Camera* source = cameraNamed(camera);
+  if (!source) return done(unexpected(Refusal{404, "no camera named '" + camera + "'"}));
   if (viewers_.size() >= kMaxViewers)
     return done(unexpected(Refusal{503, "already " + std::to_string(kMaxViewers) +
                                             " WebRTC viewers; try again later, or "
@@ -71,11 +71,21 @@ void WebRtcService::offer(const std::string& camera, std::string_view sdp,
   allowed.insert(viewerAddress);
   auto offer = readViewerOffer(sdp, allowed);
   if (!offer) return done(unexpected(Refusal{400, offer.error()}));
-  auto& encoder = encoders_[camera];
+  // The recording's own H.264 when the viewer takes it: nothing is encoded
+  // again. Otherwise VP8, encoded here.
+  bool passThrough = source->h264 && offer->h264Payload >= 0;
+  if (!passThrough && offer->vp8Payload < 0)
+    return done(unexpected(Refusal{400,
+                                   "this camera goes out as VP8 (its recording is not "
+                                   "H.264); the offer's video does not take VP8"}));
+  std::string key = camera + (passThrough ? " h264" : " vp8");
+  auto& encoder = encoders_[key];
   if (!encoder) {
-    auto started = CameraEncoder::start(*frames, camera, settings_.kbps);
+    auto started =
+        CameraEncoder::start(passThrough ? *source->h264 : *source->frames, camera,
+                             passThrough ? WebRtcVideo::kH264 : WebRtcVideo::kVp8, settings_.kbps);
     if (!started) {
-      encoders_.erase(camera);
+      encoders_.erase(key);
       return done(unexpected(Refusal{500, started.error()}));
     }
     encoder = std::move(*started);
@@ -95,16 +105,17 @@ void WebRtcService::offer(const std::string& camera, std::string_view sdp,
     done(Answer{*answer, session});
   };
   events.ended = [this, session] { removeLater(session); };
-  events.driveMessage = [this, session, camera](std::optional<std::string_view> text) {
-    viewers_[session].driving = true;
+  events.driveMessage = [this, camera](std::optional<std::string_view> text) {
     return settings_.driveMessage(camera, text);
   };
   events.driveClosed = [this, camera] { settings_.neutral(camera); };
   Viewer& viewer = viewers_[session];
   viewer.camera = camera;
+  viewer.encoder = key;
   viewer.downSince = std::chrono::steady_clock::now();
   viewer.peer = std::make_unique<WebRtcViewer>(*encoder, *offer, settings_.servers, events);
-  logLine("webrtc: " + camera + ": viewer " + viewerAddress + " (session " + session + "), " +
+  logLine("webrtc: " + camera + ": viewer " + viewerAddress + " (session " + session + ", " +
+          (passThrough ? "the recording's H.264" : "VP8") + "), " +
           std::to_string(viewers_.size()) + " now");
 }
 
@@ -150,14 +161,14 @@ void WebRtcService::removeLater(const std::string& session) {
 void WebRtcService::remove(const std::string& session) {
   auto viewer = viewers_.find(session);
   if (viewer == viewers_.end()) return;
-  std::string camera = viewer->second.camera;
+  std::string camera = viewer->second.camera, key = viewer->second.encoder;
   viewers_.erase(viewer);
   logLine("webrtc: " + camera + ": viewer gone (session " + session + "), " +
           std::to_string(viewers_.size()) + " now");
   // The encoder runs only while someone watches.
   bool watched = false;
-  for (const auto& [id, other] : viewers_) watched = watched || other.camera == camera;
-  if (!watched) encoders_.erase(camera);
+  for (const auto& [id, other] : viewers_) watched = watched || other.encoder == key;
+  if (!watched) encoders_.erase(key);
   // Each viewer's threads leave memory in glibc's per-thread arenas, kept
   // for reuse; when nobody watches, it goes back to the system.
   if (viewers_.empty()) malloc_trim(0);

@@ -29,11 +29,12 @@ class WebRtcService {
  public:
   struct Camera {
     std::string name;
-    FrameTap* frames;  // borrowed; outlives the service
+    FrameTap* frames;          // its JPEG frames; borrowed, outlives the service
+    FrameTap* h264 = nullptr;  // its recording's H.264 (--codec h264), or null
   };
   struct Settings {
     IceServers servers;
-    unsigned kbps = 600;  // each camera's VP8
+    unsigned kbps = 600;  // each camera's VP8 (H.264 goes as recorded)
     std::chrono::milliseconds idleTimeout{10000};
     // A drive data channel's message for `camera` → the reply (driving
     // done, see drive_command.h); and the channel's end → neutral.
@@ -75,19 +76,20 @@ class WebRtcService {
  private:
   struct Viewer {
     std::string camera;
+    std::string encoder;  // its key in encoders_
     std::unique_ptr<WebRtcViewer> peer;
     std::optional<std::chrono::steady_clock::time_point> downSince;  // not connected since
-    bool driving = false;
   };
   void remove(const std::string& session);
   void removeLater(const std::string& session);
-  FrameTap* framesOf(const std::string& camera) const;
+  const Camera* cameraNamed(const std::string& name) const;
 
   std::vector<Camera> cameras_;
   Settings settings_;
   std::set<std::string> allowedHosts_;  // the TURN server's, besides each viewer's own
-  std::map<std::string, std::unique_ptr<CameraEncoder>> encoders_;  // by camera
-  std::map<std::string, Viewer> viewers_;                           // by session
+  // By camera and codec ("rover-cam0 vp8"): a camera can have both at once.
+  std::map<std::string, std::unique_ptr<CameraEncoder>> encoders_;
+  std::map<std::string, Viewer> viewers_;  // by session
   guint sweepTimer_ = 0;
   std::shared_ptr<WebRtcService*> alive_ = std::make_shared<WebRtcService*>(this);
 };

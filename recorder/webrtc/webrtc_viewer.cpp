@@ -45,11 +45,20 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
   // A viewer that cannot keep up loses frames here, never holds the others.
   g_object_set(queue_, "leaky", 2, "max-size-buffers", 8u, "max-size-bytes", 0u, "max-size-time",
                guint64(0), nullptr);
-  payloader_ = make("rtpvp8pay");
-  // The payload type the viewer's offer gave VP8; 15-bit picture ids as
-  // browsers send them.
-  g_object_set(payloader_, "pt", guint(offer.vp8Payload), "mtu", 1200u, nullptr);
-  gst_util_set_object_arg(G_OBJECT(payloader_), "picture-id-mode", "15-bit");
+  bool h264 = encoder.video() == WebRtcVideo::kH264;
+  int payload = h264 ? offer.h264Payload : offer.vp8Payload;
+  if (h264) {
+    // SPS and PPS before every key frame: a viewer may join at any one.
+    payloader_ = make("rtph264pay");
+    g_object_set(payloader_, "config-interval", -1, nullptr);
+    gst_util_set_object_arg(G_OBJECT(payloader_), "aggregate-mode", "zero-latency");
+  } else {
+    // 15-bit picture ids, as browsers send them.
+    payloader_ = make("rtpvp8pay");
+    gst_util_set_object_arg(G_OBJECT(payloader_), "picture-id-mode", "15-bit");
+  }
+  // The payload type the viewer's offer gave the codec.
+  g_object_set(payloader_, "pt", guint(payload), "mtu", 1200u, nullptr);
   webrtc_ = make("webrtcbin");
   gst_util_set_object_arg(G_OBJECT(webrtc_), "bundle-policy", "max-bundle");
   if (!servers.stun.empty()) g_object_set(webrtc_, "stun-server", servers.stun.c_str(), nullptr);
@@ -66,9 +75,10 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
   gst_bin_add_many(encoder_.pipeline(), queue_, payloader_, webrtc_, nullptr);
   gst_element_link(queue_, payloader_);
 
-  GstCaps* caps = gst_caps_new_simple("application/x-rtp", "media", G_TYPE_STRING, "video",
-                                      "encoding-name", G_TYPE_STRING, "VP8", "payload", G_TYPE_INT,
-                                      offer.vp8Payload, "clock-rate", G_TYPE_INT, 90000, nullptr);
+  GstCaps* caps =
+      gst_caps_new_simple("application/x-rtp", "media", G_TYPE_STRING, "video", "encoding-name",
+                          G_TYPE_STRING, h264 ? "H264" : "VP8", "payload", G_TYPE_INT, payload,
+                          "clock-rate", G_TYPE_INT, 90000, nullptr);
   GstPadTemplate* sinks =
       gst_element_class_get_pad_template(GST_ELEMENT_GET_CLASS(webrtc_), "sink_%u");
   GstPad* sink = gst_element_request_pad(webrtc_, sinks, nullptr, caps);

@@ -1,5 +1,5 @@
 // One WebRTC viewer of a camera: a branch off the camera's encoder (a leaky
-// queue → rtpvp8pay → webrtcbin) that answers the viewer's offer, and the
+// queue → rtpvp8pay or rtph264pay → webrtcbin) that answers the viewer's offer, and the
 // data channel the page drives over. Lives on the main loop; webrtcbin's
 // promises and signals come on its threads and are handed to the main loop,
 // and nothing of them runs once the viewer is gone.

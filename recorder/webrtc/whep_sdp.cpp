@@ -4,6 +4,8 @@
 
 #include <memory>
 #include <sstream>
+#include <string_view>
+#include <vector>
 
 namespace wircam::recorder {
 
@@ -37,17 +39,40 @@ bool hasAttribute(const GstSDPMedia* media, const char* key) {
   return gst_sdp_media_get_attribute_val(media, key) != nullptr;
 }
 
-// The payload type of "<pt> VP8/90000" among the m-line's rtpmaps, or -1.
-int vp8PayloadOf(const GstSDPMedia* media) {
+// The payload types of "<pt> NAME/90000" among the m-line's rtpmaps.
+std::vector<int> payloadsOf(const GstSDPMedia* media, const char* name) {
+  std::vector<int> payloads;
   for (guint i = 0;; ++i) {
     const char* rtpmap = gst_sdp_media_get_attribute_val_n(media, "rtpmap", i);
-    if (!rtpmap) return -1;
+    if (!rtpmap) return payloads;
     int payload = -1;
     char encoding[32] = {};
     if (sscanf(rtpmap, "%d %31[^/]/90000", &payload, encoding) == 2 &&
-        g_ascii_strcasecmp(encoding, "VP8") == 0 && payload >= 0 && payload < 128)
+        g_ascii_strcasecmp(encoding, name) == 0 && payload >= 0 && payload < 128)
+      payloads.push_back(payload);
+  }
+}
+
+// The format parameters of `payload` ("a=fmtp:96 a=1;b=2"), or "".
+std::string formatOf(const GstSDPMedia* media, int payload) {
+  std::string prefix = std::to_string(payload) + " ";
+  for (guint i = 0;; ++i) {
+    const char* fmtp = gst_sdp_media_get_attribute_val_n(media, "fmtp", i);
+    if (!fmtp) return "";
+    if (std::string_view(fmtp).starts_with(prefix)) return fmtp + prefix.size();
+  }
+}
+
+// The first H.264 payload type for Main profile in packetization mode 1.
+int h264MainPayloadOf(const GstSDPMedia* media) {
+  for (int payload : payloadsOf(media, "H264")) {
+    std::string format = formatOf(media, payload);
+    auto profile = format.find("profile-level-id=");
+    if (format.find("packetization-mode=1") != std::string::npos && profile != std::string::npos &&
+        g_ascii_strncasecmp(format.c_str() + profile + 17, "4d", 2) == 0)
       return payload;
   }
+  return -1;
 }
 
 // "candidate:F C PROTO PRIO ADDRESS PORT typ T ...": the address.
@@ -83,7 +108,9 @@ Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,
         !hasAttribute(media, "inactive") && gst_sdp_media_get_port(media) != 0) {
       video = true;
       offer.videoMedia = m;
-      offer.vp8Payload = vp8PayloadOf(media);
+      auto vp8 = payloadsOf(media, "VP8");
+      offer.vp8Payload = vp8.empty() ? -1 : vp8.front();
+      offer.h264Payload = h264MainPayloadOf(media);
     }
     for (guint a = gst_sdp_media_attributes_len(media); a-- > 0;) {
       const GstSDPAttribute* attribute = gst_sdp_media_get_attribute(media, a);
@@ -94,7 +121,8 @@ Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,
     }
   }
   if (!video) return unexpected("the offer has no video m-line that receives (recvonly)");
-  if (offer.vp8Payload < 0) return unexpected("the offer's video does not take VP8/90000");
+  if (offer.vp8Payload < 0 && offer.h264Payload < 0)
+    return unexpected("the offer's video takes neither VP8 nor H.264 Main (packetization-mode=1)");
   offer.sdp = asText(message.get());
   return offer;
 }

@@ -26,13 +26,16 @@ constexpr unsigned kMaxOfferMedia = 8;
 struct ViewerOffer {
   std::string sdp;          // as it goes to webrtcbin: only the allowed candidates
   unsigned videoMedia = 0;  // index of the video m-line that receives
-  int vp8Payload = 0;       // its payload type for VP8/90000
+  int vp8Payload = -1;      // its payload type for VP8/90000, or -1
+  // For H.264 Main (profile-level-id 4d…) in packetization mode 1, as an
+  // H.264 recording is encoded, or -1.
+  int h264Payload = -1;
   bool dataChannel = false;
   unsigned droppedCandidates = 0;  // for another host, or a name
 };
 
 // The offer, or why it cannot be answered: too big, not SDP, no video the
-// viewer receives, no VP8. Candidates are kept only when their address is
+// viewer receives, neither VP8 nor H.264 Main. Candidates are kept only when their address is
 // one of `allowedHosts` (IP addresses as text: the viewer's own, and a
 // TURN server's).
 Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,

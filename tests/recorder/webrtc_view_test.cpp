@@ -85,6 +85,30 @@ TEST(WebRtcView, ThePageShowsTheCameraOverWebRtcAndItsPictureMoves) {
       << signedIn.recorder.log();
 }
 
+TEST(WebRtcView, AnH264RecordingGoesToTheBrowserAsItIsWithoutEncodingAgain) {
+  if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  SignedInPage signedIn(car.device->port(), {"--codec", "h264"}, "webrtc-h264");
+  ASSERT_TRUE(signedIn.page);
+  auto& page = *signedIn.page;
+  ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-transport=webrtc]')",
+                             milliseconds(15000)))
+      << signedIn.recorder.log();
+  ASSERT_TRUE(waitFor([&] { return inboundVideo(page, "framesDecoded") > 5; }));
+  double decoded = inboundVideo(page, "framesDecoded");
+  ASSERT_TRUE(waitFor([&] { return inboundVideo(page, "framesDecoded") > decoded + 30; }));
+  // The browser decodes H.264, and the recorder says it passed its own on.
+  auto codec = page.evaluate(
+      "(async () => { const stats = await Object.values(views)[0].webrtc.pc.getStats(); let "
+      "id = ''; stats.forEach(s => { if (s.type === 'inbound-rtp') id = s.codecId; }); return "
+      "stats.get(id).mimeType; })()");
+  EXPECT_EQ(codec, "video/H264");
+  EXPECT_NE(signedIn.recorder.log().find("the recording's H.264"), std::string::npos)
+      << signedIn.recorder.log();
+  EXPECT_EQ(pictureNow(page).substr(0, 8), "352x288:");
+}
+
 TEST(WebRtcView, WithWebRtcOffInTheBrowserThePageShowsMjpegAndSaysSo) {
   if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
   FollowedCar car;

@@ -26,6 +26,7 @@ TEST(WhepSdp, AnOfferKeepsOnlyTheViewersOwnCandidates) {
   ASSERT_TRUE(offer) << offer.error();
   EXPECT_EQ(offer->videoMedia, 0u);
   EXPECT_EQ(offer->vp8Payload, 96);
+  EXPECT_EQ(offer->h264Payload, -1);
   EXPECT_TRUE(offer->dataChannel);
   EXPECT_EQ(offer->droppedCandidates, 2u);  // the name and the other host
   EXPECT_NE(offer->sdp.find("127.0.0.1 45699"), std::string::npos) << offer->sdp;
@@ -35,6 +36,30 @@ TEST(WhepSdp, AnOfferKeepsOnlyTheViewersOwnCandidates) {
   auto withTurn = readViewerOffer(kOffer, {"127.0.0.1", "192.0.2.77"});
   ASSERT_TRUE(withTurn);
   EXPECT_EQ(withTurn->droppedCandidates, 1u);
+}
+
+TEST(WhepSdp, H264IsTakenInMainProfileAndPacketizationModeOne) {
+  std::string offered = kOffer;
+  offered.replace(offered.find("a=rtpmap:97 rtx/90000"), 0,
+                  "a=rtpmap:102 H264/90000\r\n"
+                  "a=fmtp:102 level-asymmetry-allowed=1;packetization-mode=1;"
+                  "profile-level-id=42e01f\r\n"
+                  "a=rtpmap:39 H264/90000\r\n"
+                  "a=fmtp:39 level-asymmetry-allowed=1;packetization-mode=0;"
+                  "profile-level-id=4d001f\r\n"
+                  "a=rtpmap:116 H264/90000\r\n"
+                  "a=fmtp:116 level-asymmetry-allowed=1;packetization-mode=1;"
+                  "profile-level-id=4d001f\r\n");
+  auto offer = readViewerOffer(offered, {"127.0.0.1"});
+  ASSERT_TRUE(offer) << offer.error();
+  EXPECT_EQ(offer->h264Payload, 116);  // not baseline (102), not mode 0 (39)
+  // Without VP8, H.264 alone will do.
+  std::string onlyH264 = offered;
+  onlyH264.replace(onlyH264.find("VP8"), 3, "XYZ");
+  auto h264 = readViewerOffer(onlyH264, {"127.0.0.1"});
+  ASSERT_TRUE(h264) << h264.error();
+  EXPECT_EQ(h264->vp8Payload, -1);
+  EXPECT_EQ(h264->h264Payload, 116);
 }
 
 TEST(WhepSdp, WhatCannotBeAnsweredIsRefusedWithTheReason) {
@@ -50,7 +75,8 @@ TEST(WhepSdp, WhatCannotBeAnsweredIsRefusedWithTheReason) {
                 std::to_string(kMaxOfferBytes));
   std::string noVp8 = kOffer;
   noVp8.replace(noVp8.find("VP8"), 3, "XYZ");
-  EXPECT_EQ(refused(noVp8), "the offer's video does not take VP8/90000");
+  EXPECT_EQ(refused(noVp8),
+            "the offer's video takes neither VP8 nor H.264 Main (packetization-mode=1)");
   std::string sending = kOffer;
   sending.replace(sending.find("recvonly"), 8, "sendonly");
   EXPECT_EQ(refused(sending), "the offer has no video m-line that receives (recvonly)");
