@@ -12,6 +12,7 @@
 #include "http/http_routes.h"
 #include "http/page_resources.h"
 #include "http/playback_stream.h"
+#include "log_line.h"
 #include "record/telemetry_log.h"
 
 namespace wircam::recorder {
@@ -142,7 +143,14 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     });
     self->feeds_.push_back(std::move(feed));
   }
-  if (self->content_.webrtc) {
+  auto missing = WebRtcService::missingElements();
+  if (self->content_.webrtc && !missing.empty()) {
+    std::string names;
+    for (const auto& name : missing) names += (names.empty() ? "" : ", ") + name;
+    self->webrtcOff_ = "WebRTC is off: GStreamer lacks " + names +
+                       " (gstreamer1.0-plugins-bad, gstreamer1.0-nice, gstreamer1.0-plugins-good)";
+    logLine(self->webrtcOff_ + "; the live view is MJPEG");
+  } else if (self->content_.webrtc) {
     WebRtcService::Settings settings;
     settings.servers = self->content_.iceServers;
     // Viewers reach the recorder where its web server listens, and no
@@ -423,7 +431,9 @@ std::string HttpServer::page() const {
     cameras.push_back(camera);
   }
   nlohmann::json trails = content_.trails ? content_.trails() : nlohmann::json::object();
-  std::string state = nlohmann::json{{"cameras", cameras}, {"trails", trails}}.dump();
+  std::string state =
+      nlohmann::json{{"cameras", cameras}, {"trails", trails}, {"webrtc", webrtc_ != nullptr}}
+          .dump();
   // Inside <script>, "</" could end it early.
   for (size_t at = state.find("</"); at != std::string::npos; at = state.find("</", at))
     state.replace(at, 2, "<\\/");

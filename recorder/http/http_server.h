@@ -143,7 +143,8 @@ class HttpServer {
   std::vector<std::unique_ptr<DriveSocket>> driveSockets_;
   std::unique_ptr<HttpConnections> connections_;
   std::unique_ptr<ExportDownloads> exports_;
-  std::unique_ptr<WebRtcService> webrtc_;  // with --webrtc on
+  std::unique_ptr<WebRtcService> webrtc_;                   // with --webrtc on
+  std::string webrtcOff_ = "WebRTC is off (--webrtc off)";  // why, when it is
   // Frames queued for the main loop check it: the server may be gone.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

@@ -26,7 +26,7 @@ void HttpServer::serveWhep(SoupServerMessage* message, const Route& route) {
   std::string method = soup_server_message_get_method(message);
   if (!webrtc_)
     return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
-                            "WebRTC is off (--webrtc off); the live view is /live/CAMERA.mjpg");
+                            webrtcOff_ + "; the live view is /live/CAMERA.mjpg");
   if (route.kind == Route::Kind::WhepSession) {
     if (method != "DELETE")
       return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,

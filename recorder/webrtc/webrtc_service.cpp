@@ -33,6 +33,18 @@ std::set<std::string> turnAddresses(const std::string& url) {
 
 }  // namespace
 
+std::vector<std::string> WebRtcService::missingElements() {
+  std::vector<std::string> missing;
+  for (const char* name :
+       {"webrtcbin", "nicesrc", "nicesink", "vp8enc", "rtpvp8pay", "rtph264pay", "tjpegdec"}) {
+    if (GstElementFactory* factory = gst_element_factory_find(name))
+      gst_object_unref(factory);
+    else
+      missing.push_back(name);
+  }
+  return missing;
+}
+
 WebRtcService::WebRtcService(std::vector<Camera> cameras, Settings settings)
     : cameras_(std::move(cameras)),
       settings_(std::move(settings)),

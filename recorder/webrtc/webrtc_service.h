@@ -45,6 +45,10 @@ class WebRtcService {
   // Each viewer is a webrtcbin with its own ICE, DTLS and SCTP threads.
   static constexpr size_t kMaxViewers = 32;
 
+  // The GStreamer elements WebRTC needs that are not installed (webrtcbin
+  // and ICE: gstreamer1.0-plugins-bad and gstreamer1.0-nice), by name.
+  static std::vector<std::string> missingElements();
+
   WebRtcService(std::vector<Camera> cameras, Settings settings);
   ~WebRtcService();
   WebRtcService(const WebRtcService&) = delete;

@@ -12,6 +12,7 @@ namespace {
 // trip. An answer waits this long for them at most.
 constexpr guint kGatheringSeconds = 3;
 
+// The service made sure at start that each of these is installed.
 GstElement* make(const char* factory) {
   GstElement* element = gst_element_factory_make(factory, nullptr);
   if (!element) g_error("wirc-recorder: the %s element is missing", factory);

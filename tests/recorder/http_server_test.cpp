@@ -181,7 +181,10 @@ TEST(WircRecorderHttp, EventsCarryTheDetections) {
 TEST(WircRecorderHttp, LiveViewShowsTheCameraWithTheTagOverlayInChromium) {
   if (!chromiumInstalled())
     GTEST_SKIP() << "chromium is not installed (tools/install-deps test installs it)";
-  LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11"});
+  // The MJPEG card: chromium's screenshot is taken at the page's load, when
+  // an <img> shows its first part, before a WebRTC connection is up
+  // (webrtc_view_test.cpp checks that picture).
+  LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11", "--webrtc", "off"});
   ASSERT_FALSE(live.url.empty()) << live.recorder->log();
   // Two seconds of frames, and with them detections.
   ASSERT_TRUE(waitFor([&] { return framesOf(live.url, live.camera()) >= 30; }, milliseconds(15000)))
@@ -249,7 +252,8 @@ TEST(WircRecorderHttp, CameraSnapshotAndRecordingApi) {
 TEST(WircRecorderHttp, TheCameraCardSaysLiveThenOfflineWhenTheDeviceStops) {
   if (!chromiumInstalled())
     GTEST_SKIP() << "chromium is not installed (tools/install-deps test installs it)";
-  LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11", "--follow"});
+  // The MJPEG card, for a screenshot at load (see above).
+  LiveRecorder live(startFollowDevice(), {"--detect", "tag36h11", "--follow", "--webrtc", "off"});
   ASSERT_FALSE(live.url.empty()) << live.recorder->log();
   ASSERT_TRUE(waitFor([&] { return framesOf(live.url, live.camera()) >= 30; }, milliseconds(15000)))
       << live.recorder->log();

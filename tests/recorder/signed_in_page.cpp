@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <thread>
+
 namespace wircam::testing {
 
 namespace {
@@ -21,6 +23,19 @@ FollowedCar::FollowedCar() {
   auto started = wirc::Device::start({.port = 0, .fragmentSize = 8000}, scene);
   EXPECT_TRUE(started.has_value());
   device = std::move(*started);
+}
+
+bool atNeutral(const wirc::Device& device) {
+  auto pulses = device.outputs().pulses;
+  return pulses[kSteering] == 1500 && pulses[kThrottle] == 1500;
+}
+
+std::chrono::milliseconds untilNeutral(const wirc::Device& device) {
+  using Clock = std::chrono::steady_clock;
+  auto start = Clock::now();
+  while (!atNeutral(device) && Clock::now() - start < std::chrono::seconds(3))
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  return std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - start);
 }
 
 std::filesystem::path shotPath(const std::string& name) {

@@ -4,6 +4,7 @@
 // tree.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -26,6 +27,14 @@ struct FollowedCar {
 };
 
 inline constexpr const char* kToken = "0123456789abcdef0123456789abcdef";
+
+// The simulated car's channels (pulses[kSteering] > 1500: left).
+inline constexpr size_t kSteering = 0, kThrottle = 1;
+// Both channels at neutral on the simulated device.
+bool atNeutral(const wirc::Device& device);
+// How long until they are (3 s at most), polled every 2 ms: what the
+// drive tests measure a dead-man or a closed page by.
+std::chrono::milliseconds untilNeutral(const wirc::Device& device);
 
 // build/tests/recorder/NAME
 std::filesystem::path shotPath(const std::string& name);

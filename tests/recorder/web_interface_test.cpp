@@ -27,8 +27,6 @@ using namespace wircam::testing;
 using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
 
-constexpr size_t kSteering = 0, kThrottle = 1;
-
 double shownPosition(DevToolsPage& page) {
   auto text = page.evaluate("document.getElementById('playback-time').textContent");
   return text.is_string() ? std::atof(text.get<std::string>().c_str()) : -1;
@@ -95,19 +93,6 @@ TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
   EXPECT_TRUE(page.waitUntil("document.documentElement.scrollWidth <= 390"))
       << page.evaluate("document.documentElement.scrollWidth");
   page.screenshot(shotPath("web-phone.png"));
-}
-
-// Both channels at neutral on the simulated device.
-bool atNeutral(const wirc::Device& device) {
-  auto pulses = device.outputs().pulses;
-  return pulses[kSteering] == 1500 && pulses[kThrottle] == 1500;
-}
-
-milliseconds untilNeutral(const wirc::Device& device) {
-  auto start = Clock::now();
-  while (!atNeutral(device) && Clock::now() - start < std::chrono::seconds(3))
-    std::this_thread::sleep_for(milliseconds(2));
-  return std::chrono::duration_cast<milliseconds>(Clock::now() - start);
 }
 
 TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {

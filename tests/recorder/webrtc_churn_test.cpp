@@ -112,8 +112,9 @@ TEST(WebRtcChurn, TwentyViewersComingAndGoingForAMinuteLeaveNothingBehind) {
   });
   Counts last = countOf(signedIn.recorder.pid());
   // Every viewer's threads and sockets went with it (a leak would be 2 and
-  // 16 a viewer); the browser keeps up to 6 HTTP connections open or not.
-  EXPECT_EQ(last.threads, first.threads);
+  // 16 a viewer); idle pool threads come and go, and the browser keeps up
+  // to 6 HTTP connections open or not.
+  EXPECT_LE(last.threads, first.threads);
   EXPECT_LE(last.descriptors, first.descriptors + 6);
   std::cerr << "[ measured ] " << rounds << " rounds of " << kViewers
             << " WebRTC viewers: recorder " << afterFirst / 1024 << " MB, " << first.threads

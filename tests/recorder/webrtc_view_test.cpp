@@ -27,8 +27,6 @@ using namespace wircam::testing;
 using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
 
-constexpr size_t kSteering = 0, kThrottle = 1;
-
 std::string cameraOf(const FollowedCar& car) {
   return "127.0.0.1-" + std::to_string(car.device->port()) + "-cam0";
 }
@@ -144,19 +142,6 @@ TEST(WebRtcView, WithWebRtcOffInTheRecorderThePageShowsMjpeg) {
       "v=0\r\n");
   EXPECT_EQ(answer.status, 404u);
   EXPECT_NE(answer.body.find("--webrtc off"), std::string::npos) << answer.body;
-}
-
-// Both channels at neutral on the simulated device.
-bool atNeutral(const wirc::Device& device) {
-  auto pulses = device.outputs().pulses;
-  return pulses[kSteering] == 1500 && pulses[kThrottle] == 1500;
-}
-
-milliseconds untilNeutral(const wirc::Device& device) {
-  auto start = Clock::now();
-  while (!atNeutral(device) && Clock::now() - start < std::chrono::seconds(3))
-    std::this_thread::sleep_for(milliseconds(2));
-  return std::chrono::duration_cast<milliseconds>(Clock::now() - start);
 }
 
 TEST(WebRtcView, DriveModeGoesOverTheDataChannelAndAPageThatHangsOrGoesAwayStopsTheCar) {

@@ -231,6 +231,7 @@ async function deleteSegment(file) {
 function start() {
   // Built before the page's load event, so a screenshot at load shows them.
   const initial = INITIAL_STATE;
+  webrtcOffered = initial.webrtc;
   initial.cameras.forEach(addCamera);
   Object.assign(trails, initial.trails);
   drawMap();

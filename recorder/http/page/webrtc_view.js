@@ -1,16 +1,19 @@
 // The live picture over WebRTC (WHEP: the offer POSTed, the answer back),
-// VP8 at a third of MJPEG's bitrate; MJPEG when the browser has no WebRTC,
-// the recorder has it off, or the connection does not come up. The card's
-// head says which one shows. The peer connection also carries the drive
+// at a fifth of MJPEG's bitrate and a sixth of its delay. MJPEG shows at
+// once, and stays when the browser has no WebRTC, the recorder has it off,
+// or the connection does not come up; WebRTC takes over at its first
+// frame. The card's head says which one shows. The peer connection also carries the drive
 // mode's data channel (control.js), unordered and never retransmitted: a
 // lost command is replaced by the next one, never delivered late.
-const kWebRtcPatienceMs = 5000;  // to connect, before MJPEG takes over
+const kWebRtcPatienceMs = 5000;  // to connect, and for the first frame
+let webrtcOffered = true;        // the recorder's --webrtc (the page's state)
 
 function showTransport(view, transport) {
   view.box.dataset.transport = transport;
   view.transport.textContent = transport === "webrtc" ? "WebRTC" : "MJPEG";
   view.img.hidden = transport === "webrtc";
   view.video.hidden = transport !== "webrtc";
+  view.video.classList.remove("warming");
 }
 
 function showMjpeg(view, name) {
@@ -18,17 +21,21 @@ function showMjpeg(view, name) {
   view.img.src = "/live/" + encodeURIComponent(name) + ".mjpg?t=" + Date.now();
 }
 
-// Starts the picture of a camera that went live: WebRTC first.
+// Starts the picture of a camera that went live: MJPEG now, WebRTC when
+// its first frame is there.
 async function startPicture(view, name) {
   stopPicture(view);
+  showMjpeg(view, name);
+  if (!webrtcOffered || !window.RTCPeerConnection) return;
   const attempt = view.attempt = {};
-  const webrtc = window.RTCPeerConnection ? await connectWebRtc(view, name) : null;
+  const webrtc = await connectWebRtc(view, name);
   if (view.attempt !== attempt) {  // stopped or restarted meanwhile
     if (webrtc) closeWebRtc(webrtc);
     return;
   }
-  if (!webrtc) return showMjpeg(view, name);
+  if (!webrtc) return;
   view.webrtc = webrtc;
+  view.img.removeAttribute("src");  // one stream at a time
   showTransport(view, "webrtc");
 }
 
@@ -60,6 +67,10 @@ async function connectWebRtc(view, name) {
     webrtc.session = response.headers.get("Location");
     await pc.setRemoteDescription({ type: "answer", sdp: await response.text() });
     await connected(pc);
+    // Played unseen over the MJPEG picture until its first frame.
+    view.video.classList.add("warming");
+    view.video.hidden = false;
+    await firstFrame(view.video);
     pc.addEventListener("connectionstatechange", () => {
       if (pc.connectionState !== "failed" || view.webrtc !== webrtc) return;
       // Lost on the way (a network change): MJPEG until the state changes.
@@ -71,8 +82,19 @@ async function connectWebRtc(view, name) {
   } catch (error) {
     console.log(`WebRTC for ${name}: ${error.message}; showing MJPEG`);
     closeWebRtc(webrtc);
+    view.video.hidden = true;
+    view.video.classList.remove("warming");
+    view.video.srcObject = null;
     return null;
   }
+}
+
+function firstFrame(video) {
+  return new Promise((done, fail) => {
+    const timer = setTimeout(() => fail(new Error("no frame")), kWebRtcPatienceMs);
+    const check = () => video.videoWidth ? (clearTimeout(timer), done()) : setTimeout(check, 20);
+    check();
+  });
 }
 
 function gathered(pc) {
