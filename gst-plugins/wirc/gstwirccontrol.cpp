@@ -51,7 +51,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -64,6 +63,7 @@
 #include "glib_locker.h"
 #include "login_properties.h"
 #include "manual_drive.h"
+#include "property_table.h"
 #include "target_follower.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_bus_messages.h"
@@ -75,7 +75,6 @@ GST_DEBUG_CATEGORY_STATIC(wirc_control_debug);
 namespace {
 
 using namespace wircam;
-using Clock = std::chrono::steady_clock;
 
 #define DEFAULT_HOST ""
 #define DEFAULT_PORT 0
@@ -83,9 +82,6 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_TARGET_ID -1
 #define DEFAULT_STEERING_CHANNEL 1
 #define DEFAULT_THROTTLE_CHANNEL 2
-#define DEFAULT_TARGET_DISTANCE 1.0
-#define DEFAULT_TAG_SIZE 0.16
-#define DEFAULT_HORIZONTAL_FOV 60.0
 #define DEFAULT_NEUTRAL 1500
 #define DEFAULT_MIN 1000
 #define DEFAULT_MAX 2000
@@ -94,8 +90,8 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_LOST_TIMEOUT 500
 #define DEFAULT_PCD_RATE 50.0
 #define DEFAULT_KEEPALIVE 100
-#define DEFAULT_ENABLED TRUE
-#define DEFAULT_TAKE_CONTROL FALSE
+#define DEFAULT_ENABLED true
+#define DEFAULT_TAKE_CONTROL false
 #define DEFAULT_DRIVE_TIMEOUT 250
 
 enum {
@@ -145,20 +141,21 @@ struct Settings {
   gint targetId = DEFAULT_TARGET_ID;
   guint steeringChannel = DEFAULT_STEERING_CHANNEL;
   guint throttleChannel = DEFAULT_THROTTLE_CHANNEL;
+  // Gains, camera and distance: the follower's own defaults.
   vision::FollowConfig follow;
   guint neutral = DEFAULT_NEUTRAL;
   guint min = DEFAULT_MIN;
   guint max = DEFAULT_MAX;
   guint throttleDeadband = DEFAULT_THROTTLE_DEADBAND;
   double maxThrottle = DEFAULT_MAX_THROTTLE;
-  gboolean steeringReversed = FALSE;
-  gboolean throttleReversed = FALSE;
+  bool steeringReversed = false;
+  bool throttleReversed = false;
   guint lostTimeoutMs = DEFAULT_LOST_TIMEOUT;
   double pcdRate = DEFAULT_PCD_RATE;
   guint keepaliveMs = DEFAULT_KEEPALIVE;
   bool keepaliveSet = false;
-  gboolean enabled = DEFAULT_ENABLED;
-  gboolean takeControl = DEFAULT_TAKE_CONTROL;
+  bool enabled = DEFAULT_ENABLED;
+  bool takeControl = DEFAULT_TAKE_CONTROL;
   guint driveTimeoutMs = DEFAULT_DRIVE_TIMEOUT;
   wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
   wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
@@ -167,6 +164,8 @@ struct Settings {
   std::set<std::string> given = {"pcd-rate", "keepalive", "lost-timeout"};
 };
 
+gst::PropertyTable<Settings> properties;
+
 struct WircControlState {
   Settings settings;  // guarded by the object lock
   bool settingsChanged = true;
@@ -174,7 +173,8 @@ struct WircControlState {
   // Streaming thread only.
   Settings active;  // the settings in use, refreshed when one changes
   std::optional<vision::TargetFollower> follower;
-  std::vector<vision::TagSighting> sightings;  // reused per frame
+  vision::TargetFollower::Clock::time_point lastStep;  // the last buffer's running time
+  std::vector<vision::TagSighting> sightings;          // reused per frame
   bool warnedWithoutControl = false;
 
   // Set in start(), cleared in stop(); the link's listener runs on the event loop.
@@ -201,7 +201,7 @@ vision::FollowConfig followConfig(const Settings& s) {
 vision::FollowerSettings followerSettings(const Settings& s) {
   return {.targetId = s.targetId,
           .lostTimeout = std::chrono::milliseconds(s.lostTimeoutMs),
-          .enabled = s.enabled != FALSE};
+          .enabled = s.enabled};
 }
 
 // Neutral on the element's two channels (the others are at 1500 anyway).
@@ -431,6 +431,28 @@ static gboolean gst_wirc_control_stop(GstBaseTransform* transform) {
   return TRUE;
 }
 
+// The follower's time: the buffer's running time, so that lost-timeout
+// counts the stream's time (a test clock's, a replay's) and not this
+// thread's. A buffer without a timestamp takes the pipeline clock's now.
+static vision::TargetFollower::Clock::time_point running_time_of(GstBaseTransform* transform,
+                                                                 GstBuffer* buffer) {
+  GstClockTime time = GST_CLOCK_TIME_NONE;
+  if (GST_BUFFER_PTS_IS_VALID(buffer) && transform->segment.format == GST_FORMAT_TIME)
+    time =
+        gst_segment_to_running_time(&transform->segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+  if (!GST_CLOCK_TIME_IS_VALID(time)) {
+    GstElement* element = GST_ELEMENT(transform);
+    if (GstClock* clock = gst_element_get_clock(element)) {
+      GstClockTime now = gst_clock_get_time(clock);
+      GstClockTime base = gst_element_get_base_time(element);
+      time = now > base ? now - base : 0;
+      gst_object_unref(clock);
+    }
+  }
+  if (!GST_CLOCK_TIME_IS_VALID(time)) time = 0;  // neither: a target seen is never lost by time
+  return vision::TargetFollower::Clock::time_point(std::chrono::nanoseconds(time));
+}
+
 static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, GstBuffer* buffer) {
   auto* self = GST_WIRC_CONTROL(transform);
   auto* state = self->state;
@@ -445,15 +467,19 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
     }
   }
   const Settings& settings = state->active;
-  if (!state->follower)
+  auto now = running_time_of(transform, buffer);
+  // Time that steps back is a new stream (a flush, a restarted replay):
+  // what was seen before it says nothing now.
+  if (!state->follower || now < state->lastStep)
     state->follower.emplace(followConfig(settings), followerSettings(settings));
   else if (changed)
     state->follower->reconfigure(followConfig(settings), followerSettings(settings));
+  state->lastStep = now;
 
   WircTagMeta* meta = gst_buffer_get_wirc_tag_meta(buffer);
   readSightings(meta, state->sightings);
-  auto step = state->follower->step(state->sightings, meta ? static_cast<int>(meta->width) : 0,
-                                    std::chrono::steady_clock::now());
+  auto step =
+      state->follower->step(state->sightings, meta ? static_cast<int>(meta->width) : 0, now);
   const auto& command = step.command;
 
   link::Pulses pulses = link::neutralPulses();
@@ -516,105 +542,15 @@ static void gst_wirc_control_set_property(GObject* object, guint id, const GValu
   if (id == PROP_ENABLED && !g_value_get_boolean(value)) return stop_following_now(self);
   gst::GLibLocker lock(self);
   auto& s = self->state->settings;
-  auto& f = s.follow;
-  switch (id) {
-    case PROP_HOST:
-      s.host = g_value_get_string(value) ? g_value_get_string(value) : "";
-      break;
-    case PROP_PORT:
-      s.port = g_value_get_uint(value);
-      break;
-    case PROP_PROTOCOL:
-      s.protocol = static_cast<gst::VehicleProtocol>(g_value_get_enum(value));
-      break;
-    case PROP_TARGET_ID:
-      s.targetId = g_value_get_int(value);
-      break;
-    case PROP_STEERING_CHANNEL:
-      s.steeringChannel = g_value_get_uint(value);
-      break;
-    case PROP_THROTTLE_CHANNEL:
-      s.throttleChannel = g_value_get_uint(value);
-      break;
-    case PROP_STEERING_KP:
-      f.steering.kp = g_value_get_double(value);
-      break;
-    case PROP_STEERING_KI:
-      f.steering.ki = g_value_get_double(value);
-      break;
-    case PROP_STEERING_KD:
-      f.steering.kd = g_value_get_double(value);
-      break;
-    case PROP_THROTTLE_KP:
-      f.throttle.kp = g_value_get_double(value);
-      break;
-    case PROP_THROTTLE_KI:
-      f.throttle.ki = g_value_get_double(value);
-      break;
-    case PROP_THROTTLE_KD:
-      f.throttle.kd = g_value_get_double(value);
-      break;
-    case PROP_TARGET_DISTANCE:
-      f.targetDistance = g_value_get_double(value);
-      break;
-    case PROP_TAG_SIZE:
-      f.tagSize = g_value_get_double(value);
-      break;
-    case PROP_FX:
-      f.fx = g_value_get_double(value);
-      break;
-    case PROP_HORIZONTAL_FOV:
-      f.horizontalFovDeg = g_value_get_double(value);
-      break;
-    case PROP_NEUTRAL:
-      s.neutral = g_value_get_uint(value);
-      break;
-    case PROP_MIN:
-      s.min = g_value_get_uint(value);
-      break;
-    case PROP_MAX:
-      s.max = g_value_get_uint(value);
-      break;
-    case PROP_THROTTLE_DEADBAND:
-      s.throttleDeadband = g_value_get_uint(value);
-      break;
-    case PROP_MAX_THROTTLE:
-      s.maxThrottle = g_value_get_double(value);
-      break;
-    case PROP_STEERING_REVERSED:
-      s.steeringReversed = g_value_get_boolean(value);
-      break;
-    case PROP_THROTTLE_REVERSED:
-      s.throttleReversed = g_value_get_boolean(value);
-      break;
-    case PROP_LOST_TIMEOUT:
-      s.lostTimeoutMs = g_value_get_uint(value);
-      break;
-    case PROP_PCD_RATE:
-      s.pcdRate = g_value_get_double(value);
-      break;
-    case PROP_KEEPALIVE:
-      s.keepaliveMs = g_value_get_uint(value);
-      s.keepaliveSet = true;
-      break;
-    case PROP_ENABLED:
-      s.enabled = g_value_get_boolean(value);
-      break;
-    case PROP_DRIVE_TIMEOUT:
-      s.driveTimeoutMs = g_value_get_uint(value);
-      break;
-    case PROP_TAKE_CONTROL:
-      s.takeControl = g_value_get_boolean(value);
-      break;
-    case PROP_PERIODS:
-      gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
-      break;
-    case PROP_FAILSAFE:
-      gst::setChannelListProperty(object, "failsafe", value, s.failsafe, s.given);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
-      return;
+  if (properties.set(id, value, s)) {
+    if (id == PROP_KEEPALIVE) s.keepaliveSet = true;
+  } else if (id == PROP_PERIODS) {
+    gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
+  } else if (id == PROP_FAILSAFE) {
+    gst::setChannelListProperty(object, "failsafe", value, s.failsafe, s.given);
+  } else {
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+    return;
   }
   self->state->settingsChanged = true;
 }
@@ -624,108 +560,15 @@ static void gst_wirc_control_get_property(GObject* object, guint id, GValue* val
   auto* self = GST_WIRC_CONTROL(object);
   gst::GLibLocker lock(self);
   const auto& s = self->state->settings;
-  const auto& f = s.follow;
-  switch (id) {
-    case PROP_HOST:
-      g_value_set_string(value, s.host.c_str());
-      break;
-    case PROP_PORT:
-      g_value_set_uint(value, s.port);
-      break;
-    case PROP_PROTOCOL:
-      g_value_set_enum(value, static_cast<gint>(s.protocol));
-      break;
-    case PROP_TARGET_ID:
-      g_value_set_int(value, s.targetId);
-      break;
-    case PROP_STEERING_CHANNEL:
-      g_value_set_uint(value, s.steeringChannel);
-      break;
-    case PROP_THROTTLE_CHANNEL:
-      g_value_set_uint(value, s.throttleChannel);
-      break;
-    case PROP_STEERING_KP:
-      g_value_set_double(value, f.steering.kp);
-      break;
-    case PROP_STEERING_KI:
-      g_value_set_double(value, f.steering.ki);
-      break;
-    case PROP_STEERING_KD:
-      g_value_set_double(value, f.steering.kd);
-      break;
-    case PROP_THROTTLE_KP:
-      g_value_set_double(value, f.throttle.kp);
-      break;
-    case PROP_THROTTLE_KI:
-      g_value_set_double(value, f.throttle.ki);
-      break;
-    case PROP_THROTTLE_KD:
-      g_value_set_double(value, f.throttle.kd);
-      break;
-    case PROP_TARGET_DISTANCE:
-      g_value_set_double(value, f.targetDistance);
-      break;
-    case PROP_TAG_SIZE:
-      g_value_set_double(value, f.tagSize);
-      break;
-    case PROP_FX:
-      g_value_set_double(value, f.fx);
-      break;
-    case PROP_HORIZONTAL_FOV:
-      g_value_set_double(value, f.horizontalFovDeg);
-      break;
-    case PROP_NEUTRAL:
-      g_value_set_uint(value, s.neutral);
-      break;
-    case PROP_MIN:
-      g_value_set_uint(value, s.min);
-      break;
-    case PROP_MAX:
-      g_value_set_uint(value, s.max);
-      break;
-    case PROP_THROTTLE_DEADBAND:
-      g_value_set_uint(value, s.throttleDeadband);
-      break;
-    case PROP_MAX_THROTTLE:
-      g_value_set_double(value, s.maxThrottle);
-      break;
-    case PROP_STEERING_REVERSED:
-      g_value_set_boolean(value, s.steeringReversed);
-      break;
-    case PROP_THROTTLE_REVERSED:
-      g_value_set_boolean(value, s.throttleReversed);
-      break;
-    case PROP_LOST_TIMEOUT:
-      g_value_set_uint(value, s.lostTimeoutMs);
-      break;
-    case PROP_PCD_RATE:
-      g_value_set_double(value, s.pcdRate);
-      break;
-    case PROP_KEEPALIVE:
-      g_value_set_uint(value, s.keepaliveMs);
-      break;
-    case PROP_ENABLED:
-      g_value_set_boolean(value, s.enabled);
-      break;
-    case PROP_DRIVE_TIMEOUT:
-      g_value_set_uint(value, s.driveTimeoutMs);
-      break;
-    case PROP_TAKE_CONTROL:
-      g_value_set_boolean(value, s.takeControl);
-      break;
-    case PROP_HAS_CONTROL:
-      g_value_set_boolean(value, self->state->hasControl.load());
-      break;
-    case PROP_PERIODS:
-      gst::getChannelListProperty(value, s.periods);
-      break;
-    case PROP_FAILSAFE:
-      gst::getChannelListProperty(value, s.failsafe);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
-      break;
-  }
+  if (properties.get(id, s, value)) return;
+  if (id == PROP_HAS_CONTROL)
+    g_value_set_boolean(value, self->state->hasControl.load());
+  else if (id == PROP_PERIODS)
+    gst::getChannelListProperty(value, s.periods);
+  else if (id == PROP_FAILSAFE)
+    gst::getChannelListProperty(value, s.failsafe);
+  else
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
 }
 
 static void gst_wirc_control_finalize(GObject* object) {
@@ -735,7 +578,7 @@ static void gst_wirc_control_finalize(GObject* object) {
 
 static void gst_wirc_control_init(GstWircControl* self) {
   self->state = new WircControlState();
-  self->state->manual = std::make_unique<gst::ManualDrive>([self] {
+  self->state->manual = std::make_unique<gst::ManualDrive>(GST_ELEMENT(self), [self] {
     Settings settings;
     {
       gst::GLibLocker lock(self);
@@ -745,26 +588,6 @@ static void gst_wirc_control_init(GstWircControl* self) {
                settings.throttleChannel);
   });
   gst_base_transform_set_passthrough(GST_BASE_TRANSFORM(self), TRUE);
-}
-
-// "steering-kp" → "Steering kp": the nick gst-inspect shows as the title.
-static const char* nick_of(const char* name) {
-  std::string nick = name;
-  std::replace(nick.begin(), nick.end(), '-', ' ');
-  nick[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(nick[0])));
-  return g_intern_string(nick.c_str());  // static, as G_PARAM_STATIC_STRINGS wants
-}
-
-static void install_double(GObjectClass* gobject, guint id, const char* name, const char* blurb,
-                           double min, double max, double value, GParamFlags flags) {
-  g_object_class_install_property(
-      gobject, id, g_param_spec_double(name, nick_of(name), blurb, min, max, value, flags));
-}
-
-static void install_uint(GObjectClass* gobject, guint id, const char* name, const char* blurb,
-                         guint min, guint max, guint value, GParamFlags flags) {
-  g_object_class_install_property(
-      gobject, id, g_param_spec_uint(name, nick_of(name), blurb, min, max, value, flags));
 }
 
 static void gst_wirc_control_class_init(GstWircControlClass* klass) {
@@ -777,105 +600,95 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
                                         GST_PARAM_MUTABLE_READY);
   auto live = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                        GST_PARAM_MUTABLE_PLAYING | GST_PARAM_CONTROLLABLE);
-  vision::FollowConfig d;
-
-  g_object_class_install_property(
-      gobject, PROP_HOST,
-      g_param_spec_string("host", "Host",
-                          "Address of the vehicle (for WiRC the same as wircsrc's: they share "
-                          "one login); empty = discover (WiRC) or probe the broadcast ports "
-                          "(BTEMP); RCOIP needs one",
-                          DEFAULT_HOST, ready));
-  install_uint(gobject, PROP_PORT, "port",
-               "The vehicle's port: WiRC TCP control port, RCOIP receiver or BTEMP robot UDP "
-               "port (0 = the protocol's default: 1984, 9048, 16980)",
-               0, 65535, DEFAULT_PORT, ready);
-  g_object_class_install_property(
-      gobject, PROP_PROTOCOL,
-      g_param_spec_enum("protocol", "Protocol",
-                        "What the vehicle speaks; the camera may be any video source",
-                        gst::vehicleProtocolType(), static_cast<gint>(DEFAULT_PROTOCOL), ready));
-  g_object_class_install_property(
-      gobject, PROP_TARGET_ID,
-      g_param_spec_int("target-id", "Target id",
-                       "Id of the tag to follow (-1 = the largest tag in view)", -1, 65535,
-                       DEFAULT_TARGET_ID, live));
-  install_uint(gobject, PROP_STEERING_CHANNEL, "steering-channel",
-               "PCD channel of the steering servo (1..8)", 1, 8, DEFAULT_STEERING_CHANNEL, ready);
-  install_uint(gobject, PROP_THROTTLE_CHANNEL, "throttle-channel",
-               "PCD channel of the motor controller (1..8)", 1, 8, DEFAULT_THROTTLE_CHANNEL, ready);
-  install_double(gobject, PROP_STEERING_KP, "steering-kp",
-                 "Steering PID: proportional gain (per radian of bearing)", 0, 100, d.steering.kp,
-                 live);
-  install_double(gobject, PROP_STEERING_KI, "steering-ki", "Steering PID: integral gain", 0, 100,
-                 d.steering.ki, live);
-  install_double(gobject, PROP_STEERING_KD, "steering-kd", "Steering PID: derivative gain", 0, 100,
-                 d.steering.kd, live);
-  install_double(gobject, PROP_THROTTLE_KP, "throttle-kp",
-                 "Throttle PID: proportional gain (per metre of distance error)", 0, 100,
-                 d.throttle.kp, live);
-  install_double(gobject, PROP_THROTTLE_KI, "throttle-ki", "Throttle PID: integral gain", 0, 100,
-                 d.throttle.ki, live);
-  install_double(gobject, PROP_THROTTLE_KD, "throttle-kd", "Throttle PID: derivative gain", 0, 100,
-                 d.throttle.kd, live);
-  install_double(gobject, PROP_TARGET_DISTANCE, "target-distance",
-                 "Distance to keep from the tag, metres", 0.05, 100, DEFAULT_TARGET_DISTANCE, live);
-  install_double(gobject, PROP_TAG_SIZE, "tag-size",
-                 "Edge of the tag's black border, metres (distance from "
-                 "apparent size when apriltagdetect has no pose)",
-                 0.001, 100, DEFAULT_TAG_SIZE, live);
-  install_double(gobject, PROP_FX, "fx", "Camera focal length in pixels (0 = from horizontal-fov)",
-                 0, 100000, 0, live);
-  install_double(gobject, PROP_HORIZONTAL_FOV, "horizontal-fov",
-                 "Camera horizontal field of view, degrees", 1, 179, DEFAULT_HORIZONTAL_FOV, live);
-  install_uint(gobject, PROP_NEUTRAL, "neutral", "Neutral pulse, µs (straight, stopped)", 800, 2200,
-               DEFAULT_NEUTRAL, ready);
-  install_uint(gobject, PROP_MIN, "min", "Smallest pulse ever sent, µs", 800, 2200, DEFAULT_MIN,
-               ready);
-  install_uint(gobject, PROP_MAX, "max", "Largest pulse ever sent, µs", 800, 2200, DEFAULT_MAX,
-               ready);
-  install_uint(gobject, PROP_THROTTLE_DEADBAND, "throttle-deadband",
-               "µs either side of neutral where the motor "
-               "controller does not move: commands start beyond it",
-               0, 500, DEFAULT_THROTTLE_DEADBAND, live);
-  install_double(gobject, PROP_MAX_THROTTLE, "max-throttle",
-                 "Largest throttle command, 0..1 of the way to min/max", 0, 1, DEFAULT_MAX_THROTTLE,
-                 live);
-  g_object_class_install_property(
-      gobject, PROP_STEERING_REVERSED,
-      g_param_spec_boolean("steering-reversed", "Steering reversed",
-                           "Servo mounted the other way: higher pulses steer right", FALSE, live));
-  g_object_class_install_property(
-      gobject, PROP_THROTTLE_REVERSED,
-      g_param_spec_boolean("throttle-reversed", "Throttle reversed",
-                           "Higher pulses drive backwards", FALSE, live));
-  install_uint(gobject, PROP_LOST_TIMEOUT, "lost-timeout",
-               "Milliseconds without the target (or without any "
-               "buffer) before both channels go to neutral",
-               50, 10000, DEFAULT_LOST_TIMEOUT, ready);
-  install_double(gobject, PROP_PCD_RATE, "pcd-rate",
-                 "Rate limit on changes: a changed command leaves at once unless another "
-                 "change left less than 1/pcd-rate s ago (keepalives do not count)",
-                 1, 1000, DEFAULT_PCD_RATE, ready);
-  install_uint(gobject, PROP_KEEPALIVE, "keepalive",
-               "Milliseconds between repeats of an unchanged command; keep it well below the "
-               "device's PCD timeout (200..2000 ms, 800 by default)",
-               10, static_cast<guint>(wirc::kMaxKeepalive.count()), DEFAULT_KEEPALIVE, ready);
-  g_object_class_install_property(
-      gobject, PROP_ENABLED,
-      g_param_spec_boolean("enabled", "Enabled",
-                           "Follow the tag; false = hold both channels at neutral", DEFAULT_ENABLED,
-                           live));
-  g_object_class_install_property(
-      gobject, PROP_TAKE_CONTROL,
-      g_param_spec_boolean("take-control", "Take control",
-                           "Ask the device for the control right (AREQ) at each login that "
-                           "does not bring it; the answer comes as a wirc-control-right message",
-                           DEFAULT_TAKE_CONTROL, ready));
-  install_uint(gobject, PROP_DRIVE_TIMEOUT, "drive-timeout",
-               "Milliseconds a command by hand (the drive action) holds; without a newer one "
-               "by then the vehicle goes to neutral (a dead-man)",
-               20, 5000, DEFAULT_DRIVE_TIMEOUT, live);
+  properties.installOn(gobject);
+  properties.string(PROP_HOST, "host",
+                    "Address of the vehicle (for WiRC the same as wircsrc's: they share one "
+                    "login); empty = discover (WiRC) or probe the broadcast ports (BTEMP); RCOIP "
+                    "needs one",
+                    SETTING(host), ready);
+  properties.number(PROP_PORT, "port",
+                    "The vehicle's port: WiRC TCP control port, RCOIP receiver or BTEMP robot UDP "
+                    "port (0 = the protocol's default: 1984, 9048, 16980)",
+                    0, 65535, SETTING(port), ready);
+  properties.choice(PROP_PROTOCOL, "protocol",
+                    "What the vehicle speaks; the camera may be any video source",
+                    gst::vehicleProtocolType(), SETTING(protocol), ready);
+  properties.number(PROP_TARGET_ID, "target-id",
+                    "Id of the tag to follow (-1 = the largest tag in view)", -1, 65535,
+                    SETTING(targetId), live);
+  properties.number(PROP_STEERING_CHANNEL, "steering-channel",
+                    "PCD channel of the steering servo (1..8)", 1, 8, SETTING(steeringChannel),
+                    ready);
+  properties.number(PROP_THROTTLE_CHANNEL, "throttle-channel",
+                    "PCD channel of the motor controller (1..8)", 1, 8, SETTING(throttleChannel),
+                    ready);
+  properties.number(PROP_STEERING_KP, "steering-kp",
+                    "Steering PID: proportional gain (per radian of bearing)", 0, 100,
+                    SETTING(follow.steering.kp), live);
+  properties.number(PROP_STEERING_KI, "steering-ki", "Steering PID: integral gain", 0, 100,
+                    SETTING(follow.steering.ki), live);
+  properties.number(PROP_STEERING_KD, "steering-kd", "Steering PID: derivative gain", 0, 100,
+                    SETTING(follow.steering.kd), live);
+  properties.number(PROP_THROTTLE_KP, "throttle-kp",
+                    "Throttle PID: proportional gain (per metre of distance error)", 0, 100,
+                    SETTING(follow.throttle.kp), live);
+  properties.number(PROP_THROTTLE_KI, "throttle-ki", "Throttle PID: integral gain", 0, 100,
+                    SETTING(follow.throttle.ki), live);
+  properties.number(PROP_THROTTLE_KD, "throttle-kd", "Throttle PID: derivative gain", 0, 100,
+                    SETTING(follow.throttle.kd), live);
+  properties.number(PROP_TARGET_DISTANCE, "target-distance",
+                    "Distance to keep from the tag, metres", 0.05, 100,
+                    SETTING(follow.targetDistance), live);
+  properties.number(PROP_TAG_SIZE, "tag-size",
+                    "Edge of the tag's black border, metres (distance from apparent size when "
+                    "apriltagdetect has no pose)",
+                    0.001, 100, SETTING(follow.tagSize), live);
+  properties.number(PROP_FX, "fx", "Camera focal length in pixels (0 = from horizontal-fov)", 0,
+                    100000, SETTING(follow.fx), live);
+  properties.number(PROP_HORIZONTAL_FOV, "horizontal-fov",
+                    "Camera horizontal field of view, degrees", 1, 179,
+                    SETTING(follow.horizontalFovDeg), live);
+  properties.number(PROP_NEUTRAL, "neutral", "Neutral pulse, µs (straight, stopped)", 800, 2200,
+                    SETTING(neutral), ready);
+  properties.number(PROP_MIN, "min", "Smallest pulse ever sent, µs", 800, 2200, SETTING(min),
+                    ready);
+  properties.number(PROP_MAX, "max", "Largest pulse ever sent, µs", 800, 2200, SETTING(max), ready);
+  properties.number(PROP_THROTTLE_DEADBAND, "throttle-deadband",
+                    "µs either side of neutral where the motor controller does not move: "
+                    "commands start beyond it",
+                    0, 500, SETTING(throttleDeadband), live);
+  properties.number(PROP_MAX_THROTTLE, "max-throttle",
+                    "Largest throttle command, 0..1 of the way to min/max", 0, 1,
+                    SETTING(maxThrottle), live);
+  properties.boolean(PROP_STEERING_REVERSED, "steering-reversed",
+                     "Servo mounted the other way: higher pulses steer right",
+                     SETTING(steeringReversed), live);
+  properties.boolean(PROP_THROTTLE_REVERSED, "throttle-reversed", "Higher pulses drive backwards",
+                     SETTING(throttleReversed), live);
+  properties.number(PROP_LOST_TIMEOUT, "lost-timeout",
+                    "Milliseconds without the target (or without any buffer) before both "
+                    "channels go to neutral",
+                    50, 10000, SETTING(lostTimeoutMs), ready);
+  properties.number(PROP_PCD_RATE, "pcd-rate",
+                    "Rate limit on changes: a changed command leaves at once unless another "
+                    "change left less than 1/pcd-rate s ago (keepalives do not count)",
+                    1, 1000, SETTING(pcdRate), ready);
+  properties.number(PROP_KEEPALIVE, "keepalive",
+                    "Milliseconds between repeats of an unchanged command; keep it well below "
+                    "the device's PCD timeout (200..2000 ms, 800 by default)",
+                    10, static_cast<double>(wirc::kMaxKeepalive.count()), SETTING(keepaliveMs),
+                    ready);
+  properties.boolean(PROP_ENABLED, "enabled",
+                     "Follow the tag; false = hold both channels at neutral", SETTING(enabled),
+                     live);
+  properties.boolean(PROP_TAKE_CONTROL, "take-control",
+                     "Ask the device for the control right (AREQ) at each login that does not "
+                     "bring it; the answer comes as a wirc-control-right message",
+                     SETTING(takeControl), ready);
+  properties.number(PROP_DRIVE_TIMEOUT, "drive-timeout",
+                    "Milliseconds a command by hand (the drive action) holds; without a newer "
+                    "one by then the vehicle goes to neutral (a dead-man)",
+                    20, 5000, SETTING(driveTimeoutMs), live);
   hasControlSpec = g_param_spec_boolean(
       "has-control", "Has control",
       "Whether this transmitter holds the control right (only then do commands reach the "

@@ -76,20 +76,33 @@ static wirc::FrameAssembler& assembler_of(GstWircDepay* self) {
   return *state->assembler;
 }
 
+// Time as the assembler counts it: the datagram's timestamp (udpsrc's
+// arrival time), or the pipeline clock's now for one without. So the
+// frame-timeout runs on the stream's time, and a test clock drives it.
+static Clock::time_point arrival_time(GstWircDepay* self, GstBuffer* buffer) {
+  GstClockTime time = GST_BUFFER_PTS(buffer);
+  if (!GST_CLOCK_TIME_IS_VALID(time)) {
+    GstClock* clock = gst_element_get_clock(GST_ELEMENT(self));
+    if (!clock) clock = gst_system_clock_obtain();
+    time = gst_clock_get_time(clock);
+    gst_object_unref(clock);
+  }
+  return Clock::time_point(std::chrono::nanoseconds(time));
+}
+
 static GstFlowReturn push_frames(GstWircDepay* self, std::vector<wirc::AssembledFrame>& frames,
-                                 GstClockTime arrival) {
+                                 bool stamped) {
   auto* state = self->state;
   GstFlowReturn result = GST_FLOW_OK;
-  auto now = Clock::now();
   for (auto& frame : frames) {
-    // Stamped like the datagram that started it: this buffer's time less
-    // the time that has passed since the first packet came.
-    auto age = static_cast<GstClockTime>(
-        std::chrono::duration_cast<std::chrono::nanoseconds>(now - frame.firstPacketTime).count());
+    // Stamped like the datagram that started it.
+    auto firstPacket =
+        static_cast<GstClockTime>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                      frame.firstPacketTime.time_since_epoch())
+                                      .count());
     bool discont = frame.discont;
     GstBuffer* buffer = gst::wrapFrame(std::move(frame));
-    if (GST_CLOCK_TIME_IS_VALID(arrival))
-      GST_BUFFER_PTS(buffer) = arrival > age ? arrival - age : 0;
+    if (stamped) GST_BUFFER_PTS(buffer) = firstPacket;
     if (discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
     if (GstCaps* caps = gst::jpegCapsIfChanged(buffer, state->width, state->height)) {
       gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
@@ -113,19 +126,20 @@ static GstFlowReturn gst_wirc_depay_chain(GstPad*, GstObject* parent, GstBuffer*
   auto& assembler = assembler_of(self);
   std::vector<wirc::AssembledFrame> frames;
   auto collect = [&](wirc::AssembledFrame&& frame) { frames.push_back(std::move(frame)); };
+  auto now = arrival_time(self, buffer);
   GstMapInfo map;
   if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-    assembler.pushDatagram({map.data, map.size}, Clock::now(), collect);
+    assembler.pushDatagram({map.data, map.size}, now, collect);
     gst_buffer_unmap(buffer, &map);
   }
-  assembler.expire(Clock::now(), collect);
+  assembler.expire(now, collect);
   {
     MutexLock lock(self->state->statsMutex);
     self->state->stats = assembler.stats();
   }
-  GstClockTime arrival = GST_BUFFER_PTS(buffer);
+  bool stamped = GST_BUFFER_PTS_IS_VALID(buffer);
   gst_buffer_unref(buffer);
-  return push_frames(self, frames, arrival);
+  return push_frames(self, frames, stamped);
 }
 
 static gboolean gst_wirc_depay_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {

@@ -59,6 +59,7 @@
 #include "frame_buffers.h"
 #include "glib_locker.h"
 #include "login_properties.h"
+#include "property_table.h"
 #include "wirc/stream_receiver.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_bus_messages.h"
@@ -80,13 +81,13 @@ using Clock = std::chrono::steady_clock;
 #define DEFAULT_TRANSMITTER_NAME "wircam"
 #define DEFAULT_PRIORITY 0
 #define DEFAULT_FRAME_TIMEOUT 200
-#define DEFAULT_RECONNECT TRUE
+#define DEFAULT_RECONNECT true
 #define DEFAULT_DISCOVERY_ADDRESS "255.255.255.255"
 #define DEFAULT_LOGIN_TIMEOUT 3000
 #define DEFAULT_STATS_INTERVAL 1000
 #define DEFAULT_LINK_TIMEOUT 2000
 #define DEFAULT_MAX_BAD_MESSAGES 100
-#define DEFAULT_WAIT_FOR_DEVICE FALSE
+#define DEFAULT_WAIT_FOR_DEVICE false
 
 constexpr size_t kBatch = 16;  // datagrams per recvmmsg
 // The device reports every 500 ms: two missed reports make a status stale.
@@ -124,17 +125,25 @@ struct Settings {
   std::string transmitterName = DEFAULT_TRANSMITTER_NAME;
   guint priority = DEFAULT_PRIORITY;
   guint frameTimeoutMs = DEFAULT_FRAME_TIMEOUT;
-  gboolean reconnect = DEFAULT_RECONNECT;
+  bool reconnect = DEFAULT_RECONNECT;
   std::string discoveryAddress = DEFAULT_DISCOVERY_ADDRESS;
   guint loginTimeoutMs = DEFAULT_LOGIN_TIMEOUT;
   guint statsIntervalMs = DEFAULT_STATS_INTERVAL;
   guint linkTimeoutMs = DEFAULT_LINK_TIMEOUT;
   guint maxBadMessages = DEFAULT_MAX_BAD_MESSAGES;
-  gboolean waitForDevice = DEFAULT_WAIT_FOR_DEVICE;
+  bool waitForDevice = DEFAULT_WAIT_FOR_DEVICE;
   wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
   wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
   std::set<std::string> given;  // the shared link's settings the user set
 };
+
+gst::PropertyTable<Settings> properties;
+
+// The shared link's settings: a user's value counts as given (see `given`).
+bool isLinkSetting(guint id) {
+  return id == PROP_TRANSMITTER_NAME || id == PROP_PRIORITY || id == PROP_RECONNECT ||
+         id == PROP_LOGIN_TIMEOUT || id == PROP_LINK_TIMEOUT || id == PROP_MAX_BAD_MESSAGES;
+}
 
 // The C++ side of the element; GObject memory runs no constructors.
 struct WircSrcState {
@@ -293,7 +302,7 @@ wirc::SessionConfig sessionConfig(const Settings& s) {
           .loginTimeout = std::chrono::milliseconds(s.loginTimeoutMs),
           .linkTimeout = std::chrono::milliseconds(s.linkTimeoutMs),
           .maxBadMessages = s.maxBadMessages,
-          .reconnect = s.reconnect != FALSE,
+          .reconnect = s.reconnect,
           .given = s.given};
 }
 
@@ -619,75 +628,22 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
   }
   gst::GLibLocker lock(self);
   auto& s = self->state->settings;
-  switch (id) {
-    case PROP_HOST:
-      s.host = g_value_get_string(value) ? g_value_get_string(value) : "";
-      break;
-    case PROP_PORT:
-      s.port = g_value_get_uint(value);
-      break;
-    case PROP_DEVICE:
-      s.device = g_value_get_string(value) ? g_value_get_string(value) : "";
-      break;
-    case PROP_CAMERA:
-      s.camera = g_value_get_uint(value);
-      break;
-    case PROP_STREAM_PORT:
-      s.streamPort = g_value_get_uint(value);
-      break;
-    case PROP_TRANSMITTER_NAME: {
-      std::string name = g_value_get_string(value) ? g_value_get_string(value) : "";
-      if (auto tl = wirc::encode(wirc::Tl{.name = name}); !tl) {
-        g_warning("wircsrc %s: transmitter-name '%s' refused, kept '%s': %s", GST_OBJECT_NAME(self),
-                  name.c_str(), s.transmitterName.c_str(), tl.error().message().c_str());
-        break;
-      }
-      s.transmitterName = name;
-      s.given.insert("transmitter-name");  // shared-link settings the user gave
-      break;
+  if (id == PROP_TRANSMITTER_NAME) {
+    const char* name = g_value_get_string(value) ? g_value_get_string(value) : "";
+    if (auto tl = wirc::encode(wirc::Tl{.name = name}); !tl) {
+      g_warning("wircsrc %s: transmitter-name '%s' refused, kept '%s': %s", GST_OBJECT_NAME(self),
+                name, s.transmitterName.c_str(), tl.error().message().c_str());
+      return;
     }
-    case PROP_PRIORITY:
-      s.priority = g_value_get_uint(value);
-      s.given.insert("priority");
-      break;
-    case PROP_FRAME_TIMEOUT:
-      s.frameTimeoutMs = g_value_get_uint(value);
-      break;
-    case PROP_RECONNECT:
-      s.reconnect = g_value_get_boolean(value);
-      s.given.insert("reconnect");
-      break;
-    case PROP_DISCOVERY_ADDRESS:
-      s.discoveryAddress =
-          g_value_get_string(value) ? g_value_get_string(value) : DEFAULT_DISCOVERY_ADDRESS;
-      break;
-    case PROP_LOGIN_TIMEOUT:
-      s.loginTimeoutMs = g_value_get_uint(value);
-      s.given.insert("login-timeout");
-      break;
-    case PROP_WAIT_FOR_DEVICE:
-      s.waitForDevice = g_value_get_boolean(value);
-      break;
-    case PROP_STATS_INTERVAL:
-      s.statsIntervalMs = g_value_get_uint(value);
-      break;
-    case PROP_LINK_TIMEOUT:
-      s.linkTimeoutMs = g_value_get_uint(value);
-      s.given.insert("link-timeout");
-      break;
-    case PROP_MAX_BAD_MESSAGES:
-      s.maxBadMessages = g_value_get_uint(value);
-      s.given.insert("max-bad-messages");
-      break;
-    case PROP_PERIODS:
-      gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
-      break;
-    case PROP_FAILSAFE:
-      gst::setChannelListProperty(object, "failsafe", value, s.failsafe, s.given);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
-      break;
+  }
+  if (properties.set(id, value, s)) {
+    if (isLinkSetting(id)) s.given.insert(pspec->name);
+  } else if (id == PROP_PERIODS) {
+    gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
+  } else if (id == PROP_FAILSAFE) {
+    gst::setChannelListProperty(object, "failsafe", value, s.failsafe, s.given);
+  } else {
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
   }
 }
 
@@ -702,62 +658,13 @@ static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, 
   }
   gst::GLibLocker lock(self);
   const auto& s = self->state->settings;
-  switch (id) {
-    case PROP_HOST:
-      g_value_set_string(value, s.host.c_str());
-      break;
-    case PROP_PORT:
-      g_value_set_uint(value, s.port);
-      break;
-    case PROP_DEVICE:
-      g_value_set_string(value, s.device.c_str());
-      break;
-    case PROP_CAMERA:
-      g_value_set_uint(value, s.camera);
-      break;
-    case PROP_STREAM_PORT:
-      g_value_set_uint(value, s.streamPort);
-      break;
-    case PROP_TRANSMITTER_NAME:
-      g_value_set_string(value, s.transmitterName.c_str());
-      break;
-    case PROP_PRIORITY:
-      g_value_set_uint(value, s.priority);
-      break;
-    case PROP_FRAME_TIMEOUT:
-      g_value_set_uint(value, s.frameTimeoutMs);
-      break;
-    case PROP_RECONNECT:
-      g_value_set_boolean(value, s.reconnect);
-      break;
-    case PROP_DISCOVERY_ADDRESS:
-      g_value_set_string(value, s.discoveryAddress.c_str());
-      break;
-    case PROP_WAIT_FOR_DEVICE:
-      g_value_set_boolean(value, s.waitForDevice);
-      break;
-    case PROP_LOGIN_TIMEOUT:
-      g_value_set_uint(value, s.loginTimeoutMs);
-      break;
-    case PROP_STATS_INTERVAL:
-      g_value_set_uint(value, s.statsIntervalMs);
-      break;
-    case PROP_LINK_TIMEOUT:
-      g_value_set_uint(value, s.linkTimeoutMs);
-      break;
-    case PROP_MAX_BAD_MESSAGES:
-      g_value_set_uint(value, s.maxBadMessages);
-      break;
-    case PROP_PERIODS:
-      gst::getChannelListProperty(value, s.periods);
-      break;
-    case PROP_FAILSAFE:
-      gst::getChannelListProperty(value, s.failsafe);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
-      break;
-  }
+  if (properties.get(id, s, value)) return;
+  if (id == PROP_PERIODS)
+    gst::getChannelListProperty(value, s.periods);
+  else if (id == PROP_FAILSAFE)
+    gst::getChannelListProperty(value, s.failsafe);
+  else
+    G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
 }
 
 static void gst_wirc_src_finalize(GObject* object) {
@@ -783,72 +690,47 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
 
   constexpr auto kReady = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                    GST_PARAM_MUTABLE_READY);
-  g_object_class_install_property(
-      gobject, PROP_HOST,
-      g_param_spec_string("host", "Host",
-                          "Address of the WiRC device; empty = discover it on the "
-                          "local network (see device, discovery-address)",
-                          DEFAULT_HOST, kReady));
-  g_object_class_install_property(
-      gobject, PROP_PORT,
-      g_param_spec_uint("port", "Port", "TCP control / UDP discovery port of the device", 1, 65535,
-                        DEFAULT_PORT, kReady));
-  g_object_class_install_property(
-      gobject, PROP_DEVICE,
-      g_param_spec_string("device", "Device",
-                          "When discovering: the device name or serial to "
-                          "pick (empty = the only one that answers)",
-                          DEFAULT_DEVICE, kReady));
-  g_object_class_install_property(
-      gobject, PROP_CAMERA,
-      g_param_spec_uint("camera", "Camera",
-                        "Camera index on the device (0 .. its camera count - 1)", 0, 255,
-                        DEFAULT_CAMERA, kReady));
-  g_object_class_install_property(gobject, PROP_STREAM_PORT,
-                                  g_param_spec_uint("stream-port", "Stream port",
-                                                    "Local UDP port for the video (0 = any free "
-                                                    "port)",
-                                                    0, 65535, DEFAULT_STREAM_PORT, kReady));
-  g_object_class_install_property(
-      gobject, PROP_TRANSMITTER_NAME,
-      g_param_spec_string("transmitter-name", "Transmitter name",
-                          "Name this transmitter logs in "
-                          "with (up to 64 printable ASCII characters; shown in TLST; others are "
-                          "refused when set)",
-                          DEFAULT_TRANSMITTER_NAME, kReady));
-  g_object_class_install_property(gobject, PROP_PRIORITY,
-                                  g_param_spec_uint("priority", "Priority",
-                                                    "Login priority: the highest may hand out the "
-                                                    "control right",
-                                                    0, 255, DEFAULT_PRIORITY, kReady));
-  g_object_class_install_property(
-      gobject, PROP_FRAME_TIMEOUT,
-      g_param_spec_uint("frame-timeout", "Frame timeout",
-                        "Milliseconds an incomplete frame may "
-                        "wait for its missing packets before it is dropped",
-                        10, 10000, DEFAULT_FRAME_TIMEOUT, kReady));
-  g_object_class_install_property(gobject, PROP_RECONNECT,
-                                  g_param_spec_boolean("reconnect", "Reconnect",
-                                                       "Log in again (with backoff) after the "
-                                                       "connection is lost, and restart the stream",
-                                                       DEFAULT_RECONNECT, kReady));
-  g_object_class_install_property(gobject, PROP_DISCOVERY_ADDRESS,
-                                  g_param_spec_string("discovery-address", "Discovery address",
-                                                      "Where BCSD is sent when host "
-                                                      "is empty (broadcast by default)",
-                                                      DEFAULT_DISCOVERY_ADDRESS, kReady));
-  g_object_class_install_property(gobject, PROP_LOGIN_TIMEOUT,
-                                  g_param_spec_uint("login-timeout", "Login timeout",
-                                                    "Milliseconds to wait for discovery "
-                                                    "and login before failing",
-                                                    100, 60000, DEFAULT_LOGIN_TIMEOUT, kReady));
-  g_object_class_install_property(
-      gobject, PROP_STATS_INTERVAL,
-      g_param_spec_uint("stats-interval", "Stats interval",
-                        "Milliseconds between wirc-stats "
-                        "element messages (0 = none)",
-                        0, 3600000, DEFAULT_STATS_INTERVAL,
-                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS)));
+  constexpr auto kLive = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS);
+  properties.installOn(gobject);
+  properties.string(PROP_HOST, "host",
+                    "Address of the WiRC device; empty = discover it on the local network (see "
+                    "device, discovery-address)",
+                    SETTING(host), kReady);
+  properties.number(PROP_PORT, "port", "TCP control / UDP discovery port of the device", 1, 65535,
+                    SETTING(port), kReady);
+  properties.string(PROP_DEVICE, "device",
+                    "When discovering: the device name or serial to pick (empty = the only one "
+                    "that answers)",
+                    SETTING(device), kReady);
+  properties.number(PROP_CAMERA, "camera", "Camera index on the device (0 .. its camera count - 1)",
+                    0, 255, SETTING(camera), kReady);
+  properties.number(PROP_STREAM_PORT, "stream-port",
+                    "Local UDP port for the video (0 = any free port)", 0, 65535,
+                    SETTING(streamPort), kReady);
+  properties.string(PROP_TRANSMITTER_NAME, "transmitter-name",
+                    "Name this transmitter logs in with (up to 64 printable ASCII characters; "
+                    "shown in TLST; others are refused when set)",
+                    SETTING(transmitterName), kReady);
+  properties.number(PROP_PRIORITY, "priority",
+                    "Login priority: the highest may hand out the control right", 0, 255,
+                    SETTING(priority), kReady);
+  properties.number(PROP_FRAME_TIMEOUT, "frame-timeout",
+                    "Milliseconds an incomplete frame may wait for its missing packets before it "
+                    "is dropped",
+                    10, 10000, SETTING(frameTimeoutMs), kReady);
+  properties.boolean(PROP_RECONNECT, "reconnect",
+                     "Log in again (with backoff) after the connection is lost, and restart the "
+                     "stream",
+                     SETTING(reconnect), kReady);
+  properties.string(PROP_DISCOVERY_ADDRESS, "discovery-address",
+                    "Where BCSD is sent when host is empty (broadcast by default)",
+                    SETTING(discoveryAddress), kReady);
+  properties.number(PROP_LOGIN_TIMEOUT, "login-timeout",
+                    "Milliseconds to wait for discovery and login before failing", 100, 60000,
+                    SETTING(loginTimeoutMs), kReady);
+  properties.number(PROP_STATS_INTERVAL, "stats-interval",
+                    "Milliseconds between wirc-stats element messages (0 = none)", 0, 3600000,
+                    SETTING(statsIntervalMs), kLive);
   g_object_class_install_property(
       gobject, PROP_STATS,
       g_param_spec_boxed(
@@ -856,27 +738,20 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
           "Counters: packets, bytes, frames-complete, "
           "frames-incomplete, packets-duplicate, packets-invalid, packets-foreign, ...",
           GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
-
-  g_object_class_install_property(
-      gobject, PROP_LINK_TIMEOUT,
-      g_param_spec_uint("link-timeout", "Link timeout",
-                        "Milliseconds without a status report (PSD, every 500 ms) before the "
-                        "device counts as gone (power cut, out of range) and the link logs in "
-                        "again; 0 = never (at least 1000 otherwise)",
-                        0, 600000, DEFAULT_LINK_TIMEOUT, kReady));
-  g_object_class_install_property(
-      gobject, PROP_MAX_BAD_MESSAGES,
-      g_param_spec_uint("max-bad-messages", "Max bad messages",
-                        "Malformed messages one control connection may bring before the device "
-                        "counts as misbehaving: the connection is dropped and made again after "
-                        "a backoff",
-                        1, 1000000, DEFAULT_MAX_BAD_MESSAGES, kReady));
-  g_object_class_install_property(
-      gobject, PROP_WAIT_FOR_DEVICE,
-      g_param_spec_boolean("wait-for-device", "Wait for device",
-                           "Keep trying to log in (with backoff) until the device appears, "
-                           "instead of failing after login-timeout; needs reconnect=true",
-                           DEFAULT_WAIT_FOR_DEVICE, kReady));
+  properties.number(PROP_LINK_TIMEOUT, "link-timeout",
+                    "Milliseconds without a status report (PSD, every 500 ms) before the device "
+                    "counts as gone (power cut, out of range) and the link logs in again; 0 = "
+                    "never (at least 1000 otherwise)",
+                    0, 600000, SETTING(linkTimeoutMs), kReady);
+  properties.number(PROP_MAX_BAD_MESSAGES, "max-bad-messages",
+                    "Malformed messages one control connection may bring before the device "
+                    "counts as misbehaving: the connection is dropped and made again after a "
+                    "backoff",
+                    1, 1000000, SETTING(maxBadMessages), kReady);
+  properties.boolean(PROP_WAIT_FOR_DEVICE, "wait-for-device",
+                     "Keep trying to log in (with backoff) until the device appears, instead of "
+                     "failing after login-timeout; needs reconnect=true",
+                     SETTING(waitForDevice), kReady);
   gst::installLoginProperties(gobject, PROP_PERIODS, PROP_FAILSAFE);
   g_signal_new_class_handler("end-of-stream", G_TYPE_FROM_CLASS(klass),
                              static_cast<GSignalFlags>(G_SIGNAL_RUN_LAST | G_SIGNAL_ACTION),

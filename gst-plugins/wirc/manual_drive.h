@@ -1,24 +1,26 @@
 // Driving by hand (wirccontrol's `drive` action, the recorder's drive
 // mode): each command goes to the vehicle at once and holds for a short
 // time only. When no newer one has come by then, the vehicle goes to
-// neutral on the event loop's timer — a dead-man that works whatever the
-// pipeline does, even when no frame comes at all.
+// neutral — a dead-man on the pipeline clock (a single-shot clock id), so
+// it works whatever the pipeline does, even when no frame comes at all, and
+// a test clock drives it in tests.
 #pragma once
+
+#include <gst/gst.h>
 
 #include <chrono>
 #include <functional>
 #include <memory>
 
-#include "common/mutex.h"
-#include "link/event_loop.h"
 #include "link/vehicle_link.h"
 
 namespace wircam::gst {
 
 class ManualDrive {
  public:
-  // Called on the event loop when the dead-man sent neutral.
-  explicit ManualDrive(std::function<void()> onLapsed);
+  // `element`'s clock times the dead-man (the system clock while it has
+  // none); `onLapsed` is called, on the clock's thread, once it sent neutral.
+  ManualDrive(GstElement* element, std::function<void()> onLapsed);
   ~ManualDrive();
   ManualDrive(const ManualDrive&) = delete;
   ManualDrive& operator=(const ManualDrive&) = delete;
@@ -33,14 +35,11 @@ class ManualDrive {
   bool active();
 
  private:
-  void onDeadline();
+  struct Hold;  // shared with the pending clock callback
+  static gboolean onDeadline(GstClock*, GstClockTime, GstClockID id, gpointer hold);
 
-  std::function<void()> onLapsed_;
-  Mutex mutex_;
-  std::shared_ptr<link::VehicleLink> link_ WIRCAM_GUARDED_BY(mutex_);
-  link::Pulses neutral_ WIRCAM_GUARDED_BY(mutex_) = link::neutralPulses();
-  link::Clock::time_point deadline_ WIRCAM_GUARDED_BY(mutex_);
-  link::EventLoop::Id timer_;
+  GstElement* element_;
+  std::shared_ptr<Hold> hold_;
 };
 
 }  // namespace wircam::gst

@@ -1,7 +1,9 @@
 // wirccontrol's `drive` action against the simulated device: a command by
 // hand leaves at once within the pulse limits, the follower keeps off it,
-// and without a newer one the vehicle is at neutral after drive-timeout.
+// and without a newer one the vehicle is at neutral after drive-timeout of
+// the pipeline clock's time.
 #include <gst/check/gstharness.h>
+#include <gst/check/gsttestclock.h>
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
@@ -10,78 +12,17 @@
 #include <limits>
 #include <string>
 
-#include "wait_for.h"
-#include "wirc/device.h"
-#include "wirc_tag_meta.h"
+#include "driven_control.h"
 
 namespace {
 
 using namespace wircam;
 using std::chrono::milliseconds;
+using wircam::testing::bufferWithATagOnTheRight;
+using wircam::testing::DrivenControl;
+using wircam::testing::kSteering;
+using wircam::testing::kThrottle;
 using wircam::testing::waitFor;
-using Clock = std::chrono::steady_clock;
-
-constexpr size_t kSteering = 0, kThrottle = 1;  // channels 1 and 2
-
-struct DrivenControl {
-  std::unique_ptr<wirc::Device> device;
-  GstHarness* harness = nullptr;
-  GstElement* control = nullptr;
-  GstBus* bus = gst_bus_new();
-
-  explicit DrivenControl(const std::string& properties = "") {
-    auto started = wirc::Device::start({.port = 0}, nullptr);
-    EXPECT_TRUE(started.has_value()) << started.error();
-    device = std::move(*started);
-    auto description =
-        "wirccontrol host=127.0.0.1 port=" + std::to_string(device->port()) + " " + properties;
-    harness = gst_harness_new_parse(description.c_str());
-    control = gst_harness_find_element(harness, "wirccontrol");
-    gst_element_set_bus(harness->element, bus);
-    gst_harness_set_src_caps_str(harness, "video/x-raw,format=GRAY8,width=352,height=288");
-    gst_harness_play(harness);
-    EXPECT_TRUE(waitFor([&] {
-      gboolean has = FALSE;
-      g_object_get(control, "has-control", &has, nullptr);
-      return has == TRUE;
-    }));
-  }
-  ~DrivenControl() {
-    gst_object_unref(control);
-    gst_harness_teardown(harness);
-    gst_object_unref(bus);
-  }
-  bool drive(double steering, double throttle) {
-    gboolean obeyed = FALSE;
-    g_signal_emit_by_name(control, "drive", steering, throttle, &obeyed);
-    return obeyed;
-  }
-  uint16_t pulse(size_t channel) const { return device->outputs().pulses[channel]; }
-  // The `reason` of each wirc-drive message posted so far.
-  std::vector<std::string> driveReasons() {
-    std::vector<std::string> reasons;
-    while (GstMessage* m = gst_bus_pop_filtered(bus, GST_MESSAGE_ELEMENT)) {
-      const GstStructure* s = gst_message_get_structure(m);
-      if (gst_structure_has_name(s, "wirc-drive"))
-        reasons.emplace_back(gst_structure_get_string(s, "reason"));
-      gst_message_unref(m);
-    }
-    return reasons;
-  }
-};
-
-// A buffer with one tag far to the right: the follower would steer right.
-GstBuffer* bufferWithATagOnTheRight() {
-  GstBuffer* buffer = gst_buffer_new_allocate(nullptr, 16, nullptr);
-  WircTagMeta* meta = gst_buffer_add_wirc_tag_meta(buffer, 352, 288);
-  WircTag tag{};
-  double corners[8] = {300, 124, 340, 124, 340, 164, 300, 164};
-  std::copy(corners, corners + 8, tag.corners);
-  tag.cx = 320;
-  tag.cy = 144;
-  g_array_append_val(meta->tags, tag);
-  return buffer;
-}
 
 TEST(ManualDrive, ACommandLeavesAtOnceWithinTheLimitsAndHoldsOffTheFollower) {
   // The dead-man is another test's: here it must not act while a stalled
@@ -104,50 +45,50 @@ TEST(ManualDrive, ACommandLeavesAtOnceWithinTheLimitsAndHoldsOffTheFollower) {
   EXPECT_EQ(reasons, (std::vector<std::string>{"command", "command"}));
 }
 
+// The dead-man runs on the pipeline clock: the harness's test clock shows
+// its deadline and fires it, with no waiting.
 TEST(ManualDrive, WithoutANewerCommandTheVehicleIsAtNeutralAfterTheDriveTimeout) {
   DrivenControl c("drive-timeout=300");
-  auto sent = Clock::now();
+  GstTestClock* clock = gst_harness_get_testclock(c.harness);
+  GstClockTime sent = gst_clock_get_time(GST_CLOCK(clock));
   c.drive(-1.0, 0.5);
   ASSERT_TRUE(waitFor([&] { return c.pulse(kSteering) == 1000; }));
-  // Held while the timeout runs...
-  std::this_thread::sleep_for(milliseconds(150));
+  // Held until the clock reaches the command's time plus drive-timeout...
+  ASSERT_TRUE(gst_test_clock_timed_wait_for_multiple_pending_ids(clock, 1, 5000, nullptr));
+  EXPECT_EQ(gst_test_clock_get_next_entry_time(clock), sent + 300 * GST_MSECOND);
   EXPECT_EQ(c.pulse(kSteering), 1000);
-  // ...and neutral once it has passed, with no frame coming at all.
-  ASSERT_TRUE(waitFor([&] { return c.pulse(kSteering) == 1500 && c.pulse(kThrottle) == 1500; }));
-  EXPECT_GE(Clock::now() - sent, milliseconds(300));
+  // ...and neutral once it has, with no frame coming at all.
+  ASSERT_TRUE(gst_harness_crank_single_clock_wait(c.harness));
+  EXPECT_TRUE(waitFor([&] { return c.pulse(kSteering) == 1500 && c.pulse(kThrottle) == 1500; }));
   std::vector<std::string> seen;
   EXPECT_TRUE(waitFor([&] {
     for (auto& r : c.driveReasons()) seen.push_back(r);
     return !seen.empty() && seen.back() == "dead-man";
   }));
+  gst_object_unref(clock);
 }
 
-TEST(ManualDrive, CommandsKeepItGoingAndNotANumberMeansNeutral) {
+TEST(ManualDrive, EachCommandMovesTheDeadlineAndNotANumberMeansNeutral) {
   DrivenControl c("drive-timeout=200");
-  // A command every 100 ms for 600 ms, three times the timeout. Between a
-  // command's arrival (50 ms on) and the earliest the dead-man may act
-  // (150 ms, a margin under 200) the car must be driving. Timed from the
-  // last command sent, so a stall of this thread cannot fail the test.
-  auto until = Clock::now() + milliseconds(600);
-  auto lastCommand = Clock::now();
+  GstTestClock* clock = gst_harness_get_testclock(c.harness);
+  // A command every 100 ms of pipeline time for 600 ms, three times the
+  // timeout: each earlier deadline has passed, yet none acts.
   c.drive(0, 1.0);
-  bool everNeutral = false;
-  while (Clock::now() < until) {
-    std::this_thread::sleep_for(milliseconds(10));
-    auto since = Clock::now() - lastCommand;
-    if (since > milliseconds(50) && since < milliseconds(150) && c.pulse(kThrottle) == 1500)
-      everNeutral = true;
-    if (since >= milliseconds(100)) {
-      lastCommand = Clock::now();
-      c.drive(0, 1.0);
-    }
+  for (int i = 0; i < 6; ++i) {
+    gst_test_clock_advance_time(clock, 100 * GST_MSECOND);
+    GstClockID due = gst_test_clock_process_next_clock_id(clock);
+    EXPECT_EQ(due, nullptr) << "a replaced deadline acted after " << (i + 1) * 100 << " ms";
+    if (due) gst_clock_id_unref(due);
+    c.drive(0, 1.0);
   }
-  EXPECT_FALSE(everNeutral);
+  EXPECT_TRUE(waitFor([&] { return c.pulse(kThrottle) == 1910; }));
+  EXPECT_EQ(c.device->outputs().pulses[kThrottle], 1910);
   c.drive(std::numeric_limits<double>::quiet_NaN(), 1.0);
   EXPECT_TRUE(waitFor([&] { return c.pulse(kThrottle) == 1500; }));
   auto reasons = c.driveReasons();
   ASSERT_FALSE(reasons.empty());
   EXPECT_EQ(reasons.back(), "not a number: neutral");
+  gst_object_unref(clock);
 }
 
 TEST(ManualDrive, BeforeTheElementStartsNothingIsDriven) {

@@ -159,10 +159,11 @@ TEST(VehicleLinkElements, ASettingChangedWhileStreamingIsRefused) {
   gst_object_unref(pipeline);
 }
 
-// A buffer with one tag off to the left: the follower steers.
-GstBuffer* bufferWithATag() {
+// A buffer with one tag off to the left: the follower steers (once the
+// stream's time moves on between such buffers).
+GstBuffer* bufferWithATag(GstClockTime pts) {
   GstBuffer* buffer = gst_buffer_new_allocate(nullptr, 16, nullptr);
-  GST_BUFFER_PTS(buffer) = 0;
+  GST_BUFFER_PTS(buffer) = pts;
   WircTagMeta* meta = gst_buffer_add_wirc_tag_meta(buffer, 352, 288);
   WircTag tag{};
   tag.id = 0;
@@ -194,7 +195,8 @@ TEST(VehicleLinkElements, WirccontrolShowsTheControlRightAndTheAnswerToARequest)
   ASSERT_TRUE(waitFor([&] { return device->stats().logins == 2; }));
 
   // Steering without the right: one warning, and has-control says so.
-  for (int i = 0; i < 3; ++i) gst_buffer_unref(gst_harness_push_and_pull(h, bufferWithATag()));
+  for (int i = 0; i < 3; ++i)
+    gst_buffer_unref(gst_harness_push_and_pull(h, bufferWithATag(i * 66 * GST_MSECOND)));
   gboolean hasControl = TRUE;
   g_object_get(control, "has-control", &hasControl, nullptr);
   EXPECT_FALSE(hasControl);

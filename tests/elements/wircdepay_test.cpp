@@ -27,6 +27,8 @@ class WircDepayTest : public ::testing::Test {
     pts_ += GST_MSECOND;
     ASSERT_EQ(gst_harness_push(harness_, buffer), GST_FLOW_OK);
   }
+  // The stream's time moves on by `gap` before the next datagram.
+  void wait(GstClockTime gap) { pts_ += gap; }
 
   std::vector<uint8_t> pullBytes(GstBuffer** keep = nullptr) {
     GstBuffer* buffer = gst_harness_try_pull(harness_);
@@ -100,6 +102,32 @@ TEST_F(WircDepayTest, CountsGarbageAndKeepsGoing) {
   for (const auto& p : wircam::wirc::packetizeFrame(sceneFrames()[3], 9, 64512)) push(p);
   EXPECT_EQ(pullBytes(), sceneFrames()[3]);
   EXPECT_EQ(stat("packets-invalid"), 2u);
+}
+
+// frame-timeout counts the datagrams' time, not the test's: a frame whose
+// last packet is still missing 150 ms of stream time later is held; 250 ms
+// later it is given up, though both run in microseconds here.
+TEST_F(WircDepayTest, TheFrameTimeoutRunsOnTheDatagramsTimestamps) {
+  g_object_set(harness_->element, "frame-timeout", 200u, nullptr);
+  auto first = wircam::wirc::packetizeFrame(sceneFrames()[0], 1, 1000);
+  for (size_t i = 0; i + 1 < first.size(); ++i) push(first[i]);  // last packet still to come
+  GstClockTime started = GST_SECOND;
+  wait(150 * GST_MSECOND);
+  push({1, 2, 3});  // anything that arrives: the depayloader looks at the time then
+  EXPECT_EQ(stat("frames-timed-out"), 0u);
+  push(first.back());
+  GstBuffer* buffer = nullptr;
+  EXPECT_EQ(pullBytes(&buffer), sceneFrames()[0]);
+  ASSERT_NE(buffer, nullptr);
+  EXPECT_EQ(GST_BUFFER_PTS(buffer), started);  // its first datagram's time
+  gst_buffer_unref(buffer);
+
+  auto second = wircam::wirc::packetizeFrame(sceneFrames()[1], 2, 1000);
+  for (size_t i = 0; i + 1 < second.size(); ++i) push(second[i]);
+  wait(250 * GST_MSECOND);
+  push({1, 2, 3});
+  EXPECT_EQ(stat("frames-timed-out"), 1u);
+  EXPECT_TRUE(pullBytes().empty());
 }
 
 }  // namespace
