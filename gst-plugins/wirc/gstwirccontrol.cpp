@@ -63,11 +63,11 @@
 #include "glib_locker.h"
 #include "login_properties.h"
 #include "manual_drive.h"
-#include "property_table.h"
 #include "target_follower.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_bus_messages.h"
 #include "wirc_tag_meta.h"
+#include "wirccontrol_settings.h"
 
 GST_DEBUG_CATEGORY_STATIC(wirc_control_debug);
 #define GST_CAT_DEFAULT wirc_control_debug
@@ -75,96 +75,11 @@ GST_DEBUG_CATEGORY_STATIC(wirc_control_debug);
 namespace {
 
 using namespace wircam;
-
-#define DEFAULT_HOST ""
-#define DEFAULT_PORT 0
-#define DEFAULT_PROTOCOL gst::VehicleProtocol::Wirc
-#define DEFAULT_TARGET_ID -1
-#define DEFAULT_STEERING_CHANNEL 1
-#define DEFAULT_THROTTLE_CHANNEL 2
-#define DEFAULT_NEUTRAL 1500
-#define DEFAULT_MIN 1000
-#define DEFAULT_MAX 2000
-#define DEFAULT_THROTTLE_DEADBAND 50
-#define DEFAULT_MAX_THROTTLE 0.8
-#define DEFAULT_LOST_TIMEOUT 500
-#define DEFAULT_PCD_RATE 50.0
-#define DEFAULT_KEEPALIVE 100
-#define DEFAULT_ENABLED true
-#define DEFAULT_TAKE_CONTROL false
-#define DEFAULT_DRIVE_TIMEOUT 250
-
-enum {
-  PROP_0,
-  PROP_HOST,
-  PROP_PORT,
-  PROP_PROTOCOL,
-  PROP_TARGET_ID,
-  PROP_STEERING_CHANNEL,
-  PROP_THROTTLE_CHANNEL,
-  PROP_STEERING_KP,
-  PROP_STEERING_KI,
-  PROP_STEERING_KD,
-  PROP_THROTTLE_KP,
-  PROP_THROTTLE_KI,
-  PROP_THROTTLE_KD,
-  PROP_TARGET_DISTANCE,
-  PROP_TAG_SIZE,
-  PROP_FX,
-  PROP_HORIZONTAL_FOV,
-  PROP_NEUTRAL,
-  PROP_MIN,
-  PROP_MAX,
-  PROP_THROTTLE_DEADBAND,
-  PROP_MAX_THROTTLE,
-  PROP_STEERING_REVERSED,
-  PROP_THROTTLE_REVERSED,
-  PROP_LOST_TIMEOUT,
-  PROP_PCD_RATE,
-  PROP_KEEPALIVE,
-  PROP_ENABLED,
-  PROP_TAKE_CONTROL,
-  PROP_DRIVE_TIMEOUT,
-  PROP_HAS_CONTROL,
-  PROP_PERIODS,
-  PROP_FAILSAFE,
-};
+using namespace wircam::gst::wirccontrol;
 
 enum { SIGNAL_REQUEST_CONTROL, SIGNAL_DRIVE, SIGNAL_COUNT };
 guint signals[SIGNAL_COUNT];
 GParamSpec* hasControlSpec;
-
-struct Settings {
-  std::string host = DEFAULT_HOST;
-  guint port = DEFAULT_PORT;
-  gst::VehicleProtocol protocol = DEFAULT_PROTOCOL;
-  gint targetId = DEFAULT_TARGET_ID;
-  guint steeringChannel = DEFAULT_STEERING_CHANNEL;
-  guint throttleChannel = DEFAULT_THROTTLE_CHANNEL;
-  // Gains, camera and distance: the follower's own defaults.
-  vision::FollowConfig follow;
-  guint neutral = DEFAULT_NEUTRAL;
-  guint min = DEFAULT_MIN;
-  guint max = DEFAULT_MAX;
-  guint throttleDeadband = DEFAULT_THROTTLE_DEADBAND;
-  double maxThrottle = DEFAULT_MAX_THROTTLE;
-  bool steeringReversed = false;
-  bool throttleReversed = false;
-  guint lostTimeoutMs = DEFAULT_LOST_TIMEOUT;
-  double pcdRate = DEFAULT_PCD_RATE;
-  guint keepaliveMs = DEFAULT_KEEPALIVE;
-  bool keepaliveSet = false;
-  bool enabled = DEFAULT_ENABLED;
-  bool takeControl = DEFAULT_TAKE_CONTROL;
-  guint driveTimeoutMs = DEFAULT_DRIVE_TIMEOUT;
-  wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
-  wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
-  // The shared link's settings given: the pacing ones always (the element
-  // is the link's one commander), the login ones when set.
-  std::set<std::string> given = {"pcd-rate", "keepalive", "lost-timeout"};
-};
-
-gst::PropertyTable<Settings> properties;
 
 struct WircControlState {
   Settings settings;  // guarded by the object lock
@@ -184,33 +99,6 @@ struct WircControlState {
   // Commands by hand (the `drive` action); created in init().
   std::unique_ptr<gst::ManualDrive> manual;
 };
-
-vision::FollowConfig followConfig(const Settings& s) {
-  vision::FollowConfig config = s.follow;
-  auto map = [&](bool reversed, uint16_t deadband) {
-    return vision::PulseMap{static_cast<uint16_t>(s.neutral), static_cast<uint16_t>(s.min),
-                            static_cast<uint16_t>(s.max), reversed, deadband};
-  };
-  config.steeringMap = map(s.steeringReversed, 0);
-  config.throttleMap = map(s.throttleReversed, static_cast<uint16_t>(s.throttleDeadband));
-  config.throttle.outputMax = s.maxThrottle;
-  config.throttle.outputMin = -s.maxThrottle;
-  return config;
-}
-
-vision::FollowerSettings followerSettings(const Settings& s) {
-  return {.targetId = s.targetId,
-          .lostTimeout = std::chrono::milliseconds(s.lostTimeoutMs),
-          .enabled = s.enabled};
-}
-
-// Neutral on the element's two channels (the others are at 1500 anyway).
-link::Pulses neutralOf(const Settings& s) {
-  link::Pulses pulses = link::neutralPulses();
-  pulses[s.steeringChannel - 1] = static_cast<uint16_t>(s.neutral);
-  pulses[s.throttleChannel - 1] = static_cast<uint16_t>(s.neutral);
-  return pulses;
-}
 
 double meanEdge(const WircTag& tag) {
   double total = 0;
@@ -542,7 +430,7 @@ static void gst_wirc_control_set_property(GObject* object, guint id, const GValu
   if (id == PROP_ENABLED && !g_value_get_boolean(value)) return stop_following_now(self);
   gst::GLibLocker lock(self);
   auto& s = self->state->settings;
-  if (properties.set(id, value, s)) {
+  if (setProperty(id, value, s)) {
     if (id == PROP_KEEPALIVE) s.keepaliveSet = true;
   } else if (id == PROP_PERIODS) {
     gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
@@ -560,7 +448,7 @@ static void gst_wirc_control_get_property(GObject* object, guint id, GValue* val
   auto* self = GST_WIRC_CONTROL(object);
   gst::GLibLocker lock(self);
   const auto& s = self->state->settings;
-  if (properties.get(id, s, value)) return;
+  if (getProperty(id, s, value)) return;
   if (id == PROP_HAS_CONTROL)
     g_value_set_boolean(value, self->state->hasControl.load());
   else if (id == PROP_PERIODS)
@@ -596,106 +484,13 @@ static void gst_wirc_control_class_init(GstWircControlClass* klass) {
   gobject->set_property = gst_wirc_control_set_property;
   gobject->get_property = gst_wirc_control_get_property;
   gobject->finalize = gst_wirc_control_finalize;
-  auto ready = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-                                        GST_PARAM_MUTABLE_READY);
-  auto live = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-                                       GST_PARAM_MUTABLE_PLAYING | GST_PARAM_CONTROLLABLE);
-  properties.installOn(gobject);
-  properties.string(PROP_HOST, "host",
-                    "Address of the vehicle (for WiRC the same as wircsrc's: they share one "
-                    "login); empty = discover (WiRC) or probe the broadcast ports (BTEMP); RCOIP "
-                    "needs one",
-                    SETTING(host), ready);
-  properties.number(PROP_PORT, "port",
-                    "The vehicle's port: WiRC TCP control port, RCOIP receiver or BTEMP robot UDP "
-                    "port (0 = the protocol's default: 1984, 9048, 16980)",
-                    0, 65535, SETTING(port), ready);
-  properties.choice(PROP_PROTOCOL, "protocol",
-                    "What the vehicle speaks; the camera may be any video source",
-                    gst::vehicleProtocolType(), SETTING(protocol), ready);
-  properties.number(PROP_TARGET_ID, "target-id",
-                    "Id of the tag to follow (-1 = the largest tag in view)", -1, 65535,
-                    SETTING(targetId), live);
-  properties.number(PROP_STEERING_CHANNEL, "steering-channel",
-                    "PCD channel of the steering servo (1..8)", 1, 8, SETTING(steeringChannel),
-                    ready);
-  properties.number(PROP_THROTTLE_CHANNEL, "throttle-channel",
-                    "PCD channel of the motor controller (1..8)", 1, 8, SETTING(throttleChannel),
-                    ready);
-  properties.number(PROP_STEERING_KP, "steering-kp",
-                    "Steering PID: proportional gain (per radian of bearing)", 0, 100,
-                    SETTING(follow.steering.kp), live);
-  properties.number(PROP_STEERING_KI, "steering-ki", "Steering PID: integral gain", 0, 100,
-                    SETTING(follow.steering.ki), live);
-  properties.number(PROP_STEERING_KD, "steering-kd", "Steering PID: derivative gain", 0, 100,
-                    SETTING(follow.steering.kd), live);
-  properties.number(PROP_THROTTLE_KP, "throttle-kp",
-                    "Throttle PID: proportional gain (per metre of distance error)", 0, 100,
-                    SETTING(follow.throttle.kp), live);
-  properties.number(PROP_THROTTLE_KI, "throttle-ki", "Throttle PID: integral gain", 0, 100,
-                    SETTING(follow.throttle.ki), live);
-  properties.number(PROP_THROTTLE_KD, "throttle-kd", "Throttle PID: derivative gain", 0, 100,
-                    SETTING(follow.throttle.kd), live);
-  properties.number(PROP_TARGET_DISTANCE, "target-distance",
-                    "Distance to keep from the tag, metres", 0.05, 100,
-                    SETTING(follow.targetDistance), live);
-  properties.number(PROP_TAG_SIZE, "tag-size",
-                    "Edge of the tag's black border, metres (distance from apparent size when "
-                    "apriltagdetect has no pose)",
-                    0.001, 100, SETTING(follow.tagSize), live);
-  properties.number(PROP_FX, "fx", "Camera focal length in pixels (0 = from horizontal-fov)", 0,
-                    100000, SETTING(follow.fx), live);
-  properties.number(PROP_HORIZONTAL_FOV, "horizontal-fov",
-                    "Camera horizontal field of view, degrees", 1, 179,
-                    SETTING(follow.horizontalFovDeg), live);
-  properties.number(PROP_NEUTRAL, "neutral", "Neutral pulse, µs (straight, stopped)", 800, 2200,
-                    SETTING(neutral), ready);
-  properties.number(PROP_MIN, "min", "Smallest pulse ever sent, µs", 800, 2200, SETTING(min),
-                    ready);
-  properties.number(PROP_MAX, "max", "Largest pulse ever sent, µs", 800, 2200, SETTING(max), ready);
-  properties.number(PROP_THROTTLE_DEADBAND, "throttle-deadband",
-                    "µs either side of neutral where the motor controller does not move: "
-                    "commands start beyond it",
-                    0, 500, SETTING(throttleDeadband), live);
-  properties.number(PROP_MAX_THROTTLE, "max-throttle",
-                    "Largest throttle command, 0..1 of the way to min/max", 0, 1,
-                    SETTING(maxThrottle), live);
-  properties.boolean(PROP_STEERING_REVERSED, "steering-reversed",
-                     "Servo mounted the other way: higher pulses steer right",
-                     SETTING(steeringReversed), live);
-  properties.boolean(PROP_THROTTLE_REVERSED, "throttle-reversed", "Higher pulses drive backwards",
-                     SETTING(throttleReversed), live);
-  properties.number(PROP_LOST_TIMEOUT, "lost-timeout",
-                    "Milliseconds without the target (or without any buffer) before both "
-                    "channels go to neutral",
-                    50, 10000, SETTING(lostTimeoutMs), ready);
-  properties.number(PROP_PCD_RATE, "pcd-rate",
-                    "Rate limit on changes: a changed command leaves at once unless another "
-                    "change left less than 1/pcd-rate s ago (keepalives do not count)",
-                    1, 1000, SETTING(pcdRate), ready);
-  properties.number(PROP_KEEPALIVE, "keepalive",
-                    "Milliseconds between repeats of an unchanged command; keep it well below "
-                    "the device's PCD timeout (200..2000 ms, 800 by default)",
-                    10, static_cast<double>(wirc::kMaxKeepalive.count()), SETTING(keepaliveMs),
-                    ready);
-  properties.boolean(PROP_ENABLED, "enabled",
-                     "Follow the tag; false = hold both channels at neutral", SETTING(enabled),
-                     live);
-  properties.boolean(PROP_TAKE_CONTROL, "take-control",
-                     "Ask the device for the control right (AREQ) at each login that does not "
-                     "bring it; the answer comes as a wirc-control-right message",
-                     SETTING(takeControl), ready);
-  properties.number(PROP_DRIVE_TIMEOUT, "drive-timeout",
-                    "Milliseconds a command by hand (the drive action) holds; without a newer "
-                    "one by then the vehicle goes to neutral (a dead-man)",
-                    20, 5000, SETTING(driveTimeoutMs), live);
+  installProperties(gobject);
   hasControlSpec = g_param_spec_boolean(
       "has-control", "Has control",
       "Whether this transmitter holds the control right (only then do commands reach the "
       "vehicle)",
       FALSE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS));
   g_object_class_install_property(gobject, PROP_HAS_CONTROL, hasControlSpec);
-  gst::installLoginProperties(gobject, PROP_PERIODS, PROP_FAILSAFE);
   /**
    * GstWircControl::request-control:
    *

@@ -41,15 +41,8 @@
  */
 #include "gstwircsrc.h"
 
-#include <poll.h>
-#include <sys/eventfd.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <array>
 #include <atomic>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -59,11 +52,11 @@
 #include "frame_buffers.h"
 #include "glib_locker.h"
 #include "login_properties.h"
-#include "property_table.h"
-#include "wirc/stream_receiver.h"
+#include "wirc/stream_inbox.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_bus_messages.h"
 #include "wirc_uri.h"
+#include "wircsrc_settings.h"
 
 GST_DEBUG_CATEGORY_STATIC(wirc_src_debug);
 #define GST_CAT_DEFAULT wirc_src_debug
@@ -72,78 +65,10 @@ namespace {
 
 using namespace wircam;
 using Clock = std::chrono::steady_clock;
+using namespace wircam::gst::wircsrc;
 
-#define DEFAULT_HOST ""
-#define DEFAULT_PORT 1984
-#define DEFAULT_DEVICE ""
-#define DEFAULT_CAMERA 0
-#define DEFAULT_STREAM_PORT 0
-#define DEFAULT_TRANSMITTER_NAME "wircam"
-#define DEFAULT_PRIORITY 0
-#define DEFAULT_FRAME_TIMEOUT 200
-#define DEFAULT_RECONNECT true
-#define DEFAULT_DISCOVERY_ADDRESS "255.255.255.255"
-#define DEFAULT_LOGIN_TIMEOUT 3000
-#define DEFAULT_STATS_INTERVAL 1000
-#define DEFAULT_LINK_TIMEOUT 2000
-#define DEFAULT_MAX_BAD_MESSAGES 100
-#define DEFAULT_WAIT_FOR_DEVICE false
-
-constexpr size_t kBatch = 16;  // datagrams per recvmmsg
 // The device reports every 500 ms: two missed reports make a status stale.
 constexpr std::chrono::milliseconds kStatusStaleAfter{2 * wirc::kPsdPeriodMs};
-constexpr int kReceiveBufferBytes = 8 << 20;
-
-enum {
-  PROP_0,
-  PROP_HOST,
-  PROP_PORT,
-  PROP_DEVICE,
-  PROP_CAMERA,
-  PROP_STREAM_PORT,
-  PROP_TRANSMITTER_NAME,
-  PROP_PRIORITY,
-  PROP_FRAME_TIMEOUT,
-  PROP_RECONNECT,
-  PROP_DISCOVERY_ADDRESS,
-  PROP_LOGIN_TIMEOUT,
-  PROP_STATS_INTERVAL,
-  PROP_STATS,
-  PROP_LINK_TIMEOUT,
-  PROP_MAX_BAD_MESSAGES,
-  PROP_PERIODS,
-  PROP_FAILSAFE,
-  PROP_WAIT_FOR_DEVICE,
-};
-
-struct Settings {
-  std::string host = DEFAULT_HOST;
-  guint port = DEFAULT_PORT;
-  std::string device = DEFAULT_DEVICE;
-  guint camera = DEFAULT_CAMERA;
-  guint streamPort = DEFAULT_STREAM_PORT;
-  std::string transmitterName = DEFAULT_TRANSMITTER_NAME;
-  guint priority = DEFAULT_PRIORITY;
-  guint frameTimeoutMs = DEFAULT_FRAME_TIMEOUT;
-  bool reconnect = DEFAULT_RECONNECT;
-  std::string discoveryAddress = DEFAULT_DISCOVERY_ADDRESS;
-  guint loginTimeoutMs = DEFAULT_LOGIN_TIMEOUT;
-  guint statsIntervalMs = DEFAULT_STATS_INTERVAL;
-  guint linkTimeoutMs = DEFAULT_LINK_TIMEOUT;
-  guint maxBadMessages = DEFAULT_MAX_BAD_MESSAGES;
-  bool waitForDevice = DEFAULT_WAIT_FOR_DEVICE;
-  wirc::ChannelValues periods = wirc::SessionConfig{}.periods;
-  wirc::ChannelValues failsafe = wirc::SessionConfig{}.failsafe;
-  std::set<std::string> given;  // the shared link's settings the user set
-};
-
-gst::PropertyTable<Settings> properties;
-
-// The shared link's settings: a user's value counts as given (see `given`).
-bool isLinkSetting(guint id) {
-  return id == PROP_TRANSMITTER_NAME || id == PROP_PRIORITY || id == PROP_RECONNECT ||
-         id == PROP_LOGIN_TIMEOUT || id == PROP_LINK_TIMEOUT || id == PROP_MAX_BAD_MESSAGES;
-}
 
 // The C++ side of the element; GObject memory runs no constructors.
 struct WircSrcState {
@@ -153,20 +78,10 @@ struct WircSrcState {
   Settings active;  // what start() used: properties may change meanwhile
   std::shared_ptr<wirc::TransmitterSession> session;
   int sessionListener = 0;
-  std::optional<wirc::StreamReceiver> receiver;
-  UniqueFd socket;
-  UniqueFd wake;         // unlock() writes here to end a blocking receive
-  UniqueFd linkChanged;  // the session's listener writes here
-  // end-of-stream writes here; start() drains it. For the element's life,
-  // so that the signal never races stop() closing it.
-  UniqueFd endRequest{eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)};
+  wirc::StreamInbox
+      inbox;  // its wake-ups for the element's life; its socket from start() to stop()
   Clock::time_point loginDeadline;
   bool streaming = false;  // the link was live and the camera exists
-  std::deque<wirc::AssembledFrame> ready;
-  // kBatch datagrams of up to 64 KB. Left uninitialised: the allocation is
-  // large enough to be mapped lazily, so only the bytes datagrams actually
-  // fill become resident (a zeroed vector made 1 MB resident per source).
-  std::unique_ptr<uint8_t[]> buffers{new uint8_t[kBatch * wirc::kMaxDatagramSize]};
   int width = 0;
   int height = 0;
   Clock::time_point nextStats;
@@ -189,10 +104,8 @@ struct _GstWircSrc {
   WircSrcState* state;
 };
 
-static void gst_wirc_src_uri_handler_init(gpointer iface, gpointer);
-
 G_DEFINE_TYPE_WITH_CODE(GstWircSrc, gst_wirc_src, GST_TYPE_PUSH_SRC,
-                        G_IMPLEMENT_INTERFACE(GST_TYPE_URI_HANDLER, gst_wirc_src_uri_handler_init))
+                        G_IMPLEMENT_INTERFACE(GST_TYPE_URI_HANDLER, gst::initWircUriHandler))
 
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("image/jpeg"));
@@ -202,7 +115,7 @@ namespace {
 void publishStats(GstWircSrc* self) {
   auto* state = self->state;
   MutexLock lock(state->statsMutex);
-  state->stats = state->receiver->stats();
+  state->stats = state->inbox.receiver().stats();
 }
 
 void postStats(GstWircSrc* self) {
@@ -232,20 +145,6 @@ void postStats(GstWircSrc* self) {
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), stats));
 }
 
-void signal(const UniqueFd& fd) {
-  uint64_t one = 1;
-  if (fd.valid() && write(fd.get(), &one, sizeof one) < 0) {
-    // Only fails when the counter is saturated: the reader wakes anyway.
-  }
-}
-
-void drain(const UniqueFd& fd) {
-  uint64_t value;
-  if (fd.valid() && read(fd.get(), &value, sizeof value) < 0) {
-    // Nothing was pending: fine.
-  }
-}
-
 // Link events reach the application as "wirc-session" element messages
 // and wake the streaming thread when they change what it must do.
 void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
@@ -256,7 +155,7 @@ void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
   GstStructure* s =
       gst_structure_new(wircam::bus::Session::kName, "event", G_TYPE_STRING, text.c_str(), nullptr);
   if (const auto* changed = std::get_if<link::StateChanged>(&event)) {
-    signal(state->linkChanged);
+    state->inbox.linkChanged();
     gst_structure_set(s, "state", G_TYPE_STRING, link::linkStateName(changed->state), "reason",
                       G_TYPE_STRING, changed->reason.c_str(), nullptr);
   }
@@ -266,7 +165,7 @@ void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
       MutexLock lock(state->refusalMutex);
       state->refusal = text;
     }
-    signal(state->linkChanged);
+    state->inbox.linkChanged();
   }
   if (const auto* refused = std::get_if<link::DeviceRefused>(&event);
       refused && refused->request == "TL") {
@@ -290,43 +189,21 @@ void onLinkEvent(GstWircSrc* self, const link::LinkEvent& event) {
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), s));
 }
 
-wirc::SessionConfig sessionConfig(const Settings& s) {
-  return {.host = s.host,
-          .port = static_cast<uint16_t>(s.port),
-          .device = s.device,
-          .discoveryAddress = s.discoveryAddress,
-          .transmitterName = s.transmitterName,
-          .priority = static_cast<uint8_t>(s.priority),
-          .periods = s.periods,
-          .failsafe = s.failsafe,
-          .loginTimeout = std::chrono::milliseconds(s.loginTimeoutMs),
-          .linkTimeout = std::chrono::milliseconds(s.linkTimeoutMs),
-          .maxBadMessages = s.maxBadMessages,
-          .reconnect = s.reconnect,
-          .given = s.given};
-}
-
-bool openStreamSocket(GstWircSrc* self, guint streamPort) {
-  auto* state = self->state;
-  auto socket = bindUdp(*SocketAddress::resolve("", static_cast<uint16_t>(streamPort)));
-  if (!socket) {
+bool openStreamSocket(GstWircSrc* self, const Settings& settings) {
+  auto& inbox = self->state->inbox;
+  if (auto error =
+          inbox.open(static_cast<uint16_t>(settings.streamPort),
+                     {.frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)})) {
     GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Could not open the stream port"),
-                      ("%s. Set stream-port=0 to pick a free port.", socket.error().c_str()));
+                      ("%s. Set stream-port=0 to pick a free port.", error->c_str()));
     return false;
   }
-  state->socket = std::move(*socket);
-  // The device sends whole frames in bursts of up to 64 KB datagrams.
-  int size = kReceiveBufferBytes;
-  if (setsockopt(state->socket.get(), SOL_SOCKET, SO_RCVBUFFORCE, &size, sizeof size) != 0)
-    setsockopt(state->socket.get(), SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
-  int granted = 0;
-  socklen_t length = sizeof granted;
-  getsockopt(state->socket.get(), SOL_SOCKET, SO_RCVBUF, &granted, &length);
-  if (granted < kReceiveBufferBytes)
+  constexpr int wanted = wirc::StreamInbox::kReceiveBufferBytes;
+  if (int granted = inbox.receiveBufferBytes(); granted < wanted)
     GST_ELEMENT_WARNING(self, RESOURCE, SETTINGS, ("Small UDP receive buffer"),
                         ("The kernel capped it at %d bytes (wanted %d): frames may be lost in "
                          "bursts. Raise it with: sysctl -w net.core.rmem_max=%d",
-                         granted, kReceiveBufferBytes, kReceiveBufferBytes));
+                         granted, wanted, wanted));
   return true;
 }
 
@@ -347,13 +224,9 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
                       ("%s", session.error().c_str()));
     return FALSE;
   }
-  if (!openStreamSocket(self, settings.streamPort)) return FALSE;
+  if (!openStreamSocket(self, settings)) return FALSE;
   state->session = std::move(*session);
-  state->wake = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
-  drain(state->endRequest);
-  state->linkChanged = UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
-  state->receiver.emplace(wirc::FrameAssemblerConfig{
-      .frameTimeout = std::chrono::milliseconds(settings.frameTimeoutMs)});
+  state->inbox.clearEndRequest();
   state->streaming = false;
   {
     MutexLock lock(state->refusalMutex);
@@ -370,7 +243,7 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   state->sessionListener = state->session->addListener(
       [self](const link::LinkEvent& event) { onLinkEvent(self, event); });
   // The session sends STST once logged in, and again after each reconnect.
-  uint16_t port = localAddress(state->socket.get()).port();
+  uint16_t port = state->inbox.port();
   state->session->startStream(static_cast<uint8_t>(settings.camera), port);
   GST_INFO_OBJECT(self, "camera %u will stream to port %u", settings.camera, port);
   return TRUE;
@@ -384,26 +257,22 @@ static gboolean gst_wirc_src_stop(GstBaseSrc* base) {
     state->session->stopStream(static_cast<uint8_t>(state->active.camera));
     state->session.reset();  // the last user's release logs out, without waiting
   }
-  if (state->receiver) publishStats(self);
-  state->ready.clear();
-  state->receiver.reset();
-  state->socket.reset();
-  state->wake.reset();
-  state->linkChanged.reset();
+  if (state->inbox.isOpen()) publishStats(self);
+  state->inbox.close();
   return TRUE;
 }
 
 static gboolean gst_wirc_src_unlock(GstBaseSrc* base) {
-  signal(GST_WIRC_SRC(base)->state->wake);
+  GST_WIRC_SRC(base)->state->inbox.interrupt();
   return TRUE;
 }
 
 static gboolean gst_wirc_src_unlock_stop(GstBaseSrc* base) {
-  drain(GST_WIRC_SRC(base)->state->wake);
+  GST_WIRC_SRC(base)->state->inbox.clearInterrupt();
   return TRUE;
 }
 
-static void gst_wirc_src_end_of_stream(GstWircSrc* self) { signal(self->state->endRequest); }
+static void gst_wirc_src_end_of_stream(GstWircSrc* self) { self->state->inbox.requestEnd(); }
 
 static gboolean gst_wirc_src_query(GstBaseSrc* base, GstQuery* query) {
   if (GST_QUERY_TYPE(query) == GST_QUERY_LATENCY) {
@@ -420,35 +289,11 @@ static gboolean gst_wirc_src_query(GstBaseSrc* base, GstQuery* query) {
   return GST_BASE_SRC_CLASS(gst_wirc_src_parent_class)->query(base, query);
 }
 
-// Reads whatever datagrams are queued (up to a batch) into the receiver.
-static void receive_batch(GstWircSrc* self) {
-  auto* state = self->state;
-  std::array<mmsghdr, kBatch> headers{};
-  std::array<iovec, kBatch> vectors{};
-  std::array<sockaddr_in, kBatch> sources{};
-  for (size_t i = 0; i < kBatch; ++i) {
-    vectors[i] = {state->buffers.get() + i * wirc::kMaxDatagramSize, wirc::kMaxDatagramSize};
-    headers[i].msg_hdr.msg_iov = &vectors[i];
-    headers[i].msg_hdr.msg_iovlen = 1;
-    headers[i].msg_hdr.msg_name = &sources[i];
-    headers[i].msg_hdr.msg_namelen = sizeof sources[i];
-  }
-  int count = recvmmsg(state->socket.get(), headers.data(), kBatch, MSG_DONTWAIT, nullptr);
-  auto now = Clock::now();
-  for (int i = 0; i < count; ++i) {
-    state->receiver->push(
-        SocketAddress(sources[i]),
-        {static_cast<const uint8_t*>(vectors[i].iov_base), headers[i].msg_len}, now,
-        [&](wirc::AssembledFrame&& frame) { state->ready.push_back(std::move(frame)); });
-  }
-}
-
 // What the link says: FLOW_OK to go on (streaming says whether frames can
 // come), or an error already posted.
 static GstFlowReturn follow_link(GstWircSrc* self) {
   auto* state = self->state;
   const Settings& settings = state->active;
-  drain(state->linkChanged);
   auto status = state->session->sessionStatus();
   const char* where = settings.host.empty() ? "(discovery)" : settings.host.c_str();
   std::string loginRefusal;
@@ -506,7 +351,7 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
     }
   }
   // After a reconnect the device streams from a new port.
-  state->receiver->follow(*state->session->deviceAddress(), status.logins);
+  state->inbox.receiver().follow(*state->session->deviceAddress(), status.logins);
   state->streaming = true;
   return GST_FLOW_OK;
 }
@@ -555,31 +400,26 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
   auto intervalMs = state->active.statsIntervalMs;
   bool checkLink = !state->streaming;
 
-  while (state->ready.empty()) {
+  std::optional<wirc::AssembledFrame> frame;
+  while (!(frame = state->inbox.takeFrame())) {
     if (checkLink) {
       if (GstFlowReturn flow = follow_link(self); flow != GST_FLOW_OK) return flow;
       checkLink = false;
     }
-    int timeoutMs = 100;
-    if (auto deadline = state->receiver->nextDeadline())
-      timeoutMs = std::clamp<int>(
-          static_cast<int>(
-              std::chrono::duration_cast<std::chrono::milliseconds>(*deadline - Clock::now())
-                  .count()) +
-              1,
-          0, 100);
-    std::array<pollfd, 4> fds = {
-        pollfd{state->socket.get(), POLLIN, 0}, pollfd{state->wake.get(), POLLIN, 0},
-        pollfd{state->linkChanged.get(), POLLIN, 0}, pollfd{state->endRequest.get(), POLLIN, 0}};
-    ::poll(fds.data(), fds.size(), timeoutMs);
-    if (fds[1].revents & POLLIN) return GST_FLOW_FLUSHING;
-    if (fds[3].revents & POLLIN) return GST_FLOW_EOS;  // basesrc pushes the EOS
-    // Until the first login, poll's timeout is what checks the deadline.
-    checkLink = (fds[2].revents & POLLIN) || !state->streaming;
-    if (fds[0].revents & POLLIN) receive_batch(self);
-    state->receiver->expire(Clock::now(), [&](wirc::AssembledFrame&& frame) {
-      state->ready.push_back(std::move(frame));
-    });
+    // Until the first login, this wait's bound is what checks its deadline.
+    switch (state->inbox.wait(Clock::now() + std::chrono::milliseconds(100))) {
+      case wirc::StreamInbox::Wake::Interrupted:
+        return GST_FLOW_FLUSHING;
+      case wirc::StreamInbox::Wake::EndRequested:
+        return GST_FLOW_EOS;  // basesrc pushes the EOS
+      case wirc::StreamInbox::Wake::LinkChanged:
+        checkLink = true;
+        break;
+      case wirc::StreamInbox::Wake::Frame:
+      case wirc::StreamInbox::Wake::Deadline:
+        checkLink = !state->streaming;
+        break;
+    }
     if (intervalMs > 0 && Clock::now() >= state->nextStats) {
       state->nextStats = Clock::now() + std::chrono::milliseconds(intervalMs);
       publishStats(self);
@@ -588,11 +428,9 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
   }
   publishStats(self);
 
-  wirc::AssembledFrame frame = std::move(state->ready.front());
-  state->ready.pop_front();
-  GstClockTime pts = frame_timestamp(self, frame.firstPacketTime);
-  bool discont = frame.discont;
-  GstBuffer* buffer = gst::wrapFrame(std::move(frame));
+  GstClockTime pts = frame_timestamp(self, frame->firstPacketTime);
+  bool discont = frame->discont;
+  GstBuffer* buffer = gst::wrapFrame(std::move(*frame));
 
   if (GstCaps* caps = gst::jpegCapsIfChanged(buffer, state->width, state->height)) {
     gst_base_src_set_caps(GST_BASE_SRC(self), caps);
@@ -636,7 +474,7 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
       return;
     }
   }
-  if (properties.set(id, value, s)) {
+  if (setProperty(id, value, s)) {
     if (isLinkSetting(id)) s.given.insert(pspec->name);
   } else if (id == PROP_PERIODS) {
     gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
@@ -658,7 +496,7 @@ static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, 
   }
   gst::GLibLocker lock(self);
   const auto& s = self->state->settings;
-  if (properties.get(id, s, value)) return;
+  if (getProperty(id, s, value)) return;
   if (id == PROP_PERIODS)
     gst::getChannelListProperty(value, s.periods);
   else if (id == PROP_FAILSAFE)
@@ -688,49 +526,7 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
   gobject->get_property = gst_wirc_src_get_property;
   gobject->finalize = gst_wirc_src_finalize;
 
-  constexpr auto kReady = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-                                                   GST_PARAM_MUTABLE_READY);
-  constexpr auto kLive = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS);
-  properties.installOn(gobject);
-  properties.string(PROP_HOST, "host",
-                    "Address of the WiRC device; empty = discover it on the local network (see "
-                    "device, discovery-address)",
-                    SETTING(host), kReady);
-  properties.number(PROP_PORT, "port", "TCP control / UDP discovery port of the device", 1, 65535,
-                    SETTING(port), kReady);
-  properties.string(PROP_DEVICE, "device",
-                    "When discovering: the device name or serial to pick (empty = the only one "
-                    "that answers)",
-                    SETTING(device), kReady);
-  properties.number(PROP_CAMERA, "camera", "Camera index on the device (0 .. its camera count - 1)",
-                    0, 255, SETTING(camera), kReady);
-  properties.number(PROP_STREAM_PORT, "stream-port",
-                    "Local UDP port for the video (0 = any free port)", 0, 65535,
-                    SETTING(streamPort), kReady);
-  properties.string(PROP_TRANSMITTER_NAME, "transmitter-name",
-                    "Name this transmitter logs in with (up to 64 printable ASCII characters; "
-                    "shown in TLST; others are refused when set)",
-                    SETTING(transmitterName), kReady);
-  properties.number(PROP_PRIORITY, "priority",
-                    "Login priority: the highest may hand out the control right", 0, 255,
-                    SETTING(priority), kReady);
-  properties.number(PROP_FRAME_TIMEOUT, "frame-timeout",
-                    "Milliseconds an incomplete frame may wait for its missing packets before it "
-                    "is dropped",
-                    10, 10000, SETTING(frameTimeoutMs), kReady);
-  properties.boolean(PROP_RECONNECT, "reconnect",
-                     "Log in again (with backoff) after the connection is lost, and restart the "
-                     "stream",
-                     SETTING(reconnect), kReady);
-  properties.string(PROP_DISCOVERY_ADDRESS, "discovery-address",
-                    "Where BCSD is sent when host is empty (broadcast by default)",
-                    SETTING(discoveryAddress), kReady);
-  properties.number(PROP_LOGIN_TIMEOUT, "login-timeout",
-                    "Milliseconds to wait for discovery and login before failing", 100, 60000,
-                    SETTING(loginTimeoutMs), kReady);
-  properties.number(PROP_STATS_INTERVAL, "stats-interval",
-                    "Milliseconds between wirc-stats element messages (0 = none)", 0, 3600000,
-                    SETTING(statsIntervalMs), kLive);
+  installProperties(gobject);
   g_object_class_install_property(
       gobject, PROP_STATS,
       g_param_spec_boxed(
@@ -738,21 +534,6 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
           "Counters: packets, bytes, frames-complete, "
           "frames-incomplete, packets-duplicate, packets-invalid, packets-foreign, ...",
           GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
-  properties.number(PROP_LINK_TIMEOUT, "link-timeout",
-                    "Milliseconds without a status report (PSD, every 500 ms) before the device "
-                    "counts as gone (power cut, out of range) and the link logs in again; 0 = "
-                    "never (at least 1000 otherwise)",
-                    0, 600000, SETTING(linkTimeoutMs), kReady);
-  properties.number(PROP_MAX_BAD_MESSAGES, "max-bad-messages",
-                    "Malformed messages one control connection may bring before the device "
-                    "counts as misbehaving: the connection is dropped and made again after a "
-                    "backoff",
-                    1, 1000000, SETTING(maxBadMessages), kReady);
-  properties.boolean(PROP_WAIT_FOR_DEVICE, "wait-for-device",
-                     "Keep trying to log in (with backoff) until the device appears, instead of "
-                     "failing after login-timeout; needs reconnect=true",
-                     SETTING(waitForDevice), kReady);
-  gst::installLoginProperties(gobject, PROP_PERIODS, PROP_FAILSAFE);
   g_signal_new_class_handler("end-of-stream", G_TYPE_FROM_CLASS(klass),
                              static_cast<GSignalFlags>(G_SIGNAL_RUN_LAST | G_SIGNAL_ACTION),
                              G_CALLBACK(gst_wirc_src_end_of_stream), nullptr, nullptr, nullptr,
@@ -772,51 +553,4 @@ static void gst_wirc_src_class_init(GstWircSrcClass* klass) {
   pushsrc->create = gst_wirc_src_create;
 
   GST_DEBUG_CATEGORY_INIT(wirc_src_debug, "wircsrc", 0, "WiRC camera source");
-}
-
-static GstURIType gst_wirc_src_uri_get_type(GType) { return GST_URI_SRC; }
-
-static const gchar* const* gst_wirc_src_uri_get_protocols(GType) {
-  static const gchar* const protocols[] = {"wirc", nullptr};
-  return protocols;
-}
-
-static gchar* gst_wirc_src_uri_get_uri(GstURIHandler* handler) {
-  auto* self = GST_WIRC_SRC(handler);
-  gst::GLibLocker lock(self);
-  const auto& s = self->state->settings;
-  gst::WircUri uri{.host = s.host,
-                   .port = static_cast<uint16_t>(s.port),
-                   .camera = s.camera,
-                   .device = s.device};
-  return g_strdup(uri.toString().c_str());
-}
-
-static gboolean gst_wirc_src_uri_set_uri(GstURIHandler* handler, const gchar* text,
-                                         GError** error) {
-  auto* self = GST_WIRC_SRC(handler);
-  auto uri = gst::parseWircUri(text ? text : "");
-  if (!uri) {
-    g_set_error(error, GST_URI_ERROR, GST_URI_ERROR_BAD_URI, "%s", uri.error().c_str());
-    return FALSE;
-  }
-  {
-    gst::GLibLocker lock(self);
-    if (GST_STATE(self) > GST_STATE_READY) {
-      g_set_error(error, GST_URI_ERROR, GST_URI_ERROR_BAD_STATE,
-                  "the URI cannot change while wircsrc is PAUSED or PLAYING");
-      return FALSE;
-    }
-  }
-  g_object_set(self, "host", uri->host.c_str(), "port", guint{uri->port}, "camera", uri->camera,
-               "device", uri->device.c_str(), nullptr);
-  return TRUE;
-}
-
-static void gst_wirc_src_uri_handler_init(gpointer g_iface, gpointer) {
-  auto* iface = static_cast<GstURIHandlerInterface*>(g_iface);
-  iface->get_type = gst_wirc_src_uri_get_type;
-  iface->get_protocols = gst_wirc_src_uri_get_protocols;
-  iface->get_uri = gst_wirc_src_uri_get_uri;
-  iface->set_uri = gst_wirc_src_uri_set_uri;
 }

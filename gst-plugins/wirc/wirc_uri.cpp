@@ -63,4 +63,62 @@ Expected<WircUri, std::string> parseWircUri(const std::string& text) {
   return parsed;
 }
 
+namespace {
+
+GstURIType uriType(GType) { return GST_URI_SRC; }
+
+const gchar* const* uriProtocols(GType) {
+  static const gchar* const protocols[] = {"wirc", nullptr};
+  return protocols;
+}
+
+gchar* getUri(GstURIHandler* handler) {
+  gchar* host = nullptr;
+  gchar* device = nullptr;
+  guint port = 0, camera = 0;
+  g_object_get(handler, "host", &host, "port", &port, "camera", &camera, "device", &device,
+               nullptr);
+  WircUri uri{.host = host ? host : "",
+              .port = static_cast<uint16_t>(port),
+              .camera = camera,
+              .device = device ? device : ""};
+  g_free(host);
+  g_free(device);
+  return g_strdup(uri.toString().c_str());
+}
+
+gboolean setUri(GstURIHandler* handler, const gchar* text, GError** error) {
+  auto uri = parseWircUri(text ? text : "");
+  if (!uri) {
+    g_set_error(error, GST_URI_ERROR, GST_URI_ERROR_BAD_URI, "%s", uri.error().c_str());
+    return FALSE;
+  }
+  GstState state, pending;
+  {
+    GstObject* element = GST_OBJECT(handler);
+    GST_OBJECT_LOCK(element);
+    state = GST_STATE(element);
+    pending = GST_STATE_PENDING(element);
+    GST_OBJECT_UNLOCK(element);
+  }
+  if (state > GST_STATE_READY || pending > GST_STATE_READY) {
+    g_set_error(error, GST_URI_ERROR, GST_URI_ERROR_BAD_STATE,
+                "the URI cannot change while wircsrc is PAUSED or PLAYING");
+    return FALSE;
+  }
+  g_object_set(handler, "host", uri->host.c_str(), "port", guint{uri->port}, "camera", uri->camera,
+               "device", uri->device.c_str(), nullptr);
+  return TRUE;
+}
+
+}  // namespace
+
+void initWircUriHandler(gpointer iface, gpointer) {
+  auto* handler = static_cast<GstURIHandlerInterface*>(iface);
+  handler->get_type = uriType;
+  handler->get_protocols = uriProtocols;
+  handler->get_uri = getUri;
+  handler->set_uri = setUri;
+}
+
 }  // namespace wircam::gst

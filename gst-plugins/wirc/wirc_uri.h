@@ -3,6 +3,8 @@
 // (wirc:///0?device=rover) finds the device by discovery.
 #pragma once
 
+#include <glib.h>
+
 #include <cstdint>
 #include <string>
 
@@ -20,5 +22,9 @@ struct WircUri {
 };
 
 Expected<WircUri, std::string> parseWircUri(const std::string& uri);
+
+// GstURIHandler's interface for an element with the host, port, camera and
+// device properties (wircsrc); the URI cannot change past READY.
+void initWircUriHandler(gpointer iface, gpointer);
 
 }  // namespace wircam::gst

@@ -1,0 +1,126 @@
+#include "wirc/stream_inbox.h"
+
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+
+namespace wircam::wirc {
+
+namespace {
+
+constexpr size_t kBatch = 16;  // datagrams per recvmmsg
+
+UniqueFd newEventFd() { return UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)); }
+
+void signal(const UniqueFd& fd) {
+  uint64_t one = 1;
+  if (fd.valid() && write(fd.get(), &one, sizeof one) < 0) {
+    // Only fails when the counter is saturated: the reader wakes anyway.
+  }
+}
+
+void drain(const UniqueFd& fd) {
+  uint64_t value;
+  if (fd.valid() && read(fd.get(), &value, sizeof value) < 0) {
+    // Nothing was pending: fine.
+  }
+}
+
+bool readable(const pollfd& fd) { return (fd.revents & POLLIN) != 0; }
+
+}  // namespace
+
+StreamInbox::StreamInbox()
+    : interrupt_(newEventFd()),
+      linkChanged_(newEventFd()),
+      endRequest_(newEventFd()),
+      buffers_(new uint8_t[kBatch * kMaxDatagramSize]) {}
+
+std::optional<std::string> StreamInbox::open(uint16_t port, FrameAssemblerConfig config) {
+  auto socket = bindUdp(*SocketAddress::resolve("", port));
+  if (!socket) return socket.error();
+  socket_ = std::move(*socket);
+  int size = kReceiveBufferBytes;
+  if (setsockopt(socket_.get(), SOL_SOCKET, SO_RCVBUFFORCE, &size, sizeof size) != 0)
+    setsockopt(socket_.get(), SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
+  drain(linkChanged_);
+  receiver_.emplace(config);
+  ready_.clear();
+  return std::nullopt;
+}
+
+void StreamInbox::close() {
+  ready_.clear();
+  receiver_.reset();
+  socket_.reset();
+}
+
+uint16_t StreamInbox::port() const { return localAddress(socket_.get()).port(); }
+
+int StreamInbox::receiveBufferBytes() const {
+  int granted = 0;
+  socklen_t length = sizeof granted;
+  getsockopt(socket_.get(), SOL_SOCKET, SO_RCVBUF, &granted, &length);
+  return granted;
+}
+
+void StreamInbox::interrupt() { signal(interrupt_); }
+void StreamInbox::clearInterrupt() { drain(interrupt_); }
+void StreamInbox::linkChanged() { signal(linkChanged_); }
+void StreamInbox::requestEnd() { signal(endRequest_); }
+void StreamInbox::clearEndRequest() { drain(endRequest_); }
+
+StreamInbox::Wake StreamInbox::wait(Clock::time_point deadline) {
+  if (!ready_.empty()) return Wake::Frame;
+  // An open frame's timeout may come before the caller's deadline.
+  if (auto expiry = receiver_->nextDeadline()) deadline = std::min(deadline, *expiry);
+  auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now()).count();
+  std::array<pollfd, 4> fds = {
+      pollfd{socket_.get(), POLLIN, 0}, pollfd{interrupt_.get(), POLLIN, 0},
+      pollfd{linkChanged_.get(), POLLIN, 0}, pollfd{endRequest_.get(), POLLIN, 0}};
+  ::poll(fds.data(), fds.size(), static_cast<int>(std::max<int64_t>(left, 0)));
+  if (readable(fds[1])) return Wake::Interrupted;
+  if (readable(fds[3])) return Wake::EndRequested;
+  if (readable(fds[0])) receiveBatch();
+  receiver_->expire(Clock::now(),
+                    [&](AssembledFrame&& frame) { ready_.push_back(std::move(frame)); });
+  if (readable(fds[2])) {
+    drain(linkChanged_);
+    return Wake::LinkChanged;
+  }
+  return ready_.empty() ? Wake::Deadline : Wake::Frame;
+}
+
+std::optional<AssembledFrame> StreamInbox::takeFrame() {
+  if (ready_.empty()) return std::nullopt;
+  AssembledFrame frame = std::move(ready_.front());
+  ready_.pop_front();
+  return frame;
+}
+
+// Whatever datagrams are queued, up to a batch, into the receiver.
+void StreamInbox::receiveBatch() {
+  std::array<mmsghdr, kBatch> headers{};
+  std::array<iovec, kBatch> vectors{};
+  std::array<sockaddr_in, kBatch> sources{};
+  for (size_t i = 0; i < kBatch; ++i) {
+    vectors[i] = {buffers_.get() + i * kMaxDatagramSize, kMaxDatagramSize};
+    headers[i].msg_hdr.msg_iov = &vectors[i];
+    headers[i].msg_hdr.msg_iovlen = 1;
+    headers[i].msg_hdr.msg_name = &sources[i];
+    headers[i].msg_hdr.msg_namelen = sizeof sources[i];
+  }
+  int count = recvmmsg(socket_.get(), headers.data(), kBatch, MSG_DONTWAIT, nullptr);
+  auto now = Clock::now();
+  for (int i = 0; i < count; ++i) {
+    receiver_->push(SocketAddress(sources[i]),
+                    {static_cast<const uint8_t*>(vectors[i].iov_base), headers[i].msg_len}, now,
+                    [&](AssembledFrame&& frame) { ready_.push_back(std::move(frame)); });
+  }
+}
+
+}  // namespace wircam::wirc

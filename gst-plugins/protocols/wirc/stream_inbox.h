@@ -1,0 +1,71 @@
+// The receiving end of one camera's stream for a thread that waits on it
+// (wircsrc's streaming thread): the UDP socket, the StreamReceiver that
+// turns its datagrams into frames, and the wake-ups other threads give it
+// (stop waiting, the link changed, end the stream). wait() returns at the
+// first of them, a whole frame, or the deadline.
+#pragma once
+
+#include <chrono>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "common/socket.h"
+#include "wirc/stream_receiver.h"
+
+namespace wircam::wirc {
+
+class StreamInbox {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // The device sends whole frames in bursts of up to 64 KB datagrams.
+  static constexpr int kReceiveBufferBytes = 8 << 20;
+
+  enum class Wake { Frame, Interrupted, LinkChanged, EndRequested, Deadline };
+
+  StreamInbox();
+
+  // Binds `port` (0: any free one) with a kReceiveBufferBytes buffer where
+  // the kernel allows it; frames time out after `config.frameTimeout`.
+  // Returns why not, if it cannot.
+  std::optional<std::string> open(uint16_t port, FrameAssemblerConfig config);
+  void close();
+  bool isOpen() const { return receiver_.has_value(); }
+  uint16_t port() const;
+  // What the kernel granted of kReceiveBufferBytes.
+  int receiveBufferBytes() const;
+  StreamReceiver& receiver() { return *receiver_; }
+
+  // From any thread. interrupt() holds until clearInterrupt(); an end
+  // request until clearEndRequest() (kept across open/close, so that it
+  // never races a close).
+  void interrupt();
+  void clearInterrupt();
+  void linkChanged();
+  void requestEnd();
+  void clearEndRequest();
+
+  // Waits until a frame is whole, a wake-up, or `deadline`; frames the
+  // deadline expires are given up on the way.
+  Wake wait(Clock::time_point deadline);
+  std::optional<AssembledFrame> takeFrame();
+  void dropFrames() { ready_.clear(); }
+
+ private:
+  void receiveBatch();
+
+  UniqueFd socket_;
+  UniqueFd interrupt_;
+  UniqueFd linkChanged_;
+  UniqueFd endRequest_;
+  std::optional<StreamReceiver> receiver_;
+  std::deque<AssembledFrame> ready_;
+  // Datagrams of up to 64 KB, a batch at a time. Left uninitialised: the
+  // allocation is large enough to be mapped lazily, so only the bytes
+  // datagrams actually fill become resident (a zeroed vector made 1 MB
+  // resident per source).
+  std::unique_ptr<uint8_t[]> buffers_;
+};
+
+}  // namespace wircam::wirc
