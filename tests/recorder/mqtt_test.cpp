@@ -341,6 +341,10 @@ TEST(RecorderMqttDiscovery, HomeAssistantFindsTheCameraAndItsControlsWork) {
   // Left by an earlier run with a camera that is gone.
   std::string stale = "homeassistant/sensor/wircam_wircam/rover-gone-cam0_battery/config";
   assistant.publish(stale, R"({"unique_id":"wircam_rover-gone-cam0_battery"})", true);
+  // Held by the broker and heard by this probe before the recorder starts:
+  // otherwise the recorder may clear it before the probe listens.
+  ASSERT_TRUE(assistant.waitFor(
+      stale, [](auto& m) { return !m.payload.empty(); }, 10s));
   car.recorder = std::make_unique<RecorderProcess>(
       car.device->port(),
       std::vector<std::string>{"--detect", "tag36h11", "--follow", "--mqtt", car.broker.url(),
