@@ -178,11 +178,16 @@ void MqttClient::onPublish(mosquitto*, void* self, int) {
 
 bool MqttClient::publish(const std::string& topic, const std::string& payload, bool retain,
                          int qos) {
-  if (!connected_ || published_ - written_ >= kMaxUnsent) return ++dropped_, false;
+  // Counted before it is handed over: the library may report it written
+  // (onPublish, on another thread) before mosquitto_publish returns, and
+  // written_ must never pass published_ (the difference would wrap, and
+  // every message would be dropped as "too many unsent").
+  uint64_t before = published_++, written = written_;
+  uint64_t unsent = before > written ? before - written : 0;
+  if (!connected_ || unsent >= kMaxUnsent) return --published_, ++dropped_, false;
   int rc = mosquitto_publish(handle_, nullptr, topic.c_str(), static_cast<int>(payload.size()),
                              payload.data(), qos, retain);
-  if (rc != MOSQ_ERR_SUCCESS) return ++dropped_, false;
-  ++published_;
+  if (rc != MOSQ_ERR_SUCCESS) return --published_, ++dropped_, false;
   return true;
 }
 

@@ -12,6 +12,7 @@
 #include "scene_frames.h"
 #include "wait_for.h"
 #include "wirc/device.h"
+#include "wirc/transmitter_session.h"
 
 namespace {
 
@@ -157,7 +158,10 @@ TEST(WircSrc, FollowsTheDeviceThroughARestart) {
   WircSrcHarness src(port);
   ASSERT_FALSE(src.pullBytes().empty());
   device.reset();
-  std::this_thread::sleep_for(milliseconds(300));
+  // The shared link (joined here) has noticed: what is queued came before.
+  auto shared = wirc::TransmitterSession::acquire({.host = "127.0.0.1", .port = port});
+  ASSERT_TRUE(shared.has_value());
+  ASSERT_TRUE(waitFor([&] { return (*shared)->status().state != link::LinkState::Live; }));
   while (gst_harness_buffers_in_queue(src.harness()) > 0)
     gst_buffer_unref(gst_harness_pull(src.harness()));
   device = startDevice({.port = port, .fragmentSize = 4000});
@@ -172,14 +176,11 @@ TEST(WircSrc, PcdKeepsFlowingWhileThePipelineIsBlocked) {
       "wircsrc name=src host=127.0.0.1 port=" + std::to_string(device->port()) + " ! fakesink");
   GstElement* src = gst_bin_get_by_name(GST_BIN(pipeline), "src");
   GstPad* pad = gst_element_get_static_pad(src, "src");
-  // Every buffer waits 2 s: the streaming thread stalls as a busy pipeline would.
+  // The first buffer blocks the streaming thread until the probe goes, as a
+  // stalled pipeline would.
   gulong probe = gst_pad_add_probe(
-      pad, GST_PAD_PROBE_TYPE_BUFFER,
-      [](GstPad*, GstPadProbeInfo*, gpointer) {
-        std::this_thread::sleep_for(milliseconds(2000));
-        return GST_PAD_PROBE_OK;
-      },
-      nullptr, nullptr);
+      pad, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
+      [](GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   // Keepalives from the event loop, not the stalled thread: the device's
   // watchdog (800 ms) never fires. The largest gap is in bench_control_latency.

@@ -417,7 +417,7 @@ TEST(Device, FirmwareUpdateDisconnectsEveryoneAndRestartsWithTheNewName) {
   }
   EXPECT_TRUE(a.closedByDevice());
   EXPECT_TRUE(b.closedByDevice());
-  std::this_thread::sleep_for(milliseconds(500));
+  ASSERT_TRUE(testing::waitFor([&] { return device->stats().restartsDone == 1; }));
   EXPECT_EQ(device->name(), "renamed");
   RawTransmitter again(device->port());
   EXPECT_TRUE(again.login("again", 1).has_value());

@@ -175,7 +175,7 @@ TEST(HostileDevice, ARevokeNamingAPhoneStopsThePcd) {
       bytesOf(Agr{.connectionId = 1, .name = "me", .notification = AccessNotification::Granted});
   // The phone's default name, in UTF-8, with a typographic apostrophe.
   peer.play({.chunks = {peer.wst(), granted, revokedBy("P\xC3\xA1l\xE2\x80\x99s iPhone")}});
-  auto session = linkTo(peer);
+  auto session = linkTo(peer, {.keepalive = milliseconds(25)});
   Collected<link::ControlRightChanged> changes(*session);
   ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
   ASSERT_TRUE(waitFor([&] { return changes.events().size() == 2; }));
@@ -184,7 +184,7 @@ TEST(HostileDevice, ARevokeNamingAPhoneStopsThePcd) {
   EXPECT_EQ(changes.events()[1].holder, "Pál’s iPhone");
   EXPECT_GT(datagramsWaiting(peer.controlSocket()), 0);  // PCD while it had the right
   // Three keepalive periods without the right: not one PCD.
-  std::this_thread::sleep_for(milliseconds(300));
+  std::this_thread::sleep_for(milliseconds(3 * 25));
   EXPECT_EQ(datagramsWaiting(peer.controlSocket()), 0);
 }
 

@@ -157,8 +157,11 @@ TEST(RecorderMqtt, FollowOffSendsTheCarToNeutralWithinOneCommandPeriod) {
   EXPECT_TRUE(car.probe.waitFor(
       "wircam/" + car.stream + "/status", [](auto& m) { return parsed(m)["following"] == false; },
       3s));
-  // It stays stopped while the target is in view, and ON resumes.
-  std::this_thread::sleep_for(500ms);
+  // It stays stopped while the target is in view: five more commands (half
+  // a second of keepalives) reach the car and it is still at neutral. ON
+  // resumes.
+  auto pcd = car.device->stats().pcdReceived;
+  ASSERT_TRUE(waitFor([&] { return car.device->stats().pcdReceived >= pcd + 5; }));
   EXPECT_FALSE(moving());
   car.probe.publish("wircam/" + car.stream + "/follow/set", "ON");
   bool resumed = false;
@@ -378,7 +381,13 @@ TEST(RecorderMqttDiscovery, HomeAssistantFindsTheCameraAndItsControlsWork) {
       [](auto& m) { return m.retained; }, 10s));
   // The stale config is cleared with an empty retained message.
   EXPECT_TRUE(assistant.waitFor(
-      stale, [](auto& m) { return m.payload.empty(); }, 10s));
+      stale, [](auto& m) { return m.payload.empty(); }, 10s))
+      << [&] {
+           std::string seen;
+           for (auto& m : assistant.messages(stale))
+             seen += "[" + m.payload + (m.retained ? " retained" : "") + "] ";
+           return seen;
+         }();
 
   // The camera entity's topic carries the camera's JPEG.
   std::string snapshot = configs["camera"]["topic"];

@@ -125,10 +125,12 @@ int Device::Impl::pollTimeoutMs(DeviceClock::time_point now) const {
 void Device::Impl::runTimers(DeviceClock::time_point now) {
   if (restartDone_ && now >= *restartDone_) {
     restartDone_.reset();
-    if (auto error = openListener())
+    if (auto error = openListener()) {
       log("restart failed: " + *error);
-    else
+    } else {
+      ++localStats_.restartsDone;
       log("restarted as '" + name_ + "'");
+    }
   }
   if (controller_ && now >= controlDeadline_) {
     if (auto* c = controller()) {

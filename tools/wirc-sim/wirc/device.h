@@ -81,6 +81,7 @@ struct DeviceStats {
   uint64_t errSent = 0;
   uint64_t logins = 0;
   uint64_t restarts = 0;
+  uint64_t restartsDone = 0;               // listening again after a restart
   std::chrono::milliseconds maxPcdGap{0};  // longest wait between two PCD
 };
 
