@@ -25,7 +25,7 @@
 #include <optional>
 #include <string>
 
-#include "scoped_map.h"
+#include "gst_scoped.h"
 
 GST_DEBUG_CATEGORY_STATIC(tjpeg_dec_debug);
 #define GST_CAT_DEFAULT tjpeg_dec_debug

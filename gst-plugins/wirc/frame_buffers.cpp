@@ -1,5 +1,6 @@
 #include "frame_buffers.h"
 
+#include "gst_scoped.h"
 #include "wirc/jpeg_info.h"
 #include "wirc_bus_messages.h"
 
@@ -13,10 +14,9 @@ GstBuffer* wrapFrame(wirc::AssembledFrame&& frame) {
 }
 
 GstCaps* jpegCapsIfChanged(GstBuffer* frame, int& width, int& height) {
-  GstMapInfo map;
-  if (!gst_buffer_map(frame, &map, GST_MAP_READ)) return nullptr;
-  auto info = wirc::readJpegInfo({map.data, map.size});
-  gst_buffer_unmap(frame, &map);
+  ScopedBufferMap map(frame, GST_MAP_READ);
+  if (!map) return nullptr;
+  auto info = wirc::readJpegInfo({map.data(), map.size()});
   if (!info || (info->width == width && info->height == height)) return nullptr;
   width = info->width;
   height = info->height;

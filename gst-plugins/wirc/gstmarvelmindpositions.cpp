@@ -30,7 +30,7 @@
 #include <string>
 
 #include "common/mutex.h"
-#include "glib_locker.h"
+#include "gst_scoped.h"
 #include "marvelmind/position_client.h"
 #include "wirc_bus_messages.h"
 #include "wirc_position_meta.h"

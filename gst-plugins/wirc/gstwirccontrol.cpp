@@ -60,7 +60,7 @@
 #include <vector>
 
 #include "control_link.h"
-#include "glib_locker.h"
+#include "gst_scoped.h"
 #include "login_properties.h"
 #include "manual_drive.h"
 #include "target_follower.h"

@@ -19,7 +19,7 @@
 
 #include "common/mutex.h"
 #include "frame_buffers.h"
-#include "glib_locker.h"
+#include "gst_scoped.h"
 #include "wirc/frame_assembler.h"
 
 GST_DEBUG_CATEGORY_STATIC(wirc_depay_debug);
@@ -127,11 +127,8 @@ static GstFlowReturn gst_wirc_depay_chain(GstPad*, GstObject* parent, GstBuffer*
   std::vector<wirc::AssembledFrame> frames;
   auto collect = [&](wirc::AssembledFrame&& frame) { frames.push_back(std::move(frame)); };
   auto now = arrival_time(self, buffer);
-  GstMapInfo map;
-  if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-    assembler.pushDatagram({map.data, map.size}, now, collect);
-    gst_buffer_unmap(buffer, &map);
-  }
+  if (gst::ScopedBufferMap map(buffer, GST_MAP_READ); map)
+    assembler.pushDatagram({map.data(), map.size()}, now, collect);
   assembler.expire(now, collect);
   {
     MutexLock lock(self->state->statsMutex);

@@ -50,7 +50,7 @@
 
 #include "common/mutex.h"
 #include "frame_buffers.h"
-#include "glib_locker.h"
+#include "gst_scoped.h"
 #include "login_properties.h"
 #include "wirc/stream_inbox.h"
 #include "wirc/transmitter_session.h"

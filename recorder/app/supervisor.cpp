@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "gst_scoped.h"
 #include "log_line.h"
 #include "record/segment_inspector.h"
 #include "record/segment_planner.h"
@@ -235,11 +236,8 @@ void Supervisor::publishSnapshots() {
   for (auto& c : cameras_) {
     GstBuffer* jpeg = c->frames() ? c->frames()->latest() : nullptr;
     if (!jpeg) continue;
-    GstMapInfo map;
-    if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
-      fleet_->snapshot(c->name(), std::string(reinterpret_cast<const char*>(map.data), map.size));
-      gst_buffer_unmap(jpeg, &map);
-    }
+    if (gst::ScopedBufferMap map(jpeg, GST_MAP_READ); map)
+      fleet_->snapshot(c->name(), std::string(map.view()));
     gst_buffer_unref(jpeg);
   }
 }

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <utility>
 
+#include "gst_scoped.h"
+
 namespace wircam::recorder {
 
 namespace {
@@ -149,8 +151,8 @@ std::optional<std::string> McapExport::start(GstCaps* caps) {
 }
 
 std::optional<std::string> McapExport::frame(GstBuffer* buffer, int64_t, int64_t utcNs, bool) {
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return "an unreadable frame";
+  gst::ScopedBufferMap map(buffer, GST_MAP_READ);
+  if (!map) return "an unreadable frame";
   // The JSON is built around the base64 text, which needs no escaping:
   // nlohmann's dump would look at each of its characters (a quarter of an
   // export's time).
@@ -161,12 +163,11 @@ std::optional<std::string> McapExport::frame(GstBuffer* buffer, int64_t, int64_t
   message.pop_back();  // the closing brace
   message += ",\"data\":\"";
   size_t head = message.size();
-  message.resize(head + (map.size / 3 + 1) * 4 + 4);
+  message.resize(head + (map.size() / 3 + 1) * 4 + 4);
   gint state = 0, save = 0;
   char* out = message.data() + head;
-  gsize written = g_base64_encode_step(map.data, map.size, FALSE, out, &state, &save);
+  gsize written = g_base64_encode_step(map.data(), map.size(), FALSE, out, &state, &save);
   written += g_base64_encode_close(FALSE, out + written, &state, &save);
-  gst_buffer_unmap(buffer, &map);
   message.resize(head + written);
   message += "\"}";
   auto time = static_cast<uint64_t>(std::max<int64_t>(utcNs, 0));

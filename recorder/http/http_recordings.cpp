@@ -4,6 +4,7 @@
 #include <set>
 
 #include "common/printable_text.h"
+#include "gst_scoped.h"
 #include "http/camera_feed.h"
 #include "http/http_responses.h"
 #include "http/http_server.h"
@@ -27,13 +28,10 @@ void HttpServer::serveSnapshot(SoupServerMessage* message, const std::string& ca
     return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE,
                             "camera '" + camera + "' has sent no frame yet");
   // The frame untouched: the camera's own JPEG bytes.
-  GstMapInfo map;
-  if (gst_buffer_map(jpeg, &map, GST_MAP_READ)) {
-    respond(message, SOUP_STATUS_OK, "image/jpeg",
-            std::string(reinterpret_cast<const char*>(map.data), map.size));
+  if (gst::ScopedBufferMap map(jpeg, GST_MAP_READ); map) {
+    respond(message, SOUP_STATUS_OK, "image/jpeg", std::string(map.view()));
     soup_message_headers_replace(soup_server_message_get_response_headers(message), "Cache-Control",
                                  "no-cache, no-store");
-    gst_buffer_unmap(jpeg, &map);
   }
   gst_buffer_unref(jpeg);
 }

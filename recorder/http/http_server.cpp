@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/printable_text.h"
+#include "gst_scoped.h"
 #include "http/camera_feed.h"
 #include "http/http_connections.h"
 #include "http/http_responses.h"
@@ -33,18 +34,17 @@ namespace {
 // One part of a multipart/x-mixed-replace stream, built in one piece: a
 // single copy of the frame per delivery. `extraHeaders` end in CRLF.
 GBytes* multipartFrame(GstBuffer* jpeg, const std::string& extraHeaders) {
-  GstMapInfo map;
-  if (!gst_buffer_map(jpeg, &map, GST_MAP_READ)) return nullptr;
+  gst::ScopedBufferMap map(jpeg, GST_MAP_READ);
+  if (!map) return nullptr;
   std::string header =
       std::string("--") + kBoundary +
-      "\r\nContent-Type: image/jpeg\r\nContent-Length: " + std::to_string(map.size) + "\r\n" +
+      "\r\nContent-Type: image/jpeg\r\nContent-Length: " + std::to_string(map.size()) + "\r\n" +
       extraHeaders + "\r\n";
-  GByteArray* part = g_byte_array_sized_new(static_cast<guint>(header.size() + map.size + 2));
+  GByteArray* part = g_byte_array_sized_new(static_cast<guint>(header.size() + map.size() + 2));
   g_byte_array_append(part, reinterpret_cast<const guint8*>(header.data()),
                       static_cast<guint>(header.size()));
-  g_byte_array_append(part, map.data, static_cast<guint>(map.size));
+  g_byte_array_append(part, map.data(), static_cast<guint>(map.size()));
   g_byte_array_append(part, reinterpret_cast<const guint8*>("\r\n"), 2);
-  gst_buffer_unmap(jpeg, &map);
   return g_byte_array_free_to_bytes(part);
 }
 

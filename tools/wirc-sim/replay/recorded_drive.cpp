@@ -9,6 +9,7 @@
 
 #include "export/export_range.h"
 #include "export/segment_reader.h"
+#include "gst_scoped.h"
 #include "record/recording_index.h"
 
 namespace wircam::sim {
@@ -141,11 +142,8 @@ std::optional<RecordedDrive::Frame> RecordedDrive::next() {
     }
     ++framesInSegment_;
     Frame out;
-    GstMapInfo map;
-    if (gst_buffer_map((*frame)->buffer, &map, GST_MAP_READ)) {
-      out.jpeg.assign(map.data, map.data + map.size);
-      gst_buffer_unmap((*frame)->buffer, &map);
-    }
+    if (gst::ScopedBufferMap map((*frame)->buffer, GST_MAP_READ); map)
+      out.jpeg.assign(map.data(), map.data() + map.size());
     out.ptsNs = (*frame)->ptsNs;
     out.timeNs = segment.startNs + out.ptsNs;
     out.segment = name;
