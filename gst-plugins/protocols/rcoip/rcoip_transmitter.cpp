@@ -11,7 +11,6 @@
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
 #include "link/link_registry.h"
-#include "link/reject_tally.h"
 
 namespace wircam::rcoip {
 
@@ -56,6 +55,7 @@ class Transmitter::Impl {
   void onReadable();
   void onPacerTimer();
   void onSilenceTimer();
+  void armSilenceTimer();
   void send(const link::Pulses& pulses);
   void publish(const std::vector<link::LinkEvent>& events) {
     for (const auto& event : events) listeners_.emit(event);
@@ -68,13 +68,10 @@ class Transmitter::Impl {
   EventLoop& loop_ = EventLoop::shared();
   EventLoop::Id watch_ = 0, pacerTimer_ = 0, silenceTimer_ = 0;
 
-  link::RejectTally rejected_;  // loop thread only
-
   // Guards what follows; never held while sending or emitting.
   mutable std::mutex mutex_;
   link::CommandPacer pacer_;
-  TransmitterStatus status_;
-  Clock::time_point lastReply_{};
+  ReplyMonitor monitor_;
 };
 
 Transmitter::Impl::Impl(TransmitterConfig config, SocketAddress receiver, UniqueFd socket,
@@ -87,10 +84,8 @@ Transmitter::Impl::Impl(TransmitterConfig config, SocketAddress receiver, Unique
               .minInterval = link::intervalOf(config_.rateLimit),
               .ttl = config_.commandTtl,
               .failsafe = config_.failsafe,
-              .keepaliveEarly = EventLoop::kCoalesce}) {
-  status_.vehicleAddress = receiver_.toString();
-  status_.hasControl = true;
-  status_.reason = "waiting for the receiver's first reply";
+              .keepaliveEarly = EventLoop::kCoalesce}),
+      monitor_(receiver_, config_.failInterval) {
   watch_ = loop_.watch(socket_.get(), EPOLLIN, [this](uint32_t) { onReadable(); });
   pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
   silenceTimer_ = loop_.addTimer([this] { onSilenceTimer(); });
@@ -112,7 +107,7 @@ void Transmitter::Impl::send(const link::Pulses& pulses) {
     command.channels.push_back(config_.map.toByte(channel, pulses[channel - 1]));
   if (sendDatagram(socket_.get(), receiver_, encode(command))) {
     std::lock_guard lock(mutex_);
-    ++status_.commandsSent;
+    monitor_.countCommandSent();
   }
 }
 
@@ -135,56 +130,38 @@ void Transmitter::Impl::onReadable() {
   std::array<uint8_t, 512> buffer;
   std::vector<link::LinkEvent> events;
   receiveDatagrams(socket_.get(), buffer, 64, [&](auto datagram, const SocketAddress& from) {
-    auto now = Clock::now();
     std::lock_guard lock(mutex_);
-    if (!(from == receiver_)) {
-      ++status_.foreignDatagrams;
-      return;
-    }
-    auto reply = decodeReply(datagram);
-    if (!reply) {
-      rejected_.count(decodeErrorName(reply.error()));
-      status_.inputRejected = rejected_.total();
-      return;
-    }
-    link::Telemetry telemetry{.batteryVolts = reply->batteryVolts(), .received = now};
-    if (reply->rssi) telemetry.rssi = *reply->rssi;
-    lastReply_ = now;
-    ++status_.replies;
-    status_.lastReply = *reply;
-    status_.telemetry = telemetry;
-    if (status_.state != link::LinkState::Live) {
-      bool again = status_.state == link::LinkState::Lost;
-      status_.state = link::LinkState::Live;
-      status_.reason.clear();
-      ++status_.logins;
-      events.push_back(link::StateChanged{
-          link::LinkState::Live,
-          (again ? "replies again from " : "replies from ") + receiver_.toString()});
-    }
-    events.push_back(link::TelemetryReceived{telemetry});
+    auto caused = monitor_.onDatagram(from, datagram, Clock::now());
+    events.insert(events.end(), caused.begin(), caused.end());
   });
-  if (!events.empty()) loop_.arm(silenceTimer_, Clock::now() + config_.failInterval);
-  if (auto summary = rejected_.summary(Clock::now())) events.push_back(*summary);
+  {
+    std::lock_guard lock(mutex_);
+    if (auto summary = monitor_.rejectSummary(Clock::now())) events.push_back(*summary);
+  }
+  armSilenceTimer();
   publish(events);
 }
 
 void Transmitter::Impl::onSilenceTimer() {
-  auto now = Clock::now();
-  std::string reason;
+  std::vector<link::LinkEvent> events;
   {
     std::lock_guard lock(mutex_);
-    if (status_.state != link::LinkState::Live) return;
-    auto silent = now - lastReply_;
-    if (silent < config_.failInterval)
-      return loop_.arm(silenceTimer_, lastReply_ + config_.failInterval);
-    reason = "no reply from " + receiver_.toString() + " for " +
-             std::to_string(std::chrono::duration_cast<milliseconds>(silent).count()) +
-             " ms (fail interval): it is off, out of range or gone";
-    status_.state = link::LinkState::Lost;
-    status_.reason = reason;
+    events = monitor_.onDeadline(Clock::now());
   }
-  publish({link::StateChanged{link::LinkState::Lost, reason}});
+  armSilenceTimer();
+  publish(events);
+}
+
+void Transmitter::Impl::armSilenceTimer() {
+  std::optional<Clock::time_point> deadline;
+  {
+    std::lock_guard lock(mutex_);
+    deadline = monitor_.nextDeadline();
+  }
+  if (deadline)
+    loop_.arm(silenceTimer_, *deadline);
+  else
+    loop_.disarm(silenceTimer_);
 }
 
 Expected<std::shared_ptr<Transmitter>, std::string> Transmitter::acquire(
@@ -228,7 +205,7 @@ void Transmitter::requestControl() {
 
 TransmitterStatus Transmitter::transmitterStatus() const {
   std::lock_guard lock(impl_->mutex_);
-  return impl_->status_;
+  return impl_->monitor_.status();
 }
 
 }  // namespace wircam::rcoip

@@ -15,6 +15,7 @@
 #include "link/channel_byte_map.h"
 #include "link/vehicle_link.h"
 #include "rcoip/rcoip_messages.h"
+#include "rcoip/reply_monitor.h"
 
 namespace wircam::rcoip {
 
@@ -31,12 +32,6 @@ struct TransmitterConfig {
 
   std::string key() const { return "rcoip://" + host + ":" + std::to_string(port); }
   std::string settings() const;  // "channels=8 keepalive=1000ms ..."
-};
-
-struct TransmitterStatus : link::LinkStatus {
-  std::optional<Reply> lastReply;
-  uint64_t replies = 0;
-  uint64_t foreignDatagrams = 0;  // from anyone but the receiver: ignored
 };
 
 class Transmitter : public link::VehicleLink {
