@@ -14,6 +14,7 @@
 #include <string>
 
 #include "btemp/btemp_messages.h"
+#include "btemp/btemp_registration.h"
 #include "common/expected.h"
 #include "link/channel_byte_map.h"
 #include "link/vehicle_link.h"
@@ -33,13 +34,6 @@ struct ControllerConfig {
 
   std::string key() const;  // "btemp://HOST:PORT" or "btemp://broadcast"
   std::string settings() const;
-};
-
-struct ControllerStatus : link::LinkStatus {
-  std::optional<NodeInfo> robot;
-  std::optional<Pins> lastPins;
-  uint64_t videoSegments = 0;     // recognised and ignored
-  uint64_t foreignDatagrams = 0;  // from anyone but the robot: ignored
 };
 
 class Controller : public link::VehicleLink {
