@@ -18,56 +18,10 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "marvelmind/beacon_tracker.h"
 #include "marvelmind/marvelmind_messages.h"
 
 namespace wircam::marvelmind {
-
-using Clock = std::chrono::steady_clock;
-
-enum class Mode { kPoll, kStream };
-
-struct ClientConfig {
-  std::string host = "127.0.0.1";  // the dashboard
-  uint16_t port = kDefaultDashboardPort;
-  std::vector<uint8_t> beacons;  // the vehicle's beacon addresses, 1..254
-  Mode mode = Mode::kPoll;
-  uint16_t listenPort = 0;  // stream mode: where the dashboard pushes (0: any free one)
-  double pollRate = 10;     // requests per second per beacon, poll mode
-  Resolution resolution = Resolution::kCentimetres;
-  TimestampUnit timestampUnit = TimestampUnit::kSixtyFourths;
-  std::chrono::milliseconds staleAfter{1000};
-
-  std::string dashboard() const { return host + ":" + std::to_string(port); }
-};
-// The problem with a configuration, if any.
-std::optional<std::string> validate(const ClientConfig& config);
-
-struct Position {
-  uint8_t beacon = 0;
-  double x = 0, y = 0, z = 0;  // metres
-  double timestamp = 0;        // the dashboard's time of the measurement, seconds
-  Clock::time_point measured;  // the same instant on this machine's clock
-  Clock::time_point received;
-};
-
-struct PositionReceived {
-  Position position;
-};
-struct PositionStale {
-  uint8_t beacon;
-  std::string reason;  // "no reply from the dashboard at ... for 1000 ms", ...
-};
-using PositionEvent = std::variant<PositionReceived, PositionStale>;
-
-struct ClientStats {
-  uint64_t requests = 0;
-  uint64_t replies = 0;                      // valid replies for our beacons
-  uint64_t positions = 0;                    // of those, new measurements
-  uint64_t repeats = 0;                      // the dashboard's latest again (no new measurement)
-  uint64_t foreign = 0;                      // datagrams from anyone but the dashboard
-  std::map<std::string, uint64_t> rejected;  // by reason: "bad CRC", "wrong beacon", ...
-  uint64_t rejectedTotal() const;
-};
 
 class PositionClient {
  public:
