@@ -432,11 +432,7 @@ static void gst_wirc_control_set_property(GObject* object, guint id, const GValu
   auto& s = self->state->settings;
   if (setProperty(id, value, s)) {
     if (id == PROP_KEEPALIVE) s.keepaliveSet = true;
-  } else if (id == PROP_PERIODS) {
-    gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
-  } else if (id == PROP_FAILSAFE) {
-    gst::setChannelListProperty(object, "failsafe", value, s.failsafe, s.given);
-  } else {
+  } else if (!gst::setLoginProperty(object, id, PROP_PERIODS, PROP_FAILSAFE, value, s)) {
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
     return;
   }
@@ -451,11 +447,7 @@ static void gst_wirc_control_get_property(GObject* object, guint id, GValue* val
   if (getProperty(id, s, value)) return;
   if (id == PROP_HAS_CONTROL)
     g_value_set_boolean(value, self->state->hasControl.load());
-  else if (id == PROP_PERIODS)
-    gst::getChannelListProperty(value, s.periods);
-  else if (id == PROP_FAILSAFE)
-    gst::getChannelListProperty(value, s.failsafe);
-  else
+  else if (!gst::getLoginProperty(id, PROP_PERIODS, PROP_FAILSAFE, value, s))
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
 }
 

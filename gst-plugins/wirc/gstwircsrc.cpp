@@ -476,11 +476,7 @@ static void gst_wirc_src_set_property(GObject* object, guint id, const GValue* v
   }
   if (setProperty(id, value, s)) {
     if (isLinkSetting(id)) s.given.insert(pspec->name);
-  } else if (id == PROP_PERIODS) {
-    gst::setChannelListProperty(object, "periods", value, s.periods, s.given);
-  } else if (id == PROP_FAILSAFE) {
-    gst::setChannelListProperty(object, "failsafe", value, s.failsafe, s.given);
-  } else {
+  } else if (!gst::setLoginProperty(object, id, PROP_PERIODS, PROP_FAILSAFE, value, s)) {
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
   }
 }
@@ -497,11 +493,7 @@ static void gst_wirc_src_get_property(GObject* object, guint id, GValue* value, 
   gst::GLibLocker lock(self);
   const auto& s = self->state->settings;
   if (getProperty(id, s, value)) return;
-  if (id == PROP_PERIODS)
-    gst::getChannelListProperty(value, s.periods);
-  else if (id == PROP_FAILSAFE)
-    gst::getChannelListProperty(value, s.failsafe);
-  else
+  if (!gst::getLoginProperty(id, PROP_PERIODS, PROP_FAILSAFE, value, s))
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
 }
 

@@ -21,4 +21,25 @@ void setChannelListProperty(GObject* element, const char* name, const GValue* va
                             wirc::ChannelValues& target, std::set<std::string>& given);
 void getChannelListProperty(GValue* value, const wirc::ChannelValues& source);
 
+// set_property's and get_property's part for an element's `periods` and
+// `failsafe` (ids `periodsId`, `failsafeId`; the settings' members of those
+// names, and `given`); false for any other id.
+template <typename Settings>
+bool setLoginProperty(GObject* element, guint id, guint periodsId, guint failsafeId,
+                      const GValue* value, Settings& s) {
+  if (id != periodsId && id != failsafeId) return false;
+  bool periods = id == periodsId;
+  setChannelListProperty(element, periods ? "periods" : "failsafe", value,
+                         periods ? s.periods : s.failsafe, s.given);
+  return true;
+}
+
+template <typename Settings>
+bool getLoginProperty(guint id, guint periodsId, guint failsafeId, GValue* value,
+                      const Settings& s) {
+  if (id != periodsId && id != failsafeId) return false;
+  getChannelListProperty(value, id == periodsId ? s.periods : s.failsafe);
+  return true;
+}
+
 }  // namespace wircam::gst
