@@ -78,8 +78,8 @@ struct WircSrcState {
   Settings active;  // what start() used: properties may change meanwhile
   std::shared_ptr<wirc::TransmitterSession> session;
   int sessionListener = 0;
-  wirc::StreamInbox
-      inbox;  // its wake-ups for the element's life; its socket from start() to stop()
+  // Its wake-ups serve the element's life; its socket lives from start() to stop().
+  wirc::StreamInbox inbox;
   Clock::time_point loginDeadline;
   bool streaming = false;  // the link was live and the camera exists
   int width = 0;
