@@ -74,14 +74,15 @@ Expected<std::shared_ptr<link::VehicleLink>, std::string> acquireControlLink(
       rcoip::TransmitterConfig config{
           .host = s.host, .port = port, .commandTtl = s.commandTtl, .rateLimit = s.rateLimit};
       if (s.keepaliveGiven) config.keepalive = s.keepalive;
-      return upcast(rcoip::Transmitter::acquire(config));
+      return upcast(rcoip::Transmitter::acquire(config, user));
     }
     case VehicleProtocol::Btemp:
       return upcast(btemp::Controller::acquire({.host = s.host,
                                                 .port = port,
                                                 .ctrlPeriod = s.keepalive,
                                                 .commandTtl = s.commandTtl,
-                                                .rateLimit = s.rateLimit}));
+                                                .rateLimit = s.rateLimit},
+                                               user));
   }
   return unexpected(std::string("unknown protocol"));
 }

@@ -167,16 +167,23 @@ TEST(RcoipLink, RefusesSettingsTheReceiverCannotLiveWith) {
   EXPECT_FALSE(rcoip::Transmitter::acquire({.failInterval = milliseconds(900)}));
 }
 
-TEST(RcoipLink, IsSharedByEveryUserWithTheSameSettingsAndRefusesOthers) {
+TEST(RcoipLink, IsSharedByEveryUserWithTheSameSettingsAndRefusesOthersNamingBoth) {
   RawPeer receiver;
-  auto a = rcoip::Transmitter::acquire({.host = "127.0.0.1", .port = receiver.port()});
-  auto b = rcoip::Transmitter::acquire({.host = "127.0.0.1", .port = receiver.port()});
+  auto a = rcoip::Transmitter::acquire({.host = "127.0.0.1", .port = receiver.port()}, "first");
+  auto b = rcoip::Transmitter::acquire({.host = "127.0.0.1", .port = receiver.port()}, "second");
   ASSERT_TRUE(a && b);
   EXPECT_EQ(a->get(), b->get());
   auto c = rcoip::Transmitter::acquire(
-      {.host = "127.0.0.1", .port = receiver.port(), .channelCount = 4});
+      {.host = "127.0.0.1", .port = receiver.port(), .channelCount = 4}, "third");
   ASSERT_FALSE(c);
-  EXPECT_NE(c.error().find("channels=4"), std::string::npos) << c.error();
+  // The same message as WiRC's: the setting, both values, both users.
+  for (const char* part : {"channels=4 of third", "channels=8 of ", "conflicts with"})
+    EXPECT_NE(c.error().find(part), std::string::npos) << c.error();
+  // Once the others let go, the link closes and the next user opens it anew.
+  a->reset();
+  b->reset();
+  EXPECT_TRUE(rcoip::Transmitter::acquire(
+      {.host = "127.0.0.1", .port = receiver.port(), .channelCount = 4}, "third"));
 }
 
 // --- BTEMP ---------------------------------------------------------------

@@ -40,12 +40,12 @@ std::string ControllerConfig::key() const {
                       : "btemp://" + host + ":" + std::to_string(port);
 }
 
-std::string ControllerConfig::settings() const {
-  std::string text =
-      "ctrl-period=" + ms(ctrlPeriod) + " keepalive-timeout=" + ms(keepaliveTimeout) +
-      " lost-timeout=" + ms(commandTtl) + " rate=" + std::to_string(static_cast<int>(rateLimit));
-  if (auto overrides = map.toString(); !overrides.empty()) text += " map=" + overrides;
-  return text;
+link::SettingValues ControllerConfig::settings() const {
+  return {{"ctrl-period", ms(ctrlPeriod)},
+          {"keepalive-timeout", ms(keepaliveTimeout)},
+          {"lost-timeout", ms(commandTtl)},
+          {"rate", std::to_string(static_cast<int>(rateLimit))},
+          {"map", map.toString()}};
 }
 
 // The I/O around the Registration: the socket and timers on the event loop.
@@ -196,14 +196,15 @@ void Controller::Impl::onReadable() {
 }
 
 Expected<std::shared_ptr<Controller>, std::string> Controller::acquire(
-    const ControllerConfig& config) {
+    const ControllerConfig& config, const std::string& user) {
   if (config.ctrlPeriod.count() <= 0 || config.ctrlPeriod >= config.keepaliveTimeout)
     return unexpected("ctrl period " + ms(config.ctrlPeriod) +
                       " must be above 0 and below the keepalive timeout (" +
                       ms(config.keepaliveTimeout) + ")");
   static link::LinkRegistry<Controller> registry;
   return registry.acquire(
-      config.key(), config.settings(), [&]() -> Expected<std::shared_ptr<Controller>, std::string> {
+      config.key(), config.settings(), user,
+      [&]() -> Expected<std::shared_ptr<Controller>, std::string> {
         if (!config.host.empty())
           if (auto robot = SocketAddress::resolve(config.host, config.port); !robot)
             return unexpected(robot.error());

@@ -17,6 +17,7 @@
 #include "btemp/btemp_registration.h"
 #include "common/expected.h"
 #include "link/channel_byte_map.h"
+#include "link/shared_settings.h"
 #include "link/vehicle_link.h"
 
 namespace wircam::btemp {
@@ -33,12 +34,16 @@ struct ControllerConfig {
   link::Pulses failsafe = link::neutralPulses();
 
   std::string key() const;  // "btemp://HOST:PORT" or "btemp://broadcast"
-  std::string settings() const;
+  // What the link is opened with, by setting ("ctrl-period" → "100ms", ...).
+  link::SettingValues settings() const;
 };
 
 class Controller : public link::VehicleLink {
  public:
-  static Expected<std::shared_ptr<Controller>, std::string> acquire(const ControllerConfig& config);
+  // The process-wide link to this robot, used by `user` (an element's name):
+  // shared while the settings agree, a conflict naming both users otherwise.
+  static Expected<std::shared_ptr<Controller>, std::string> acquire(const ControllerConfig& config,
+                                                                    const std::string& user = "");
   ~Controller() override;
   Controller(const Controller&) = delete;
   Controller& operator=(const Controller&) = delete;

@@ -1,7 +1,7 @@
 // The links of one protocol in this process, shared by vehicle: the first
 // user opens the link, later users that name the same vehicle get the same
-// one when they ask for the same settings, and an error naming both when not
-// (a setting is never dropped in silence).
+// one, under the one settings policy of every protocol (SettingClaims: a
+// setting is never dropped in silence, and a conflict names both users).
 #pragma once
 
 #include <map>
@@ -10,35 +10,48 @@
 #include <string>
 
 #include "common/expected.h"
+#include "link/shared_settings.h"
 
 namespace wircam::link {
 
 template <typename Link>
 class LinkRegistry {
  public:
-  // `settings` is what the link is opened with, as the user would read it;
-  // `open()` returns Expected<std::shared_ptr<Link>, std::string>.
+  // `settings` is what the link is opened with, as the user would read it
+  // (all of them count as given: an open link cannot change them);
+  // `open()` returns Expected<std::shared_ptr<Link>, std::string>. The
+  // registry must outlive the links it hands out (a function's static).
   template <typename Open>
   Expected<std::shared_ptr<Link>, std::string> acquire(const std::string& key,
-                                                       const std::string& settings, Open open) {
+                                                       const SettingValues& settings,
+                                                       const std::string& user, Open open) {
     std::lock_guard lock(mutex_);
     auto& entry = entries_[key];
-    if (auto link = entry.link.lock()) {
-      if (entry.settings != settings)
-        return unexpected("the link to " + key + " is open with " + entry.settings +
-                          "; this user asks for " + settings +
-                          ": give every user of one vehicle the same settings");
-      return link;
+    std::shared_ptr<Link> link = entry.link.lock();
+    if (!link) {
+      Expected<std::shared_ptr<Link>, std::string> opened = open();
+      if (!opened) return opened;
+      link = *opened;
+      entry = {link, settings, std::make_shared<SettingClaims>()};
     }
-    Expected<std::shared_ptr<Link>, std::string> opened = open();
-    if (opened) entry = {*opened, settings};
-    return opened;
+    if (auto claimed = entry.claims->claim(key, user, settings, entry.settings, false); !claimed)
+      return unexpected(claimed.error());
+    // Each user holds its own reference; letting go ends its claims.
+    auto* strong = new std::shared_ptr<Link>(link);
+    return std::shared_ptr<Link>(link.get(), [this, strong, claims = entry.claims, user](Link*) {
+      {
+        std::lock_guard released(mutex_);
+        claims->release(user);
+      }
+      delete strong;
+    });
   }
 
  private:
   struct Entry {
     std::weak_ptr<Link> link;
-    std::string settings;
+    SettingValues settings;
+    std::shared_ptr<SettingClaims> claims;
   };
   std::mutex mutex_;
   std::map<std::string, Entry> entries_;

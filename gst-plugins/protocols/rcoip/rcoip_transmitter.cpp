@@ -38,12 +38,13 @@ Expected<std::monostate, std::string> validate(const TransmitterConfig& c) {
 
 }  // namespace
 
-std::string TransmitterConfig::settings() const {
-  std::string text = "channels=" + std::to_string(channelCount) + " keepalive=" + ms(keepalive) +
-                     " fail-interval=" + ms(failInterval) + " lost-timeout=" + ms(commandTtl) +
-                     " rate=" + std::to_string(static_cast<int>(rateLimit));
-  if (auto overrides = map.toString(); !overrides.empty()) text += " map=" + overrides;
-  return text;
+link::SettingValues TransmitterConfig::settings() const {
+  return {{"channels", std::to_string(channelCount)},
+          {"keepalive", ms(keepalive)},
+          {"fail-interval", ms(failInterval)},
+          {"lost-timeout", ms(commandTtl)},
+          {"rate", std::to_string(static_cast<int>(rateLimit))},
+          {"map", map.toString()}};
 }
 
 class Transmitter::Impl {
@@ -165,10 +166,10 @@ void Transmitter::Impl::armSilenceTimer() {
 }
 
 Expected<std::shared_ptr<Transmitter>, std::string> Transmitter::acquire(
-    const TransmitterConfig& config) {
+    const TransmitterConfig& config, const std::string& user) {
   if (auto valid = validate(config); !valid) return unexpected(valid.error());
   static link::LinkRegistry<Transmitter> registry;
-  return registry.acquire(config.key(), config.settings(),
+  return registry.acquire(config.key(), config.settings(), user,
                           [&]() -> Expected<std::shared_ptr<Transmitter>, std::string> {
                             auto receiver = SocketAddress::resolve(config.host, config.port);
                             if (!receiver) return unexpected(receiver.error());

@@ -13,6 +13,7 @@
 
 #include "common/expected.h"
 #include "link/channel_byte_map.h"
+#include "link/shared_settings.h"
 #include "link/vehicle_link.h"
 #include "rcoip/rcoip_messages.h"
 #include "rcoip/reply_monitor.h"
@@ -31,14 +32,17 @@ struct TransmitterConfig {
   link::Pulses failsafe = link::neutralPulses();
 
   std::string key() const { return "rcoip://" + host + ":" + std::to_string(port); }
-  std::string settings() const;  // "channels=8 keepalive=1000ms ..."
+  // What the link is opened with, by setting ("channels" → "8", ...).
+  link::SettingValues settings() const;
 };
 
 class Transmitter : public link::VehicleLink {
  public:
-  // The process-wide link to this receiver (shared while settings agree).
+  // The process-wide link to this receiver, used by `user` (an element's
+  // name): shared while the settings agree, a conflict naming both users
+  // otherwise.
   static Expected<std::shared_ptr<Transmitter>, std::string> acquire(
-      const TransmitterConfig& config);
+      const TransmitterConfig& config, const std::string& user = "");
   ~Transmitter() override;
   Transmitter(const Transmitter&) = delete;
   Transmitter& operator=(const Transmitter&) = delete;

@@ -14,6 +14,7 @@
 
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
+#include "link/shared_settings.h"
 #include "wirc/channel_list.h"
 #include "wirc/discovery.h"
 #include "wirc/login_machine.h"
@@ -178,7 +179,7 @@ class TransmitterSession::Impl {
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   LoginMachine machine_;
-  std::map<std::string, std::string> owners_;  // setting name → the user who gave it
+  link::SettingClaims claims_;  // who gave which of the link's settings
   link::CommandPacer pacer_;
 
   // The TCP connection; sendMutex_ serialises writers from any thread.
@@ -426,17 +427,15 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
   {
     std::lock_guard settingsLock(impl->mutex_);
     auto& linkConfig = impl->machine_.config();
+    link::SettingValues given, current;
     for (const auto& setting : sharedSettings()) {
-      if (!config.given.count(setting.name)) continue;
-      std::string wanted = setting.text(config), current = setting.text(linkConfig);
-      auto owner = impl->owners_.find(setting.name);
-      if (wanted != current && owner != impl->owners_.end() && owner->second != user)
-        return unexpected(std::string(setting.name) + "=" + wanted + " of " + user +
-                          " conflicts with " + setting.name + "=" + current + " of " +
-                          owner->second + ", which shares the link to " + config.key() +
-                          ": give both the same value, or set it on one only");
-      impl->owners_[setting.name] = user;
-      if (wanted == current) continue;
+      current[setting.name] = setting.text(linkConfig);
+      if (config.given.count(setting.name)) given[setting.name] = setting.text(config);
+    }
+    auto changes = impl->claims_.claim(config.key(), user, given, current, true);
+    if (!changes) return unexpected(changes.error());
+    for (const auto& setting : sharedSettings()) {
+      if (std::find(changes->begin(), changes->end(), setting.name) == changes->end()) continue;
       setting.adopt(linkConfig, config);
       relogin = relogin || setting.needsLogin;
     }
@@ -466,7 +465,7 @@ TransmitterSession::~TransmitterSession() = default;
 
 void TransmitterSession::release(const std::string& user) {
   std::lock_guard lock(impl_->mutex_);
-  std::erase_if(impl_->owners_, [&](const auto& owner) { return owner.second == user; });
+  impl_->claims_.release(user);
 }
 
 std::optional<std::string> TransmitterSession::waitLoggedIn(milliseconds timeout) {
