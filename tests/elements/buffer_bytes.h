@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "gst_scoped.h"
+
 inline std::vector<uint8_t> bufferBytes(GstBuffer* buffer) {
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return {};
-  std::vector<uint8_t> bytes(map.data, map.data + map.size);
-  gst_buffer_unmap(buffer, &map);
-  return bytes;
+  wircam::gst::ScopedBufferMap map(buffer, GST_MAP_READ);
+  if (!map) return {};
+  return {map.data(), map.data() + map.size()};
 }

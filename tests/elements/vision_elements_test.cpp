@@ -7,6 +7,7 @@
 #include <cmath>
 #include <regex>
 
+#include "gst_scoped.h"
 #include "pipelines.h"
 #include "scene_frames.h"
 #include "wirc_position_meta.h"
@@ -140,13 +141,14 @@ TEST(TagOverlay, OutlinesTheDetectedTag) {
   // where the tag itself is black or white (V near 128).
   GstVideoInfo info;
   gst_video_info_set_format(&info, GST_VIDEO_FORMAT_I420, 352, 288);
-  GstVideoFrame frame;
-  ASSERT_TRUE(gst_video_frame_map(&frame, &info, out, GST_MAP_READ));
-  int x = static_cast<int>(std::lround(tag.corners[0])) / 2,
-      y = static_cast<int>(std::lround(tag.corners[1])) / 2;
-  auto* v = static_cast<const uint8_t*>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 2));
-  EXPECT_GT(v[y * GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 2) + x], 180);
-  gst_video_frame_unmap(&frame);
+  {
+    wircam::gst::ScopedVideoFrameMap frame(&info, out, GST_MAP_READ);
+    ASSERT_TRUE(frame);
+    int x = static_cast<int>(std::lround(tag.corners[0])) / 2,
+        y = static_cast<int>(std::lround(tag.corners[1])) / 2;
+    auto* v = static_cast<const uint8_t*>(GST_VIDEO_FRAME_PLANE_DATA(frame.get(), 2));
+    EXPECT_GT(v[y * GST_VIDEO_FRAME_PLANE_STRIDE(frame.get(), 2) + x], 180);
+  }
   gst_buffer_unref(out);
   gst_harness_teardown(h);
 }
@@ -161,15 +163,13 @@ TEST(TagOverlay, WritesEachBeaconsPositionInTheBottomLeftCorner) {
   };
   // The text's yellow pixels in the bottom left 200×40.
   auto yellowPixels = [](GstBuffer* buffer) {
-    GstMapInfo map;
-    gst_buffer_map(buffer, &map, GST_MAP_READ);
+    wircam::gst::ScopedBufferMap map(buffer, GST_MAP_READ);
     int count = 0;
-    for (int y = 200; y < 240; ++y)
+    for (int y = 200; y < 240 && map; ++y)
       for (int x = 0; x < 200; ++x) {
-        const uint8_t* p = map.data + (y * 320 + x) * 3;
+        const uint8_t* p = map.data() + (y * 320 + x) * 3;
         if (p[0] > 150 && p[1] > 130 && p[2] < 100) ++count;
       }
-    gst_buffer_unmap(buffer, &map);
     return count;
   };
   GstBuffer* plain = gst_harness_push_and_pull(h, blackFrame());

@@ -5,6 +5,8 @@
 
 #include <cstdlib>
 
+#include "gst_scoped.h"
+
 namespace wircam::testing {
 
 bool chromiumInstalled() { return std::system("command -v chromium > /dev/null") == 0; }
@@ -59,13 +61,13 @@ Picture readPng(const std::filesystem::path& file) {
     gst_video_info_from_caps(&info, gst_sample_get_caps(sample));
     picture.width = GST_VIDEO_INFO_WIDTH(&info);
     picture.height = GST_VIDEO_INFO_HEIGHT(&info);
-    GstMapInfo map;
-    gst_buffer_map(gst_sample_get_buffer(sample), &map, GST_MAP_READ);
-    int stride = GST_VIDEO_INFO_PLANE_STRIDE(&info, 0);
-    for (int y = 0; y < picture.height; ++y)
-      picture.rgb.insert(picture.rgb.end(), map.data + y * stride,
-                         map.data + y * stride + picture.width * 3);
-    gst_buffer_unmap(gst_sample_get_buffer(sample), &map);
+    {
+      gst::ScopedBufferMap map(gst_sample_get_buffer(sample), GST_MAP_READ);
+      int stride = GST_VIDEO_INFO_PLANE_STRIDE(&info, 0);
+      for (int y = 0; y < picture.height && map; ++y)
+        picture.rgb.insert(picture.rgb.end(), map.data() + y * stride,
+                           map.data() + y * stride + picture.width * 3);
+    }
     gst_sample_unref(sample);
   }
   gst_element_set_state(pipeline, GST_STATE_NULL);

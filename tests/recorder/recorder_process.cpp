@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "gst_scoped.h"
 #include "wait_for.h"
 
 namespace wircam::testing {
@@ -172,12 +173,11 @@ GstPadProbeReturn onText(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   const char* format = gst_structure_get_string(gst_caps_get_structure(caps, 0), "format");
   bool markup = format && std::string(format) == "pango-markup";
   gst_caps_unref(caps);
-  GstMapInfo map;
   // Empty buffers are the recorder's heartbeats (they carry no line).
-  if (gst_buffer_get_size(buffer) > 0 && gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-    std::string text(reinterpret_cast<const char*>(map.data), map.size);
+  if (gst_buffer_get_size(buffer) == 0) return GST_PAD_PROBE_OK;
+  if (gst::ScopedBufferMap map(buffer, GST_MAP_READ); map) {
+    std::string text(map.view());
     static_cast<Reading*>(data)->contents.telemetry.push_back(markup ? unescapeMarkup(text) : text);
-    gst_buffer_unmap(buffer, &map);
   }
   return GST_PAD_PROBE_OK;
 }
@@ -208,13 +208,11 @@ std::vector<std::string> frameDigests(const fs::path& file) {
   std::vector<std::string> digests;
   // A file that does not demux ends the frames (a wait, not a hang).
   while (GstSample* sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), 10 * GST_SECOND)) {
-    GstMapInfo map;
-    GstBuffer* buffer = gst_sample_get_buffer(sample);
-    gst_buffer_map(buffer, &map, GST_MAP_READ);
-    gchar* md5 = g_compute_checksum_for_data(G_CHECKSUM_MD5, map.data, map.size);
-    digests.emplace_back(md5);
-    g_free(md5);
-    gst_buffer_unmap(buffer, &map);
+    if (gst::ScopedBufferMap map(gst_sample_get_buffer(sample), GST_MAP_READ); map) {
+      gchar* md5 = g_compute_checksum_for_data(G_CHECKSUM_MD5, map.data(), map.size());
+      digests.emplace_back(md5);
+      g_free(md5);
+    }
     gst_sample_unref(sample);
   }
   gst_element_set_state(pipeline, GST_STATE_NULL);
