@@ -15,6 +15,14 @@ inline constexpr int kSanitizerSlowdown = 4;
 inline constexpr int kSanitizerSlowdown = 1;
 #endif
 
+// Under AddressSanitizer freed memory waits in a quarantine: resident
+// memory is no measure of a leak there.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kAddressSanitizer = true;
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+
 // `timeout`, stretched under a sanitizer.
 inline std::chrono::milliseconds patience(std::chrono::milliseconds timeout) {
   return timeout * kSanitizerSlowdown;
