@@ -8,6 +8,7 @@
 
 #include "follow_scene.h"
 #include "vehicle_control.h"
+#include "wait_for.h"
 #include "wirc/device.h"
 
 namespace {
@@ -15,6 +16,7 @@ namespace {
 using namespace wircam;
 using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
+using wircam::testing::waitFor;
 
 constexpr int kLostTimeoutMs = 500;
 
@@ -55,11 +57,14 @@ struct CousinLoop {
   wirc::ChannelOutputs car() const { return control->outputs(Clock::now()); }
 };
 
-class CousinFollowLoop : public testing::TestWithParam<const char*> {};
+class CousinFollowLoop : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(CousinFollowLoop, KeepsTheMovingTargetCentredAtTheSetDistance) {
   CousinLoop loop(GetParam());
-  std::this_thread::sleep_for(milliseconds(12000));
+  // 9 s of the scene's own time measured (135 frames at 15 fps, after its
+  // 3 s to settle).
+  ASSERT_TRUE(
+      waitFor([&] { return loop.scene->summary().measuredTicks >= 135; }, milliseconds(30000)));
   auto summary = loop.scene->summary();
   ASSERT_GT(summary.measuredTicks, 100u);
   // The same range as the WiRC loop (follow_loop_test).
@@ -71,8 +76,14 @@ TEST_P(CousinFollowLoop, KeepsTheMovingTargetCentredAtTheSetDistance) {
 
 TEST_P(CousinFollowLoop, StopsTheCarWhenTheTagIsHiddenAndFailsSafeWhenTheControllerLeaves) {
   CousinLoop loop(GetParam());
-  std::this_thread::sleep_for(milliseconds(4000));
-  ASSERT_NE(loop.car().pulses[1], wirc::kPulseNeutral);
+  // Following: commands arriving (no failsafe) with the throttle above
+  // neutral (beyond the byte map's 6 µs step).
+  ASSERT_TRUE(waitFor(
+      [&] {
+        auto car = loop.car();
+        return !car.failsafe && car.pulses[1] > wirc::kPulseNeutral + 6;
+      },
+      milliseconds(10000)));
   loop.scene->setTargetHidden(true);
   auto deadline = Clock::now() + milliseconds(3000);
   // The byte map carries 1500 µs as 128 (1503 µs back): neutral within a step.
@@ -86,6 +97,6 @@ TEST_P(CousinFollowLoop, StopsTheCarWhenTheTagIsHiddenAndFailsSafeWhenTheControl
   EXPECT_TRUE(loop.control->outputs(Clock::now() + milliseconds(2100)).failsafe);
 }
 
-INSTANTIATE_TEST_SUITE_P(Protocols, CousinFollowLoop, testing::Values("rcoip", "btemp"));
+INSTANTIATE_TEST_SUITE_P(Protocols, CousinFollowLoop, ::testing::Values("rcoip", "btemp"));
 
 }  // namespace

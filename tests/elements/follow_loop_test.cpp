@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "follow_scene.h"
+#include "wait_for.h"
 #include "wirc/device.h"
 
 namespace {
@@ -13,6 +14,7 @@ namespace {
 using namespace wircam;
 using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
+using wircam::testing::waitFor;
 
 // How soon after lost-timeout the car stops is the unit tests' business
 // (TargetFollower, CommandPacer: fake clock) and the benchmarks'; these
@@ -61,7 +63,10 @@ struct Loop {
 
 TEST(FollowLoop, KeepsTheMovingTargetCentredAtTheSetDistanceWithPacketLoss) {
   Loop loop({.loss = 0.02, .seed = 17});
-  std::this_thread::sleep_for(milliseconds(20000));
+  // 17 s of the scene's own time measured (255 frames at 15 fps, after its
+  // 3 s to settle): the scene's clock, not the test's, says when.
+  ASSERT_TRUE(
+      waitFor([&] { return loop.scene->summary().measuredTicks >= 255; }, milliseconds(40000)));
   auto summary = loop.scene->summary();
   ASSERT_GT(summary.measuredTicks, 200u);
   EXPECT_LT(summary.meanBearingDeg, 3.0);
@@ -75,8 +80,9 @@ TEST(FollowLoop, KeepsTheMovingTargetCentredAtTheSetDistanceWithPacketLoss) {
 
 TEST(FollowLoop, StopsTheCarWhenTheTagIsHidden) {
   Loop loop;
-  std::this_thread::sleep_for(milliseconds(4000));  // following, throttle above neutral
-  ASSERT_NE(loop.device->outputs().pulses[1], wirc::kPulseNeutral);
+  // Following: the throttle above neutral.
+  ASSERT_TRUE(waitFor([&] { return loop.device->outputs().pulses[1] != wirc::kPulseNeutral; },
+                      milliseconds(10000)));
   loop.scene->setTargetHidden(true);
   int stoppedAfter = loop.millisecondsUntilStopped(milliseconds(3000));
   ASSERT_GE(stoppedAfter, 0) << "the car never stopped";
@@ -86,17 +92,15 @@ TEST(FollowLoop, StopsTheCarWhenTheTagIsHidden) {
 
 TEST(FollowLoop, StopsTheCarWhenThePipelineStalls) {
   Loop loop;
-  std::this_thread::sleep_for(milliseconds(4000));
-  ASSERT_NE(loop.device->outputs().pulses[1], wirc::kPulseNeutral);
+  ASSERT_TRUE(waitFor([&] { return loop.device->outputs().pulses[1] != wirc::kPulseNeutral; },
+                      milliseconds(10000)));
   GstElement* src = gst_bin_get_by_name(GST_BIN(loop.pipeline), "src");
   GstPad* pad = gst_element_get_static_pad(src, "src");
+  // The source's next buffer blocks its streaming thread until the probe
+  // goes, as a stalled pipeline would.
   gulong probe = gst_pad_add_probe(
-      pad, GST_PAD_PROBE_TYPE_BUFFER,
-      [](GstPad*, GstPadProbeInfo*, gpointer) {
-        std::this_thread::sleep_for(milliseconds(3000));
-        return GST_PAD_PROBE_OK;
-      },
-      nullptr, nullptr);
+      pad, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
+      [](GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
   int stoppedAfter = loop.millisecondsUntilStopped(milliseconds(2500));
   ASSERT_GE(stoppedAfter, 0) << "the car never stopped";
   EXPECT_FALSE(loop.device->outputs().failsafe);  // stopped by neutral PCD, link kept
