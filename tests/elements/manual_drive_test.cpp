@@ -82,7 +82,6 @@ TEST(ManualDrive, EachCommandMovesTheDeadlineAndNotANumberMeansNeutral) {
     c.drive(0, 1.0);
   }
   EXPECT_TRUE(waitFor([&] { return c.pulse(kThrottle) == 1910; }));
-  EXPECT_EQ(c.device->outputs().pulses[kThrottle], 1910);
   c.drive(std::numeric_limits<double>::quiet_NaN(), 1.0);
   EXPECT_TRUE(waitFor([&] { return c.pulse(kThrottle) == 1500; }));
   auto reasons = c.driveReasons();

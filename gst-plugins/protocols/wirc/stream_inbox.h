@@ -50,7 +50,6 @@ class StreamInbox {
   // deadline expires are given up on the way.
   Wake wait(Clock::time_point deadline);
   std::optional<AssembledFrame> takeFrame();
-  void dropFrames() { ready_.clear(); }
 
  private:
   void receiveBatch();
