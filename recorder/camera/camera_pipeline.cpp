@@ -24,7 +24,8 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
   gst_object_set_name(GST_OBJECT(camera->pipeline_), plan.name.c_str());
   camera->planner_ =
       std::make_unique<SegmentPlanner>(files.folder, plan.name, files.extension, files.limits);
-  camera->track_ = std::make_unique<TelemetryTrack>(camera->element(plan.telemetrySource));
+  camera->track_ = std::make_unique<TelemetryTrack>(camera->element(plan.telemetrySource),
+                                                    plan.muxer.textGapEvents);
   camera->telemetry_ = std::make_unique<TelemetryRouter>(*camera->planner_, *camera->track_);
   camera->writer_ = std::make_unique<SegmentWriter>(
       SegmentWriter::Parts{.pipeline = camera->pipeline_,

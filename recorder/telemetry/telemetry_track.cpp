@@ -16,13 +16,13 @@ bool TelemetryTrack::write(const std::string& json, GstClockTime pts, GstClockTi
     return true;
   }
   if (fileStart == openStart_) {
-    push(json, pts, openFile_);
+    pushLine(json, pts, openFile_);
     return true;
   }
   // The file before, as long as the newest has not begun: after its first
   // buffer, the text track has moved on.
   if (fileStart != previousStart_ || sentFile_ == openFile_) return false;
-  push(json, pts, openFile_ - 1);
+  pushLine(json, pts, openFile_ - 1);
   return true;
 }
 
@@ -32,7 +32,7 @@ uint64_t TelemetryTrack::fileOpened(GstClockTime start) {
   previousStart_ = std::exchange(openStart_, start);
   while (!waiting_.empty() && waiting_.front().fileStart <= start) {
     if (waiting_.front().fileStart == start)
-      push(waiting_.front().json, waiting_.front().pts, openFile_);
+      pushLine(waiting_.front().json, waiting_.front().pts, openFile_);
     waiting_.pop_front();
   }
   return openFile_;
@@ -41,7 +41,10 @@ uint64_t TelemetryTrack::fileOpened(GstClockTime start) {
 void TelemetryTrack::heartbeat(GstClockTime frameTime) {
   if (!source_) return;
   MutexLock lock(mutex_);
-  if (openFile_ != 0) push({}, frameTime + 1, openFile_, true);
+  if (openFile_ == 0) return;
+  if (!gapsAhead_) return pushGap(frameTime + 1, kLineDuration, openFile_);
+  if (sentFile_ == openFile_ && frameTime + kGapLead / 2 < promised_) return;
+  pushGap(frameTime + 1, kGapLead, openFile_);
 }
 
 GstPadProbeReturn TelemetryTrack::passGap(GstPad* pad, GstPadProbeInfo* info, bool asEvent) {
@@ -60,16 +63,36 @@ void TelemetryTrack::end() {
   if (source_) gst_app_src_end_of_stream(GST_APP_SRC(source_));
 }
 
-void TelemetryTrack::push(const std::string& json, GstClockTime pts, uint64_t file, bool gap) {
-  if (file != sentFile_) last_ = 0;  // each file's times rise on their own
-  sentFile_ = file;
-  GstBuffer* buffer =
-      json.empty() ? gst_buffer_new() : gst_buffer_new_memdup(json.data(), json.size());
+void TelemetryTrack::pushLine(const std::string& json, GstClockTime pts, uint64_t file) {
+  moveTo(file);
   last_ = std::max(last_, pts);
-  GST_BUFFER_PTS(buffer) = last_;
-  GST_BUFFER_DURATION(buffer) = GST_MSECOND;  // an event, not a caption to read
+  send(gst_buffer_new_memdup(json.data(), json.size()), last_, kLineDuration, file);
+  if (gapsAhead_ && promised_ > last_ + kLineDuration)
+    pushGap(last_ + kLineDuration, promised_ - last_ - kLineDuration, file);
+}
+
+void TelemetryTrack::pushGap(GstClockTime from, GstClockTime duration, uint64_t file) {
+  moveTo(file);
+  // An empty sample, for mp4mux: the lines after it must not go before it.
+  if (!gapsAhead_) last_ = std::max(last_, from);
+  promised_ = std::max(promised_, from + duration);
+  GstBuffer* gap = gst_buffer_new();
+  GST_BUFFER_FLAG_SET(gap, GST_BUFFER_FLAG_GAP);
+  send(gap, from, duration, file);
+}
+
+void TelemetryTrack::moveTo(uint64_t file) {
+  if (file == sentFile_) return;
+  sentFile_ = file;
+  last_ = 0;
+  promised_ = 0;
+}
+
+void TelemetryTrack::send(GstBuffer* buffer, GstClockTime pts, GstClockTime duration,
+                          uint64_t file) {
+  GST_BUFFER_PTS(buffer) = pts;
+  GST_BUFFER_DURATION(buffer) = duration;
   GST_BUFFER_OFFSET(buffer) = file;
-  if (gap) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_GAP);
   gst_app_src_push_buffer(GST_APP_SRC(source_), buffer);
 }
 

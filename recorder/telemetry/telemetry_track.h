@@ -21,7 +21,9 @@ class TelemetryTrack {
  public:
   // `source` is the stream's appsrc (text/x-raw, format=utf8); borrowed.
   // Null: the files have no text track, and every line is refused.
-  explicit TelemetryTrack(GstElement* source) : source_(source) {}
+  // `gapsAhead`: the muxer takes gaps as GAP events (matroskamux), so the
+  // heartbeat may promise a stretch ahead of the frames (heartbeat()).
+  TelemetryTrack(GstElement* source, bool gapsAhead) : source_(source), gapsAhead_(gapsAhead) {}
 
   // A line for the file that starts at running time `fileStart`. A muxer
   // wants the timestamps of a track to rise, but events arrive a little out
@@ -37,13 +39,20 @@ class TelemetryTrack {
   uint64_t fileOpened(GstClockTime start);
 
   // A muxer hands on a frame only once every track has passed its time,
-  // so a sparse text track would hold the video back: at each frame the
-  // text says it has nothing until just after it (a gap: an empty buffer
-  // flagged GAP, which the SegmentWriter passes on as the muxer wants it).
-  // (A gap further ahead would spare the text's thread most wake-ups, but
-  // a line that comes behind a gap the muxer has passed is then lost or
-  // misplaced: tried, and the recorder's tests failed.)
+  // so a sparse text track would hold the video back: the text says it has
+  // nothing until past the frame (a gap: an empty buffer flagged GAP, which
+  // the SegmentWriter passes on as the muxer wants it). Called before each
+  // frame reaches the muxer, on the frame's thread.
+  // - With gapsAhead, one gap promises kGapLead, renewed once a frame comes
+  //   within half of it: the text's thread wakes twice a second, not at
+  //   every frame. A line is still written at its own time, behind the
+  //   promise; as a line takes the muxer's idea of the track's position
+  //   back to its time, the promise is restated after it, or the frames
+  //   past the line would wait for a gap that no frame asks for.
+  // - Otherwise (mp4mux: its gaps are empty samples, whose times must
+  //   rise, and lines after them), a gap just after each frame.
   void heartbeat(GstClockTime frameTime);
+  static constexpr GstClockTime kGapLead = GST_SECOND;
   static bool isGap(GstBuffer* buffer) {
     return GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_GAP) && gst_buffer_get_size(buffer) == 0;
   }
@@ -59,8 +68,11 @@ class TelemetryTrack {
   static uint64_t fileOf(GstBuffer* buffer) { return GST_BUFFER_OFFSET(buffer); }
 
  private:
-  void push(const std::string& json, GstClockTime pts, uint64_t file, bool gap = false)
-      WIRCAM_REQUIRES(mutex_);
+  void pushLine(const std::string& json, GstClockTime pts, uint64_t file) WIRCAM_REQUIRES(mutex_);
+  void pushGap(GstClockTime from, GstClockTime duration, uint64_t file) WIRCAM_REQUIRES(mutex_);
+  // Buffers for `file` from now on: its times rise on their own.
+  void moveTo(uint64_t file) WIRCAM_REQUIRES(mutex_);
+  void send(GstBuffer* buffer, GstClockTime pts, GstClockTime duration, uint64_t file);
 
   struct Waiting {
     std::string json;
@@ -68,14 +80,17 @@ class TelemetryTrack {
   };
 
   GstElement* source_;
+  const bool gapsAhead_;
   Mutex mutex_;  // lines come from the main loop, heartbeats and openings from streaming
   uint64_t openFile_ WIRCAM_GUARDED_BY(mutex_) = 0;       // the newest file's number (0: none)
   GstClockTime openStart_ WIRCAM_GUARDED_BY(mutex_) = 0;  // and its start
   GstClockTime previousStart_ WIRCAM_GUARDED_BY(mutex_) = GST_CLOCK_TIME_NONE;  // the one before's
   uint64_t sentFile_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the file of the newest buffer sent
   GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the newest line's time
+  GstClockTime promised_ WIRCAM_GUARDED_BY(mutex_) = 0;    // where the newest gap ends
   std::deque<Waiting> waiting_ WIRCAM_GUARDED_BY(mutex_);  // for files still to open
   static constexpr size_t kMaxWaiting = 1024;
+  static constexpr GstClockTime kLineDuration = GST_MSECOND;  // an event, not a caption to read
 };
 
 }  // namespace wircam::recorder
