@@ -5,7 +5,9 @@
 //   stock:  N × multifilesrc ! rtpjpegpay ! udpsink  →  one gst-launch with
 //           N × (udpsrc ! rtpjpegdepay ! matroskamux ! filesink)
 // Senders are separate processes; the receiving process's CPU (user + system)
-// and peak memory come from wait4(), its CPU over its whole life. Frames are
+// and peak memory come from wait4(), its CPU over its whole life; its CPU
+// while recording (from a quarter of the run to the senders' end, out of
+// /proc, so without starting and stopping) is shown beside it. Frames are
 // counted in the files. The senders stop first and the receiver 0.3 s later,
 // so "lost" counts the frames sent that did not reach a file, not those
 // sent while the receiver was told to stop.
@@ -105,6 +107,37 @@ int threadsOf(pid_t root) {
   return count;
 }
 
+// A process's CPU (user + system) so far, in seconds.
+double cpuSecondsOf(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  std::getline(stat, line);
+  auto close = line.rfind(')');
+  if (close == std::string::npos) return 0;
+  std::istringstream rest(line.substr(close + 2));
+  std::string field;
+  for (int i = 3; i < 14; ++i) rest >> field;  // state … cmajflt
+  long user = 0, system = 0;
+  rest >> user >> system;
+  return static_cast<double>(user + system) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+// The CPU a process spends over a stretch of its run.
+class CpuWindow {
+ public:
+  explicit CpuWindow(pid_t pid) : pid_(pid), cpu_(cpuSecondsOf(pid)), start_(Clock::now()) {}
+  // Percent of one core, per stream.
+  double end(int streams) const {
+    double wall = std::chrono::duration<double>(Clock::now() - start_).count();
+    return 100 * (cpuSecondsOf(pid_) - cpu_) / wall / streams;
+  }
+
+ private:
+  pid_t pid_;
+  double cpu_;
+  Clock::time_point start_;
+};
+
 // "frames sent        N" from a wirc-sim summary.
 int framesSent(const fs::path& summary) {
   std::ifstream in(summary);
@@ -120,10 +153,11 @@ struct Run {
   int sent = 0, recorded = 0, threads = 0;
   Usage usage;
   double seconds = 0;
+  double recordingCpu = 0;  // % per stream while recording
   std::string row(int streams) const {
     char text[128];
-    std::snprintf(text, sizeof text, "lost %4d of %5d, %5.2f %%, %5.2f MB, %4d thr",
-                  sent - recorded, sent, 100 * usage.cpuSeconds / seconds / streams,
+    std::snprintf(text, sizeof text, "lost %4d of %5d, %5.3f / %5.3f %%, %5.2f MB, %4d thr",
+                  sent - recorded, sent, 100 * usage.cpuSeconds / seconds / streams, recordingCpu,
                   usage.maxRssKb / 1024.0 / streams, threads);
     return text;
   }
@@ -147,9 +181,12 @@ Run recordWithWircam(const fs::path& work, const fs::path& bin, int basePort, in
   auto start = Clock::now();
   pid_t recorder = spawn((bin / "wirc-recorder").string() + devices + " --out " +
                          (work / "rec").string() + " --segment 600" + extra);
-  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 4));
+  CpuWindow recording(recorder);
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 4));
   run.threads = threadsOf(recorder);
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+  run.recordingCpu = recording.end(n);
   for (pid_t sim : sims) wircam::bench::stopGroup(sim, SIGINT);
   std::this_thread::sleep_for(kDrain);
   kill(recorder, SIGINT);
@@ -187,9 +224,12 @@ Run recordWithStock(const fs::path& work, int basePort, int n, double seconds) {
               " caps=image/jpeg,width=352,height=288,framerate=15/1 ! identity sleep-time=66666"
               " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" +
               std::to_string(basePort + 2 * i + 1)));
-  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 4));
+  CpuWindow recording(receiver);
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 4));
   run.threads = threadsOf(receiver);
   for (pid_t s : senders) waitpid(s, nullptr, 0);
+  run.recordingCpu = recording.end(n);
   std::this_thread::sleep_for(kDrain);
   kill(receiver, SIGINT);
   run.usage = waitForUsage(receiver);
@@ -221,9 +261,9 @@ int main(int argc, char** argv) {
   }
   int basePort = 21000 + getpid() % 20000;
 
-  std::printf("%-8s | %-46s | %-46s | %-46s\n", "streams",
-              "wirc-recorder: lost, CPU, memory, threads", "--telemetry-track off: same",
-              "udpsrc ! rtpjpegdepay ! matroskamux: same");
+  std::printf("%-8s | %-54s | %-54s | %-54s\n", "streams",
+              "wirc-recorder: lost, CPU life / recording, memory, threads",
+              "--telemetry-track off: same", "udpsrc ! rtpjpegdepay ! matroskamux: same");
   for (int n : counts) {
     Run track = recordWithWircam(work, bin, basePort, n, seconds, "");
     Run sidecarOnly = recordWithWircam(work, bin, basePort, n, seconds, " --telemetry-track off");
