@@ -334,6 +334,10 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto seconds = number(value);
     if (!seconds || *seconds < 1 || *seconds > 86400) return "seconds, 1..86400";
     o.hookTimeoutSeconds = *seconds;
+  } else if (name == "hook-drain") {
+    auto seconds = number(value);
+    if (!seconds || *seconds < 0 || *seconds > 3600) return "seconds, 0..3600";
+    o.hookDrainSeconds = *seconds;
   } else if (name == "marvelmind") {
     o.marvelmind = value;
   } else if (name == "beacon") {
@@ -442,6 +446,7 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"mqtt-detections-rate", required_argument, nullptr, kValue},
                                    {"on-segment-closed", required_argument, nullptr, kValue},
                                    {"hook-timeout", required_argument, nullptr, kValue},
+                                   {"hook-drain", required_argument, nullptr, kValue},
                                    {"beacon", required_argument, nullptr, kValue},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};

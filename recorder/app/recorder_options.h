@@ -107,6 +107,7 @@ struct RecorderOptions {
   double mqttDetectionsRate = 0;             // per second and stream at most; 0 = every frame
   std::vector<std::string> onSegmentClosed;  // the command and its arguments
   double hookTimeoutSeconds = 600;
+  double hookDrainSeconds = 15;  // what the queue gets at exit
   // Marvelmind positions of every device that names none of its own.
   std::optional<std::string> marvelmind;  // HOST[:PORT]
   std::optional<std::string> beacons;

@@ -118,6 +118,7 @@ file and exits 0.
                          failures are retried with backoff (e.g. a script
                          that runs rclone: README.md, "Fleets")
   --hook-timeout S       a hook running longer is stopped and retried (default 600)
+  --hook-drain S         at exit, how long the hooks still queued get (default 15)
   --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>; without
                          HOST on 127.0.0.1 only
   -h, --help             this text
@@ -129,7 +130,7 @@ stall-timeout, http, http-token, http-cert, http-key, http-idle-timeout, webrtc,
 webrtc-stun, webrtc-turn, webrtc-kbps, rtsp,
 periods, failsafe, marvelmind, beacon, mqtt, mqtt-cafile, mqtt-prefix,
 mqtt-discovery, mqtt-snapshot-interval, mqtt-detections-rate,
-on-segment-closed, hook-timeout), and one [device NAME] group per vehicle with
+on-segment-closed, hook-timeout, hook-drain), and one [device NAME] group per vehicle with
 host, port, cameras (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as
 on the command line), marvelmind and beacon:
 

@@ -42,7 +42,6 @@ std::optional<std::string> checkFamily(const std::string& family) {
 // A stop's own bound, past the cameras' kFinishTime: whatever a camera or
 // device does, the run ends within 3 s of it.
 constexpr guint kStopBoundMs = 2900;
-constexpr int kHookDrainSeconds = 15;
 
 }  // namespace
 
@@ -497,7 +496,9 @@ int Supervisor::run() {
   for (auto& c : cameras_) c->halt();  // what still runs (a second signal, the backstop)
   if (hook_) {
     // The last segments' uploads get a little time; what is left is named.
-    for (const auto& left : hook_->drain(std::chrono::seconds(kHookDrainSeconds)))
+    auto limit = std::chrono::duration<double>(options_.hookDrainSeconds);
+    for (const auto& left :
+         hook_->drain(std::chrono::duration_cast<std::chrono::milliseconds>(limit)))
       logLine("--on-segment-closed did not get to " + left + " before exit");
   }
   return exitCode_;

@@ -127,7 +127,7 @@ gboolean SegmentHook::onRetry(gpointer data) {
   return G_SOURCE_REMOVE;
 }
 
-std::vector<std::string> SegmentHook::drain(std::chrono::seconds limit) {
+std::vector<std::string> SegmentHook::drain(std::chrono::milliseconds limit) {
   auto end = std::chrono::steady_clock::now() + limit;
   // A tick, so a retry waiting longer than the limit does not hold it up.
   guint tick = g_timeout_add(

@@ -36,7 +36,7 @@ class SegmentHook {
                      const std::string& sidecar);
   // Lets the queue run for up to `limit` (at exit); the segments it could
   // not hand over, by path.
-  std::vector<std::string> drain(std::chrono::seconds limit);
+  std::vector<std::string> drain(std::chrono::milliseconds limit);
   // Ends a drain now (a second SIGINT).
   void stopDraining() { drainStopped_ = true; }
 

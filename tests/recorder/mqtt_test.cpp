@@ -280,9 +280,9 @@ TEST(RecorderMqtt, AHangingHookIsStoppedRetriedAndReportedWhileRecordingGoesOn) 
   std::ofstream(hang) << "#!/bin/sh\nsleep 1000\n";
   fs::permissions(hang, fs::perms::owner_all);
   auto start = std::chrono::steady_clock::now();
-  RecorderProcess recorder(device->port(),
-                           {"--mqtt", broker.url(), "--segment", "2", "--duration", "5",
-                            "--on-segment-closed", hang.string(), "--hook-timeout", "1"});
+  RecorderProcess recorder(device->port(), {"--mqtt", broker.url(), "--segment", "2", "--duration",
+                                            "5", "--on-segment-closed", hang.string(),
+                                            "--hook-timeout", "1", "--hook-drain", "2"});
   EXPECT_EQ(recorder.wait(), 0) << recorder.log();
   // Recording was not held up: the segments are all there and whole, and
   // the exit came after at most the hooks' drain time.

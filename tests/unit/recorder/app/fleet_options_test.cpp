@@ -17,18 +17,21 @@ Expected<RecorderOptions, std::string> parse(std::vector<std::string> words) {
 
 TEST(FleetOptions, MqttPrefixHookAndTheirErrors) {
   auto options = parse({"--mqtt", "mqtt://127.0.0.1:1883", "--mqtt-prefix", "lab/node-a",
-                        "--on-segment-closed", "upload --to 'my bucket'", "--hook-timeout", "30"});
+                        "--on-segment-closed", "upload --to 'my bucket'", "--hook-timeout", "30",
+                        "--hook-drain", "2.5"});
   ASSERT_TRUE(options) << options.error();
   EXPECT_EQ(*options->mqtt, "mqtt://127.0.0.1:1883");
   EXPECT_EQ(options->mqttPrefix, "lab/node-a");
   // Split like a shell would, quotes and all, but no shell runs it.
   EXPECT_EQ(options->onSegmentClosed, (std::vector<std::string>{"upload", "--to", "my bucket"}));
   EXPECT_EQ(options->hookTimeoutSeconds, 30);
+  EXPECT_EQ(options->hookDrainSeconds, 2.5);
   EXPECT_FALSE(parse({"--mqtt", "tcp://x"}));
   EXPECT_FALSE(parse({"--mqtt-prefix", "a/#"}));
   EXPECT_FALSE(parse({"--mqtt-prefix", "/a"}));
   EXPECT_FALSE(parse({"--on-segment-closed", "upload 'unclosed"}));
   EXPECT_FALSE(parse({"--hook-timeout", "0"}));
+  EXPECT_FALSE(parse({"--hook-drain", "-1"}));
   EXPECT_FALSE(parse({"--mqtt-detections-rate", "-1"}));
 }
 
