@@ -51,7 +51,7 @@ link::SettingValues ControllerConfig::settings() const {
 // The I/O around the Registration: the socket and timers on the event loop.
 class Controller::Impl {
  public:
-  Impl(ControllerConfig config, UniqueFd socket, link::LinkListeners& listeners);
+  Impl(ControllerConfig config, UniqueFd socket, link::LinkListeners& listeners, EventLoop& loop);
   ~Impl();
 
   void onReadable();
@@ -72,11 +72,11 @@ class Controller::Impl {
     return ctrl;
   }
 
+  EventLoop& loop_;
   const ControllerConfig config_;
   const NodeInfo self_{randomGuid(), nodeFlags(NodeType::Controller)};
   UniqueFd socket_;
   link::LinkListeners& listeners_;
-  EventLoop& loop_ = EventLoop::shared();
   EventLoop::Id watch_ = 0, phaseTimer_ = 0, pacerTimer_ = 0;
 
   // Guards what follows; never held while sending or emitting.
@@ -85,8 +85,10 @@ class Controller::Impl {
   link::CommandPacer pacer_;
 };
 
-Controller::Impl::Impl(ControllerConfig config, UniqueFd socket, link::LinkListeners& listeners)
-    : config_(std::move(config)),
+Controller::Impl::Impl(ControllerConfig config, UniqueFd socket, link::LinkListeners& listeners,
+                       EventLoop& loop)
+    : loop_(loop),
+      config_(std::move(config)),
       socket_(std::move(socket)),
       listeners_(listeners),
       registration_(self_, config_.host, config_.port, config_.keepaliveTimeout, Clock::now()),
@@ -196,14 +198,14 @@ void Controller::Impl::onReadable() {
 }
 
 Expected<std::shared_ptr<Controller>, std::string> Controller::acquire(
-    const ControllerConfig& config, const std::string& user) {
+    const ControllerConfig& config, const std::string& user, EventLoop& loop) {
   if (config.ctrlPeriod.count() <= 0 || config.ctrlPeriod >= config.keepaliveTimeout)
     return unexpected("ctrl period " + ms(config.ctrlPeriod) +
                       " must be above 0 and below the keepalive timeout (" +
                       ms(config.keepaliveTimeout) + ")");
   static link::LinkRegistry<Controller> registry;
   return registry.acquire(
-      config.key(), config.settings(), user,
+      loop, config.key(), config.settings(), user,
       [&]() -> Expected<std::shared_ptr<Controller>, std::string> {
         if (!config.host.empty())
           if (auto robot = SocketAddress::resolve(config.host, config.port); !robot)
@@ -211,7 +213,7 @@ Expected<std::shared_ptr<Controller>, std::string> Controller::acquire(
         auto socket = openBroadcastSocket();
         if (!socket) return unexpected(socket.error());
         std::shared_ptr<Controller> link(new Controller());
-        link->impl_ = std::make_unique<Impl>(config, std::move(*socket), link->listeners_);
+        link->impl_ = std::make_unique<Impl>(config, std::move(*socket), link->listeners_, loop);
         return link;
       });
 }

@@ -17,6 +17,7 @@
 #include "btemp/btemp_registration.h"
 #include "common/expected.h"
 #include "link/channel_byte_map.h"
+#include "link/event_loop.h"
 #include "link/shared_settings.h"
 #include "link/vehicle_link.h"
 
@@ -42,8 +43,10 @@ class Controller : public link::VehicleLink {
  public:
   // The process-wide link to this robot, used by `user` (an element's name):
   // shared while the settings agree, a conflict naming both users otherwise.
-  static Expected<std::shared_ptr<Controller>, std::string> acquire(const ControllerConfig& config,
-                                                                    const std::string& user = "");
+  // It runs on `loop`.
+  static Expected<std::shared_ptr<Controller>, std::string> acquire(
+      const ControllerConfig& config, const std::string& user = "",
+      link::EventLoop& loop = link::EventLoop::shared());
   ~Controller() override;
   Controller(const Controller&) = delete;
   Controller& operator=(const Controller&) = delete;

@@ -8,11 +8,14 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include "common/expected.h"
 #include "link/shared_settings.h"
 
 namespace wircam::link {
+
+class EventLoop;
 
 template <typename Link>
 class LinkRegistry {
@@ -21,12 +24,15 @@ class LinkRegistry {
   // (all of them count as given: an open link cannot change them);
   // `open()` returns Expected<std::shared_ptr<Link>, std::string>. The
   // registry must outlive the links it hands out (a function's static).
+  // Links on different event loops are different links (a test may own
+  // a loop).
   template <typename Open>
-  Expected<std::shared_ptr<Link>, std::string> acquire(const std::string& key,
+  Expected<std::shared_ptr<Link>, std::string> acquire(const EventLoop& loop,
+                                                       const std::string& key,
                                                        const SettingValues& settings,
                                                        const std::string& user, Open open) {
     std::lock_guard lock(mutex_);
-    auto& entry = entries_[key];
+    auto& entry = entries_[{&loop, key}];
     std::shared_ptr<Link> link = entry.link.lock();
     if (!link) {
       Expected<std::shared_ptr<Link>, std::string> opened = open();
@@ -54,7 +60,7 @@ class LinkRegistry {
     std::shared_ptr<SettingClaims> claims;
   };
   std::mutex mutex_;
-  std::map<std::string, Entry> entries_;
+  std::map<std::pair<const EventLoop*, std::string>, Entry> entries_;
 };
 
 }  // namespace wircam::link

@@ -45,7 +45,8 @@ Expected<std::vector<uint8_t>, std::string> parseBeacons(const std::string& text
 // The I/O around the BeaconTracker: the socket and timers on the event loop.
 class PositionClient::Impl {
  public:
-  Impl(ClientConfig config, SocketAddress dashboard, UniqueFd socket, Listener listener);
+  Impl(ClientConfig config, SocketAddress dashboard, UniqueFd socket, Listener listener,
+       EventLoop& loop);
   ~Impl();
 
   void onReadable();
@@ -53,12 +54,12 @@ class PositionClient::Impl {
   void onStaleTimer();
   void armStaleTimer();
 
+  EventLoop& loop_;
   const ClientConfig config_;
   const SocketAddress dashboard_;
   UniqueFd socket_;
   const Listener listener_;
   const Clock::duration pollPeriod_;
-  EventLoop& loop_ = EventLoop::shared();
   EventLoop::Id watch_ = 0, pollTimer_ = 0, staleTimer_ = 0;
 
   mutable Mutex mutex_;  // never held while the listener runs
@@ -66,8 +67,9 @@ class PositionClient::Impl {
 };
 
 PositionClient::Impl::Impl(ClientConfig config, SocketAddress dashboard, UniqueFd socket,
-                           Listener listener)
-    : config_(std::move(config)),
+                           Listener listener, EventLoop& loop)
+    : loop_(loop),
+      config_(std::move(config)),
       dashboard_(dashboard),
       socket_(std::move(socket)),
       listener_(std::move(listener)),
@@ -138,7 +140,7 @@ void PositionClient::Impl::armStaleTimer() {
 }
 
 Expected<std::unique_ptr<PositionClient>, std::string> PositionClient::start(
-    const ClientConfig& config, Listener listener) {
+    const ClientConfig& config, Listener listener, EventLoop& loop) {
   if (auto problem = validate(config)) return unexpected(*problem);
   SocketAddress dashboard;
   if (!config.host.empty()) {
@@ -152,7 +154,7 @@ Expected<std::unique_ptr<PositionClient>, std::string> PositionClient::start(
   setNonBlocking(socket->get());
   std::unique_ptr<PositionClient> client(new PositionClient());
   client->impl_ =
-      std::make_unique<Impl>(config, dashboard, std::move(*socket), std::move(listener));
+      std::make_unique<Impl>(config, dashboard, std::move(*socket), std::move(listener), loop);
   return client;
 }
 

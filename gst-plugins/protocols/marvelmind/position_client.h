@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "link/event_loop.h"
 #include "marvelmind/beacon_tracker.h"
 #include "marvelmind/marvelmind_messages.h"
 
@@ -27,9 +28,10 @@ class PositionClient {
  public:
   using Listener = std::function<void(const PositionEvent&)>;
 
-  // `listener` runs on the event loop thread and must not block.
-  static Expected<std::unique_ptr<PositionClient>, std::string> start(const ClientConfig& config,
-                                                                      Listener listener);
+  // `listener` runs on `loop`'s thread and must not block.
+  static Expected<std::unique_ptr<PositionClient>, std::string> start(
+      const ClientConfig& config, Listener listener,
+      link::EventLoop& loop = link::EventLoop::shared());
   // Once it returns, the listener is not running and never runs again.
   ~PositionClient();
   PositionClient(const PositionClient&) = delete;

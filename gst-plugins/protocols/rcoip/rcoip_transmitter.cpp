@@ -50,7 +50,7 @@ link::SettingValues TransmitterConfig::settings() const {
 class Transmitter::Impl {
  public:
   Impl(TransmitterConfig config, SocketAddress receiver, UniqueFd socket,
-       link::LinkListeners& listeners);
+       link::LinkListeners& listeners, EventLoop& loop);
   ~Impl();
 
   void onReadable();
@@ -62,11 +62,11 @@ class Transmitter::Impl {
     for (const auto& event : events) listeners_.emit(event);
   }
 
+  EventLoop& loop_;
   const TransmitterConfig config_;
   const SocketAddress receiver_;
   UniqueFd socket_;
   link::LinkListeners& listeners_;
-  EventLoop& loop_ = EventLoop::shared();
   EventLoop::Id watch_ = 0, pacerTimer_ = 0, silenceTimer_ = 0;
 
   // Guards what follows; never held while sending or emitting.
@@ -76,8 +76,9 @@ class Transmitter::Impl {
 };
 
 Transmitter::Impl::Impl(TransmitterConfig config, SocketAddress receiver, UniqueFd socket,
-                        link::LinkListeners& listeners)
-    : config_(std::move(config)),
+                        link::LinkListeners& listeners, EventLoop& loop)
+    : loop_(loop),
+      config_(std::move(config)),
       receiver_(receiver),
       socket_(std::move(socket)),
       listeners_(listeners),
@@ -166,10 +167,10 @@ void Transmitter::Impl::armSilenceTimer() {
 }
 
 Expected<std::shared_ptr<Transmitter>, std::string> Transmitter::acquire(
-    const TransmitterConfig& config, const std::string& user) {
+    const TransmitterConfig& config, const std::string& user, EventLoop& loop) {
   if (auto valid = validate(config); !valid) return unexpected(valid.error());
   static link::LinkRegistry<Transmitter> registry;
-  return registry.acquire(config.key(), config.settings(), user,
+  return registry.acquire(loop, config.key(), config.settings(), user,
                           [&]() -> Expected<std::shared_ptr<Transmitter>, std::string> {
                             auto receiver = SocketAddress::resolve(config.host, config.port);
                             if (!receiver) return unexpected(receiver.error());
@@ -178,7 +179,7 @@ Expected<std::shared_ptr<Transmitter>, std::string> Transmitter::acquire(
                             setNonBlocking(socket->get());
                             std::shared_ptr<Transmitter> link(new Transmitter());
                             link->impl_ = std::make_unique<Impl>(
-                                config, *receiver, std::move(*socket), link->listeners_);
+                                config, *receiver, std::move(*socket), link->listeners_, loop);
                             return link;
                           });
 }

@@ -13,6 +13,7 @@
 
 #include "common/expected.h"
 #include "link/channel_byte_map.h"
+#include "link/event_loop.h"
 #include "link/shared_settings.h"
 #include "link/vehicle_link.h"
 #include "rcoip/rcoip_messages.h"
@@ -40,9 +41,10 @@ class Transmitter : public link::VehicleLink {
  public:
   // The process-wide link to this receiver, used by `user` (an element's
   // name): shared while the settings agree, a conflict naming both users
-  // otherwise.
+  // otherwise. It runs on `loop`.
   static Expected<std::shared_ptr<Transmitter>, std::string> acquire(
-      const TransmitterConfig& config, const std::string& user = "");
+      const TransmitterConfig& config, const std::string& user = "",
+      link::EventLoop& loop = link::EventLoop::shared());
   ~Transmitter() override;
   Transmitter(const Transmitter&) = delete;
   Transmitter& operator=(const Transmitter&) = delete;

@@ -124,7 +124,7 @@ const char* errorCodeMeaning(uint16_t code) {
 // loop, and the mutex every thread takes to reach the machine.
 class TransmitterSession::Impl {
  public:
-  Impl(SessionConfig config, link::LinkListeners& listeners);
+  Impl(SessionConfig config, link::LinkListeners& listeners, EventLoop& loop);
   ~Impl();
 
   // Hands an event to the machine (under the mutex) and carries out what it
@@ -160,7 +160,7 @@ class TransmitterSession::Impl {
   bool sendControl(const Message& message);
   void sendPcd(const link::Pulses& pulses);
 
-  EventLoop& loop_ = EventLoop::shared();
+  EventLoop& loop_;
   link::LinkListeners& listeners_;
   UniqueFd psdSocket_;  // PSD arrive here
   UniqueFd pcdSocket_;  // PCD leave from here
@@ -199,8 +199,10 @@ UniqueFd boundUdp() {
 }
 }  // namespace
 
-TransmitterSession::Impl::Impl(SessionConfig config, link::LinkListeners& listeners)
-    : listeners_(listeners),
+TransmitterSession::Impl::Impl(SessionConfig config, link::LinkListeners& listeners,
+                               EventLoop& loop)
+    : loop_(loop),
+      listeners_(listeners),
       psdSocket_(boundUdp()),
       pcdSocket_(boundUdp()),
       machine_(config, boundPort(psdSocket_), Clock::now()),
@@ -397,7 +399,7 @@ void TransmitterSession::Impl::onPacerTimer() {
 // ---------------------------------------------------------------------------
 
 Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::acquire(
-    const SessionConfig& config, const std::string& user) {
+    const SessionConfig& config, const std::string& user, EventLoop& loop) {
   if (config.keepalive > kMaxKeepalive || config.keepalive.count() <= 0)
     return unexpected("keepalive " + ms(config.keepalive) + " is outside 1.." + ms(kMaxKeepalive) +
                       ": it must stay well below the device's PCD timeout (200..2000 ms)");
@@ -411,12 +413,14 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
   std::shared_ptr<TransmitterSession> session;
   {
     static std::mutex registryMutex;
-    static std::map<std::string, std::weak_ptr<TransmitterSession>> registry;
+    // By device and loop: sessions on different loops are different links.
+    static std::map<std::pair<const EventLoop*, std::string>, std::weak_ptr<TransmitterSession>>
+        registry;
     std::lock_guard lock(registryMutex);
-    auto& entry = registry[config.key()];
+    auto& entry = registry[{&loop, config.key()}];
     session = entry.lock();
     if (!session) {
-      session.reset(new TransmitterSession(config));
+      session.reset(new TransmitterSession(config, loop));
       entry = session;
     }
   }
@@ -458,8 +462,8 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
                                              });
 }
 
-TransmitterSession::TransmitterSession(const SessionConfig& config)
-    : impl_(std::make_unique<Impl>(config, listeners_)) {}
+TransmitterSession::TransmitterSession(const SessionConfig& config, EventLoop& loop)
+    : impl_(std::make_unique<Impl>(config, listeners_, loop)) {}
 
 TransmitterSession::~TransmitterSession() = default;
 

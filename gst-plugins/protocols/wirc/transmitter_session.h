@@ -16,6 +16,7 @@
 
 #include "common/expected.h"
 #include "common/socket.h"
+#include "link/event_loop.h"
 #include "link/vehicle_link.h"
 #include "wirc/messages.h"
 
@@ -83,9 +84,10 @@ class TransmitterSession : public link::VehicleLink {
   // name) until the returned pointer is dropped; the last one logs out.
   // A setting `user` gave that another user gave differently is refused,
   // naming both; one that nobody gave is adopted, logging in again when
-  // it changes the login.
+  // it changes the login. It runs on `loop` (a test may own one).
   static Expected<std::shared_ptr<TransmitterSession>, std::string> acquire(
-      const SessionConfig& config, const std::string& user = "");
+      const SessionConfig& config, const std::string& user = "",
+      link::EventLoop& loop = link::EventLoop::shared());
 
   ~TransmitterSession() override;
   TransmitterSession(const TransmitterSession&) = delete;
@@ -115,7 +117,7 @@ class TransmitterSession : public link::VehicleLink {
   class Impl;
 
  private:
-  explicit TransmitterSession(const SessionConfig& config);
+  TransmitterSession(const SessionConfig& config, link::EventLoop& loop);
   void release(const std::string& user);
   std::unique_ptr<Impl> impl_;
 };
