@@ -1,6 +1,6 @@
 // What steers the simulated car when it is not WiRC's PCD: an RCOIP receiver
-// or a BTEMP robot on its own UDP port (wirc-sim --control). The camera
-// still streams over WiRC MJPEG.
+// or a BTEMP robot on its own UDP port (wirc-sim --control), each one of
+// these. The camera still streams over WiRC MJPEG.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +16,7 @@ namespace wircam::sim {
 class VehicleControl {
  public:
   virtual ~VehicleControl() = default;
+  // What the vehicle puts out at `now` (the failsafe once commands stopped).
   virtual wirc::ChannelOutputs outputs(wirc::DeviceClock::time_point now) = 0;
   virtual uint16_t port() const = 0;
   virtual std::string description() const = 0;    // "RCOIP receiver"

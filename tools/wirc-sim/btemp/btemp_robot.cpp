@@ -39,7 +39,7 @@ class Robot::Impl {
 
   mutable Mutex mutex_;
   std::optional<SocketAddress> controller_ WIRCAM_GUARDED_BY(mutex_);
-  RobotOutputs outputs_ WIRCAM_GUARDED_BY(mutex_);
+  wirc::ChannelOutputs outputs_ WIRCAM_GUARDED_BY(mutex_);
   std::array<uint8_t, 4> throttle_ WIRCAM_GUARDED_BY(mutex_){};
   std::optional<Clock::time_point> lastHeard_ WIRCAM_GUARDED_BY(mutex_);
   std::optional<Clock::time_point> lastPins_ WIRCAM_GUARDED_BY(mutex_);
@@ -53,7 +53,7 @@ Robot::Impl::Impl(RobotConfig config, UniqueFd socket, Logger logger)
 
 void Robot::Impl::expire(Clock::time_point now) {
   if (outputs_.failsafe || !lastHeard_ || now - *lastHeard_ <= config_.failInterval) return;
-  outputs_ = RobotOutputs{};
+  outputs_ = wirc::ChannelOutputs{};
   throttle_ = {};
   ++stats_.failsafeEntries;
   log("BTEMP: the controller went quiet: failsafe (neutral)");
@@ -147,7 +147,7 @@ Robot::~Robot() = default;
 
 uint16_t Robot::port() const { return localAddress(impl_->socket_.get()).port(); }
 
-RobotOutputs Robot::outputs(Clock::time_point now) {
+wirc::ChannelOutputs Robot::outputs(Clock::time_point now) {
   MutexLock lock(impl_->mutex_);
   impl_->expire(now);
   return impl_->outputs_;
@@ -156,6 +156,15 @@ RobotOutputs Robot::outputs(Clock::time_point now) {
 RobotStats Robot::stats() const {
   MutexLock lock(impl_->mutex_);
   return impl_->stats_;
+}
+
+std::string Robot::summary() const {
+  auto s = stats();
+  return "BTEMP              " + std::to_string(s.ctrl) + " CTRL (" +
+         std::to_string(s.ctrlForeign) + " from unregistered, " + std::to_string(s.rejected) +
+         " rejected), " + std::to_string(s.pings) + " PING, " + std::to_string(s.registrations) +
+         " RCTR, " + std::to_string(s.pinsSent) + " PINS, " + std::to_string(s.failsafeEntries) +
+         " failsafe entries";
 }
 
 }  // namespace wircam::btemp

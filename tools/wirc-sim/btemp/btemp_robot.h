@@ -15,6 +15,7 @@
 #include "common/expected.h"
 #include "link/channel_byte_map.h"
 #include "link/event_loop.h"
+#include "vehicle_control.h"
 
 namespace wircam::btemp {
 
@@ -27,11 +28,6 @@ struct RobotConfig {
   uint32_t inputs = 0x1;  // what the input pins read
 };
 
-struct RobotOutputs {
-  link::Pulses pulses = link::neutralPulses();
-  bool failsafe = true;  // not commanded yet, or commands stopped
-};
-
 struct RobotStats {
   uint64_t pings = 0;
   uint64_t registrations = 0;
@@ -42,17 +38,20 @@ struct RobotStats {
   uint64_t failsafeEntries = 0;
 };
 
-class Robot {
+class Robot : public sim::VehicleControl {
  public:
   using Logger = std::function<void(const std::string&)>;
   static Expected<std::unique_ptr<Robot>, std::string> start(RobotConfig config,
                                                              Logger logger = {});
-  ~Robot();
+  ~Robot() override;
   Robot(const Robot&) = delete;
   Robot& operator=(const Robot&) = delete;
 
-  uint16_t port() const;
-  RobotOutputs outputs(link::Clock::time_point now);
+  uint16_t port() const override;
+  wirc::ChannelOutputs outputs(link::Clock::time_point now) override;
+  std::string description() const override { return "BTEMP robot"; }
+  std::string summary() const override;
+  uint64_t commandsReceived() const override { return stats().ctrl; }
   RobotStats stats() const;
 
   class Impl;

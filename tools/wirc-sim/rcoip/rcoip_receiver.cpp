@@ -35,7 +35,7 @@ class Receiver::Impl {
   EventLoop::Id watch_ = 0;
 
   mutable Mutex mutex_;
-  ReceiverOutputs outputs_ WIRCAM_GUARDED_BY(mutex_);
+  wirc::ChannelOutputs outputs_ WIRCAM_GUARDED_BY(mutex_);
   std::optional<Clock::time_point> lastCommand_ WIRCAM_GUARDED_BY(mutex_);
   std::optional<Clock::time_point> lastReply_ WIRCAM_GUARDED_BY(mutex_);
   ReceiverStats stats_ WIRCAM_GUARDED_BY(mutex_);
@@ -50,7 +50,7 @@ Receiver::Impl::~Impl() { loop_.remove(watch_); }
 
 void Receiver::Impl::expire(Clock::time_point now) {
   if (outputs_.failsafe || !lastCommand_ || now - *lastCommand_ <= config_.failInterval) return;
-  outputs_ = ReceiverOutputs{};
+  outputs_ = wirc::ChannelOutputs{};
   ++stats_.failsafeEntries;
   log("RCOIP: no command for " + std::to_string(config_.failInterval.count()) +
       " ms: failsafe (neutral)");
@@ -108,7 +108,7 @@ Receiver::~Receiver() = default;
 
 uint16_t Receiver::port() const { return localAddress(impl_->socket_.get()).port(); }
 
-ReceiverOutputs Receiver::outputs(Clock::time_point now) {
+wirc::ChannelOutputs Receiver::outputs(Clock::time_point now) {
   MutexLock lock(impl_->mutex_);
   impl_->expire(now);
   return impl_->outputs_;
@@ -117,6 +117,13 @@ ReceiverOutputs Receiver::outputs(Clock::time_point now) {
 ReceiverStats Receiver::stats() const {
   MutexLock lock(impl_->mutex_);
   return impl_->stats_;
+}
+
+std::string Receiver::summary() const {
+  auto s = stats();
+  return "RCOIP              " + std::to_string(s.commands) + " commands (" +
+         std::to_string(s.rejected) + " rejected), " + std::to_string(s.replies) + " replies, " +
+         std::to_string(s.failsafeEntries) + " failsafe entries";
 }
 
 }  // namespace wircam::rcoip

@@ -15,6 +15,7 @@
 #include "link/channel_byte_map.h"
 #include "link/event_loop.h"
 #include "rcoip/rcoip_messages.h"
+#include "vehicle_control.h"
 
 namespace wircam::rcoip {
 
@@ -29,11 +30,6 @@ struct ReceiverConfig {
   bool replyWithoutRssi = false;  // the known 2-byte variant
 };
 
-struct ReceiverOutputs {
-  link::Pulses pulses = link::neutralPulses();
-  bool failsafe = true;  // no command yet, or none for the fail interval
-};
-
 struct ReceiverStats {
   uint64_t commands = 0;
   uint64_t rejected = 0;  // malformed datagrams
@@ -41,18 +37,20 @@ struct ReceiverStats {
   uint64_t failsafeEntries = 0;
 };
 
-class Receiver {
+class Receiver : public sim::VehicleControl {
  public:
   using Logger = std::function<void(const std::string&)>;
   static Expected<std::unique_ptr<Receiver>, std::string> start(ReceiverConfig config,
                                                                 Logger logger = {});
-  ~Receiver();
+  ~Receiver() override;
   Receiver(const Receiver&) = delete;
   Receiver& operator=(const Receiver&) = delete;
 
-  uint16_t port() const;
-  // What the receiver puts out at `now` (the failsafe once commands stopped).
-  ReceiverOutputs outputs(link::Clock::time_point now);
+  uint16_t port() const override;
+  wirc::ChannelOutputs outputs(link::Clock::time_point now) override;
+  std::string description() const override { return "RCOIP receiver"; }
+  std::string summary() const override;
+  uint64_t commandsReceived() const override { return stats().commands; }
   ReceiverStats stats() const;
 
   class Impl;
