@@ -44,8 +44,8 @@ class TelemetryTrack {
   // the SegmentWriter passes on as the muxer wants it). Called before each
   // frame reaches the muxer, on the frame's thread.
   // - With gapsAhead, one gap promises kGapLead, renewed once a frame comes
-  //   within half of it: the text's thread wakes twice a second, not at
-  //   every frame. A line is still written at its own time, behind the
+  //   within half of it: the text's thread wakes for gaps twice a second,
+  //   not at every frame. A line is still written at its own time, behind the
   //   promise; as a line takes the muxer's idea of the track's position
   //   back to its time, the promise is restated after it, or the frames
   //   past the line would wait for a gap that no frame asks for.
