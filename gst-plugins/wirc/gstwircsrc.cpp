@@ -45,6 +45,7 @@
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -52,6 +53,7 @@
 #include "frame_buffers.h"
 #include "gst_scoped.h"
 #include "login_properties.h"
+#include "wirc/frame_time.h"
 #include "wirc/stream_inbox.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_bus_messages.h"
@@ -378,20 +380,19 @@ static GstClockTime arrival_clock_time(GstClock* clock, Clock::time_point firstP
   return now > static_cast<GstClockTime>(age) ? now - static_cast<GstClockTime>(age) : 0;
 }
 
-// A frame's running time: when its first packet arrived, and never before the
-// previous frame's (a frame completed late, after a newer one, takes the
-// newer one's time), so no segment ever sees time step back from its start.
+// A frame's running time: when its first packet arrived, rising by at least
+// a millisecond from frame to frame (wirc::nextFrameTime).
 static GstClockTime frame_timestamp(GstWircSrc* self, Clock::time_point firstPacket) {
   GstClock* clock = gst_element_get_clock(GST_ELEMENT(self));
   if (!clock) return GST_CLOCK_TIME_NONE;
   GstClockTime arrival = arrival_clock_time(clock, firstPacket);
   gst_object_unref(clock);
   GstClockTime base = gst_element_get_base_time(GST_ELEMENT(self));
-  GstClockTime pts = arrival > base ? arrival - base : 0;
   auto& last = self->state->lastPts;
-  if (GST_CLOCK_TIME_IS_VALID(last) && pts < last) pts = last;
-  last = pts;
-  return pts;
+  std::optional<uint64_t> previous;
+  if (GST_CLOCK_TIME_IS_VALID(last)) previous = last;
+  last = wirc::nextFrameTime(arrival > base ? arrival - base : 0, previous);
+  return last;
 }
 
 static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
