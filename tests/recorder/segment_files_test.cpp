@@ -123,9 +123,13 @@ TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
                             "stream_disposition=default,forced:stream_tags=title -of csv=p=0 '" +
                             video.string() + "'"),
               std::string(container) == "mkv" ? "0,0,telemetry\n" : "0,0\n");
-    // Its sidecar is on its own timeline, every line within the file.
+    // Its sidecar is on its own timeline, every line within the file. (The
+    // last file ends with the recording, and may end before a statistics
+    // line comes.)
     auto lines = sidecarOf(video);
-    ASSERT_FALSE(lines.empty());
+    if (i + 1 < videos.size()) {
+      ASSERT_FALSE(lines.empty());
+    }
     for (const auto& line : lines) {
       ASSERT_TRUE(line.contains("pts") && line.contains("utc")) << line;
       EXPECT_LE(line["pts"].get<double>() / 1e9, duration + 0.1) << line;
@@ -158,6 +162,7 @@ TEST(SegmentFilesSidecarOnly, WithTheTelemetryTrackOffAFileIsItsFramesAndTheSide
   ASSERT_EQ(index["segments"].size(), videos.size()) << index;
   for (const auto& video : videos) {
     SCOPED_TRACE(video.filename().string());
+    bool last = video == videos.back();
     EXPECT_EQ(commandOutput("ffprobe -v error -show_entries stream=codec_type -of csv=p=0 '" +
                             video.string() + "'"),
               "video\n");
@@ -171,7 +176,9 @@ TEST(SegmentFilesSidecarOnly, WithTheTelemetryTrackOffAFileIsItsFramesAndTheSide
         EXPECT_EQ(segment["frames"], static_cast<int>(frames.size())) << segment;
       }
     }
-    EXPECT_FALSE(sidecarOf(video).empty());
+    if (!last) {
+      EXPECT_FALSE(sidecarOf(video).empty());  // (the last may end before a line)
+    }
   }
   std::string sidecar;
   for (const auto& line : sidecarOf(videos[0])) sidecar += line.dump();
