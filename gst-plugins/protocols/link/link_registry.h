@@ -42,14 +42,9 @@ class LinkRegistry {
     }
     if (auto claimed = entry.claims->claim(key, user, settings, entry.settings, false); !claimed)
       return unexpected(claimed.error());
-    // Each user holds its own reference; letting go ends its claims.
-    auto* strong = new std::shared_ptr<Link>(link);
-    return std::shared_ptr<Link>(link.get(), [this, strong, claims = entry.claims, user](Link*) {
-      {
-        std::lock_guard released(mutex_);
-        claims->release(user);
-      }
-      delete strong;
+    return userReference(link, [this, claims = entry.claims, user] {
+      std::lock_guard released(mutex_);
+      claims->release(user);
     });
   }
 

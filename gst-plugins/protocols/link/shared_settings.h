@@ -7,8 +7,10 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/expected.h"
@@ -33,5 +35,16 @@ class SettingClaims {
  private:
   std::map<std::string, std::set<std::string>> claimants_;  // setting → users who gave it
 };
+
+// A user's own reference to a shared link: when the user lets go,
+// `release` runs (its claims end), then the link goes if it was the last.
+template <typename Link, typename Release>
+std::shared_ptr<Link> userReference(std::shared_ptr<Link> link, Release release) {
+  auto* strong = new std::shared_ptr<Link>(std::move(link));
+  return std::shared_ptr<Link>(strong->get(), [strong, release = std::move(release)](Link*) {
+    release();
+    delete strong;
+  });
+}
 
 }  // namespace wircam::link

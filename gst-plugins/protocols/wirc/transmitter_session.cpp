@@ -453,13 +453,8 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
     });
   }
 
-  // Each user holds its own reference; dropping it gives its settings back.
-  auto* strong = new std::shared_ptr<TransmitterSession>(session);
-  return std::shared_ptr<TransmitterSession>(session.get(),
-                                             [strong, user](TransmitterSession* link) {
-                                               link->release(user);
-                                               delete strong;
-                                             });
+  // Dropping it gives the user's settings back.
+  return link::userReference(session, [held = session.get(), user] { held->release(user); });
 }
 
 TransmitterSession::TransmitterSession(const SessionConfig& config, EventLoop& loop)
