@@ -130,9 +130,9 @@ stall-timeout, http, http-token, http-cert, http-key, http-idle-timeout, webrtc,
 webrtc-stun, webrtc-turn, webrtc-kbps, rtsp,
 periods, failsafe, marvelmind, beacon, mqtt, mqtt-cafile, mqtt-prefix,
 mqtt-discovery, mqtt-snapshot-interval, mqtt-detections-rate,
-on-segment-closed, hook-timeout, hook-drain), and one [device NAME] group per vehicle with
-host, port, cameras (e.g. 0;1), follow, control (rcoip://H:P or btemp://H:P, as
-on the command line), marvelmind and beacon:
+on-segment-closed, hook-timeout, hook-drain), and one [device NAME] group per
+vehicle with host, port, cameras (e.g. 0;1), follow, control (rcoip://H:P or
+btemp://H:P, as on the command line), marvelmind and beacon:
 
   [recorder]
   out=recordings
