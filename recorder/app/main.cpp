@@ -5,10 +5,12 @@
 #include <filesystem>
 
 #include "app/recorder_options.h"
+#include "app/slice_allocator.h"
 #include "app/supervisor.h"
 
 int main(int argc, char** argv) {
   using namespace wircam::recorder;
+  useMallocForSlices(argv);
   auto options = parseOptions(argc, argv);
   if (!options) {
     if (options.error() == "help") {

@@ -3,11 +3,9 @@
 #include <getopt.h>
 #include <glib.h>
 
-#include <cmath>
-#include <cstdlib>
-#include <map>
 #include <memory>
 
+#include "app/option_values.h"
 #include "fleet/mqtt_url.h"
 #include "marvelmind/position_client.h"
 #include "record/retention.h"
@@ -20,99 +18,6 @@ const char* extensionOf(Container container) {
 }
 
 namespace {
-std::optional<double> number(const char* text);
-}  // namespace
-
-std::optional<ServerAddress> parseServerAddress(const std::string& text) {
-  auto colon = text.rfind(':');
-  if (colon == std::string::npos) return std::nullopt;
-  auto port = number(text.substr(colon + 1).c_str());
-  if (!port || *port < 0 || *port > 65535) return std::nullopt;
-  return ServerAddress{text.substr(0, colon), static_cast<uint16_t>(*port)};
-}
-
-namespace {
-
-// "500M", "20G", "1048576": bytes.
-std::optional<uint64_t> size(const char* text) {
-  char* end = nullptr;
-  double value = std::strtod(text, &end);
-  if (end == text || !std::isfinite(value) || value < 0) return std::nullopt;
-  std::string unit = end;
-  double scale = unit.empty()  ? 1
-                 : unit == "K" ? 1e3
-                 : unit == "M" ? 1e6
-                 : unit == "G" ? 1e9
-                 : unit == "T" ? 1e12
-                               : 0;
-  // Past 2^64 bytes the cast would be undefined, and no disk is that big.
-  if (scale == 0 || value * scale >= 1.8e19) return std::nullopt;
-  return static_cast<uint64_t>(value * scale);
-}
-
-std::optional<double> number(const char* text) {
-  char* end = nullptr;
-  double value = std::strtod(text, &end);
-  // NaN passes every range check and then casts to garbage: refused here.
-  if (end == text || *end != '\0' || !std::isfinite(value)) return std::nullopt;
-  return value;
-}
-
-Expected<DeviceTarget, std::string> deviceTarget(const std::string& argument) {
-  DeviceTarget target;
-  std::string text = argument.substr(0, argument.find(','));
-  if (text.size() < argument.size()) {
-    std::string extra = argument.substr(text.size() + 1);
-    if (extra.rfind("control=", 0) != 0)
-      return unexpected("--device " + argument + ": after the comma only control=URI");
-    auto control = parseControlTarget(extra.substr(8));
-    if (!control) return unexpected("--device " + argument + ": " + control.error());
-    target.control = *control;
-  }
-  auto colon = text.rfind(':');
-  target.host = text.substr(0, colon);
-  if (colon != std::string::npos) {
-    auto port = number(text.substr(colon + 1).c_str());
-    if (!port || *port < 1 || *port > 65535) return unexpected("bad port in --device " + text);
-    target.port = static_cast<uint16_t>(*port);
-  }
-  if (target.host.empty())
-    return unexpected("--device needs a host, as in 192.168.1.1 or 127.0.0.1:1984");
-  target.label = target.host + (target.port == 1984 ? "" : "-" + std::to_string(target.port));
-  return target;
-}
-
-// "steering-kp=1.25,max-throttle=0.5" → " steering-kp=1.25 max-throttle=0.5"
-// for wirccontrol: the follower's gains and limits, each within the
-// element's range (nothing else reaches the pipeline's description).
-Expected<std::string, std::string> followTuning(const char* value) {
-  static const std::map<std::string, std::pair<double, double>> kTunable = {
-      {"steering-kp", {0, 100}},        {"steering-ki", {0, 100}}, {"steering-kd", {0, 100}},
-      {"throttle-kp", {0, 100}},        {"throttle-ki", {0, 100}}, {"throttle-kd", {0, 100}},
-      {"target-distance", {0.05, 100}}, {"max-throttle", {0, 1}}};
-  auto decimal = [](double v) {
-    char digits[G_ASCII_DTOSTR_BUF_SIZE];
-    return std::string(g_ascii_dtostr(digits, sizeof digits, v));
-  };
-  std::string tuning;
-  std::unique_ptr<gchar*, decltype(&g_strfreev)> pairs(g_strsplit(value, ",", -1), g_strfreev);
-  for (gchar** pair = pairs.get(); *pair; ++pair) {
-    std::string text = *pair;
-    auto equals = text.find('=');
-    auto range = kTunable.find(text.substr(0, equals));
-    if (range == kTunable.end())
-      return unexpected("'" + text.substr(0, equals) +
-                        "' is not one of steering-kp, steering-ki, steering-kd, throttle-kp, "
-                        "throttle-ki, throttle-kd, target-distance, max-throttle");
-    auto given =
-        equals == std::string::npos ? std::nullopt : number(text.substr(equals + 1).c_str());
-    auto [low, high] = range->second;
-    if (!given || *given < low || *given > high)
-      return unexpected(range->first + " takes a number in " + decimal(low) + ".." + decimal(high));
-    tuning += " " + range->first + "=" + decimal(*given);
-  }
-  return tuning;
-}
 
 // Applies one option given by its long name (from the command line or the
 // config file's [recorder] group).
@@ -204,7 +109,7 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     if (!seconds || *seconds < 1) return "seconds >= 1";
     o.segmentSeconds = *seconds;
   } else if (name == "segment-size") {
-    auto bytes = size(value);
+    auto bytes = byteSize(value);
     if (!bytes || *bytes < 100000) return "a size of at least 100K, like 100M";
     o.segmentBytes = *bytes;
   } else if (name == "format") {
@@ -277,7 +182,7 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     if (!seconds || *seconds <= 0) return "seconds > 0";
     o.statusSeconds = *seconds;
   } else if (name == "max-bytes" || name == "min-free") {
-    auto bytes = size(value);
+    auto bytes = byteSize(value);
     if (!bytes) return "a size like 500M or 20G";
     (name == "max-bytes" ? o.maxBytes : o.minFree) = *bytes;
   } else if (name == "max-age" || name == "keep-events") {
@@ -352,55 +257,7 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
   return std::nullopt;
 }
 
-// The dashboard and beacons of a device, both or neither.
-Expected<std::optional<PositionSource>, std::string> positionSource(
-    const std::optional<std::string>& dashboard, const std::optional<std::string>& beacons) {
-  if (!dashboard && !beacons) return std::optional<PositionSource>();
-  if (!dashboard)
-    return unexpected(std::string("beacon= needs marvelmind=HOST[:PORT] (--marvelmind)"));
-  if (!beacons)
-    return unexpected("marvelmind " + *dashboard + " needs the vehicle's beacon (--beacon ADDR)");
-  PositionSource source;
-  auto colon = dashboard->rfind(':');
-  source.host = dashboard->substr(0, colon);
-  if (colon != std::string::npos) {
-    auto port = number(dashboard->substr(colon + 1).c_str());
-    if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
-      return unexpected("marvelmind '" + *dashboard + "': a port is 1..65535");
-    source.port = static_cast<uint16_t>(*port);
-  }
-  if (source.host.empty() || source.host.find_first_of("/ \"'") != std::string::npos)
-    return unexpected("marvelmind '" + *dashboard + "' needs a host, as in 192.168.1.50:49200");
-  auto parsed = marvelmind::parseBeacons(*beacons);
-  if (!parsed) return unexpected(parsed.error());
-  for (uint8_t beacon : *parsed)
-    source.beacons += (source.beacons.empty() ? "" : ",") + std::to_string(beacon);
-  return std::optional<PositionSource>(source);
-}
-
 }  // namespace
-
-Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri) {
-  auto scheme = uri.find("://");
-  ControlTarget target;
-  target.protocol = uri.substr(0, scheme);
-  if (scheme == std::string::npos ||
-      (target.protocol != "wirc" && target.protocol != "rcoip" && target.protocol != "btemp"))
-    return unexpected("control '" + uri + "' is not rcoip://HOST:PORT, btemp://HOST:PORT or " +
-                      "wirc://HOST:PORT");
-  std::string address = uri.substr(scheme + 3);
-  auto colon = address.rfind(':');
-  target.host = address.substr(0, colon);
-  if (colon != std::string::npos) {
-    auto port = number(address.substr(colon + 1).c_str());
-    if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
-      return unexpected("control '" + uri + "': a port is 1..65535");
-    target.port = static_cast<uint16_t>(*port);
-  }
-  if (target.host.empty() || target.host.find_first_of("/ \"'") != std::string::npos)
-    return unexpected("control '" + uri + "' needs a host, as in rcoip://192.168.4.1:9048");
-  return target;
-}
 
 Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   enum { kDevice = 1000, kConfig, kValue };

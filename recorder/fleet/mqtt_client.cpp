@@ -1,12 +1,12 @@
 #include "fleet/mqtt_client.h"
 
-#include <mosquitto.h>
 #include <poll.h>
 #include <unistd.h>
 
 #include <cstdlib>
 
 #include "common/socket.h"
+#include "fleet/mosquitto_library.h"
 
 namespace wircam::recorder {
 
@@ -18,8 +18,10 @@ constexpr int kReachTimeoutMs = 2000;
 
 }  // namespace
 
-MqttClient::MqttClient(MqttUrl url, MqttWill will, mosquitto* handle, Handlers handlers)
-    : url_(std::move(url)),
+MqttClient::MqttClient(const MosquittoLibrary& lib, MqttUrl url, MqttWill will, mosquitto* handle,
+                       Handlers handlers)
+    : lib_(lib),
+      url_(std::move(url)),
       handle_(handle),
       handlers_(std::move(handlers)),
       will_(std::move(will)) {}
@@ -28,35 +30,34 @@ Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttU
                                                                      const std::string& clientId,
                                                                      const MqttWill& will,
                                                                      Handlers handlers) {
-  static const int initialised = mosquitto_lib_init();
-  (void)initialised;
-  mosquitto* handle = mosquitto_new(clientId.c_str(), true, nullptr);
+  auto library = mosquittoLibrary();
+  if (!library) return unexpected(library.error());
+  const MosquittoLibrary& lib = **library;
+  mosquitto* handle = lib.create(clientId.c_str(), true, nullptr);
   if (!handle) return unexpected(std::string("cannot create an MQTT client"));
-  std::unique_ptr<MqttClient> client(new MqttClient(url, will, handle, std::move(handlers)));
-  mosquitto_user_data_set(handle, client.get());
-  mosquitto_threaded_set(handle, true);
+  std::unique_ptr<MqttClient> client(new MqttClient(lib, url, will, handle, std::move(handlers)));
+  lib.userDataSet(handle, client.get());
+  lib.threadedSet(handle, true);
   if (!url.user.empty() &&
-      mosquitto_username_pw_set(handle, url.user.c_str(),
-                                url.password.empty() ? nullptr : url.password.c_str()) !=
-          MOSQ_ERR_SUCCESS)
+      lib.usernamePwSet(handle, url.user.c_str(),
+                        url.password.empty() ? nullptr : url.password.c_str()) != MOSQ_ERR_SUCCESS)
     return unexpected(std::string("the MQTT user name or password is not valid UTF-8"));
   if (url.tls) {
     // The broker's certificate is checked against the CA file (or the
     // system's CAs) and its host name; a handshake that fails is said.
-    int rc =
-        url.caFile.empty()
-            ? mosquitto_tls_set(handle, nullptr, "/etc/ssl/certs", nullptr, nullptr, nullptr)
-            : mosquitto_tls_set(handle, url.caFile.c_str(), nullptr, nullptr, nullptr, nullptr);
+    int rc = url.caFile.empty()
+                 ? lib.tlsSet(handle, nullptr, "/etc/ssl/certs", nullptr, nullptr, nullptr)
+                 : lib.tlsSet(handle, url.caFile.c_str(), nullptr, nullptr, nullptr, nullptr);
     if (rc != MOSQ_ERR_SUCCESS)
-      return unexpected("--mqtt-cafile " + url.caFile + ": " + mosquitto_strerror(rc) +
+      return unexpected("--mqtt-cafile " + url.caFile + ": " + lib.strerror(rc) +
                         " (a PEM file of the CA that signed the broker's certificate)");
   }
-  if (mosquitto_will_set(handle, will.topic.c_str(), static_cast<int>(will.payload.size()),
-                         will.payload.data(), 1, true) != MOSQ_ERR_SUCCESS)
+  if (lib.willSet(handle, will.topic.c_str(), static_cast<int>(will.payload.size()),
+                  will.payload.data(), 1, true) != MOSQ_ERR_SUCCESS)
     return unexpected("cannot set the MQTT last will on '" + will.topic + "'");
-  mosquitto_connect_callback_set(handle, onConnect);
-  mosquitto_message_callback_set(handle, onMessage);
-  mosquitto_publish_callback_set(handle, onPublish);
+  lib.connectCallbackSet(handle, onConnect);
+  lib.messageCallbackSet(handle, onMessage);
+  lib.publishCallbackSet(handle, onPublish);
   client->thread_ = std::thread([c = client.get()] { c->run(); });
   return client;
 }
@@ -65,7 +66,7 @@ MqttClient::~MqttClient() {
   stopping_ = true;
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
-  mosquitto_destroy(handle_);
+  lib_.destroy(handle_);
 }
 
 void MqttClient::report(const std::string& line) {
@@ -94,7 +95,7 @@ bool MqttClient::reachable() {
 
 std::string MqttClient::cannotConnect(int rc) const {
   std::string where = "MQTT broker " + url_.host + ":" + std::to_string(url_.port) + ": ";
-  if (rc != MOSQ_ERR_TLS) return where + mosquitto_strerror(rc);
+  if (rc != MOSQ_ERR_TLS) return where + lib_.strerror(rc);
   std::string ca = url_.caFile.empty() ? "the system's CAs" : "--mqtt-cafile " + url_.caFile;
   return where + "the TLS handshake failed: the broker's certificate is not one " + ca +
          " signed for " + url_.host +
@@ -115,7 +116,7 @@ void MqttClient::run() {
         waitBackoff();
         continue;
       }
-      int rc = mosquitto_connect(handle_, url_.host.c_str(), url_.port, kKeepaliveSeconds);
+      int rc = lib_.connect(handle_, url_.host.c_str(), url_.port, kKeepaliveSeconds);
       if (rc != MOSQ_ERR_SUCCESS) {
         report(cannotConnect(rc));
         waitBackoff();
@@ -123,12 +124,12 @@ void MqttClient::run() {
       }
       session = true;
     }
-    int rc = mosquitto_loop(handle_, 100, 1);
+    int rc = lib_.loop(handle_, 100, 1);
     if (rc != MOSQ_ERR_SUCCESS) {
       session = false;
       if (connected_.exchange(false))
         report("lost the MQTT broker " + url_.host + ":" + std::to_string(url_.port) + " (" +
-               mosquitto_strerror(rc) + "); reconnecting with backoff");
+               lib_.strerror(rc) + "); reconnecting with backoff");
       else
         report(cannotConnect(rc));  // the TLS handshake comes after mosquitto_connect
       waitBackoff();
@@ -136,12 +137,11 @@ void MqttClient::run() {
   }
   if (connected_) {
     // The last word, as the will would say it; then a clean goodbye.
-    mosquitto_publish(handle_, nullptr, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
-                      will_.payload.data(), 1, true);
-    for (int turn = 0; turn < 5 && mosquitto_want_write(handle_); ++turn)
-      mosquitto_loop(handle_, 100, 1);
-    mosquitto_disconnect(handle_);
-    mosquitto_loop(handle_, 100, 1);
+    lib_.publish(handle_, nullptr, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
+                 will_.payload.data(), 1, true);
+    for (int turn = 0; turn < 5 && lib_.wantWrite(handle_); ++turn) lib_.loop(handle_, 100, 1);
+    lib_.disconnect(handle_);
+    lib_.loop(handle_, 100, 1);
     connected_ = false;
   }
 }
@@ -150,8 +150,8 @@ void MqttClient::onConnect(mosquitto*, void* self, int rc) {
   auto* client = static_cast<MqttClient*>(self);
   if (rc != 0) {
     client->report(std::string("the MQTT broker refused the connection: ") +
-                   mosquitto_connack_string(rc) + "; retrying with backoff");
-    mosquitto_disconnect(client->handle_);
+                   client->lib_.connackString(rc) + "; retrying with backoff");
+    client->lib_.disconnect(client->handle_);
     return;
   }
   // What an earlier session left unsent is gone with it.
@@ -185,14 +185,14 @@ bool MqttClient::publish(const std::string& topic, const std::string& payload, b
   uint64_t before = published_++, written = written_;
   uint64_t unsent = before > written ? before - written : 0;
   if (!connected_ || unsent >= kMaxUnsent) return --published_, ++dropped_, false;
-  int rc = mosquitto_publish(handle_, nullptr, topic.c_str(), static_cast<int>(payload.size()),
-                             payload.data(), qos, retain);
+  int rc = lib_.publish(handle_, nullptr, topic.c_str(), static_cast<int>(payload.size()),
+                        payload.data(), qos, retain);
   if (rc != MOSQ_ERR_SUCCESS) return --published_, ++dropped_, false;
   return true;
 }
 
 void MqttClient::subscribe(const std::string& pattern) {
-  mosquitto_subscribe(handle_, nullptr, pattern.c_str(), 1);
+  lib_.subscribe(handle_, nullptr, pattern.c_str(), 1);
 }
 
 MqttClient::Stats MqttClient::stats() const {

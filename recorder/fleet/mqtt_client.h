@@ -1,7 +1,7 @@
-// An MQTT client on a thread of its own (libmosquitto), for the recorder's
-// fleet topics. Publishing never waits: it hands the message to the
-// library, or drops and counts it while the broker is away or too much is
-// still unsent. The connection is made again with backoff (1 s doubling to
+// An MQTT client on a thread of its own (libmosquitto, opened on the first
+// start), for the recorder's fleet topics. Publishing never waits: it hands
+// the message to the library, or drops and counts it while the broker is
+// away or too much is still unsent. The connection is made again with backoff (1 s doubling to
 // 30 s) for as long as the client lives, and every wait is bounded, so a
 // dead broker never holds up a recording or its stop.
 #pragma once
@@ -20,6 +20,10 @@
 
 struct mosquitto;
 struct mosquitto_message;
+
+namespace wircam::recorder {
+struct MosquittoLibrary;
+}
 
 namespace wircam::recorder {
 
@@ -67,7 +71,8 @@ class MqttClient {
   Stats stats() const;
 
  private:
-  MqttClient(MqttUrl url, MqttWill will, mosquitto* handle, Handlers handlers);
+  MqttClient(const MosquittoLibrary& lib, MqttUrl url, MqttWill will, mosquitto* handle,
+             Handlers handlers);
   void run();
   bool reachable();
   // Why a connection could not be made, in words (a TLS failure explained).
@@ -78,6 +83,7 @@ class MqttClient {
   static void onMessage(mosquitto*, void* self, const mosquitto_message* message);
   static void onPublish(mosquitto*, void* self, int mid);
 
+  const MosquittoLibrary& lib_;
   const MqttUrl url_;
   mosquitto* handle_;
   const Handlers handlers_;

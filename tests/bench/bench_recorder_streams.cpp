@@ -159,7 +159,8 @@ struct Run {
     std::snprintf(text, sizeof text, "lost %4d of %5d, %5.3f / %5.3f %%, %5.2f MB, %4d thr",
                   sent - recorded, sent, 100 * usage.cpuSeconds / seconds / streams, recordingCpu,
                   usage.maxRssKb / 1024.0 / streams, threads);
-    return text;
+    // Killed after a minute of not stopping: its files may be unfinished.
+    return text + std::string(usage.exitCode == 128 + SIGKILL ? " (did not stop: killed)" : "");
   }
 };
 

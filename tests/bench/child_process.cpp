@@ -23,10 +23,18 @@ void stopGroup(pid_t pid, int signal) {
   waitpid(pid, nullptr, 0);
 }
 
-Usage waitForUsage(pid_t pid) {
+Usage waitForUsage(pid_t pid, std::chrono::seconds giveUpAfter) {
   int status = 0;
   rusage usage{};
-  wait4(pid, &status, 0, &usage);
+  auto deadline = std::chrono::steady_clock::now() + giveUpAfter;
+  while (wait4(pid, &status, WNOHANG, &usage) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(-pid, SIGKILL);
+      wait4(pid, &status, 0, &usage);
+      break;
+    }
+    usleep(20000);
+  }
   return {static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
               static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) / 1e6,
           usage.ru_maxrss, WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status)};

@@ -3,6 +3,7 @@
 
 #include <sys/types.h>
 
+#include <chrono>
 #include <string>
 
 namespace wircam::bench {
@@ -15,12 +16,14 @@ pid_t spawn(const std::string& command, const std::string& output = "/dev/null")
 void stopGroup(pid_t pid, int signal);
 
 // Waits for a child and says what it used: CPU (user + system) and peak
-// memory, and how it ended.
+// memory, and how it ended. One still running after `giveUpAfter` is
+// killed with its group (exit code 137), so a receiver that never stops
+// cannot hang the whole bench.
 struct Usage {
   double cpuSeconds = 0;
   long maxRssKb = 0;
   int exitCode = 0;  // 128 + the signal that ended it
 };
-Usage waitForUsage(pid_t pid);
+Usage waitForUsage(pid_t pid, std::chrono::seconds giveUpAfter = std::chrono::seconds(60));
 
 }  // namespace wircam::bench

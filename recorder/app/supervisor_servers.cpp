@@ -1,0 +1,93 @@
+// The servers a supervisor starts beside its cameras (web, MQTT, the
+// segment hook, RTSP), each fed from the supervisor's own state and
+// commands.
+#include "app/supervisor.h"
+#include "log_line.h"
+#include "status/camera_report.h"
+
+namespace wircam::recorder {
+
+std::optional<std::string> Supervisor::startServers() {
+  if (options_.http) {
+    HttpServer::Content content;
+    for (auto& c : cameras_)
+      content.cameras.push_back({c->name(), c->frames(), c->encodedFrames()});
+    content.recordingsFolder = options_.outDir;
+    content.token = options_.httpToken;
+    content.certificateFile = options_.httpCert;
+    content.keyFile = options_.httpKey;
+    content.webrtc = options_.webrtc;
+    content.iceServers = {options_.webrtcStun, options_.webrtcTurn};
+    content.webrtcKbps = options_.webrtcKbps;
+    content.status = [this] { return status(); };
+    content.metrics = [this] { return metrics(); };
+    content.trails = [this] { return trails(); };
+    content.cameraStates = [this] {
+      nlohmann::json cameras = nlohmann::json::array();
+      for (const auto& c : cameras_) cameras.push_back(cameraJson(c->report()));
+      return cameras;
+    };
+    content.deleteRecording = [this](const std::string& file) { return deleteSegment(file); };
+    content.recordings = [this] {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& entry : index_.entries()) list.push_back(toJson(entry));
+      return list;
+    };
+    content.openSegments = [this] { return openSegments(); };
+    content.command = [this](const FleetCommand& c) { return commands_.apply(c, "web"); };
+    content.drive = [this](const std::string& camera, double steering, double throttle) {
+      return commands_.drive(camera, steering, throttle);
+    };
+    auto server = HttpServer::start(
+        *options_.http, std::move(content),
+        std::chrono::milliseconds(static_cast<int64_t>(options_.httpIdleSeconds * 1000)));
+    if (!server) return server.error();
+    http_ = std::move(*server);
+    logLine("live view at " + http_->url());
+    std::string host = options_.http->listenHost();
+    if (!options_.httpToken.empty() && options_.httpCert.empty() && host != "127.0.0.1" &&
+        host != "localhost" && host != "::1")
+      logLine("the access token travels in clear over plain HTTP on " + host +
+              ": anyone on the network can read it; give --http-cert and --http-key for HTTPS");
+  }
+  if (options_.mqtt) {
+    FleetPublisher::Settings settings{.url = *parseMqttUrl(*options_.mqtt),
+                                      .prefix = options_.mqttPrefix,
+                                      .detectionsRate = options_.mqttDetectionsRate};
+    settings.url.caFile = options_.mqttCaFile;
+    if (options_.mqttDiscovery)
+      settings.discovery = DiscoveryNames{.discoveryPrefix = *options_.mqttDiscovery,
+                                          .topicPrefix = options_.mqttPrefix,
+                                          .version = WIRCAM_VERSION};
+    for (auto& c : cameras_) settings.streams.push_back(c->name());
+    auto fleet = FleetPublisher::start(
+        settings, [this](const FleetCommand& c) { commands_.apply(c, "MQTT"); });
+    if (!fleet) return fleet.error();
+    fleet_ = std::move(*fleet);
+    logLine("MQTT to " + settings.url.host + ":" + std::to_string(settings.url.port) + " under " +
+            settings.prefix + "/");
+  }
+  if (!options_.onSegmentClosed.empty()) {
+    hook_ = std::make_unique<SegmentHook>(
+        options_.onSegmentClosed,
+        std::chrono::seconds(static_cast<int64_t>(options_.hookTimeoutSeconds)),
+        [this](const std::string& name, const nlohmann::json& hookEvent) {
+          std::string type = hookEvent.value("type", "");
+          if (type == "hook-failed" || type == "hook-gave-up") ++recorded_[name].hookFailures;
+          if (Camera* c = cameraNamed(name)) event(*c, hookEvent);
+        });
+  }
+  if (options_.rtsp) {
+    std::vector<RtspServer::Camera> cameras;
+    for (auto& c : cameras_)
+      cameras.push_back(
+          {"/" + c->plan().device + "/cam" + std::to_string(c->plan().camera), c->frames()});
+    auto server = RtspServer::start(*options_.rtsp, cameras, options_.httpToken);
+    if (!server) return server.error();
+    rtsp_ = std::move(*server);
+    for (auto& camera : cameras) logLine("RTSP at " + rtsp_->url() + camera.path);
+  }
+  return std::nullopt;
+}
+
+}  // namespace wircam::recorder
