@@ -22,8 +22,10 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS ON)
 # Elements plugged by name: matroskamux, splitmuxsink, jpegdec (good),
 # videoconvert, appsrc/appsink (base); Python reads the metas with these.
+# libmosquitto1 is opened by wirc-recorder at run time (--mqtt), so
+# dpkg-shlibdeps cannot see it.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "gstreamer1.0-plugins-base, gstreamer1.0-plugins-good, gir1.2-gstreamer-1.0")
+    "gstreamer1.0-plugins-base, gstreamer1.0-plugins-good, gir1.2-gstreamer-1.0, libmosquitto1")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS
     "gstreamer1.0-plugins-ugly, gstreamer1.0-tools, python3-gi, mosquitto, ffmpeg")
 include(CPack)
