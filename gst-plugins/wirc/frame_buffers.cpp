@@ -6,11 +6,25 @@
 
 namespace wircam::gst {
 
-GstBuffer* wrapFrame(wirc::AssembledFrame&& frame) {
-  auto* owned = new wirc::FrameBuffer(std::move(frame.data));
+namespace {
+
+struct WrappedFrame {
+  wirc::FrameBuffer buffer;
+  std::shared_ptr<wirc::FrameBufferReturns> returns;
+};
+
+}  // namespace
+
+GstBuffer* wrapFrame(wirc::AssembledFrame&& frame,
+                     std::shared_ptr<wirc::FrameBufferReturns> returns) {
+  auto* owned = new WrappedFrame{std::move(frame.data), std::move(returns)};
+  auto& bytes = owned->buffer;
   return gst_buffer_new_wrapped_full(
-      GST_MEMORY_FLAG_READONLY, owned->data(), owned->capacity(), 0, owned->size(), owned,
-      [](gpointer data) { delete static_cast<wirc::FrameBuffer*>(data); });
+      GST_MEMORY_FLAG_READONLY, bytes.data(), bytes.capacity(), 0, bytes.size(), owned,
+      [](gpointer data) {
+        std::unique_ptr<WrappedFrame> done(static_cast<WrappedFrame*>(data));
+        if (done->returns) done->returns->put(std::move(done->buffer));
+      });
 }
 
 GstCaps* jpegCapsIfChanged(GstBuffer* frame, int& width, int& height) {

@@ -4,12 +4,17 @@
 
 #include <gst/gst.h>
 
+#include <memory>
+
 #include "wirc/frame_assembler.h"
+#include "wirc/frame_buffer_returns.h"
 
 namespace wircam::gst {
 
-// Hands the frame's memory to a GstBuffer; it is freed with the buffer.
-GstBuffer* wrapFrame(wirc::AssembledFrame&& frame);
+// Hands the frame's memory to a GstBuffer; when the buffer is freed it goes
+// to `returns` (to be filled again), or is freed too without one.
+GstBuffer* wrapFrame(wirc::AssembledFrame&& frame,
+                     std::shared_ptr<wirc::FrameBufferReturns> returns = nullptr);
 
 // New image/jpeg caps when the frame's size (read from its SOF) differs from
 // width × height, which are updated; nullptr when nothing changed.

@@ -82,6 +82,8 @@ struct WircSrcState {
   int sessionListener = 0;
   // Its wake-ups serve the element's life; its socket lives from start() to stop().
   wirc::StreamInbox inbox;
+  // The frames' memory, back from the buffers downstream freed.
+  std::shared_ptr<wirc::FrameBufferReturns> returns = std::make_shared<wirc::FrameBufferReturns>();
   Clock::time_point loginDeadline;
   bool streaming = false;  // the link was live and the camera exists
   int width = 0;
@@ -401,6 +403,7 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
   auto intervalMs = state->active.statsIntervalMs;
   bool checkLink = !state->streaming;
 
+  while (auto spare = state->returns->take()) state->inbox.receiver().recycle(std::move(*spare));
   std::optional<wirc::AssembledFrame> frame;
   while (!(frame = state->inbox.takeFrame())) {
     if (checkLink) {
@@ -431,7 +434,7 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
 
   GstClockTime pts = frame_timestamp(self, frame->firstPacketTime);
   bool discont = frame->discont;
-  GstBuffer* buffer = gst::wrapFrame(std::move(*frame));
+  GstBuffer* buffer = gst::wrapFrame(std::move(*frame), state->returns);
 
   if (GstCaps* caps = gst::jpegCapsIfChanged(buffer, state->width, state->height)) {
     gst_base_src_set_caps(GST_BASE_SRC(self), caps);

@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
       std::printf("MQTT adds %.2f %% CPU per stream (%.0f %% more than without)\n",
                   cpuPerStream - withoutCpu, 100.0 * (cpuPerStream - withoutCpu) / withoutCpu);
   }
-  for (pid_t sim : sims) stopGroup(sim, SIGINT);
+  wircam::bench::stopGroups(sims, SIGINT);
   stopGroup(broker, SIGTERM);
   fs::remove_all(work);
   return 0;

@@ -188,7 +188,7 @@ Run recordWithWircam(const fs::path& work, const fs::path& bin, int basePort, in
   run.threads = threadsOf(recorder);
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
   run.recordingCpu = recording.end(n);
-  for (pid_t sim : sims) wircam::bench::stopGroup(sim, SIGINT);
+  wircam::bench::stopGroups(sims, SIGINT);
   std::this_thread::sleep_for(kDrain);
   kill(recorder, SIGINT);
   run.usage = waitForUsage(recorder);

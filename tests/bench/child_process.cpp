@@ -18,9 +18,11 @@ pid_t spawn(const std::string& command, const std::string& output) {
   return pid;
 }
 
-void stopGroup(pid_t pid, int signal) {
-  kill(-pid, signal);
-  waitpid(pid, nullptr, 0);
+void stopGroup(pid_t pid, int signal) { stopGroups({pid}, signal); }
+
+void stopGroups(const std::vector<pid_t>& pids, int signal) {
+  for (pid_t pid : pids) kill(-pid, signal);
+  for (pid_t pid : pids) waitpid(pid, nullptr, 0);
 }
 
 Usage waitForUsage(pid_t pid, std::chrono::seconds giveUpAfter) {

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <string>
+#include <vector>
 
 namespace wircam::bench {
 
@@ -14,6 +15,9 @@ pid_t spawn(const std::string& command, const std::string& output = "/dev/null")
 
 // Signals the whole group and waits for its leader.
 void stopGroup(pid_t pid, int signal);
+// The same for many at once: all are signalled before any is waited for,
+// so they stop together (one by one, 200 senders take seconds).
+void stopGroups(const std::vector<pid_t>& pids, int signal);
 
 // Waits for a child and says what it used: CPU (user + system) and peak
 // memory, and how it ended. One still running after `giveUpAfter` is
