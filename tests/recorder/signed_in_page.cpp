@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <thread>
+
+#include "wait_for.h"
 
 namespace wircam::testing {
 
@@ -36,6 +39,36 @@ std::chrono::milliseconds untilNeutral(const wirc::Device& device) {
   while (!atNeutral(device) && Clock::now() - start < std::chrono::seconds(3))
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   return std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - start);
+}
+
+void expectJunkStopsTheCarAtOnce(DevToolsPage& page, const wirc::Device& device) {
+  page.evaluate(
+      "window.keep = setInterval(() => probe.send(JSON.stringify({seq: 1, steering: 0, "
+      "throttle: 1})), 100)");
+  ASSERT_TRUE(waitFor([&] { return device.outputs().pulses[kThrottle] > 1500; }));
+  ASSERT_TRUE(page.waitUntil("window.answer && window.answer.ack === 1"));
+  page.evaluate("clearInterval(keep); probe.send('{\"steering\": \"hard left\"}')");
+  auto neutral = untilNeutral(device);
+  EXPECT_LT(neutral.count(), 120) << "neutral " << neutral.count() << " ms after the junk";
+  ASSERT_TRUE(page.waitUntil("window.answer.error"));
+  EXPECT_EQ(page.evaluate("window.answer.error"), "'steering' is not a number");
+  EXPECT_EQ(page.evaluate("window.answer.neutral"), true);
+}
+
+void expectAHungPageStopsTheCar(DevToolsPage& page, const wirc::Device& device) {
+  page.pauseScripts();
+  auto hung = untilNeutral(device);
+  EXPECT_LE(hung.count(), 250 + 100 + 100) << "neutral " << hung.count() << " ms after the hang";
+  std::cerr << "[ measured ] hung page → neutral in " << hung.count() << " ms\n";
+}
+
+void expectAClosedTabStopsTheCar(DevToolsPage& page, const wirc::Device& device) {
+  page.call("Debugger.resume");
+  ASSERT_TRUE(waitFor([&] { return device.outputs().pulses[kThrottle] > 1500; }));
+  page.closeTab();
+  auto closed = untilNeutral(device);
+  EXPECT_LE(closed.count(), 250 + 100) << "neutral " << closed.count() << " ms after closing";
+  std::cerr << "[ measured ] closed tab → neutral in " << closed.count() << " ms\n";
 }
 
 std::filesystem::path shotPath(const std::string& name) {

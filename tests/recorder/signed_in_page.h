@@ -36,6 +36,19 @@ bool atNeutral(const wirc::Device& device);
 // drive tests measure a dead-man or a closed page by.
 std::chrono::milliseconds untilNeutral(const wirc::Device& device);
 
+// A page's drive channel (window.probe, a WebSocket or a WebRTC data
+// channel, whose answers land in window.answer) sends full ahead every
+// 100 ms, then junk: the junk is answered with its reason and the car is at
+// neutral at once, not when the dead-man would lapse (150 ms later at least).
+void expectJunkStopsTheCarAtOnce(DevToolsPage& page, const wirc::Device& device);
+// The page, driving, hangs (its scripts stop): the dead-man stops the car
+// within 250 ms of the last command, a command period (100 ms) being the
+// most that passes between them, and 100 ms for the polling under load.
+void expectAHungPageStopsTheCar(DevToolsPage& page, const wirc::Device& device);
+// The hung page comes back, drives again, and its tab is closed: neutral
+// within a dead-man and a command period.
+void expectAClosedTabStopsTheCar(DevToolsPage& page, const wirc::Device& device);
+
 // build/tests/recorder/NAME
 std::filesystem::path shotPath(const std::string& name);
 

@@ -139,14 +139,8 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
   std::cerr << "[ measured ] drive command round trip " << roundTrip.get<double>() << " ms\n";
   page.screenshot(shotPath("web-drive.png"));
 
-  // The page hangs (its scripts stop, the socket stays open): the dead-man
-  // stops the car within 250 ms of the last command, and a command period
-  // (100 ms) is the most that can pass between them.
-  page.pauseScripts();
-  auto hung = untilNeutral(*car.device);
-  EXPECT_LE(hung.count(), 250 + 100 + 100)
-      << "neutral " << hung.count() << " ms after the page hung";
-  std::cerr << "[ measured ] hung page → neutral in " << hung.count() << " ms\n";
+  // The page hangs (its scripts stop, the socket stays open).
+  expectAHungPageStopsTheCar(page, *car.device);
   // Counted for Prometheus.
   std::string lapses = "wircam_drive_deadman_lapses_total{stream=\"127.0.0.1-" +
                        std::to_string(car.device->port()) + "-cam0\"} 1";
@@ -156,14 +150,7 @@ TEST(WebInterface, DriveModeMovesTheCarAndAPageThatHangsOrGoesAwayStopsIt) {
                .body.find(lapses) != std::string::npos;
   }));
 
-  // It comes back, drives again, and its tab is closed: neutral at once.
-  page.call("Debugger.resume");
-  ASSERT_TRUE(waitFor([&] { return car.device->outputs().pulses[kThrottle] > 1500; }));
-  page.closeTab();
-  auto closed = untilNeutral(*car.device);
-  EXPECT_LE(closed.count(), 250 + 100)
-      << "neutral " << closed.count() << " ms after the tab closed";
-  std::cerr << "[ measured ] closed tab → neutral in " << closed.count() << " ms\n";
+  expectAClosedTabStopsTheCar(page, *car.device);
 }
 
 TEST(WebInterface, AMalformedDriveMessageIsAnsweredAndStopsTheCar) {
@@ -181,22 +168,7 @@ TEST(WebInterface, AMalformedDriveMessageIsAnsweredAndStopsTheCar) {
       camera + "/drive`); probe.onmessage = e => { window.answer = JSON.parse(e.data); }; " +
       "probe.onopen = () => done('open'); probe.onclose = () => done('closed'); })");
   ASSERT_EQ(opened, "open");
-  // (held by sending it every 100 ms until the malformed one)
-  page.evaluate(
-      "window.keep = setInterval(() => probe.send(JSON.stringify({seq: 1, "
-      "steering: 0, throttle: 1})), 100)");
-  ASSERT_TRUE(waitFor([&] { return car.device->outputs().pulses[kThrottle] > 1500; }));
-  ASSERT_TRUE(page.waitUntil("window.answer && window.answer.ack === 1"));
-  // ...then junk: answered with the reason, and the car is at neutral at
-  // once, not only when the dead-man would have lapsed.
-  page.evaluate("clearInterval(keep); probe.send('{\"steering\": \"hard left\"}')");
-  // The last good command left at most 100 ms before: the dead-man would
-  // take 150 ms more at least.
-  auto neutral = untilNeutral(*car.device);
-  EXPECT_LT(neutral.count(), 120) << "neutral " << neutral.count() << " ms after the junk";
-  ASSERT_TRUE(page.waitUntil("window.answer.error"));
-  EXPECT_EQ(page.evaluate("window.answer.error"), "'steering' is not a number");
-  EXPECT_EQ(page.evaluate("window.answer.neutral"), true);
+  expectJunkStopsTheCarAtOnce(page, *car.device);
 }
 
 TEST(WebInterface, WithoutTheTokenControlIsRefused) {

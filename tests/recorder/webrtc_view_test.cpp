@@ -183,21 +183,8 @@ TEST(WebRtcView, DriveModeGoesOverTheDataChannelAndAPageThatHangsOrGoesAwayStops
   std::cerr << "[ measured ] drive command round trip over the data channel "
             << roundTrip.get<double>() << " ms\n";
 
-  // The page hangs: wirccontrol's dead-man stops the car within 250 ms of
-  // the last command, and a command period (100 ms) is the most that can
-  // pass between them (and 100 ms for the check's own polling under load).
-  page.pauseScripts();
-  auto hung = untilNeutral(*car.device);
-  EXPECT_LE(hung.count(), 250 + 100 + 100) << "neutral " << hung.count() << " ms after the hang";
-  std::cerr << "[ measured ] hung page → neutral in " << hung.count() << " ms\n";
-
-  // It comes back, drives again, and its tab is closed: neutral.
-  page.call("Debugger.resume");
-  ASSERT_TRUE(waitFor([&] { return car.device->outputs().pulses[kThrottle] > 1500; }));
-  page.closeTab();
-  auto closed = untilNeutral(*car.device);
-  EXPECT_LE(closed.count(), 250 + 100) << "neutral " << closed.count() << " ms after closing";
-  std::cerr << "[ measured ] closed tab → neutral in " << closed.count() << " ms\n";
+  expectAHungPageStopsTheCar(page, *car.device);
+  expectAClosedTabStopsTheCar(page, *car.device);
   // And the recorder lets the viewer go.
   EXPECT_TRUE(signedIn.recorder.waitForText("viewer gone", milliseconds(15000)))
       << signedIn.recorder.log();
@@ -214,21 +201,11 @@ TEST(WebRtcView, JunkOnTheDataChannelIsAnsweredAndStopsTheCar) {
       page.waitUntil("document.querySelector('.camera[data-transport=webrtc]') && "
                      "Object.values(views)[0].webrtc.drive.readyState === 'open'",
                      milliseconds(15000)));
-  // The page's own channel, full ahead every 100 ms...
+  // The page's own channel, full ahead, then junk, text and binary.
   page.evaluate(
       "window.probe = Object.values(views)[0].webrtc.drive; probe.onmessage = e => { "
-      "window.answer = JSON.parse(e.data); }; window.keep = setInterval(() => "
-      "probe.send(JSON.stringify({seq: 1, steering: 0, throttle: 1})), 100)");
-  ASSERT_TRUE(waitFor([&] { return car.device->outputs().pulses[kThrottle] > 1500; }));
-  ASSERT_TRUE(page.waitUntil("window.answer && window.answer.ack === 1"));
-  // ...then junk, text and binary: answered with the reason, and neutral at
-  // once (the dead-man would take 150 ms more at least).
-  page.evaluate("clearInterval(keep); probe.send('{\"steering\": \"hard left\"}')");
-  auto neutral = untilNeutral(*car.device);
-  EXPECT_LT(neutral.count(), 120) << "neutral " << neutral.count() << " ms after the junk";
-  ASSERT_TRUE(page.waitUntil("window.answer.error"));
-  EXPECT_EQ(page.evaluate("window.answer.error"), "'steering' is not a number");
-  EXPECT_EQ(page.evaluate("window.answer.neutral"), true);
+      "window.answer = JSON.parse(e.data); }");
+  expectJunkStopsTheCarAtOnce(page, *car.device);
   page.evaluate("window.answer = null; probe.send(new Uint8Array([1, 2, 3]))");
   ASSERT_TRUE(page.waitUntil("window.answer && window.answer.error"));
   EXPECT_EQ(page.evaluate("window.answer.error"), "not a text message");
