@@ -14,6 +14,7 @@
 
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
+#include "link/link_registry.h"
 #include "link/shared_settings.h"
 #include "wirc/channel_list.h"
 #include "wirc/discovery.h"
@@ -179,7 +180,6 @@ class TransmitterSession::Impl {
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   LoginMachine machine_;
-  link::SettingClaims claims_;  // who gave which of the link's settings
   link::CommandPacer pacer_;
 
   // The TCP connection; sendMutex_ serialises writers from any thread.
@@ -410,62 +410,51 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
     return unexpected("transmitter-name " + quoted(config.transmitterName) +
                       " cannot be sent: " + tl.error().message());
 
-  std::shared_ptr<TransmitterSession> session;
-  {
-    static std::mutex registryMutex;
-    // By device and loop: sessions on different loops are different links.
-    static std::map<std::pair<const EventLoop*, std::string>, std::weak_ptr<TransmitterSession>>
-        registry;
-    std::lock_guard lock(registryMutex);
-    auto& entry = registry[{&loop, config.key()}];
-    session = entry.lock();
-    if (!session) {
-      session.reset(new TransmitterSession(config, loop));
-      entry = session;
-    }
-  }
-
-  // Take over the settings `user` gave, unless someone else gave others.
-  auto* impl = session->impl_.get();
+  // The settings this user gave; a shared link takes over those nobody
+  // else gave (logging in again where one needs it).
+  link::SettingValues given;
+  for (const auto& setting : sharedSettings())
+    if (config.given.count(setting.name)) given[setting.name] = setting.text(config);
+  static link::LinkRegistry<TransmitterSession> registry;
   bool relogin = false;
-  {
-    std::lock_guard settingsLock(impl->mutex_);
-    auto& linkConfig = impl->machine_.config();
-    link::SettingValues given, current;
-    for (const auto& setting : sharedSettings()) {
-      current[setting.name] = setting.text(linkConfig);
-      if (config.given.count(setting.name)) given[setting.name] = setting.text(config);
-    }
-    auto changes = impl->claims_.claim(config.key(), user, given, current, true);
-    if (!changes) return unexpected(changes.error());
-    for (const auto& setting : sharedSettings()) {
-      if (std::find(changes->begin(), changes->end(), setting.name) == changes->end()) continue;
-      setting.adopt(linkConfig, config);
-      relogin = relogin || setting.needsLogin;
-    }
-    impl->pacer_ = link::CommandPacer(pacerConfig(linkConfig));
-  }
-  if (relogin) {
+  auto session = registry.acquireChangeable(
+      loop, config.key(), given, user,
+      [&]() -> Expected<std::shared_ptr<TransmitterSession>, std::string> {
+        return std::shared_ptr<TransmitterSession>(new TransmitterSession(config, loop));
+      },
+      [](TransmitterSession& shared) {
+        std::lock_guard lock(shared.impl_->mutex_);
+        link::SettingValues current;
+        for (const auto& setting : sharedSettings())
+          current[setting.name] = setting.text(shared.impl_->machine_.config());
+        return current;
+      },
+      [&](TransmitterSession& shared, const std::vector<std::string>& changes) {
+        auto* impl = shared.impl_.get();
+        std::lock_guard lock(impl->mutex_);
+        auto& linkConfig = impl->machine_.config();
+        for (const auto& setting : sharedSettings()) {
+          if (std::find(changes.begin(), changes.end(), setting.name) == changes.end()) continue;
+          setting.adopt(linkConfig, config);
+          relogin = relogin || setting.needsLogin;
+        }
+        impl->pacer_ = link::CommandPacer(pacerConfig(linkConfig));
+      });
+  if (session && relogin) {
+    auto* impl = (*session)->impl_.get();
     impl->loop_.invoke([impl, &user] {
       impl->handle([&](LoginMachine& m) {
         return m.relogin("logging in again with the settings of " + user, Clock::now());
       });
     });
   }
-
-  // Dropping it gives the user's settings back.
-  return link::userReference(session, [held = session.get(), user] { held->release(user); });
+  return session;
 }
 
 TransmitterSession::TransmitterSession(const SessionConfig& config, EventLoop& loop)
     : impl_(std::make_unique<Impl>(config, listeners_, loop)) {}
 
 TransmitterSession::~TransmitterSession() = default;
-
-void TransmitterSession::release(const std::string& user) {
-  std::lock_guard lock(impl_->mutex_);
-  impl_->claims_.release(user);
-}
 
 std::optional<std::string> TransmitterSession::waitLoggedIn(milliseconds timeout) {
   std::unique_lock lock(impl_->mutex_);

@@ -118,7 +118,6 @@ class TransmitterSession : public link::VehicleLink {
 
  private:
   TransmitterSession(const SessionConfig& config, link::EventLoop& loop);
-  void release(const std::string& user);
   std::unique_ptr<Impl> impl_;
 };
 
