@@ -39,7 +39,7 @@ std::chrono::milliseconds untilNeutral(const wirc::Device& device);
 // A page's drive channel (window.probe, a WebSocket or a WebRTC data
 // channel, whose answers land in window.answer) sends full ahead every
 // 100 ms, then junk: the junk is answered with its reason and the car is at
-// neutral at once, not when the dead-man would lapse (150 ms later at least).
+// neutral at once, not when the dead-man would lapse.
 void expectJunkStopsTheCarAtOnce(DevToolsPage& page, const wirc::Device& device);
 // The page, driving, hangs (its scripts stop): the dead-man stops the car
 // within 250 ms of the last command, a command period (100 ms) being the
