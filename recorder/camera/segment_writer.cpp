@@ -76,6 +76,7 @@ SegmentWriter::SegmentWriter(Parts parts, SegmentPlanner& planner, TelemetryTrac
 }
 
 SegmentWriter::~SegmentWriter() {
+  if (textDrain_) g_source_remove(textDrain_);
   if (sourceProbe_) gst_pad_remove_probe(sourcePad_, sourceProbe_);
   gst_pad_remove_probe(videoPad_, videoProbe_);
   if (textProbe_) gst_pad_remove_probe(textPad_, textProbe_);
@@ -217,7 +218,28 @@ bool SegmentWriter::moveText(GstPad* pad, uint64_t number) {
 }
 
 void SegmentWriter::end() {
+  if (!parts_.textTail) return endFrames();
+  // The frames end once the text's lines have all gone to the muxers: a
+  // muxer finishes at the end of its frames, and lines still queued (the
+  // text's thread runs behind the frames' under load) would be cut off.
+  // (The last line may wait in its muxer for a frame: the frames' end
+  // releases it.) Text held up longer gets kTextDrain.
   track_.end();
+  textDrainEnds_ = std::chrono::steady_clock::now() + kTextDrain;
+  textDrain_ = g_timeout_add(5, onTextDrainTick, this);
+}
+
+gboolean SegmentWriter::onTextDrainTick(gpointer self) {
+  auto* writer = static_cast<SegmentWriter*>(self);
+  if (!writer->track_.allSent() && std::chrono::steady_clock::now() < writer->textDrainEnds_)
+    return G_SOURCE_CONTINUE;
+  writer->textDrain_ = 0;
+  writer->endFrames();
+  return G_SOURCE_REMOVE;
+}
+
+void SegmentWriter::endFrames() {
+  if (framesEnded_.exchange(true)) return;
   // Not gst_element_send_event(EOS): basesrc takes the stream lock for it,
   // and would hold the main loop for as long as a frame is held downstream.
   g_signal_emit_by_name(parts_.source, "end-of-stream");

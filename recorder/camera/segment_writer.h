@@ -15,6 +15,8 @@
 
 #include <gst/gst.h>
 
+#include <atomic>
+#include <chrono>
 #include <deque>
 #include <functional>
 #include <memory>
@@ -46,8 +48,8 @@ class SegmentWriter {
   SegmentWriter(const SegmentWriter&) = delete;
   SegmentWriter& operator=(const SegmentWriter&) = delete;
 
-  // The end of the recording: EOS from the source, and the text track ends
-  // after its lines; each open file is finished.
+  // The end of the recording: the text track ends after its lines, then
+  // the source's frames (EOS); each open file is finished. On the main loop.
   void end();
   // A file is finished (its SegmentFile::kClosedMessage), and, with
   // `release`, out of the pipeline. (Not while the run ends: the filesink
@@ -68,6 +70,9 @@ class SegmentWriter {
   // The text goes to file `number` from now on; false: it has no file.
   bool moveText(GstPad* pad, uint64_t number);
   void open(GstClockTime start);
+  // EOS from the source, once (after the text's lines, or kTextDrain after end()).
+  void endFrames();
+  static gboolean onTextDrainTick(gpointer self);
 
   Parts parts_;
   SegmentPlanner& planner_;
@@ -80,6 +85,11 @@ class SegmentWriter {
   gulong sourceProbe_ = 0, videoProbe_ = 0, textProbe_ = 0;
 
   static constexpr GstClockTime kKeyFrameInterval = GST_SECOND / 2;
+  // How long the frames wait at the end for the text's lines to go first.
+  static constexpr std::chrono::milliseconds kTextDrain{300};
+  guint textDrain_ = 0;  // the wait's ticks, on the main loop
+  std::chrono::steady_clock::time_point textDrainEnds_;
+  std::atomic<bool> framesEnded_{false};
   GstSegment sourceSegment_{};     // the source's segment, on its thread
   GstSegment videoSegment_{};      // the frames' segment where they leave, on that thread
   GstClockTime lastKeyFrame_ = 0;  // asked of the encoder, on the source's thread

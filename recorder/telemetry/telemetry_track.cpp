@@ -63,6 +63,10 @@ void TelemetryTrack::end() {
   if (source_) gst_app_src_end_of_stream(GST_APP_SRC(source_));
 }
 
+bool TelemetryTrack::allSent() const {
+  return !source_ || gst_app_src_get_current_level_buffers(GST_APP_SRC(source_)) == 0;
+}
+
 void TelemetryTrack::pushLine(const std::string& json, GstClockTime pts, uint64_t file) {
   moveTo(file);
   last_ = std::max(last_, pts);

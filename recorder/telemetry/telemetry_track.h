@@ -64,6 +64,9 @@ class TelemetryTrack {
 
   // No more lines: the text track ends after the ones sent.
   void end();
+  // Every line sent has left the track's queue for the muxer (where the
+  // last may still wait for a frame).
+  bool allSent() const;
 
   static uint64_t fileOf(GstBuffer* buffer) { return GST_BUFFER_OFFSET(buffer); }
 
