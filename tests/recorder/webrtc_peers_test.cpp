@@ -141,15 +141,17 @@ TEST(WhepPeers, CandidatesForOtherHostsNeverGetAPacketAndAViewerThatNeverConnect
   EXPECT_NE(answered.body.find("a=end-of-candidates"), std::string::npos) << answered.body;
   auto answeredAt = Clock::now();
   // The recorder checks connectivity towards the viewer's candidate (ICE's
-  // STUN requests, resent as they go unanswered)...
-  ASSERT_TRUE(waitFor([&] { return own.received() >= 3; })) << whep.recorder.log();
-  // ...and never towards the other host's, which it was never given.
-  EXPECT_EQ(other.received(), 0);
+  // STUN requests: under load only one may leave before the viewer is let
+  // go)...
+  ASSERT_TRUE(waitFor([&] { return own.received() >= 1; })) << whep.recorder.log();
   EXPECT_TRUE(whep.recorder.waitForText("left out 1 ICE candidate(s)", milliseconds(1000)));
   // The viewer never answers: its elements go within the idle timeout (and
   // the sweep's half second).
   ASSERT_TRUE(whep.recorder.waitForText("viewer gone", milliseconds(10000))) << whep.recorder.log();
   auto gone = std::chrono::duration_cast<milliseconds>(Clock::now() - answeredAt);
+  // ...and, over the viewer's whole life, never towards the other host's,
+  // which it was never given.
+  EXPECT_EQ(other.received(), 0);
   EXPECT_LT(gone.count(), 1500 + 500 + 1000) << "let go after " << gone.count() << " ms";
   std::cerr << "[ measured ] unconnected viewer let go " << gone.count()
             << " ms after its answer\n";
