@@ -13,7 +13,6 @@
 #include "record/segment_inspector.h"
 #include "record/segment_planner.h"
 #include "status/camera_report.h"
-#include "telemetry/telemetry_track.h"
 #include "telemetry/telemetry_track_flags.h"
 
 namespace wircam::recorder {

@@ -239,7 +239,6 @@ gboolean SegmentWriter::onTextDrainTick(gpointer self) {
 }
 
 void SegmentWriter::endFrames() {
-  if (framesEnded_.exchange(true)) return;
   // Not gst_element_send_event(EOS): basesrc takes the stream lock for it,
   // and would hold the main loop for as long as a frame is held downstream.
   g_signal_emit_by_name(parts_.source, "end-of-stream");

@@ -15,7 +15,6 @@
 
 #include <gst/gst.h>
 
-#include <atomic>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -49,7 +48,8 @@ class SegmentWriter {
   SegmentWriter& operator=(const SegmentWriter&) = delete;
 
   // The end of the recording: the text track ends after its lines, then
-  // the source's frames (EOS); each open file is finished. On the main loop.
+  // the source's frames (EOS); each open file is finished. On the main
+  // loop, once.
   void end();
   // A file is finished (its SegmentFile::kClosedMessage), and, with
   // `release`, out of the pipeline. (Not while the run ends: the filesink
@@ -70,7 +70,7 @@ class SegmentWriter {
   // The text goes to file `number` from now on; false: it has no file.
   bool moveText(GstPad* pad, uint64_t number);
   void open(GstClockTime start);
-  // EOS from the source, once (after the text's lines, or kTextDrain after end()).
+  // EOS from the source (after the text's lines, or kTextDrain after end()).
   void endFrames();
   static gboolean onTextDrainTick(gpointer self);
 
@@ -89,7 +89,6 @@ class SegmentWriter {
   static constexpr std::chrono::milliseconds kTextDrain{300};
   guint textDrain_ = 0;  // the wait's ticks, on the main loop
   std::chrono::steady_clock::time_point textDrainEnds_;
-  std::atomic<bool> framesEnded_{false};
   GstSegment sourceSegment_{};     // the source's segment, on its thread
   GstSegment videoSegment_{};      // the frames' segment where they leave, on that thread
   GstClockTime lastKeyFrame_ = 0;  // asked of the encoder, on the source's thread

@@ -26,6 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 using wircam::bench::spawn;
 using wircam::bench::stopGroup;
+using wircam::bench::stopGroups;
 using wircam::bench::Usage;
 using wircam::bench::waitForUsage;
 
@@ -108,7 +109,7 @@ int main(int argc, char** argv) {
       std::printf("MQTT adds %.2f %% CPU per stream (%.0f %% more than without)\n",
                   cpuPerStream - withoutCpu, 100.0 * (cpuPerStream - withoutCpu) / withoutCpu);
   }
-  wircam::bench::stopGroups(sims, SIGINT);
+  stopGroups(sims, SIGINT);
   stopGroup(broker, SIGTERM);
   fs::remove_all(work);
   return 0;

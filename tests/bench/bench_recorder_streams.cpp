@@ -35,6 +35,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using wircam::bench::spawn;
+using wircam::bench::stopGroups;
 using wircam::bench::Usage;
 using wircam::bench::waitForUsage;
 
@@ -188,7 +189,7 @@ Run recordWithWircam(const fs::path& work, const fs::path& bin, int basePort, in
   run.threads = threadsOf(recorder);
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
   run.recordingCpu = recording.end(n);
-  wircam::bench::stopGroups(sims, SIGINT);
+  stopGroups(sims, SIGINT);
   std::this_thread::sleep_for(kDrain);
   kill(recorder, SIGINT);
   run.usage = waitForUsage(recorder);

@@ -64,31 +64,32 @@ void runsOnItsOwnLoop(Open open) {
   loop.reset();  // its thread ends: nothing of the links is left on it
 }
 
+// The same for the link `Link::acquire` opens with a `Config` naming the
+// simulated `peer` on loopback.
+template <typename Link, typename Config, typename Peer>
+void runsOnItsOwnLoopTo(const Peer& peer) {
+  Config config{.host = "127.0.0.1", .port = peer.port()};
+  runsOnItsOwnLoop([&](link::EventLoop& loop, const std::string& user) {
+    return Link::acquire(config, user, loop);
+  });
+}
+
 TEST(OwnEventLoop, AWircSessionRunsOnTheLoopItIsGiven) {
   auto device = wirc::Device::start({.port = 0}, nullptr);
   ASSERT_TRUE(device) << device.error();
-  wirc::SessionConfig config{.host = "127.0.0.1", .port = (*device)->port()};
-  runsOnItsOwnLoop([&](link::EventLoop& loop, const std::string& user) {
-    return wirc::TransmitterSession::acquire(config, user, loop);
-  });
+  runsOnItsOwnLoopTo<wirc::TransmitterSession, wirc::SessionConfig>(**device);
 }
 
 TEST(OwnEventLoop, AnRcoipLinkRunsOnTheLoopItIsGiven) {
   auto receiver = rcoip::Receiver::start({.port = 0});
   ASSERT_TRUE(receiver);
-  rcoip::TransmitterConfig config{.host = "127.0.0.1", .port = (*receiver)->port()};
-  runsOnItsOwnLoop([&](link::EventLoop& loop, const std::string& user) {
-    return rcoip::Transmitter::acquire(config, user, loop);
-  });
+  runsOnItsOwnLoopTo<rcoip::Transmitter, rcoip::TransmitterConfig>(**receiver);
 }
 
 TEST(OwnEventLoop, ABtempLinkRunsOnTheLoopItIsGiven) {
   auto robot = btemp::Robot::start({.port = 0});
   ASSERT_TRUE(robot);
-  btemp::ControllerConfig config{.host = "127.0.0.1", .port = (*robot)->port()};
-  runsOnItsOwnLoop([&](link::EventLoop& loop, const std::string& user) {
-    return btemp::Controller::acquire(config, user, loop);
-  });
+  runsOnItsOwnLoopTo<btemp::Controller, btemp::ControllerConfig>(**robot);
 }
 
 TEST(OwnEventLoop, AMarvelmindClientRunsOnTheLoopItIsGiven) {
