@@ -97,11 +97,21 @@ struct ExportDownloads::Download {
     soup_server_message_unpause(message);
   }
 
-  // The response is over: the export stopped (if it still ran), and the
-  // recorder's log says how it ended.
+  // The export's files, written or half written: never kept.
+  void removeFiles() {
+    file.close();
+    std::error_code ignored;
+    fs::remove(request.out, ignored);
+    fs::remove(fs::path(request.out).replace_extension(".jsonl"), ignored);
+  }
+
+  // The response is over: the export stopped (if it still ran), its files
+  // gone, and then the recorder's log says how it ended (a reader of the log
+  // finds nothing left behind).
   void end() {
     stop = true;
     if (worker.joinable()) worker.join();  // the result is written then
+    removeFiles();
     std::string what =
         "export of " + request.camera + " (" + exportFormatName(request.format) + ")";
     if (!result) return;
@@ -123,10 +133,7 @@ struct ExportDownloads::Download {
       g_signal_handler_disconnect(message, finishedHandler);
       if (wroteHandler) g_signal_handler_disconnect(message, wroteHandler);
     }
-    file.close();
-    std::error_code ignored;
-    fs::remove(request.out, ignored);
-    fs::remove(fs::path(request.out).replace_extension(".jsonl"), ignored);
+    removeFiles();
   }
 };
 
