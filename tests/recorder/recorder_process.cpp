@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "gst_scoped.h"
+#include "shell_command.h"
 #include "wait_for.h"
 
 namespace wircam::testing {
@@ -219,6 +220,11 @@ std::vector<std::string> frameDigests(const fs::path& file) {
   gst_object_unref(sink);
   gst_object_unref(pipeline);
   return digests;
+}
+
+std::string ffmpegDecodeErrors(const fs::path& file) {
+  return runCommand("ffmpeg -v error -i '" + file.string() + "' -enc_time_base -1 -f null -")
+      .output;
 }
 
 Contents contentsOf(const fs::path& file) {

@@ -70,4 +70,11 @@ Contents contentsOf(const std::filesystem::path& file);
 // (Matroska or MP4).
 std::vector<std::string> frameDigests(const std::filesystem::path& file);
 
+// What ffmpeg says as it decodes every frame of `file`: empty when it says
+// nothing. At the file's own times (-enc_time_base -1): left to itself,
+// ffmpeg re-times the frames on the stream's guessed rate, where two that
+// arrived a few milliseconds apart (the burst after a stall) share a tick
+// and it calls that a non-monotonic timestamp.
+std::string ffmpegDecodeErrors(const std::filesystem::path& file);
+
 }  // namespace wircam::testing
