@@ -7,7 +7,9 @@
 // Senders are separate processes; the receiving process's CPU (user + system)
 // and peak memory come from wait4(), its CPU over its whole life; its CPU
 // while recording (from a quarter of the run to the senders' end, out of
-// /proc, so without starting and stopping) is shown beside it. Frames are
+// /proc, so without starting and stopping) is shown beside it, and so is
+// its private memory halfway through (RssAnon: the peak also counts the
+// shared libraries' code, once per process however many streams). Frames are
 // counted in the files. The senders stop first and the receiver 0.3 s later,
 // so "lost" counts the frames sent that did not reach a file, not those
 // sent while the receiver was told to stop.
@@ -108,6 +110,16 @@ int threadsOf(pid_t root) {
   return count;
 }
 
+// A process's private memory now (RssAnon: its heap, stacks and other
+// anonymous pages), in KB: what each stream adds, without the shared
+// libraries' code that the peak (VmHWM) also counts once.
+long privateKbOf(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.starts_with("RssAnon:")) return std::atol(line.c_str() + 8);
+  return 0;
+}
+
 // A process's CPU (user + system) so far, in seconds.
 double cpuSecondsOf(pid_t pid) {
   std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
@@ -152,14 +164,16 @@ int framesSent(const fs::path& summary) {
 // One receiver's run: frames sent and recorded, its resources.
 struct Run {
   int sent = 0, recorded = 0, threads = 0;
+  long privateKb = 0;  // halfway through, as the threads
   Usage usage;
   double seconds = 0;
   double recordingCpu = 0;  // % per stream while recording
   std::string row(int streams) const {
-    char text[128];
-    std::snprintf(text, sizeof text, "lost %4d of %5d, %5.3f / %5.3f %%, %5.2f MB, %4d thr",
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "lost %4d of %5d, %5.3f / %5.3f %%, %5.2f MB (%5.2f private), %4d thr",
                   sent - recorded, sent, 100 * usage.cpuSeconds / seconds / streams, recordingCpu,
-                  usage.maxRssKb / 1024.0 / streams, threads);
+                  usage.maxRssKb / 1024.0 / streams, privateKb / 1024.0 / streams, threads);
     // Killed after a minute of not stopping: its files may be unfinished.
     return text + std::string(usage.exitCode == 128 + SIGKILL ? " (did not stop: killed)" : "");
   }
@@ -187,6 +201,7 @@ Run recordWithWircam(const fs::path& work, const fs::path& bin, int basePort, in
   CpuWindow recording(recorder);
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 4));
   run.threads = threadsOf(recorder);
+  run.privateKb = privateKbOf(recorder);
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
   run.recordingCpu = recording.end(n);
   stopGroups(sims, SIGINT);
@@ -230,6 +245,7 @@ Run recordWithStock(const fs::path& work, int basePort, int n, double seconds) {
   CpuWindow recording(receiver);
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 4));
   run.threads = threadsOf(receiver);
+  run.privateKb = privateKbOf(receiver);
   for (pid_t s : senders) waitpid(s, nullptr, 0);
   run.recordingCpu = recording.end(n);
   std::this_thread::sleep_for(kDrain);
@@ -263,8 +279,8 @@ int main(int argc, char** argv) {
   }
   int basePort = 21000 + getpid() % 20000;
 
-  std::printf("%-8s | %-54s | %-54s | %-54s\n", "streams",
-              "wirc-recorder: lost, CPU life / recording, memory, threads",
+  std::printf("%-8s | %-68s | %-68s | %-68s\n", "streams",
+              "wirc-recorder: lost, CPU life / recording, memory (private), threads",
               "--telemetry-track off: same", "udpsrc ! rtpjpegdepay ! matroskamux: same");
   for (int n : counts) {
     Run track = recordWithWircam(work, bin, basePort, n, seconds, "");
