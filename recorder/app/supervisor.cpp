@@ -1,7 +1,6 @@
 #include "app/supervisor.h"
 
 #include <glib-unix.h>
-#include <libsoup/soup.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -258,15 +257,13 @@ std::optional<std::pair<guint, std::string>> Supervisor::deleteSegment(const std
   using Refusal = std::pair<guint, std::string>;
   for (const auto& path : openSegments())
     if (std::filesystem::path(path).filename() == file)
-      return Refusal(SOUP_STATUS_CONFLICT,
-                     "'" + file + "' is being recorded; it can go once closed");
+      return Refusal(kHttpConflict, "'" + file + "' is being recorded; it can go once closed");
   const auto& entries = index_.entries();
   if (std::none_of(entries.begin(), entries.end(), [&](const auto& e) { return e.file == file; }))
-    return Refusal(SOUP_STATUS_NOT_FOUND, "no recording named '" + file + "'");
+    return Refusal(kHttpNotFound, "no recording named '" + file + "'");
   auto video = std::filesystem::path(options_.outDir) / file;
   if (auto error = removeSegment(video))
-    return Refusal(SOUP_STATUS_INTERNAL_SERVER_ERROR,
-                   "cannot delete '" + file + "': " + error.message());
+    return Refusal(kHttpInternalError, "cannot delete '" + file + "': " + error.message());
   logLine("deleted " + file + " (asked over HTTP)");
   updateIndex({video.string()});
   return std::nullopt;

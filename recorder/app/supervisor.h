@@ -20,8 +20,7 @@
 #include "camera/camera.h"
 #include "common/expected.h"
 #include "fleet/fleet_publisher.h"
-#include "http/http_server.h"
-#include "http/rtsp_server.h"
+#include "http/live_servers.h"
 #include "record/disk_guard.h"
 #include "record/recording_index.h"
 #include "record/retention.h"
@@ -85,8 +84,8 @@ class Supervisor : CameraObserver {
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Camera>> cameras_;
   CommandDispatcher commands_;
-  std::unique_ptr<HttpServer> http_;
-  std::unique_ptr<RtspServer> rtsp_;
+  std::unique_ptr<WebServer> http_;        // with --http
+  std::unique_ptr<RtspService> rtsp_;      // with --rtsp
   std::unique_ptr<FleetPublisher> fleet_;  // with --mqtt
   std::unique_ptr<SegmentHook> hook_;      // with --on-segment-closed
   std::vector<guint> timers_;              // the run's timeouts, removed when it ends

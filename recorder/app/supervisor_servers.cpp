@@ -1,6 +1,7 @@
 // The servers a supervisor starts beside its cameras (web, MQTT, the
 // segment hook, RTSP), each fed from the supervisor's own state and
 // commands.
+#include "app/live_servers_module.h"
 #include "app/supervisor.h"
 #include "log_line.h"
 #include "status/camera_report.h"
@@ -9,7 +10,9 @@ namespace wircam::recorder {
 
 std::optional<std::string> Supervisor::startServers() {
   if (options_.http) {
-    HttpServer::Content content;
+    auto servers = liveServers();
+    if (!servers) return servers.error();
+    WebContent content;
     for (auto& c : cameras_)
       content.cameras.push_back({c->name(), c->frames(), c->encodedFrames()});
     content.recordingsFolder = options_.outDir;
@@ -38,7 +41,7 @@ std::optional<std::string> Supervisor::startServers() {
     content.drive = [this](const std::string& camera, double steering, double throttle) {
       return commands_.drive(camera, steering, throttle);
     };
-    auto server = HttpServer::start(
+    auto server = (*servers)->startWeb(
         *options_.http, std::move(content),
         std::chrono::milliseconds(static_cast<int64_t>(options_.httpIdleSeconds * 1000)));
     if (!server) return server.error();
@@ -78,11 +81,13 @@ std::optional<std::string> Supervisor::startServers() {
         });
   }
   if (options_.rtsp) {
-    std::vector<RtspServer::Camera> cameras;
+    auto servers = liveServers();
+    if (!servers) return servers.error();
+    std::vector<RtspCamera> cameras;
     for (auto& c : cameras_)
       cameras.push_back(
           {"/" + c->plan().device + "/cam" + std::to_string(c->plan().camera), c->frames()});
-    auto server = RtspServer::start(*options_.rtsp, cameras, options_.httpToken);
+    auto server = (*servers)->startRtsp(*options_.rtsp, cameras, options_.httpToken);
     if (!server) return server.error();
     rtsp_ = std::move(*server);
     for (auto& camera : cameras) logLine("RTSP at " + rtsp_->url() + camera.path);

@@ -25,49 +25,15 @@
 #include "http/export_downloads.h"
 #include "http/http_connections.h"
 #include "http/http_routes.h"
+#include "http/live_servers.h"
 #include "webrtc/webrtc_service.h"
 
 namespace wircam::recorder {
 
-class HttpServer {
+class HttpServer : public WebServer {
  public:
-  struct Camera {
-    std::string name;
-    FrameTap* frames;             // borrowed; outlives the server
-    FrameTap* encoded = nullptr;  // the recording's H.264 (--codec h264), or null
-  };
-  struct Content {
-    std::vector<Camera> cameras;
-    std::string recordingsFolder;
-    std::function<nlohmann::json()> status;  // called on the main thread
-    // GET /metrics: the Prometheus text (main thread).
-    std::function<std::string()> metrics;
-    // /api/cameras: [{name, state, fps, has_control, following}, ...]
-    std::function<nlohmann::json()> cameraStates;
-    // /api/recordings: the recording index's entries (url added here)
-    std::function<nlohmann::json()> recordings;
-    std::string token;  // empty: no authentication (this machine only)
-    // HTTPS with this certificate and key (PEM files); empty: plain HTTP.
-    std::string certificateFile, keyFile;
-    // Deletes a finished segment (video and sidecar) and its index entry;
-    // the HTTP status and reason when it cannot.
-    std::function<std::optional<std::pair<guint, std::string>>(const std::string& file)>
-        deleteRecording;
-    // Each stream's recent Marvelmind positions, for the page's map:
-    // {"<stream>": {"points": [{"x","y","utc"}, ...], "stale": bool}}.
-    std::function<nlohmann::json()> trails;
-    std::function<std::vector<std::string>()> openSegments;
-    // Follow, target, request-control from the page: why not, if refused.
-    std::function<std::optional<std::string>(const FleetCommand&)> command;
-    // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
-    std::function<std::optional<bool>(const std::string& camera, double steering, double throttle)>
-        drive;
-    // The WebRTC live view (WHEP at /api/cameras/NAME/whep), with these ICE
-    // servers and each camera's VP8 rate.
-    bool webrtc = false;
-    IceServers iceServers;
-    unsigned webrtcKbps = 600;
-  };
+  using Camera = WebCamera;
+  using Content = WebContent;
 
   // Limits that keep hostile clients from holding the recorder's memory or
   // connections: a request body is never read (only GET and HEAD are
@@ -83,16 +49,11 @@ class HttpServer {
   static Expected<std::unique_ptr<HttpServer>, std::string> start(
       const ServerAddress& address, Content content,
       std::chrono::milliseconds idleTimeout = std::chrono::seconds(10));
-  ~HttpServer();
+  ~HttpServer() override;
 
-  // "http://HOST:PORT/", with the port the system picked for port 0.
-  const std::string& url() const { return url_; }
-
-  // Connections open now (counted from accept to close).
-  size_t openConnections() const { return connections_->open(); }
-
-  // Sends one camera's detections to every open page (main thread).
-  void publishDetections(const std::string& camera, const nlohmann::json& detections);
+  const std::string& url() const override { return url_; }
+  size_t openConnections() const override { return connections_->open(); }
+  void publishDetections(const std::string& camera, const nlohmann::json& detections) override;
 
  private:
   struct Client;

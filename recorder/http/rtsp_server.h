@@ -14,24 +14,21 @@
 #include "app/recorder_options.h"
 #include "camera/frame_tap.h"
 #include "common/expected.h"
+#include "http/live_servers.h"
 
 namespace wircam::recorder {
 
-class RtspServer {
+class RtspServer : public RtspService {
  public:
-  struct Camera {
-    std::string path;  // "/<device>/cam<N>"
-    FrameTap* frames;  // borrowed; outlives the server
-  };
+  using Camera = RtspCamera;
 
   // With a token every request needs it (rtsp_token_auth.h).
   static Expected<std::unique_ptr<RtspServer>, std::string> start(const ServerAddress& address,
                                                                   std::vector<Camera> cameras,
                                                                   const std::string& token = "");
-  ~RtspServer();
+  ~RtspServer() override;
 
-  // "rtsp://HOST:PORT", the port the system picked for port 0.
-  const std::string& url() const { return url_; }
+  const std::string& url() const override { return url_; }
 
  private:
   struct Mount;

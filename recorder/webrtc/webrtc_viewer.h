@@ -20,17 +20,10 @@
 
 #include "common/expected.h"
 #include "webrtc/camera_encoder.h"
+#include "webrtc/ice_servers.h"
 #include "webrtc/whep_sdp.h"
 
 namespace wircam::recorder {
-
-struct IceServers {
-  std::string stun;  // "stun://HOST:PORT"; empty: none (nothing is contacted)
-  std::string turn;  // "turn://USER:PASSWORD@HOST:PORT"; empty: none
-  // The local addresses ICE gathers on (the web server's own: loopback by
-  // default); empty: every interface.
-  std::vector<std::string> localAddresses;
-};
 
 class WebRtcViewer {
  public:

@@ -19,6 +19,7 @@ for file in bin/wirc-recorder bin/wirc-cli bin/wirc-sim include/wircam/wirc_tag_
             "lib/$multiarch/gstreamer-1.0/libgstwirc.so" \
             "lib/$multiarch/gstreamer-1.0/libgstwircvision.so" \
             "lib/$multiarch/libwircam-gst.so.0" "lib/$multiarch/pkgconfig/wircam-gst.pc" \
+            "lib/$multiarch/wircam/wirc-recorder-servers.so" \
             "lib/$multiarch/girepository-1.0/Wirc-1.0.typelib" share/gir-1.0/Wirc-1.0.gir; do
   [[ -e "$prefix/$file" ]] || { echo "missing: $prefix/$file" >&2; exit 1; }
 done
@@ -35,6 +36,11 @@ for element in wircsrc wircdepay wirccontrol marvelmindpositions tjpegdec aprilt
 done
 grep -q "Usage: wirc-cli" <<<"$("$prefix/bin/wirc-cli" --help)"
 grep -q "Usage: wirc-recorder" <<<"$("$prefix/bin/wirc-recorder" --help 2>&1)"
+# The installed recorder finds its web server's module (lib/<multiarch>/wircam/).
+served=$("$prefix/bin/wirc-recorder" --device 127.0.0.1:9 --out "$prefix/recordings" \
+         --http 127.0.0.1:0 --duration 1 2>&1 || true)
+grep -q "live view at http://127.0.0.1:" <<<"$served" ||
+  { echo "the installed wirc-recorder did not start its web server: $served" >&2; exit 1; }
 
 # C through pkg-config: a tag meta added and read back.
 cat >"$prefix/meta.c" <<'C'

@@ -1,0 +1,110 @@
+// What wirc-recorder sees of its web and RTSP servers. Both live in a module
+// of their own (wirc-recorder-servers.so), which the recorder loads only for
+// --http or --rtsp (app/live_servers_module.h): their code and the libraries
+// they bring (libsoup with krb5, sqlite, nghttp2 and psl; the RTSP server;
+// WebRTC), about 2 MB resident, stay out of a recorder that serves nothing.
+// The recorder links none of it: it starts the servers through the module's
+// table and uses them through these interfaces.
+#pragma once
+
+#include <glib.h>
+
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "app/recorder_options.h"
+#include "camera/frame_tap.h"
+#include "common/expected.h"
+#include "fleet/fleet_command.h"
+#include "webrtc/ice_servers.h"
+
+namespace wircam::recorder {
+
+struct WebCamera {
+  std::string name;
+  FrameTap* frames;             // borrowed; outlives the server
+  FrameTap* encoded = nullptr;  // the recording's H.264 (--codec h264), or null
+};
+
+// The HTTP statuses the supervisor answers with (deleteRecording), as
+// libsoup numbers them; the recorder itself does not include libsoup.
+inline constexpr guint kHttpNotFound = 404, kHttpConflict = 409, kHttpInternalError = 500;
+
+// What the web server shows and obeys, from the supervisor.
+struct WebContent {
+  std::vector<WebCamera> cameras;
+  std::string recordingsFolder;
+  std::function<nlohmann::json()> status;  // called on the main thread
+  // GET /metrics: the Prometheus text (main thread).
+  std::function<std::string()> metrics;
+  // /api/cameras: [{name, state, fps, has_control, following}, ...]
+  std::function<nlohmann::json()> cameraStates;
+  // /api/recordings: the recording index's entries (url added here)
+  std::function<nlohmann::json()> recordings;
+  std::string token;  // empty: no authentication (this machine only)
+  // HTTPS with this certificate and key (PEM files); empty: plain HTTP.
+  std::string certificateFile, keyFile;
+  // Deletes a finished segment (video and sidecar) and its index entry;
+  // the HTTP status and reason when it cannot.
+  std::function<std::optional<std::pair<guint, std::string>>(const std::string& file)>
+      deleteRecording;
+  // Each stream's recent Marvelmind positions, for the page's map:
+  // {"<stream>": {"points": [{"x","y","utc"}, ...], "stale": bool}}.
+  std::function<nlohmann::json()> trails;
+  std::function<std::vector<std::string>()> openSegments;
+  // Follow, target, request-control from the page: why not, if refused.
+  std::function<std::optional<std::string>(const FleetCommand&)> command;
+  // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
+  std::function<std::optional<bool>(const std::string& camera, double steering, double throttle)>
+      drive;
+  // The WebRTC live view (WHEP at /api/cameras/NAME/whep), with these ICE
+  // servers and each camera's VP8 rate.
+  bool webrtc = false;
+  IceServers iceServers;
+  unsigned webrtcKbps = 600;
+};
+
+class WebServer {
+ public:
+  virtual ~WebServer() = default;
+  // "http://HOST:PORT/", with the port the system picked for port 0.
+  virtual const std::string& url() const = 0;
+  // Connections open now (counted from accept to close).
+  virtual size_t openConnections() const = 0;
+  // Sends one camera's detections to every open page (main thread).
+  virtual void publishDetections(const std::string& camera, const nlohmann::json& detections) = 0;
+};
+
+struct RtspCamera {
+  std::string path;  // "/<device>/cam<N>"
+  FrameTap* frames;  // borrowed; outlives the server
+};
+
+class RtspService {
+ public:
+  virtual ~RtspService() = default;
+  // "rtsp://HOST:PORT", the port the system picked for port 0.
+  virtual const std::string& url() const = 0;
+};
+
+// The module's table, which its one exported function (kLiveServersEntry)
+// returns.
+struct LiveServers {
+  Expected<std::unique_ptr<WebServer>, std::string> (*startWeb)(
+      const ServerAddress& address, WebContent content, std::chrono::milliseconds idleTimeout);
+  // With a token every request needs it.
+  Expected<std::unique_ptr<RtspService>, std::string> (*startRtsp)(const ServerAddress& address,
+                                                                   std::vector<RtspCamera> cameras,
+                                                                   const std::string& token);
+};
+
+inline constexpr const char* kLiveServersEntry = "wircam_live_servers";
+
+}  // namespace wircam::recorder
