@@ -2,7 +2,7 @@
 // of their own (wirc-recorder-servers.so), which the recorder loads only for
 // --http or --rtsp (app/live_servers_module.h): their code and the libraries
 // they bring (libsoup with krb5, sqlite, nghttp2 and psl; the RTSP server;
-// WebRTC), about 2 MB resident, stay out of a recorder that serves nothing.
+// WebRTC), about 3 MB resident, stay out of a recorder that serves nothing.
 // The recorder links none of it: it starts the servers through the module's
 // table and uses them through these interfaces.
 #pragma once

@@ -1,7 +1,7 @@
 // What a running wirc-recorder holds beside its cameras: libraries it was
 // not asked to use are not loaded (libmosquitto brings OpenSSL, 1.8 MB
 // resident; the web and RTSP servers libsoup, krb5, sqlite and more, about
-// 2 MB), and GLib's per-thread slice caches are off.
+// 3 MB), and GLib's per-thread slice caches are off.
 #include <glib.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
