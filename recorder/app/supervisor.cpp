@@ -353,9 +353,11 @@ nlohmann::json Supervisor::trails() const {
 }
 
 std::vector<std::string> Supervisor::openSegments() const {
+  // Not only the files being written: the one before a cut is still being
+  // finished (its muxer's end, then its title) until its camera hears so.
   std::vector<std::string> open;
   for (const auto& c : cameras_)
-    if (!c->openSegment().empty()) open.push_back(c->openSegment());
+    for (auto& file : c->unfinishedSegments()) open.push_back(std::move(file));
   return open;
 }
 

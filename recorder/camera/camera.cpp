@@ -289,4 +289,8 @@ gboolean Camera::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
   return G_SOURCE_CONTINUE;
 }
 
+std::vector<std::string> Camera::unfinishedSegments() const {
+  return pipeline_ ? pipeline_->writer().unfinished() : std::vector<std::string>{};
+}
+
 }  // namespace wircam::recorder

@@ -88,6 +88,9 @@ class Camera {
   const std::deque<Position>& trail() const { return trail_; }
   bool positionStale() const { return !report_.positionStale.empty(); }
   const std::string& openSegment() const { return report_.segment; }
+  // Every file of the running pipeline not finished yet: the one being
+  // written, and the one before it while its muxer still writes its end.
+  std::vector<std::string> unfinishedSegments() const;
   double kbps() const { return report_.kbps; }
   // A line of the camera's telemetry, now (a command, say).
   void writeTelemetry(const nlohmann::json& line);
