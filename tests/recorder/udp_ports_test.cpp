@@ -25,7 +25,9 @@ using namespace wircam::testing;
 using namespace std::chrono_literals;
 
 // The local ports of the UDP sockets process `pid` holds, one entry per
-// socket (a port held twice appears twice).
+// socket (a port held twice appears twice). Read by socket: /proc/net/udp
+// is read a page at a time, and a line can come twice when sockets open or
+// close between two reads (seen once under load).
 std::vector<uint16_t> udpPortsOf(pid_t pid) {
   std::set<std::string> inodes;
   for (const auto& fd : fs::directory_iterator("/proc/" + std::to_string(pid) + "/fd")) {
@@ -34,7 +36,7 @@ std::vector<uint16_t> udpPortsOf(pid_t pid) {
     if (!error && target.rfind("socket:[", 0) == 0)
       inodes.insert(target.substr(8, target.size() - 9));
   }
-  std::vector<uint16_t> ports;
+  std::map<std::string, uint16_t> portOf;  // by socket inode
   std::ifstream table("/proc/net/udp");
   std::string line;
   std::getline(table, line);  // the header
@@ -44,9 +46,11 @@ std::vector<uint16_t> udpPortsOf(pid_t pid) {
     fields >> slot >> local >> remote >> state >> queues >> timer >> retransmits >> uid >>
         timeout >> inode;
     if (inodes.count(inode))
-      ports.push_back(
-          static_cast<uint16_t>(std::stoul(local.substr(local.find(':') + 1), nullptr, 16)));
+      portOf[inode] =
+          static_cast<uint16_t>(std::stoul(local.substr(local.find(':') + 1), nullptr, 16));
   }
+  std::vector<uint16_t> ports;
+  for (const auto& [inode, port] : portOf) ports.push_back(port);
   return ports;
 }
 
