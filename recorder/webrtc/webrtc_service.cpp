@@ -3,6 +3,8 @@
 #include <gio/gio.h>
 #include <malloc.h>
 
+#include <utility>
+
 #include "log_line.h"
 #include "webrtc/whep_sdp.h"
 
@@ -109,12 +111,17 @@ void WebRtcService::offer(const std::string& camera, std::string_view sdp,
     logLine("webrtc: " + camera + ": left out " + std::to_string(offer->droppedCandidates) +
             " ICE candidate(s) of the offer for other hosts than the viewer " + viewerAddress);
   WebRtcViewer::Events events;
-  events.answered = [this, session, done](Expected<std::string, std::string> answer) {
+  events.answered = [this, session](Expected<std::string, std::string> answer) {
+    auto viewer = viewers_.find(session);
+    if (viewer == viewers_.end() || !viewer->second.unanswered) return;
+    Done reply = std::exchange(viewer->second.unanswered, nullptr);
     if (!answer) {
       removeLater(session);
-      return done(unexpected(Refusal{400, answer.error()}));
+      return reply(unexpected(Refusal{400, answer.error()}));
     }
-    done(Answer{*answer, session});
+    // The browser has the idle timeout to connect from its answer on.
+    viewer->second.downSince = std::chrono::steady_clock::now();
+    reply(Answer{*answer, session});
   };
   events.ended = [this, session] { removeLater(session); };
   events.driveMessage = [this, camera](std::optional<std::string_view> text) {
@@ -125,6 +132,7 @@ void WebRtcService::offer(const std::string& camera, std::string_view sdp,
   viewer.camera = camera;
   viewer.encoder = key;
   viewer.downSince = std::chrono::steady_clock::now();
+  viewer.unanswered = std::move(done);
   viewer.peer = std::make_unique<WebRtcViewer>(*encoder, *offer, settings_.servers, events);
   logLine("webrtc: " + camera + ": viewer " + viewerAddress + " (session " + session + ", " +
           (passThrough ? "the recording's H.264" : "VP8") + "), " +
@@ -174,6 +182,7 @@ void WebRtcService::remove(const std::string& session) {
   auto viewer = viewers_.find(session);
   if (viewer == viewers_.end()) return;
   std::string camera = viewer->second.camera, key = viewer->second.encoder;
+  Done unanswered = std::move(viewer->second.unanswered);
   viewers_.erase(viewer);
   logLine("webrtc: " + camera + ": viewer gone (session " + session + "), " +
           std::to_string(viewers_.size()) + " now");
@@ -184,6 +193,12 @@ void WebRtcService::remove(const std::string& session) {
   // Each viewer's threads leave memory in glibc's per-thread arenas, kept
   // for reuse; when nobody watches, it goes back to the system.
   if (viewers_.empty()) malloc_trim(0);
+  // Gone before it could answer (its candidates not gathered within the
+  // idle timeout, a loaded machine): the request is answered all the same.
+  if (unanswered)
+    unanswered(unexpected(Refusal{503,
+                                  "the viewer's connection could not be prepared in time; "
+                                  "try again, or /live/CAMERA.mjpg"}));
 }
 
 }  // namespace wircam::recorder

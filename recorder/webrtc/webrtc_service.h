@@ -83,6 +83,7 @@ class WebRtcService {
     std::string encoder;  // its key in encoders_
     std::unique_ptr<WebRtcViewer> peer;
     std::optional<std::chrono::steady_clock::time_point> downSince;  // not connected since
+    Done unanswered;  // the offer's request, until the viewer answers it
   };
   void remove(const std::string& session);
   void removeLater(const std::string& session);

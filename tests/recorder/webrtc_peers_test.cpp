@@ -121,6 +121,24 @@ TEST(WhepPeers, BadOffersAreRefusedWithTheReason) {
   EXPECT_TRUE(whep.recorder.waitForText("live", milliseconds(5000)));
 }
 
+TEST(WhepPeers, AnOfferTheViewerCannotAnswerInTimeIsAnsweredAllTheSame) {
+  // A STUN server that never replies holds the viewer's gathering past the
+  // idle timeout: the viewer is let go, and its offer gets a 503, not a
+  // request left hanging.
+  UdpListener silentStun("127.0.0.1");
+  WhepRecorder whep({"--http-idle-timeout", "1", "--webrtc-stun",
+                     "stun://127.0.0.1:" + std::to_string(silentStun.port())});
+  ASSERT_FALSE(whep.url.empty()) << whep.recorder.log();
+  auto started = Clock::now();
+  auto answered = whep.offer(offerWith(""));
+  EXPECT_EQ(answered.status, 503u) << answered.body;
+  EXPECT_NE(answered.body.find("could not be prepared in time"), std::string::npos)
+      << answered.body;
+  EXPECT_LT(Clock::now() - started, milliseconds(patience(milliseconds(10000))));
+  EXPECT_GT(silentStun.received(), 0) << "the viewer asked the STUN server";
+  EXPECT_TRUE(whep.recorder.waitForText("viewer gone", milliseconds(1000)));
+}
+
 TEST(WhepPeers, CandidatesForOtherHostsNeverGetAPacketAndAViewerThatNeverConnectsIsLetGo) {
   WhepRecorder whep({"--http-idle-timeout", "1.5"});
   ASSERT_FALSE(whep.url.empty()) << whep.recorder.log();
