@@ -114,7 +114,7 @@ TEST(WircCli, DrivesAnRcoipReceiverThenNeutralAndShowsItsBattery) {
   ASSERT_TRUE(receiver);
   auto run = wircCli("drive --protocol rcoip --host 127.0.0.1 --port " +
                      std::to_string((*receiver)->port()) +
-                     " --steering 1800 --throttle 1600 --duration 1");
+                     " --steering 1800 --throttle 1600 --duration 2");
   EXPECT_EQ(run.exitCode, 0) << run.output;
   EXPECT_NE(run.output.find("battery 11.12 V"), std::string::npos) << run.output;
   EXPECT_GT((*receiver)->stats().commands, 1u);
@@ -129,7 +129,7 @@ TEST(WircCli, DrivesABtempRobotAndShowsItsPins) {
   ASSERT_TRUE(robot);
   std::string where = " --host 127.0.0.1 --port " + std::to_string((*robot)->port());
   auto drive =
-      wircCli("drive --protocol btemp" + where + " --steering 1800 --throttle 1600 --duration 1");
+      wircCli("drive --protocol btemp" + where + " --steering 1800 --throttle 1600 --duration 2");
   EXPECT_EQ(drive.exitCode, 0) << drive.output;
   EXPECT_NE(drive.output.find("PDM duty"), std::string::npos) << drive.output;
   EXPECT_GT((*robot)->stats().ctrl, 5u);
