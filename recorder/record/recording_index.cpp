@@ -35,8 +35,9 @@ bool isVideo(const fs::path& path) {
 }  // namespace
 
 std::optional<SegmentName> parseSegmentName(const std::string& file) {
+  // "_N" when two start in one second ("-N" in recordings of earlier versions).
   static const std::regex kName(
-      R"(^(.+)-(\d{4})(\d{2})(\d{2})T(\d{2})(\d{2})(\d{2})Z(-\d+)?\.(mkv|mp4)$)");
+      R"(^(.+)-(\d{4})(\d{2})(\d{2})T(\d{2})(\d{2})(\d{2})Z([-_]\d+)?\.(mkv|mp4)$)");
   std::smatch m;
   if (!std::regex_match(file, m, kName)) return std::nullopt;
   return SegmentName{m[1], m[2].str() + "-" + m[3].str() + "-" + m[4].str() + "T" + m[5].str() +

@@ -46,7 +46,9 @@ std::string SegmentPlanner::isoUtc(int64_t unixMs) {
 std::string SegmentPlanner::nameFor(int64_t unixMs) {
   std::string base = stem_ + "-" + compactUtc(unixMs);
   for (int counter = 1;; ++counter) {
-    std::string name = base + (counter == 1 ? "" : "-" + std::to_string(counter)) + extension_;
+    // "_2" sorts after the name without it ('_' after '.'), so the files of
+    // one camera list in the order they were recorded ("-2" came first).
+    std::string name = base + (counter == 1 ? "" : "_" + std::to_string(counter)) + extension_;
     std::error_code error;
     if (!used_.count(name) && !std::filesystem::exists(folder_ / name, error)) {
       used_.insert(name);

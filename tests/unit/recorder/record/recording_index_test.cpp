@@ -75,6 +75,8 @@ TEST(SegmentName, GivesTheCameraAndTheUtcStart) {
   ASSERT_TRUE(name);
   EXPECT_EQ(name->camera, "rover-cam1");
   EXPECT_EQ(name->startUtc, "2026-11-22T14:32:05.000Z");
+  EXPECT_EQ(parseSegmentName("rover-cam1-20261122T143205Z_3.mkv")->startUtc,
+            "2026-11-22T14:32:05.000Z");
   EXPECT_FALSE(parseSegmentName("rover-cam1-20261122-143205-000.mkv"));
   EXPECT_FALSE(parseSegmentName("index.json"));
 }

@@ -83,13 +83,17 @@ TEST_F(SegmentPlannerTest, TheByteLimitCutsAtTheNextFrame) {
   EXPECT_EQ(p.current()->bytes, 0u);
 }
 
-TEST_F(SegmentPlannerTest, NamesThatWouldCollideGetACounter) {
+TEST_F(SegmentPlannerTest, NamesThatWouldCollideGetACounterAndStillSortInTimeOrder) {
   std::ofstream(folder_ / "rover-cam0-20261122T120000Z.mkv") << "from an earlier run";
   auto p = planner({.maxDuration = kSecond / 2});
   p.onFrame(0, at(kNoon));
-  EXPECT_EQ(fs::path(p.current()->path).filename(), "rover-cam0-20261122T120000Z-2.mkv");
+  EXPECT_EQ(fs::path(p.current()->path).filename(), "rover-cam0-20261122T120000Z_2.mkv");
+  std::string second = p.current()->path;
   p.onFrame(kSecond / 2, at(kNoon + 500));  // the same second
-  EXPECT_EQ(fs::path(p.current()->path).filename(), "rover-cam0-20261122T120000Z-3.mkv");
+  EXPECT_EQ(fs::path(p.current()->path).filename(), "rover-cam0-20261122T120000Z_3.mkv");
+  // As `ls` lists them: the earlier run's, then these two, in time order.
+  EXPECT_LT((folder_ / "rover-cam0-20261122T120000Z.mkv").string(), second);
+  EXPECT_LT(second, p.current()->path);
 }
 
 TEST_F(SegmentPlannerTest, ATimeBelongsToTheLastSegmentStartedAtOrBeforeIt) {
