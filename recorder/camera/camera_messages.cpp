@@ -34,6 +34,22 @@ void Camera::writeTelemetry(const nlohmann::json& line) {
 CameraReport Camera::report() const {
   CameraReport report = report_;
   report.everLive = everLive_;
+  // The counters as they are now, from the source's own stats (updated at
+  // each frame), not as its once-a-second message left them: two scrapes
+  // a few seconds apart read the camera's true rate.
+  if (GstElement* source = pipeline_ ? pipeline_->element(plan_.source) : nullptr;
+      source && g_object_class_find_property(G_OBJECT_GET_CLASS(source), "stats")) {
+    GstStructure* now = nullptr;
+    g_object_get(source, "stats", &now, nullptr);
+    if (now) {
+      auto stats = bus::Stats::read(now);
+      gst_structure_free(now);
+      report.frames = std::max(report.frames, earlierRuns_.frames + stats.framesComplete);
+      report.incomplete =
+          std::max(report.incomplete, earlierRuns_.incomplete + stats.framesIncomplete);
+      report.bytes = std::max(report.bytes, earlierRuns_.bytes + stats.bytes);
+    }
+  }
   if (!plan_.controller.empty()) {
     ControlReport control;
     if (GstElement* element = controller()) {

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <memory>
 
+#include "export/cut_segment.h"
 #include "export/mcap_export.h"
 #include "export/muxed_export.h"
 #include "export/segment_reader.h"
@@ -38,6 +39,15 @@ struct TimedLine {
   nlohmann::json json;
 };
 
+// A line's own time: its "utc", which the recorder writes as it happens
+// (lines of an outage come before the next segment's first frame); the
+// segment's start plus its "pts" for lines without one.
+int64_t utcOf(const nlohmann::json& line, const ExportSegment& segment) {
+  if (line.contains("utc") && line["utc"].is_string())
+    if (auto utc = parseIsoTime(line["utc"].get<std::string>())) return *utc;
+  return segment.startNs + std::max<int64_t>(line.value("pts", int64_t{0}), 0);
+}
+
 // A segment's sidecar lines at their UTC (its start plus their "pts"), in
 // time order; lines that do not parse are left out.
 std::vector<TimedLine> linesOf(const ExportSegment& segment) {
@@ -45,8 +55,7 @@ std::vector<TimedLine> linesOf(const ExportSegment& segment) {
   for (const auto& text : sidecarLines(segment.video)) {
     auto json = nlohmann::json::parse(text, nullptr, false);
     if (!json.is_object()) continue;
-    int64_t pts = json.value("pts", int64_t{0});
-    lines.push_back({segment.startNs + std::max<int64_t>(pts, 0), std::move(json)});
+    lines.push_back({utcOf(json, segment), std::move(json)});
   }
   std::stable_sort(lines.begin(), lines.end(),
                    [](const auto& a, const auto& b) { return a.utcNs < b.utcNs; });
@@ -87,11 +96,16 @@ class Timeline {
       origin_ = utcNs;
       report.firstUtcNs = utcNs;
     }
-    // Rising by a frame at least: a segment's start from a rebuilt index
-    // may be known to its name's second only, and players count in frames.
+    // Each frame at its own time. Where that would not rise (a segment's
+    // start from a rebuilt index may be known to its name's second only),
+    // a frame follows the one before by the frames' last real interval:
+    // players count in frames. Only intervals between frames count, never
+    // an outage's gap, so the frames after a gap keep their own times.
+    if (lastUtc_ && utcNs > *lastUtc_ && utcNs - *lastUtc_ <= kLongestFrameInterval)
+      step_ = utcNs - *lastUtc_;
     int64_t pts = lastFrame_ < 0 ? 0 : std::max(utcNs - *origin_, lastFrame_ + step_);
-    if (lastFrame_ >= 0) step_ = std::clamp<int64_t>(pts - lastFrame_, 1000000, 1000000000);
     lastFrame_ = pts;
+    lastUtc_ = utcNs;
     report.lastUtcNs = utcNs;
     ++report.frames;
     return failed(sink_.frame(buffer, pts, utcNs, key));
@@ -119,8 +133,10 @@ class Timeline {
   std::ofstream& jsonl_;
   const ExportRequest& request_;
   std::optional<int64_t> origin_;
+  static constexpr int64_t kLongestFrameInterval = 1000000000;  // 1 fps
   int64_t lastFrame_ = -1;
-  int64_t step_ = 1000000000 / 15;  // the frames' last interval
+  std::optional<int64_t> lastUtc_;
+  int64_t step_ = 1000000000 / 15;  // the frames' last real interval
 };
 
 // The frames of one segment and its lines, merged by time.
@@ -141,11 +157,17 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
   while (true) {
     auto frame = (*reader)->next();
     if (!frame) {
-      notes.push_back(name + ": broken off after " + std::to_string(frames) + " frames (" +
-                      frame.error() + "): the rest skipped");
+      notes.push_back(frames ? name + ": broken off after " + std::to_string(frames) + " frames (" +
+                                   frame.error() + "): the rest skipped"
+                             : name + ": skipped (" + frame.error() + ")");
       break;
     }
-    if (!*frame) break;
+    if (!*frame) {
+      if (endsMidElement(segment.video))
+        notes.push_back(name + ": " + std::to_string(frames) +
+                        " whole frames; the file ends mid-frame");
+      break;
+    }
     if (frames++ == 0 && caps && !sameFrames(caps, (*reader)->caps())) {
       notes.push_back(
           name + ": its frames differ from the first segment's (" +

@@ -5,6 +5,7 @@
 #include <gst/gst.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <string>
 
@@ -33,9 +34,13 @@ re-based in FILE's .jsonl beside it.
   --out FILE         the file to write (replaced)
 
 Segments still being written are left out, and a broken one is skipped:
-both are said. Exit 0 when written, 1 when there is nothing to export or it
-cannot be written, 2 for a wrong command line.
+both are said; so is a segment that cannot be read (zeros, a cut or empty
+file), which is given up within 2 s. Exit 0 when written, 1 when there is
+nothing to export, it cannot be written or it was stopped (SIGINT, SIGTERM:
+no output is left behind), 2 for a wrong command line.
 )";
+
+volatile std::sig_atomic_t stopRequested = 0;
 
 int usageError(const std::string& problem) {
   std::fprintf(stderr, "wirc-export: %s\n(wirc-export --help for the options)\n", problem.c_str());
@@ -99,8 +104,15 @@ int main(int argc, char** argv) {
   if (request.start && request.end && *request.end < *request.start)
     return usageError("--end is before --start");
 
+  // SIGINT and SIGTERM stop the export within 50 frames; the export then
+  // removes what it had written, so no partial file is left.
+  struct sigaction stop = {};
+  stop.sa_handler = [](int) { stopRequested = 1; };
+  sigaction(SIGINT, &stop, nullptr);
+  sigaction(SIGTERM, &stop, nullptr);
   bool terminal = isatty(STDERR_FILENO);
   auto report = exportRange(request, [terminal](uint64_t done, uint64_t total) {
+    if (stopRequested) return false;
     if (!terminal || total == 0) return true;
     std::fprintf(stderr, "\rwirc-export: %llu of %llu frames (%d%%)",
                  static_cast<unsigned long long>(done), static_cast<unsigned long long>(total),

@@ -3,6 +3,7 @@
 #include <gst/app/gstappsink.h>
 
 #include <fstream>
+#include <optional>
 #include <utility>
 
 namespace wircam::recorder {
@@ -52,20 +53,45 @@ SegmentReader::~SegmentReader() {
   if (caps_) gst_caps_unref(caps_);
 }
 
+namespace {
+
+constexpr GstClockTime kWaitSlice = 50 * GST_MSECOND;
+// Longer than any healthy segment takes to give its next frame (its
+// demuxer reads from a local file), short enough that a broken one is
+// given up before a user wonders.
+constexpr GstClockTime kStallLimit = 2 * GST_SECOND;
+
+// The demuxer's error, if it posted one: what is wrong with the file.
+std::optional<std::string> demuxerError(GstElement* pipeline) {
+  GstBus* bus = gst_element_get_bus(pipeline);
+  GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
+  gst_object_unref(bus);
+  if (!message) return std::nullopt;
+  GError* error = nullptr;
+  gst_message_parse_error(message, &error, nullptr);
+  std::string text = error ? error->message : "unreadable";
+  if (error) g_error_free(error);
+  gst_message_unref(message);
+  return text;
+}
+
+}  // namespace
+
 Expected<std::optional<SegmentFrame>, std::string> SegmentReader::next() {
-  GstSample* sample = gst_app_sink_pull_sample(GST_APP_SINK(sink_));
-  if (!sample) {
-    // The end, or an error that ended it.
-    GstBus* bus = gst_element_get_bus(pipeline_);
-    GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
-    gst_object_unref(bus);
-    if (!message) return std::optional<SegmentFrame>();
-    GError* error = nullptr;
-    gst_message_parse_error(message, &error, nullptr);
-    std::string text = error ? error->message : "unreadable";
-    if (error) g_error_free(error);
-    gst_message_unref(message);
-    return unexpected(text);
+  // A demuxer that errors (zeros, random bytes, text named .mkv) or finds
+  // no video track never ends the appsink's stream: a plain pull would wait
+  // for ever. So the wait is in slices, each ended by a frame, the stream's
+  // end or the demuxer's error, and a file that gives none of them for
+  // kStallLimit is given up.
+  GstSample* sample = nullptr;
+  for (GstClockTime waited = 0; !sample; waited += kWaitSlice) {
+    sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink_), kWaitSlice);
+    if (sample) break;
+    if (auto error = demuxerError(pipeline_)) return unexpected(*error);
+    if (gst_app_sink_is_eos(GST_APP_SINK(sink_))) return std::optional<SegmentFrame>();
+    if (waited >= kStallLimit)
+      return unexpected(std::string(caps_ ? "no further frame" : "no video frame") + " within " +
+                        std::to_string(kStallLimit / GST_SECOND) + " s");
   }
   if (!caps_) caps_ = gst_caps_ref(gst_sample_get_caps(sample));
   SegmentFrame frame;

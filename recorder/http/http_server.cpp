@@ -195,11 +195,20 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* 
       length <= static_cast<goffset>(kMaxOfferBytes))
     return;
   // libsoup would read the whole body before answering: answer on the
-  // socket now, and close it. Nothing of this request was written yet.
+  // socket now, with the reason in JSON as every error of the API, and
+  // close it. Nothing of this request was written yet.
+  std::string reason =
+      !known ? "method " + method + " is not served: GET, HEAD, DELETE or POST"
+      : routeOf(path).kind != Route::Kind::Whep ? std::string("this request takes no body")
+      : length < 0 ? std::string("the offer needs a Content-Length (no chunked body)")
+                   : "the offer is " + std::to_string(length) + " bytes; at most " +
+                         std::to_string(kMaxOfferBytes);
+  std::string body = nlohmann::json{{"error", printableText(reason)}}.dump();
   std::string answer = !known
                            ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE, POST\r\n"
                            : "HTTP/1.1 413 Content Too Large\r\n";
-  answer += "Content-Length: 0\r\nConnection: close\r\n\r\n";
+  answer += "Content-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
+            "\r\nConnection: close\r\n\r\n" + body;
   soup_message_body_set_accumulate(soup_server_message_get_request_body(message), FALSE);
   if (GSocket* socket = self->connections_->socketOf(message)) {
     // Over TLS a plain answer would be noise: the connection just closes.

@@ -2,6 +2,7 @@
 
 #include <gst/gst.h>
 
+#include <atomic>
 #include <chrono>
 
 #include "record/segment_planner.h"
@@ -10,8 +11,13 @@ namespace wircam::recorder {
 
 namespace {
 
+// A damaged segment's demuxer may neither end nor give a frame: it is given
+// up after this long without one.
+constexpr GstClockTime kStallLimit = 2 * GST_SECOND;
+constexpr GstClockTime kWaitSlice = 100 * GST_MSECOND;
+
 struct VideoSpan {
-  uint64_t frames = 0;
+  std::atomic<uint64_t> frames = 0;  // counted on the streaming thread
   GstClockTime first = GST_CLOCK_TIME_NONE, last = 0, lastDuration = 0;
 };
 
@@ -68,10 +74,20 @@ std::optional<IndexEntry> inspectSegment(const std::filesystem::path& file) {
   g_signal_connect(demuxer, "pad-added", G_CALLBACK(onPadAdded), &span);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   GstBus* bus = gst_element_get_bus(pipeline);
-  // A segment is read in milliseconds; a damaged one ends in an error.
-  GstMessage* end = gst_bus_timed_pop_filtered(
-      bus, 30 * GST_SECOND, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
-  if (end) gst_message_unref(end);
+  // A segment is read in milliseconds; a damaged one ends in an error or
+  // stalls.
+  uint64_t seen = 0;
+  for (GstClockTime quiet = 0; quiet < kStallLimit;) {
+    GstMessage* end = gst_bus_timed_pop_filtered(
+        bus, kWaitSlice, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
+    if (end) {
+      gst_message_unref(end);
+      break;
+    }
+    uint64_t frames = span.frames;
+    quiet = frames == seen ? quiet + kWaitSlice : 0;
+    seen = frames;
+  }
   gst_object_unref(bus);
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(pipeline);

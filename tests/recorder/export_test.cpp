@@ -4,13 +4,17 @@
 // @mcap/core with Foxglove's schemas under node).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "camera_checks.h"
+#include "export/export_range.h"
 #include "recorder_process.h"
 #include "shell_command.h"
 #include "simulated_device.h"
@@ -20,6 +24,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace wircam;
+
+std::string contentsOfFile(const fs::path& file) {
+  std::ifstream in(file);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
 using namespace wircam::testing;
 using std::chrono::milliseconds;
 
@@ -103,6 +112,17 @@ TEST_F(Export, AllOfItAsMatroskaIsEveryFrameUntouchedOnOneTimelineWithTheOutageA
     widest = std::max(widest, times[i] - times[i - 1]);
   }
   EXPECT_GT(widest, 0.4);  // the outage (the device off, the login's backoff)
+  // Only the outage: after it each frame is at its own time again, so the
+  // export lasts as long as the recording did.
+  size_t gaps = 0;
+  for (size_t i = 1; i < times.size(); ++i) gaps += times[i] - times[i - 1] > 0.4;
+  EXPECT_EQ(gaps, 1u);
+  auto index = segments();
+  double recorded = (*recorder::parseIsoTime(index.back()["start_utc"]) -
+                     *recorder::parseIsoTime(index.front()["start_utc"])) /
+                        1e9 +
+                    index.back()["duration_s"].get<double>();
+  EXPECT_NEAR(times.back(), recorded, 0.5);
   EXPECT_EQ(ffmpegDecodeErrors(out), "");
   // The telemetry: a named text track, and the same lines re-based beside.
   EXPECT_EQ(runCommand("ffprobe -v error -select_streams s:0 -show_entries "
@@ -175,6 +195,12 @@ TEST_F(Export, McapIsReadByMcapCoreWithEveryMessageValidAgainstFoxglovesSchemas)
     EXPECT_EQ(image["format"], "jpeg");
   }
   EXPECT_EQ(images, recorded);
+  // Each line at its own time, those of the outage too (the loss, the
+  // retries, the new login): log_time is the line's utc, and a Log's
+  // timestamp its log_time.
+  EXPECT_GT(result["linesTimed"].get<int>(), 3);
+  EXPECT_EQ(result["linesOffTheirUtc"], nlohmann::json::array()) << result["linesOffTheirUtc"];
+  EXPECT_EQ(result["logsOffTheirTimestamp"], 0);
   // Seekable: chunks in the index, and a read from the middle starts there.
   EXPECT_GE(result["chunks"].get<int>(), 2);
   auto seek = result["seek"];
@@ -226,6 +252,106 @@ TEST_F(Export, ADeletedIndexIsRebuiltAndABrokenSegmentSkippedWithAWord) {
   EXPECT_GE(exported.size(), whole.size() - lost);
   EXPECT_LT(exported.size(), whole.size());
   EXPECT_EQ(ffmpegDecodeErrors(out), "");
+}
+
+// What a power loss, a killed process or a user can leave where a segment
+// was: zeros, nothing, random bytes, text. Each is given up within its
+// bound and said; the export holds every frame of the others.
+TEST_F(Export, SegmentsOfZerosEmptyRandomOrTextAreSkippedInBoundedTimeAndSaid) {
+  fs::path copy = output("damaged");
+  fs::remove_all(copy);
+  fs::copy(recorder_->out(), copy);
+  auto files = recorder_->files(".mkv");
+  ASSERT_GE(files.size(), 4u);
+  std::vector<std::string> damaged;
+  for (size_t i = 1; i <= 3; ++i) damaged.push_back(files[i].filename().string());
+  std::ofstream(copy / damaged[0], std::ios::binary | std::ios::trunc)
+      << std::string(64 * 1024, '\0');
+  std::ofstream(copy / damaged[1], std::ios::binary | std::ios::trunc);  // empty
+  {
+    std::ofstream random(copy / damaged[2], std::ios::binary | std::ios::trunc);
+    uint32_t x = 12345;
+    for (int i = 0; i < 64 * 1024; ++i)
+      random.put(static_cast<char>((x = x * 1103515245 + 12345) >> 16));
+  }
+  fs::path text = copy / (files[0].stem().string() + "_9.mkv");
+  std::ofstream(text) << "not a recording\n";
+  fs::path out = output("damaged.mkv");
+  auto started = std::chrono::steady_clock::now();
+  auto ran = runCommand("timeout 30 " +
+                        exportCommand(copy, *camera_, "--format mkv --out '" + out.string() + "'"));
+  double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
+  EXPECT_LT(seconds, 4 * 2.0 + 3);  // 2 s a file at most
+  for (const auto& name : damaged)
+    EXPECT_NE(ran.output.find("wirc-export: " + name + ": skipped ("), std::string::npos)
+        << name << "\n"
+        << ran.output;
+  std::vector<std::string> whole;
+  for (size_t i = 0; i < files.size(); ++i)
+    if (i < 1 || i > 3)
+      for (auto& digest : frameDigests(files[i])) whole.push_back(digest);
+  EXPECT_EQ(frameDigests(out), whole);
+
+  // Nothing readable at all: exit 1, said, and no output left behind.
+  fs::path none = output("nothing-readable");
+  fs::remove_all(none);
+  fs::create_directories(none);
+  std::ofstream(none / damaged[0], std::ios::binary) << std::string(4096, '\0');
+  fs::path nothing = output("nothing.mkv");
+  auto refused =
+      runCommand("timeout 30 " +
+                 exportCommand(none, *camera_, "--format mkv --out '" + nothing.string() + "'"));
+  EXPECT_EQ(refused.exitCode, 1) << refused.output;
+  EXPECT_FALSE(fs::exists(nothing));
+}
+
+TEST_F(Export, ACutSegmentIsSaidToEndMidFrame) {
+  fs::path copy = output("cut");
+  fs::remove_all(copy);
+  fs::copy(recorder_->out(), copy);
+  auto files = recorder_->files(".mkv");
+  fs::path cut = copy / files[1].filename();
+  fs::resize_file(cut, fs::file_size(cut) / 2);
+  fs::path out = output("cut.mkv");
+  auto ran = runCommand("timeout 30 " +
+                        exportCommand(copy, *camera_, "--format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
+  EXPECT_NE(ran.output.find(files[1].filename().string() + ": "), std::string::npos) << ran.output;
+  EXPECT_NE(ran.output.find(" whole frames; the file ends mid-frame"), std::string::npos)
+      << ran.output;
+}
+
+TEST_F(Export, SigintStopsAnExportAndLeavesNoFileBehind) {
+  // A folder of a thousand links to one segment: long enough to be stopped.
+  fs::path many = output("many");
+  fs::remove_all(many);
+  fs::create_directories(many);
+  auto files = recorder_->files(".mkv");
+  std::string stem = files[0].stem().string();
+  for (int i = 2; i < 1000; ++i)
+    fs::create_hard_link(files[0], many / (stem + "_" + std::to_string(i) + ".mkv"));
+  fs::path out = output("stopped.mkv"), said = output("stopped.txt");
+  std::string command = "exec " +
+                        exportCommand(many, *camera_, "--format mkv --out '" + out.string() + "'") +
+                        " > '" + said.string() + "' 2>&1";
+  pid_t exporter = fork();
+  if (exporter == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), nullptr);
+    _exit(127);
+  }
+  ASSERT_TRUE(waitFor([&] { return fs::exists(out); }, milliseconds(30000)));
+  kill(exporter, SIGINT);
+  int status = 0;
+  ASSERT_TRUE(
+      waitFor([&] { return waitpid(exporter, &status, WNOHANG) == exporter; }, milliseconds(3000)));
+  std::string output = contentsOfFile(said);
+  ASSERT_TRUE(WIFEXITED(status)) << output;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << output;
+  EXPECT_NE(output.find("stopped"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(fs::path(out).replace_extension(".jsonl")));
 }
 
 }  // namespace

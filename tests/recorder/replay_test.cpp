@@ -194,6 +194,46 @@ TEST_F(Replay, WircSimReplaysTheDriveForARecorderAndStopsAtItsEndWithASummary) {
   EXPECT_EQ(frameDigests(segmentOf(viewer)), recorded);
 }
 
+TEST_F(Replay, WircSimSaysWhatIsWrongWithAFileOfZerosAndThatACutFileEndsMidFrame) {
+  fs::path folder = original_->out().parent_path() / "damaged";
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  // Zeros where the segment was (a power loss): refused at once, naming it.
+  fs::path zeros = folder / segmentOf(*original_).filename();
+  std::ofstream(zeros, std::ios::binary) << std::string(64 * 1024, '\0');
+  auto refused = runCommand("timeout 10 " + std::string(WIRC_SIM) +
+                            " --port 0 --duration 60 --replay '" + zeros.string() + "'");
+  EXPECT_EQ(refused.exitCode, 1) << refused.output;
+  EXPECT_NE(refused.output.find(zeros.string() + " holds no readable frame; " +
+                                zeros.filename().string() + ": skipped ("),
+            std::string::npos)
+      << refused.output;
+
+  // Cut in the middle: its whole frames, and the summary says so.
+  fs::path cut = folder / ("cut-cam0" + segmentOf(*original_).extension().string());
+  fs::copy(segmentOf(*original_), cut);
+  fs::resize_file(cut, fs::file_size(cut) / 2);
+  std::string command = std::string(WIRC_SIM) + " --port 0 --speed 4 --duration 60 --replay '" +
+                        cut.string() + "' 2>/dev/null";
+  FILE* sim = popen(command.c_str(), "r");
+  ASSERT_TRUE(sim);
+  char line[512];
+  uint16_t port = 0;
+  constexpr std::string_view kListening = "wirc-sim: listening on 127.0.0.1:";
+  while (!port && std::fgets(line, sizeof line, sim))
+    if (std::string_view(line).starts_with(kListening))
+      port = static_cast<uint16_t>(std::atoi(line + kListening.size()));
+  ASSERT_NE(port, 0);
+  RecorderProcess viewer(port, {"--duration", "60"});
+  std::string rest;
+  while (std::fgets(line, sizeof line, sim)) rest += line;
+  EXPECT_EQ(pclose(sim), 0) << rest;
+  viewer.signal(SIGINT);
+  viewer.wait();
+  EXPECT_NE(rest.find("cut-cam0.mkv: played "), std::string::npos) << rest;
+  EXPECT_NE(rest.find(" whole frames; the file ends mid-frame"), std::string::npos) << rest;
+}
+
 TEST_F(Replay, WhatCannotBeReplayedIsSaidAndABrokenFileIsPlayedAsFarAsItIsWhole) {
   fs::path folder = original_->out().parent_path() / "mixed";
   fs::remove_all(folder);

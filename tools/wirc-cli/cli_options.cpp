@@ -48,10 +48,12 @@ Commands:
                                stdin; print one JSON object per message
   encode [--raw]               read JSON objects (one per line) on stdin; print
                                each message as hex (or raw bytes with --raw)
-  compare-commands RECORDED.jsonl REPLAYED.jsonl [--json]
-                               a recorded drive's commands (the recorder's sidecar,
-                               its "control" lines) against those its replay drew
-                               (wirc-sim --replay --commands-out), frame by frame:
+  compare-commands RECORDED... REPLAYED.jsonl [--json]
+                               a recorded drive's commands (the recorder's sidecars,
+                               their "control" lines: files, or a recordings
+                               folder) against those its replay drew (wirc-sim
+                               --replay --commands-out), frame by frame (the
+                               same segment, the same time in it):
                                the frames compared, mean and max |Δ| of steering
                                and throttle (µs), how far each steers from
                                neutral, the frames where one steers left and the

@@ -1,8 +1,11 @@
 #include "command_comparison.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 
 namespace wircam::cli {
 
@@ -33,7 +36,8 @@ std::optional<std::string> eachLine(std::istream& in, Take take) {
 
 }  // namespace
 
-Expected<CommandsByFrame, std::string> recordedCommands(std::istream& sidecar) {
+Expected<CommandsByFrame, std::string> recordedCommands(std::istream& sidecar,
+                                                        const std::string& segment) {
   CommandsByFrame commands;
   auto problem = eachLine(sidecar, [&](const nlohmann::json& line) -> std::optional<std::string> {
     if (line.value("type", "") != "control") return std::nullopt;
@@ -41,8 +45,8 @@ Expected<CommandsByFrame, std::string> recordedCommands(std::istream& sidecar) {
         !line["steering-pulse"].is_number() || !line.contains("throttle-pulse") ||
         !line["throttle-pulse"].is_number())
       return "a control line without pts, steering-pulse and throttle-pulse";
-    commands[frameKey(line["pts"].get<int64_t>())] = {line["steering-pulse"].get<int>(),
-                                                      line["throttle-pulse"].get<int>()};
+    commands[{segment, frameKey(line["pts"].get<int64_t>())}] = {line["steering-pulse"].get<int>(),
+                                                                 line["throttle-pulse"].get<int>()};
     return std::nullopt;
   });
   if (problem) return unexpected(*problem);
@@ -65,12 +69,55 @@ Expected<CommandsByFrame, std::string> replayedCommands(std::istream& lines, int
                  ? channels[number - 1].get<int>()
                  : 1500;
     };
-    commands[frameKey(line["pts"].get<int64_t>())] = {channel(steeringChannel),
-                                                      channel(throttleChannel)};
+    // Replays written before segments were named match by time alone.
+    std::string segment =
+        line.contains("segment") && line["segment"].is_string()
+            ? std::filesystem::path(line["segment"].get<std::string>()).stem().string()
+            : "";
+    commands[{segment, frameKey(line["pts"].get<int64_t>())}] = {channel(steeringChannel),
+                                                                 channel(throttleChannel)};
     return std::nullopt;
   });
   if (problem) return unexpected(*problem);
   if (commands.empty()) return unexpected(std::string("no commands"));
+  return commands;
+}
+
+Expected<CommandsByFrame, std::string> recordedCommandsIn(const std::vector<std::string>& paths) {
+  namespace fs = std::filesystem;
+  CommandsByFrame commands;
+  auto take = [&](const fs::path& sidecar) -> std::optional<std::string> {
+    std::ifstream in(sidecar);
+    if (!in) return "cannot read " + sidecar.string();
+    auto some = recordedCommands(in, sidecar.stem().string());
+    if (!some) return sidecar.string() + ": " + some.error();
+    commands.merge(*some);
+    return std::nullopt;
+  };
+  for (const auto& path : paths) {
+    std::error_code error;
+    if (!fs::is_directory(path, error)) {
+      if (auto problem = take(path)) return unexpected(*problem);
+      continue;
+    }
+    // A folder's sidecars: those beside a segment; one without control lines
+    // (a camera that did not follow) is left out.
+    std::vector<fs::path> sidecars;
+    for (const auto& entry : fs::directory_iterator(path, error))
+      if (entry.path().extension() == ".jsonl" &&
+          (fs::exists(fs::path(entry.path()).replace_extension(".mkv"), error) ||
+           fs::exists(fs::path(entry.path()).replace_extension(".mp4"), error)))
+        sidecars.push_back(entry.path());
+    std::sort(sidecars.begin(), sidecars.end());
+    size_t before = commands.size();
+    for (const auto& sidecar : sidecars) {
+      std::ifstream in(sidecar);
+      if (auto some = recordedCommands(in, sidecar.stem().string())) commands.merge(*some);
+    }
+    if (commands.size() == before)
+      return unexpected(path +
+                        ": no sidecar with control lines: record with wirc-recorder --follow");
+  }
   return commands;
 }
 
@@ -79,6 +126,7 @@ Comparison compareCommands(const CommandsByFrame& recorded, const CommandsByFram
   uint64_t run = 0;
   for (const auto& [frame, mine] : recorded) {
     auto other = replayed.find(frame);
+    if (other == replayed.end()) other = replayed.find({"", frame.ms});
     if (other == replayed.end()) continue;
     const FrameCommand& theirs = other->second;
     ++c.frames;

@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "common/expected.h"
 
@@ -18,16 +19,28 @@ struct FrameCommand {
   int steering = 1500, throttle = 1500;
 };
 
-// Frames are keyed by their time in the segment, in whole milliseconds (what
+// A frame: its segment (the file's name without its extension: every
+// segment starts at pts 0) and its time in it, in whole milliseconds (what
 // Matroska keeps of a frame's time: the sidecar's pts is finer).
-using CommandsByFrame = std::map<int64_t, FrameCommand>;
+struct FrameKey {
+  std::string segment;
+  int64_t ms = 0;
+  auto operator<=>(const FrameKey&) const = default;
+};
+using CommandsByFrame = std::map<FrameKey, FrameCommand>;
 
-// A recorder's sidecar: its "control" lines (steering-pulse,
-// throttle-pulse), each at the pts of the frame it was made from.
-Expected<CommandsByFrame, std::string> recordedCommands(std::istream& sidecar);
-// A --commands-out file: each PCD with the pts of the frame on screen; the
-// last one that came during a frame is its command. Steering and throttle
-// are PCD channels `steeringChannel` and `throttleChannel` (1-based).
+// A recorder's sidecar, of the segment named `segment`: its "control" lines
+// (steering-pulse, throttle-pulse), each at the pts of the frame it was made
+// from.
+Expected<CommandsByFrame, std::string> recordedCommands(std::istream& sidecar,
+                                                        const std::string& segment = "");
+// The control lines of every sidecar in `paths`: sidecar files, or folders
+// of recordings (each .jsonl beside a segment of the same name).
+Expected<CommandsByFrame, std::string> recordedCommandsIn(const std::vector<std::string>& paths);
+// A --commands-out file: each PCD with the segment and pts of the frame on
+// screen; the last one that came during a frame is its command. Steering
+// and throttle are PCD channels `steeringChannel` and `throttleChannel`
+// (1-based).
 Expected<CommandsByFrame, std::string> replayedCommands(std::istream& lines,
                                                         int steeringChannel = 1,
                                                         int throttleChannel = 2);

@@ -22,17 +22,22 @@ struct Command {
   int arguments = -1;  // positional arguments it takes; -1: not checked
 };
 
-// compare-commands RECORDED REPLAYED: exit 1 when a file cannot be read.
+// compare-commands RECORDED... REPLAYED: exit 1 when a file cannot be read.
 int compareCommandFiles(const Options& o) {
-  std::ifstream recordedFile(o.positional[0]), replayedFile(o.positional[1]);
-  if (!recordedFile) usageError("cannot read " + o.positional[0]);
-  if (!replayedFile) usageError("cannot read " + o.positional[1]);
-  auto recorded = recordedCommands(recordedFile);
+  if (o.positional.size() < 2)
+    usageError("compare-commands takes RECORDED (sidecars or a recordings folder) and REPLAYED");
+  std::vector<std::string> recordedPaths(o.positional.begin(), o.positional.end() - 1);
+  const std::string& replayedPath = o.positional.back();
+  std::ifstream replayedFile(replayedPath);
+  if (!replayedFile) usageError("cannot read " + replayedPath);
+  auto recorded = recordedCommandsIn(recordedPaths);
+  if (!recorded) {
+    std::fprintf(stderr, "wirc-cli: %s\n", recorded.error().c_str());
+    return 1;
+  }
   auto replayed = replayedCommands(replayedFile);
-  if (!recorded || !replayed) {
-    bool first = !recorded;
-    std::fprintf(stderr, "wirc-cli: %s: %s\n", o.positional[first ? 0 : 1].c_str(),
-                 (first ? recorded.error() : replayed.error()).c_str());
+  if (!replayed) {
+    std::fprintf(stderr, "wirc-cli: %s: %s\n", replayedPath.c_str(), replayed.error().c_str());
     return 1;
   }
   auto comparison = compareCommands(*recorded, *replayed);
@@ -57,7 +62,7 @@ constexpr Command kWircCommands[] = {
     {"drive", drive},
     {"decode", decode},
     {"encode", encode},
-    {"compare-commands", compareCommandFiles, 2},
+    {"compare-commands", compareCommandFiles},
 };
 
 int positions(Options& o) {

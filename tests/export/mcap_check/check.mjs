@@ -39,7 +39,15 @@ for (const [id, channel] of reader.channelsById) {
   });
 }
 
-const result = { topics: {}, images: [], invalid: [], chunks: reader.chunkIndexes.length };
+const result = {
+  topics: {},
+  images: [],
+  invalid: [],
+  chunks: reader.chunkIndexes.length,
+  linesTimed: 0,
+  linesOffTheirUtc: [],
+  logsOffTheirTimestamp: 0,
+};
 result.compression = [...new Set(reader.chunkIndexes.map((c) => c.compression))];
 result.statistics = reader.statistics
   ? { messages: Number(reader.statistics.messageCount), chunks: reader.statistics.chunkCount }
@@ -55,6 +63,18 @@ for await (const message of reader.readMessages()) {
   for (const [who, check] of [["ours", v.ours], ["foxglove", v.theirs]]) {
     if (check && !check(json) && result.invalid.length < 5)
       result.invalid.push({ topic: v.topic, who, errors: check.errors });
+  }
+  // A telemetry line's log_time is its own utc (ms); a Log's timestamp is
+  // its log_time.
+  if (v.name === "wircam.Telemetry" && typeof json.utc === "string") {
+    result.linesTimed += 1;
+    const utcNs = BigInt(Date.parse(json.utc)) * 1000000n;
+    if (utcNs !== message.logTime && result.linesOffTheirUtc.length < 5)
+      result.linesOffTheirUtc.push({ utc: json.utc, logTime: message.logTime.toString() });
+  }
+  if (v.name === "foxglove.Log") {
+    const stamp = BigInt(json.timestamp.sec) * 1000000000n + BigInt(json.timestamp.nsec);
+    if (stamp !== message.logTime) result.logsOffTheirTimestamp += 1;
   }
   if (v.name === "foxglove.CompressedImage") {
     const data = Buffer.from(json.data, "base64");

@@ -18,12 +18,15 @@ std::string control(int64_t ptsNs, int steering, int throttle) {
          "\n";
 }
 
-// A --commands-out line: a PCD during the frame at `ptsNs` (ms precision).
-std::string pcd(int64_t ptsNs, int steering, int throttle) {
+// A --commands-out line: a PCD during the frame at `ptsNs` (ms precision)
+// of `segment`.
+std::string pcd(int64_t ptsNs, int steering, int throttle, const std::string& segment = "") {
   std::vector<int> channels(12, 1500);
   channels[0] = steering;
   channels[1] = throttle;
-  return nlohmann::json{{"frame", 0}, {"pts", ptsNs}, {"channels", channels}}.dump() + "\n";
+  nlohmann::json line = {{"frame", 0}, {"pts", ptsNs}, {"channels", channels}};
+  if (!segment.empty()) line["segment"] = segment;
+  return line.dump() + "\n";
 }
 
 TEST(CommandComparison, MatchesFramesAtTheMillisecondMatroskaKeepsAndComparesThem) {
@@ -70,6 +73,27 @@ TEST(CommandComparison, TheLongestRunOfDisagreementIsConsecutiveFrames) {
   auto c = compareCommands(*recordedCommands(a), *replayedCommands(b));
   EXPECT_EQ(c.directionDisagreements, 5u);
   EXPECT_EQ(c.longestDisagreement, 3u);
+}
+
+TEST(CommandComparison, FramesOfDifferentSegmentsAtTheSamePtsAreNotMixed) {
+  // Every segment starts at pts 0: two segments steering opposite ways at
+  // the same times, replayed exactly.
+  std::istringstream first(control(0, 1600, 1500) + control(66000000, 1610, 1500));
+  std::istringstream second(control(0, 1400, 1500) + control(66000000, 1390, 1500));
+  auto recorded = recordedCommands(first, "rover-cam0-20261124T145935Z");
+  auto more = recordedCommands(second, "rover-cam0-20261124T145937Z");
+  ASSERT_TRUE(recorded && more);
+  recorded->merge(*more);
+  std::istringstream replay(pcd(0, 1400, 1500, "rover-cam0-20261124T145937Z.mkv") +
+                            pcd(0, 1600, 1500, "rover-cam0-20261124T145935Z.mkv") +
+                            pcd(66000000, 1390, 1500, "rover-cam0-20261124T145937Z.mkv") +
+                            pcd(66000000, 1610, 1500, "rover-cam0-20261124T145935Z.mkv"));
+  auto replayed = replayedCommands(replay);
+  ASSERT_TRUE(replayed.has_value()) << replayed.error();
+  auto c = compareCommands(*recorded, *replayed);
+  EXPECT_EQ(c.frames, 4u);
+  EXPECT_DOUBLE_EQ(c.meanSteeringDelta, 0);
+  EXPECT_EQ(c.directionDisagreements, 0u);
 }
 
 TEST(CommandComparison, SaysWhatIsWrongWithAFile) {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "export/cut_segment.h"
 #include "export/export_range.h"
 #include "export/segment_reader.h"
 #include "gst_scoped.h"
@@ -73,16 +74,31 @@ Expected<std::unique_ptr<RecordedDrive>, std::string> RecordedDrive::open(
     return unexpected("no such file or folder: " + path.string());
   }
   // The WiRC protocol carries JPEG: an H.264 recording cannot be replayed.
-  auto first = recorder::SegmentReader::open(drive->segments_.front().video);
-  if (!first) return unexpected(first.error());
-  auto frame = (*first)->next();
-  if (!frame || !*frame)
-    return unexpected(drive->segments_.front().video.string() + " holds no readable frame");
-  if (!isJpeg((*first)->caps()))
-    return unexpected(drive->segments_.front().video.filename().string() + " holds " +
-                      mediaTypeOf((*first)->caps()) +
-                      ": the WiRC protocol carries JPEG frames, so only recordings made with "
-                      "--codec jpeg (the default) can be replayed");
+  // The first segment with a frame tells; those before it that cannot be
+  // read (zeros, empty, not a recording) are skipped, said.
+  for (; drive->first_ < drive->segments_.size(); ++drive->first_) {
+    const auto& video = drive->segments_[drive->first_].video;
+    auto reader = recorder::SegmentReader::open(video);
+    std::string problem = reader ? "" : reader.error();
+    if (reader) {
+      auto frame = (*reader)->next();
+      if (frame && *frame) {
+        if (!isJpeg((*reader)->caps()))
+          return unexpected(video.filename().string() + " holds " + mediaTypeOf((*reader)->caps()) +
+                            ": the WiRC protocol carries JPEG frames, so only recordings made "
+                            "with --codec jpeg (the default) can be replayed");
+        break;
+      }
+      problem = frame ? "no frame in it" : frame.error();
+    }
+    drive->damaged(video.filename().string() + ": skipped (" + problem + ")");
+  }
+  if (drive->first_ == drive->segments_.size()) {
+    std::string why;
+    for (const auto& damage : drive->damage_) why += "; " + damage;
+    return unexpected(path.string() + " holds no readable frame" + why);
+  }
+  drive->current_ = drive->first_;
   drive->readBattery();
   return drive;
 }
@@ -118,7 +134,7 @@ std::optional<RecordedDrive::Frame> RecordedDrive::next() {
     if (!reader_) {
       auto opened = recorder::SegmentReader::open(segment.video);
       if (!opened) {
-        notes_.push_back(name + ": " + opened.error() + ": skipped");
+        damaged(name + ": skipped (" + opened.error() + ")");
         ++current_;
         continue;
       }
@@ -127,14 +143,18 @@ std::optional<RecordedDrive::Frame> RecordedDrive::next() {
     }
     auto frame = reader_->next();
     // The segment's end, a break in it, or frames the protocol cannot carry:
-    // on to the next segment (the last two said).
+    // on to the next segment (all but a whole file's end said).
     std::optional<std::string> skipped;
     if (!frame)
-      skipped = "broken off after " + std::to_string(framesInSegment_) + " frames (" +
-                frame.error() + ")";
+      skipped = framesInSegment_ ? "played " + std::to_string(framesInSegment_) +
+                                       " frames, then: " + frame.error()
+                                 : "skipped (" + frame.error() + ")";
     else if (*frame && !isJpeg(reader_->caps()))
       skipped = "holds " + mediaTypeOf(reader_->caps()) + ": skipped";
-    if (skipped) notes_.push_back(name + ": " + *skipped);
+    else if (!*frame && recorder::endsMidElement(segment.video))
+      skipped =
+          "played " + std::to_string(framesInSegment_) + " whole frames; the file ends mid-frame";
+    if (skipped) damaged(name + ": " + *skipped);
     if (skipped || !*frame) {
       reader_.reset();
       ++current_;
@@ -153,9 +173,16 @@ std::optional<RecordedDrive::Frame> RecordedDrive::next() {
   return std::nullopt;
 }
 
+void RecordedDrive::damaged(std::string what) {
+  // Said once, however often --loop passes it.
+  if (std::find(damage_.begin(), damage_.end(), what) != damage_.end()) return;
+  notes_.push_back(what);
+  damage_.push_back(std::move(what));
+}
+
 void RecordedDrive::rewind() {
   reader_.reset();
-  current_ = 0;
+  current_ = first_;
   framesRead_ = 0;
 }
 

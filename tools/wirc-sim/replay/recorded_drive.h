@@ -53,6 +53,9 @@ class RecordedDrive {
   // What the user should know, each said once: segments left out or broken
   // off, a drive without battery reports.
   std::vector<std::string> takeNotes();
+  // The segments skipped or cut short, and how ("x.mkv: played 30 whole
+  // frames; the file ends mid-frame"), for the replay's summary.
+  const std::vector<std::string>& damage() const { return damage_; }
 
  private:
   struct Segment {
@@ -61,14 +64,17 @@ class RecordedDrive {
   };
   RecordedDrive() = default;
   void readBattery();
+  void damaged(std::string what);
 
   std::string camera_;
   std::vector<Segment> segments_;
+  size_t first_ = 0;  // the first segment with a readable frame
   size_t current_ = 0;
   std::unique_ptr<recorder::SegmentReader> reader_;
   uint64_t framesInSegment_ = 0, framesRead_ = 0;
   std::vector<std::pair<int64_t, uint16_t>> battery_;  // (time, mV), in time order
   std::vector<std::string> notes_;
+  std::vector<std::string> damage_;
 };
 
 }  // namespace wircam::sim

@@ -104,6 +104,7 @@ std::string ReplayScene::summary() const {
                      std::to_string(drive_->segments()) + " segment" +
                      (drive_->segments() == 1 ? "" : "s") + " (" + drive_->camera() + ")";
   if (loops_) text += ", " + std::to_string(loops_ + 1) + " times";
+  for (const auto& damage : drive_->damage()) text += "; " + damage;
   if (commands_)
     text += ", " + std::to_string(commandsWritten_) + " PCD written to " + options_.commandsOut;
   return text;
