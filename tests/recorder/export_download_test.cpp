@@ -189,3 +189,20 @@ TEST_F(ExportDownload, AClientThatLeavesLeavesNothingBehind) {
   EXPECT_TRUE(fs::is_empty(recorder_->out() / ".exports"));
   EXPECT_EQ(fetch(*url_ + "api/status").status, 200u);
 }
+
+// Last, as it damages the recording: a finished segment turned to zeros
+// (what a power loss can leave). Exports go on answering, each leaving it
+// out and saying so, and hold no export slot (two) for ever.
+TEST_F(ExportDownload, ASegmentOfZerosIsLeftOutAndSaidAndHoldsNoExportSlot) {
+  auto index = segments();
+  ASSERT_GE(index.size(), 2u);
+  std::string damaged = index[0]["file"];
+  std::ofstream(recorder_->out() / damaged, std::ios::binary | std::ios::trunc)
+      << std::string(64 * 1024, '\0');
+  for (int i = 0; i < 3; ++i) {
+    auto response = fetch(exportUrl("camera=" + *camera_ + "&format=mkv"));
+    ASSERT_EQ(response.status, 200u) << i << ": " << response.body.substr(0, 300);
+    EXPECT_NE(response.headers["x-export-notes"].find(damaged + ": skipped ("), std::string::npos)
+        << response.headers["x-export-notes"];
+  }
+}

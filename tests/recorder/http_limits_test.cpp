@@ -9,6 +9,7 @@
 #include <sys/socket.h>
 
 #include <algorithm>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "common/socket.h"
@@ -51,6 +52,22 @@ std::string statusLine(uint16_t port, const std::string& request) {
   return answer.substr(0, answer.find("\r\n"));
 }
 
+// The whole answer, up to the server's close.
+std::string answerTo(uint16_t port, const std::string& request) {
+  auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(port));
+  if (!fd) return "";
+  ::send(fd->get(), request.data(), request.size(), MSG_NOSIGNAL);
+  std::string answer;
+  char chunk[512];
+  pollfd p{fd->get(), POLLIN, 0};
+  while (::poll(&p, 1, 5000) > 0) {
+    ssize_t n = ::recv(fd->get(), chunk, sizeof chunk, 0);
+    if (n <= 0) break;
+    answer.append(chunk, static_cast<size_t>(n));
+  }
+  return answer;
+}
+
 struct ServedRecorder {
   std::unique_ptr<wircam::wirc::Device> device = startSequenceDevice();
   std::unique_ptr<RecorderProcess> recorder;
@@ -83,6 +100,23 @@ TEST(WircRecorderHttpLimits, ABodyDeclaredAsAGigabyteIsRefusedUnread) {
   std::string get = "GET /api/status HTTP/1.1\r\nHost: x\r\nContent-Length: 1000000000\r\n\r\n";
   EXPECT_NE(statusLine(portOf(served.url), get).find("413"), std::string::npos);
   EXPECT_LT(residentKb(served.recorder->pid()) - before, kMemoryLimitKb);
+}
+
+TEST(WircRecorderHttpLimits, ARefusedBodyIsAnsweredWithItsReasonInJson) {
+  ServedRecorder served({"--http", "127.0.0.1:0"});
+  ASSERT_FALSE(served.url.empty()) << served.recorder->log();
+  // A WHEP offer over the cap: 413, and why, as every error of the API.
+  auto answer = answerTo(portOf(served.url),
+                         "POST /api/cameras/x-cam0/whep HTTP/1.1\r\nHost: x\r\n"
+                         "Content-Type: application/sdp\r\nContent-Length: 20000\r\n\r\n");
+  EXPECT_EQ(answer.rfind("HTTP/1.1 413 ", 0), 0u) << answer;
+  EXPECT_NE(answer.find("Content-Type: application/json"), std::string::npos) << answer;
+  auto body = nlohmann::json::parse(answer.substr(answer.find("\r\n\r\n") + 4), nullptr, false);
+  EXPECT_EQ(body.value("error", ""), "the offer is 20000 bytes; at most 16384") << answer;
+  auto put = answerTo(portOf(served.url),
+                      "PUT /api/status HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n\r\n");
+  EXPECT_EQ(put.rfind("HTTP/1.1 405 ", 0), 0u) << put;
+  EXPECT_NE(put.find("{\"error\":\"method PUT is not served"), std::string::npos) << put;
 }
 
 TEST(WircRecorderHttpLimits, AnEndlessHeaderIsCutOffWithoutHoldingMemory) {

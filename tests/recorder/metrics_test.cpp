@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <set>
+#include <thread>
 
 #include "http_fetch.h"
 #include "prometheus_server.h"
@@ -52,6 +54,18 @@ TEST(RecorderMetrics, TheTextIsPrometheussAndNeedsTheToken) {
   auto at = metrics.body.find(pcd);
   ASSERT_NE(at, std::string::npos) << metrics.body;
   EXPECT_GT(std::stoull(metrics.body.substr(at + pcd.size())), 5u);
+  // Read when scraped, not once a second: scrapes 200 ms apart (three
+  // frames at 15 fps) see the count move nearly every time.
+  std::string frames = "wircam_frames_received_total{" + stream + "} ";
+  std::set<uint64_t> seen;
+  for (int i = 0; i < 8; ++i) {
+    auto body = fetch(*url + "metrics", "GET", bearer).body;
+    auto count = body.find(frames);
+    ASSERT_NE(count, std::string::npos) << body;
+    seen.insert(std::stoull(body.substr(count + frames.size())));
+    std::this_thread::sleep_for(milliseconds(200));
+  }
+  EXPECT_GE(seen.size(), 6u);
   fs::path text = recorder.out().parent_path() / "metrics.txt";
   std::ofstream(text) << metrics.body;
   auto checked = runCommand("promtool check metrics < '" + text.string() + "'");

@@ -5,9 +5,11 @@
 // gain steers less, and wirc-cli compare-commands says so.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -371,3 +373,44 @@ TEST_F(Replay, TheBatteryIsTheRecordedOne) {
 }
 
 }  // namespace
+
+// A replay of a folder of segments against the folder itself: each segment
+// starts at pts 0, so commands match by segment and pts.
+TEST(CompareCommands, ARecordingsFolderIsMatchedSegmentBySegment) {
+  fs::path folder = fs::temp_directory_path() / ("compare-" + std::to_string(getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  const std::string segments[] = {"rover-cam0-20261124T145935Z", "rover-cam0-20261124T145937Z"};
+  std::ofstream replayed(folder / "replayed.jsonl");
+  for (int s = 0; s < 2; ++s) {
+    std::ofstream(folder / (segments[s] + ".mkv"));  // the segment beside its sidecar
+    std::ofstream sidecar(folder / (segments[s] + ".jsonl"));
+    for (int frame = 0; frame < 5; ++frame) {
+      int64_t pts = frame * 66666667LL;
+      int steering = s == 0 ? 1600 + frame : 1400 - frame;  // left, then right
+      sidecar << nlohmann::json{{"type", "control"},
+                                {"pts", pts},
+                                {"steering-pulse", steering},
+                                {"throttle-pulse", 1550}}
+                     .dump()
+              << "\n";
+      std::vector<int> channels = {steering, 1550, 1500, 1500};
+      replayed << nlohmann::json{{"frame", s * 5 + frame},
+                                 {"pts",
+                                  std::llround(pts / 1e6) * 1000000},  // as Matroska keeps it
+                                 {"segment", segments[s] + ".mkv"},
+                                 {"channels", channels}}
+                      .dump()
+               << "\n";
+    }
+  }
+  replayed.close();
+  auto ran = runCommand(std::string(WIRC_CLI) + " compare-commands '" + folder.string() + "' '" +
+                        (folder / "replayed.jsonl").string() + "' --json");
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
+  auto result = nlohmann::json::parse(ran.output, nullptr, false);
+  EXPECT_EQ(result["frames"], 10) << ran.output;
+  EXPECT_EQ(result["steering_delta_us"]["max"], 0) << ran.output;
+  EXPECT_EQ(result["direction_disagreements"], 0) << ran.output;
+  fs::remove_all(folder);
+}
