@@ -5,11 +5,24 @@
 # the web server's usual ports (1984, 8080...): so that the test can run
 # beside any other, they run in a private network namespace (its own
 # loopback) when unshare(1) can make one.
-#   run_getting_started.sh docs/getting-started.md BUILD_DIR [TIMEOUT_S]
+# The README's "Record your first drive" block must be made of lines of
+# this page, so that running the page runs it too.
+#   run_getting_started.sh docs/getting-started.md BUILD_DIR [TIMEOUT_S] [README.md]
 set -euo pipefail
 page=$(realpath "$1")
 build=$(realpath "$2")
 limit=${3:-300}
+readme=${4:-}
+if [[ -n "$readme" ]]; then
+  first_drive=$(awk '/^## Record your first drive/ { found = 1; next }
+                     found && /^```sh/ { inside = 1; next }
+                     inside && /^```/ { exit }
+                     inside' "$readme")
+  [[ -n "$first_drive" ]] || { echo "$readme: no first-drive block" >&2; exit 1; }
+  while IFS= read -r line; do
+    grep -qxF -- "$line" "$page" || { echo "$readme: '$line' is not in $page" >&2; exit 1; }
+  done <<<"$first_drive"
+fi
 work=$(mktemp -d)
 group=""
 cleanup() {

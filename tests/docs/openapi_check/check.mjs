@@ -309,11 +309,12 @@ try {
     await check("delete, being recorded", "DELETE", urlA + "api/recordings/" + enc(open.name),
       { headers: bearer, expect: 409 });
   else problem("no segment being recorded to try deleting");
-  const later = await request("GET", urlA + "api/recordings", { headers: bearer });
-  const another = JSON.parse(later.body.toString()).find((e) => e.file !== toKeep.file);
-  if (another)
-    await check("delete by its download URL", "DELETE", urlA + "recordings/" + enc(another.file),
-      { headers: bearer, expect: 200 });
+  const another = await waitFor("a third finished segment", async () => {
+    const later = await request("GET", urlA + "api/recordings", { headers: bearer });
+    return JSON.parse(later.body.toString()).find((e) => e.file !== toKeep.file);
+  });
+  await check("delete by its download URL", "DELETE", urlA + "recordings/" + enc(another.file),
+    { headers: bearer, expect: 200 });
   await check("delete without token", "DELETE", urlA + "api/recordings/" + enc(toKeep.file), { expect: 401 });
 
   // Live and playback streams
