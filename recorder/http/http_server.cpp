@@ -197,12 +197,13 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* 
   // libsoup would read the whole body before answering: answer on the
   // socket now, with the reason in JSON as every error of the API, and
   // close it. Nothing of this request was written yet.
-  std::string reason =
-      !known ? "method " + method + " is not served: GET, HEAD, DELETE or POST"
-      : routeOf(path).kind != Route::Kind::Whep ? std::string("this request takes no body")
-      : length < 0 ? std::string("the offer needs a Content-Length (no chunked body)")
-                   : "the offer is " + std::to_string(length) + " bytes; at most " +
-                         std::to_string(kMaxOfferBytes);
+  std::string reason = !known ? "method " + method + " is not served: GET, HEAD, DELETE or POST"
+                       : routeOf(path).kind != Route::Kind::Whep
+                           ? std::string("this request takes no body")
+                       : soup_message_headers_get_encoding(headers) != SOUP_ENCODING_CONTENT_LENGTH
+                           ? std::string("the offer needs a Content-Length (no chunked body)")
+                           : "the offer is " + std::to_string(length) + " bytes; at most " +
+                                 std::to_string(kMaxOfferBytes);
   std::string body = nlohmann::json{{"error", printableText(reason)}}.dump();
   std::string answer = !known
                            ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE, POST\r\n"

@@ -19,6 +19,30 @@ GstElement* make(const char* factory) {
   return element;
 }
 
+// The caps of `payload` on the offer's video m-line, its format parameters
+// included; nothing if the offer does not parse (it did before).
+GstCaps* offeredCaps(const ViewerOffer& offer, int payload) {
+  GstSDPMessage* sdp = nullptr;
+  if (gst_sdp_message_new_from_text(offer.sdp.c_str(), &sdp) != GST_SDP_OK) return nullptr;
+  GstCaps* caps = nullptr;
+  if (const GstSDPMedia* media = gst_sdp_message_get_media(sdp, offer.videoMedia)) {
+    caps = gst_sdp_media_get_caps_from_media(media, payload);
+    if (caps) {
+      caps = gst_caps_make_writable(caps);
+      GstStructure* structure = gst_caps_get_structure(caps, 0);
+      gst_structure_set_name(structure, "application/x-rtp");
+      gst_structure_set(structure, "media", G_TYPE_STRING, "video", "payload", G_TYPE_INT, payload,
+                        nullptr);
+      // What the stream itself says (its level, its parameter sets) comes
+      // from the payloader's caps; a level the offer named would not
+      // intersect with them.
+      gst_structure_remove_fields(structure, "profile-level-id", "sprop-parameter-sets", nullptr);
+    }
+  }
+  gst_sdp_message_free(sdp);
+  return caps;
+}
+
 }  // namespace
 
 void WebRtcViewer::handOver(gpointer handle, std::function<void(WebRtcViewer&)> call) {
@@ -48,6 +72,7 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
                guint64(0), nullptr);
   bool h264 = encoder.video() == WebRtcVideo::kH264;
   int payload = h264 ? offer.h264Payload : offer.vp8Payload;
+  if (h264) h264Payload_ = offer.h264Payload, h264Format_ = offer.h264Format;
   if (h264) {
     // SPS and PPS before every key frame: a viewer may join at any one.
     payloader_ = make("rtph264pay");
@@ -76,20 +101,27 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
   gst_bin_add_many(encoder_.pipeline(), queue_, payloader_, webrtc_, nullptr);
   gst_element_link(queue_, payloader_);
 
-  GstCaps* caps =
-      gst_caps_new_simple("application/x-rtp", "media", G_TYPE_STRING, "video", "encoding-name",
-                          G_TYPE_STRING, h264 ? "H264" : "VP8", "payload", G_TYPE_INT, payload,
-                          "clock-rate", G_TYPE_INT, 90000, nullptr);
+  // The answer names exactly the codec and payload type that will flow, as
+  // the offer wrote them (for H.264 its profile-level-id and
+  // packetization-mode): webrtcbin would otherwise answer with the first
+  // payload type of the codec's name, or with what has flowed so far (for
+  // the first viewer, nothing: an inactive VP8 line).
+  GstCaps* caps = offeredCaps(offer, payload);
+  if (!caps)
+    caps = gst_caps_new_simple("application/x-rtp", "media", G_TYPE_STRING, "video",
+                               "encoding-name", G_TYPE_STRING, h264 ? "H264" : "VP8", "payload",
+                               G_TYPE_INT, payload, "clock-rate", G_TYPE_INT, 90000, nullptr);
   GstPadTemplate* sinks =
       gst_element_class_get_pad_template(GST_ELEMENT_GET_CLASS(webrtc_), "sink_%u");
   GstPad* sink = gst_element_request_pad(webrtc_, sinks, nullptr, caps);
-  gst_caps_unref(caps);
   GstWebRTCRTPTransceiver* transceiver = nullptr;
   g_object_get(sink, "transceiver", &transceiver, nullptr);
   if (transceiver) {
-    g_object_set(transceiver, "direction", GST_WEBRTC_RTP_TRANSCEIVER_DIRECTION_SENDONLY, nullptr);
+    g_object_set(transceiver, "direction", GST_WEBRTC_RTP_TRANSCEIVER_DIRECTION_SENDONLY,
+                 "codec-preferences", caps, nullptr);
     gst_object_unref(transceiver);
   }
+  gst_caps_unref(caps);
   GstPad* payloaded = gst_element_get_static_pad(payloader_, "src");
   gst_pad_link(payloaded, sink);
   gst_object_unref(payloaded);
@@ -205,7 +237,8 @@ void WebRtcViewer::onGatheringState(GstElement* webrtc, GParamSpec*, gpointer ha
 
 void WebRtcViewer::answerIfGathered() {
   if (answered_ || answer_.empty() || !gathered_) return;
-  finish(answerWithCandidates(answer_, candidates_));
+  finish(
+      answerWithH264Format(answerWithCandidates(answer_, candidates_), h264Payload_, h264Format_));
 }
 
 void WebRtcViewer::finish(Expected<std::string, std::string> answer) {

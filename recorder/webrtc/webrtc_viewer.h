@@ -76,6 +76,8 @@ class WebRtcViewer {
   GstElement* payloader_ = nullptr;
   GstElement* webrtc_ = nullptr;
   GstPad* teePad_ = nullptr;
+  int h264Payload_ = -1;          // the recording's H.264 goes out as this
+  std::string h264Format_;        // as the offer gave its format
   std::vector<gulong> handlers_;  // on webrtc_
   GstElement* rtpbin_ = nullptr;  // webrtcbin's own
   gulong heardHandler_ = 0;

@@ -63,16 +63,26 @@ std::string formatOf(const GstSDPMedia* media, int payload) {
   }
 }
 
-// The first H.264 payload type for Main profile in packetization mode 1.
+// The H.264 payload type for Main profile (profile_idc 0x4d) in
+// packetization mode 1 that takes the recording's stream: one that allows
+// any level (level-asymmetry-allowed=1) first, else the highest level
+// offered. -1 when none is Main: its profile must match exactly, and a
+// Constrained Baseline (42e0…) payload type would carry nothing.
 int h264MainPayloadOf(const GstSDPMedia* media) {
+  int best = -1, bestScore = -1;
   for (int payload : payloadsOf(media, "H264")) {
     std::string format = formatOf(media, payload);
     auto profile = format.find("profile-level-id=");
-    if (format.find("packetization-mode=1") != std::string::npos && profile != std::string::npos &&
-        g_ascii_strncasecmp(format.c_str() + profile + 17, "4d", 2) == 0)
-      return payload;
+    if (format.find("packetization-mode=1") == std::string::npos || profile == std::string::npos ||
+        format.size() < profile + 17 + 6 ||
+        g_ascii_strncasecmp(format.c_str() + profile + 17, "4d", 2) != 0)
+      continue;
+    int level =
+        static_cast<int>(g_ascii_strtoll(format.substr(profile + 17 + 4, 2).c_str(), nullptr, 16));
+    int score = (format.find("level-asymmetry-allowed=1") != std::string::npos ? 256 : 0) + level;
+    if (score > bestScore) best = payload, bestScore = score;
   }
-  return -1;
+  return best;
 }
 
 // "candidate:F C PROTO PRIO ADDRESS PORT typ T ...": the address.
@@ -111,6 +121,7 @@ Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,
       auto vp8 = payloadsOf(media, "VP8");
       offer.vp8Payload = vp8.empty() ? -1 : vp8.front();
       offer.h264Payload = h264MainPayloadOf(media);
+      if (offer.h264Payload >= 0) offer.h264Format = formatOf(media, offer.h264Payload);
     }
     for (guint a = gst_sdp_media_attributes_len(media); a-- > 0;) {
       const GstSDPAttribute* attribute = gst_sdp_media_get_attribute(media, a);
@@ -125,6 +136,28 @@ Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,
     return unexpected("the offer's video takes neither VP8 nor H.264 Main (packetization-mode=1)");
   offer.sdp = asText(message.get());
   return offer;
+}
+
+std::string answerWithH264Format(const std::string& answer, int payload,
+                                 const std::string& format) {
+  auto message = parse(answer);
+  if (!message || payload < 0 || format.empty()) return answer;
+  bool mended = false;
+  for (unsigned m = 0; m < gst_sdp_message_medias_len(message.get()); ++m) {
+    auto* media = const_cast<GstSDPMedia*>(gst_sdp_message_get_media(message.get(), m));
+    if (payloadsOf(media, "H264") != std::vector<int>{payload}) continue;
+    if (formatOf(media, payload).find("profile-level-id=") != std::string::npos) continue;
+    std::string prefix = std::to_string(payload) + " ";
+    for (guint i = gst_sdp_media_attributes_len(media); i-- > 0;) {
+      const GstSDPAttribute* attribute = gst_sdp_media_get_attribute(media, i);
+      if (g_strcmp0(attribute->key, "fmtp") == 0 && attribute->value &&
+          std::string_view(attribute->value).starts_with(prefix))
+        gst_sdp_media_remove_attribute(media, i);
+    }
+    gst_sdp_media_add_attribute(media, "fmtp", (prefix + format).c_str());
+    mended = true;
+  }
+  return mended ? asText(message.get()) : answer;
 }
 
 std::string answerWithCandidates(const std::string& answer,

@@ -30,6 +30,7 @@ struct ViewerOffer {
   // For H.264 Main (profile-level-id 4d…) in packetization mode 1, as an
   // H.264 recording is encoded, or -1.
   int h264Payload = -1;
+  std::string h264Format;  // its format parameters, as offered
   bool dataChannel = false;
   unsigned droppedCandidates = 0;  // for another host, or a name
 };
@@ -44,6 +45,12 @@ Expected<ViewerOffer, std::string> readViewerOffer(std::string_view body,
 // A candidate webrtcbin gathered: the m-line it belongs to and its text
 // ("candidate:1 1 UDP 2015363327 10.0.0.2 41230 typ host").
 using LocalCandidate = std::pair<unsigned, std::string>;
+
+// `answer` naming the profile the viewer offered for H.264 `payload`
+// (`format`, its a=fmtp) where webrtcbin left it out (it writes what has
+// flowed, and before the first frame nothing): without profile-level-id a
+// viewer must take it for Baseline. `answer` unchanged otherwise.
+std::string answerWithH264Format(const std::string& answer, int payload, const std::string& format);
 
 // `answer` with each candidate added to its m-line and end-of-candidates
 // on every m-line; `answer` unchanged if it does not parse.

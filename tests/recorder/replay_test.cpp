@@ -203,7 +203,7 @@ TEST_F(Replay, WircSimSaysWhatIsWrongWithAFileOfZerosAndThatACutFileEndsMidFrame
   // Zeros where the segment was (a power loss): refused at once, naming it.
   fs::path zeros = folder / segmentOf(*original_).filename();
   std::ofstream(zeros, std::ios::binary) << std::string(64 * 1024, '\0');
-  auto refused = runCommand("timeout 10 " + std::string(WIRC_SIM) +
+  auto refused = runCommand("timeout -k 2 10 " + std::string(WIRC_SIM) +
                             " --port 0 --duration 60 --replay '" + zeros.string() + "'");
   EXPECT_EQ(refused.exitCode, 1) << refused.output;
   EXPECT_NE(refused.output.find(zeros.string() + " holds no readable frame; " +

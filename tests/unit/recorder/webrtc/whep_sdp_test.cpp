@@ -106,5 +106,47 @@ TEST(WhepSdp, TheAnswerCarriesEachCandidateOnceAndTheirEnd) {
   EXPECT_EQ(answerWithCandidates("not sdp", {}), "not sdp");
 }
 
+TEST(WhepSdp, OfMainPayloadTypesOneThatAllowsAnyLevelIsTakenAndItsFormatKept) {
+  std::string offered = kOffer;
+  offered.replace(offered.find("a=rtpmap:97 rtx/90000"), 0,
+                  "a=rtpmap:120 H264/90000\r\n"
+                  "a=fmtp:120 packetization-mode=1;profile-level-id=4d0015\r\n"
+                  "a=rtpmap:121 H264/90000\r\n"
+                  "a=fmtp:121 packetization-mode=1;profile-level-id=4d0028\r\n"
+                  "a=rtpmap:116 H264/90000\r\n"
+                  "a=fmtp:116 level-asymmetry-allowed=1;packetization-mode=1;"
+                  "profile-level-id=4d001f\r\n");
+  auto offer = readViewerOffer(offered, {"127.0.0.1"});
+  ASSERT_TRUE(offer) << offer.error();
+  EXPECT_EQ(offer->h264Payload, 116);
+  EXPECT_EQ(offer->h264Format,
+            "level-asymmetry-allowed=1;packetization-mode=1;profile-level-id=4d001f");
+  // Without one that allows any level, the highest level.
+  offered.erase(
+      offered.find("level-asymmetry-allowed=1;packetization-mode=1;profile-level-id=4d001f"),
+      std::string("level-asymmetry-allowed=1;").size());
+  auto highest = readViewerOffer(offered, {"127.0.0.1"});
+  ASSERT_TRUE(highest) << highest.error();
+  EXPECT_EQ(highest->h264Payload, 121);
+}
+
+TEST(WhepSdp, AnAnswerWithoutTheProfileGetsTheOfferedFormat) {
+  const std::string answer =
+      "v=0\r\no=- 1 0 IN IP4 0.0.0.0\r\ns=-\r\nt=0 0\r\n"
+      "m=video 9 UDP/TLS/RTP/SAVPF 116\r\nc=IN IP4 0.0.0.0\r\na=sendonly\r\n"
+      "a=rtpmap:116 H264/90000\r\na=fmtp:116 packetization-mode=1\r\n";
+  auto mended = answerWithH264Format(
+      answer, 116, "level-asymmetry-allowed=1;packetization-mode=1;profile-level-id=4d001f");
+  EXPECT_NE(mended.find("a=fmtp:116 level-asymmetry-allowed=1;packetization-mode=1;"
+                        "profile-level-id=4d001f\r\n"),
+            std::string::npos)
+      << mended;
+  EXPECT_EQ(mended.find("a=fmtp:116 packetization-mode=1\r\n"), std::string::npos) << mended;
+  // One that names its profile (what flows) is left as it is.
+  std::string named = answer;
+  named.replace(named.find("packetization-mode=1\r\n"), 0, "profile-level-id=4d4014;");
+  EXPECT_EQ(answerWithH264Format(named, 116, "profile-level-id=4d001f"), named);
+}
+
 }  // namespace
 }  // namespace wircam::recorder
