@@ -64,7 +64,8 @@ TEST(CameraFaults, ACameraWhoseDatagramsGoElsewhereIsNoVideoWhileTheOtherRecords
       << streamEntry(*url, lostName) << recorder.log();
   EXPECT_EQ(cameraEntry(*url, goodName)["state"], "live");
   expectSigintEndsItWithinThreeSeconds(recorder);
-  EXPECT_GT(indexedFrames(recorder.out(), goodName), 30u) << recorder.log();
+  // Every frame received before the stop is in the file.
+  EXPECT_GE(indexedFrames(recorder.out(), goodName), 30u) << recorder.log();
   EXPECT_EQ(indexedFrames(recorder.out(), lostName), 0u);
   auto videos = recorder.files(".mkv");
   ASSERT_EQ(videos.size(), 1u);

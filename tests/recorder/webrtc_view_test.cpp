@@ -63,7 +63,7 @@ TEST(WebRtcView, ThePageShowsTheCameraOverWebRtcAndItsPictureMoves) {
   ASSERT_TRUE(signedIn.page);
   auto& page = *signedIn.page;
   ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-transport=webrtc]')",
-                             milliseconds(15000)))
+                             milliseconds(30000)))
       << signedIn.recorder.log();
   EXPECT_EQ(page.evaluate("document.querySelector('.transport').textContent"), "WebRTC");
   // The browser decodes frame after frame: 30 more take 2 s at the
@@ -91,7 +91,7 @@ TEST(WebRtcView, AnH264RecordingGoesToTheBrowserAsItIsWithoutEncodingAgain) {
   ASSERT_TRUE(signedIn.page);
   auto& page = *signedIn.page;
   ASSERT_TRUE(page.waitUntil("document.querySelector('.camera[data-transport=webrtc]')",
-                             milliseconds(15000)))
+                             milliseconds(30000)))
       << signedIn.recorder.log();
   ASSERT_TRUE(waitFor([&] { return inboundVideo(page, "framesDecoded") > 5; }));
   double decoded = inboundVideo(page, "framesDecoded");
@@ -157,7 +157,7 @@ TEST(WebRtcView, DriveModeGoesOverTheDataChannelAndAPageThatHangsOrGoesAwayStops
   ASSERT_TRUE(
       page.waitUntil("document.querySelector('.camera[data-transport=webrtc] button.drive') && "
                      "Object.values(views)[0].webrtc.drive.readyState === 'open'",
-                     milliseconds(15000)))
+                     milliseconds(30000)))
       << signedIn.recorder.log();
   signedIn.clickOn("button.drive");
   ASSERT_TRUE(
@@ -200,7 +200,7 @@ TEST(WebRtcView, JunkOnTheDataChannelIsAnsweredAndStopsTheCar) {
   ASSERT_TRUE(
       page.waitUntil("document.querySelector('.camera[data-transport=webrtc]') && "
                      "Object.values(views)[0].webrtc.drive.readyState === 'open'",
-                     milliseconds(15000)));
+                     milliseconds(30000)));
   // The page's own channel, full ahead, then junk, text and binary.
   page.evaluate(
       "window.probe = Object.values(views)[0].webrtc.drive; probe.onmessage = e => { "

@@ -6,6 +6,7 @@
 // mode's data channel (control.js), unordered and never retransmitted: a
 // lost command is replaced by the next one, never delivered late.
 const kWebRtcPatienceMs = 5000;  // to connect, and for the first frame
+const kWebRtcRetryMs = 3000, kWebRtcRetryMaxMs = 60000;  // after a failed try
 let webrtcOffered = true;        // the recorder's --webrtc (the page's state)
 
 function showTransport(view, transport) {
@@ -28,12 +29,19 @@ async function startPicture(view, name) {
   showMjpeg(view, name);
   if (!webrtcOffered || !window.RTCPeerConnection) return;
   const attempt = view.attempt = {};
-  const webrtc = await connectWebRtc(view, name);
-  if (view.attempt !== attempt) {  // stopped or restarted meanwhile
-    if (webrtc) closeWebRtc(webrtc);
-    return;
+  let webrtc = null;
+  for (let retryMs = kWebRtcRetryMs; ; retryMs = Math.min(2 * retryMs, kWebRtcRetryMaxMs)) {
+    webrtc = await connectWebRtc(view, name);
+    if (view.attempt !== attempt) {  // stopped or restarted meanwhile
+      if (webrtc) closeWebRtc(webrtc);
+      return;
+    }
+    if (webrtc) break;
+    // Not up in time (a loaded machine, a network that drops UDP): MJPEG
+    // stays, and WebRTC is tried again, less often each time.
+    await new Promise(done => setTimeout(done, retryMs));
+    if (view.attempt !== attempt) return;
   }
-  if (!webrtc) return;
   view.webrtc = webrtc;
   view.img.removeAttribute("src");  // one stream at a time
   showTransport(view, "webrtc");
