@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
+#include <ctime>
 
 namespace wircam::wirc {
 
@@ -47,6 +49,10 @@ std::optional<std::string> StreamInbox::open(uint16_t port, FrameAssemblerConfig
   int size = kReceiveBufferBytes;
   if (setsockopt(socket_.get(), SOL_SOCKET, SO_RCVBUFFORCE, &size, sizeof size) != 0)
     setsockopt(socket_.get(), SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
+  // The kernel stamps each datagram as it arrives: a frame's time is when
+  // its first packet came, not when a busy machine let this thread read it.
+  int on = 1;
+  setsockopt(socket_.get(), SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
   drain(linkChanged_);
   receiver_.emplace(config);
   ready_.clear();
@@ -102,25 +108,49 @@ std::optional<AssembledFrame> StreamInbox::takeFrame() {
   return frame;
 }
 
-// Whatever datagrams are queued, up to a batch, into the receiver.
+// Whatever datagrams are queued, up to a batch, into the receiver, each at
+// its arrival: the kernel's stamp (wall clock) carried onto the steady
+// clock by its age now.
 void StreamInbox::receiveBatch() {
   std::array<mmsghdr, kBatch> headers{};
   std::array<iovec, kBatch> vectors{};
   std::array<sockaddr_in, kBatch> sources{};
+  std::array<std::array<char, CMSG_SPACE(sizeof(timespec))>, kBatch> stamps{};
   for (size_t i = 0; i < kBatch; ++i) {
     vectors[i] = {buffers_.get() + i * kMaxDatagramSize, kMaxDatagramSize};
     headers[i].msg_hdr.msg_iov = &vectors[i];
     headers[i].msg_hdr.msg_iovlen = 1;
     headers[i].msg_hdr.msg_name = &sources[i];
     headers[i].msg_hdr.msg_namelen = sizeof sources[i];
+    headers[i].msg_hdr.msg_control = stamps[i].data();
+    headers[i].msg_hdr.msg_controllen = stamps[i].size();
   }
   int count = recvmmsg(socket_.get(), headers.data(), kBatch, MSG_DONTWAIT, nullptr);
   auto now = Clock::now();
+  timespec wallNow{};
+  clock_gettime(CLOCK_REALTIME, &wallNow);
   for (int i = 0; i < count; ++i) {
     receiver_->push(SocketAddress(sources[i]),
-                    {static_cast<const uint8_t*>(vectors[i].iov_base), headers[i].msg_len}, now,
+                    {static_cast<const uint8_t*>(vectors[i].iov_base), headers[i].msg_len},
+                    arrivalOf(headers[i].msg_hdr, now, wallNow),
                     [&](AssembledFrame&& frame) { ready_.push_back(std::move(frame)); });
   }
+}
+
+StreamInbox::Clock::time_point StreamInbox::arrivalOf(const msghdr& message, Clock::time_point now,
+                                                      const timespec& wallNow) {
+  for (cmsghdr* c = CMSG_FIRSTHDR(&message); c; c = CMSG_NXTHDR(const_cast<msghdr*>(&message), c)) {
+    if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMPNS) continue;
+    timespec stamp;
+    std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
+    auto age = std::chrono::seconds(wallNow.tv_sec - stamp.tv_sec) +
+               std::chrono::nanoseconds(wallNow.tv_nsec - stamp.tv_nsec);
+    // A wall clock stepped meanwhile (NTP) would make nonsense of the age:
+    // only a plausible one is taken.
+    if (age < Clock::duration::zero() || age > kLongestPlausibleAge) return now;
+    return now - std::chrono::duration_cast<Clock::duration>(age);
+  }
+  return now;
 }
 
 }  // namespace wircam::wirc

@@ -5,7 +5,10 @@
 // first of them, a whole frame, or the deadline.
 #pragma once
 
+#include <sys/socket.h>
+
 #include <chrono>
+#include <ctime>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -53,6 +56,11 @@ class StreamInbox {
 
  private:
   void receiveBatch();
+  // A datagram's arrival from the kernel's stamp on `message`; `now` if it
+  // has none (or an implausible one).
+  static Clock::time_point arrivalOf(const msghdr& message, Clock::time_point now,
+                                     const timespec& wallNow);
+  static constexpr auto kLongestPlausibleAge = std::chrono::seconds(5);
 
   UniqueFd socket_;
   UniqueFd interrupt_;
