@@ -11,33 +11,35 @@ int64_t unixMsNow() { return g_get_real_time() / 1000; }
 }  // namespace
 
 Camera::Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy,
-               CameraObserver& observer)
+               CameraObserver& observer, PipelineBuilder build)
     : plan_(std::move(plan)),
       files_(std::move(files)),
       observer_(observer),
-      health_(policy, now()) {
+      machine_(policy, now()),
+      build_(std::move(build)) {
   report_.name = plan_.name;
   report_.device = plan_.device;
   report_.camera = plan_.camera;
-  report_.state = toString(state_);
+  report_.state = toString(machine_.health().state(now()));
   report_.stateSinceUnixMs = unixMsNow();
   report_.positions = !plan_.positions.empty();
 }
 
 Expected<std::unique_ptr<Camera>, std::string> Camera::create(StreamPlan plan, CameraFiles files,
                                                               CameraHealth::Policy policy,
-                                                              CameraObserver& observer) {
-  std::unique_ptr<Camera> camera(new Camera(std::move(plan), std::move(files), policy, observer));
-  auto pipeline = CameraPipeline::build(camera->plan_, camera->files_, camera->frames(),
-                                        camera->encodedFrames());
+                                                              CameraObserver& observer,
+                                                              PipelineBuilder build) {
+  std::unique_ptr<Camera> camera(
+      new Camera(std::move(plan), std::move(files), policy, observer, std::move(build)));
+  auto pipeline =
+      camera->build_(camera->plan_, camera->files_, camera->frames(), camera->encodedFrames());
   if (!pipeline) return unexpected(pipeline.error());
   camera->pipeline_ = std::move(*pipeline);
   return camera;
 }
 
 Camera::~Camera() {
-  for (guint timer : {finishDeadline_, restartTimer_})
-    if (timer) g_source_remove(timer);
+  if (deadlineTimer_) g_source_remove(deadlineTimer_);
   if (busWatch_) g_source_remove(busWatch_);
   pipeline_.reset();
 }
@@ -72,72 +74,79 @@ GstElement* Camera::controller() const {
 }
 
 void Camera::tick() {
-  if (pipeline_ && !finishing_) {
+  CameraActions actions;
+  if (pipeline_ && machine_.phase() == CameraPhase::kRunning) {
     uint64_t frames = pipeline_->framesPlanned();
-    if (frames != framesSeen_) health_.frame(now());
+    if (frames != framesSeen_) actions = machine_.frame(now());
     framesSeen_ = frames;
-    if (health_.stalled(now()))
-      fault(CameraFault::kStall,
-            "no frame for " +
-                std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(
-                                   health_.policy().stallTimeout)
-                                   .count()) +
-                " ms while logged in");
   }
-  followState();
+  auto due = machine_.tick(hasFrames(), now());
+  actions.insert(actions.end(), due.begin(), due.end());
+  apply(std::move(actions));
 }
 
-void Camera::followState() {
-  CameraState state = health_.state(now());
-  if (state == state_) return;
-  state_ = state;
-  report_.state = toString(state);
+void Camera::apply(CameraActions actions) {
+  using Kind = CameraAction::Kind;
+  for (auto& action : actions) {
+    switch (action.kind) {
+      case Kind::kEndFile:
+        endFile(action.forGood);
+        break;
+      case Kind::kTearDown:
+        tearDown();
+        break;
+      case Kind::kBuild:
+        rebuild();  // applies what its outcome brings
+        break;
+      case Kind::kPublishState:
+        publishState();
+        break;
+      case Kind::kEnded:
+        observer_.ended(*this);
+        break;
+      case Kind::kLog:
+        logLine(name() + ": " + action.text);
+        break;
+    }
+  }
+  // One timer, at the machine's next deadline (a finish cut off, a restart).
+  if (deadlineTimer_) g_source_remove(std::exchange(deadlineTimer_, 0));
+  if (auto deadline = machine_.nextDeadline()) {
+    auto delay = std::chrono::duration_cast<std::chrono::milliseconds>(*deadline - now());
+    deadlineTimer_ =
+        g_timeout_add(static_cast<guint>(std::max<int64_t>(0, delay.count())), onDeadline, this);
+  }
+}
+
+gboolean Camera::onDeadline(gpointer data) {
+  auto* self = static_cast<Camera*>(data);
+  self->deadlineTimer_ = 0;
+  self->apply(self->machine_.tick(self->hasFrames(), now()));
+  return G_SOURCE_REMOVE;
+}
+
+void Camera::publishState() {
+  report_.state = toString(machine_.health().state(now()));
   report_.stateSinceUnixMs = unixMsNow();
   logLine(name() + ": " + report_.state +
           (report_.linkReason.empty() ? "" : " (" + report_.linkReason + ")"));
   observer_.event(*this, {{"type", "state"}, {"state", report_.state}});
 }
 
-void Camera::fault(CameraFault fault, const std::string& why) {
-  if (stopping_ || finishing_ || !pipeline_) return;
-  restartAt_ = health_.fault(fault, now());
-  auto delay = std::chrono::duration_cast<std::chrono::milliseconds>(restartAt_ - now());
-  logLine(name() + ": " + why + ": closing its file and starting its pipeline again in " +
-          std::to_string(delay.count()) + " ms");
-  followState();
-  finish(Then::kRestart);
-}
-
-void Camera::finish(Then then) {
-  if (!pipeline_ || finishing_) return;
-  if (then == Then::kRestart) {
+void Camera::endFile(bool forGood) {
+  if (!pipeline_) return;
+  if (forGood) {
+    // What waited for frames that will not come goes into the last file.
+    pipeline_->telemetry().finish();
+  } else {
     auto waiting = pipeline_->telemetry().handOver();
     carriedTelemetry_.insert(carriedTelemetry_.end(), std::make_move_iterator(waiting.begin()),
                              std::make_move_iterator(waiting.end()));
-  } else {
-    // What waited for frames that will not come goes into the last file.
-    pipeline_->telemetry().finish();
   }
-  if (!pipeline_->hasFrames()) {
-    tearDown();  // no file to finish (and no EOS would pass a camera that never sent a frame)
-    return;
-  }
-  finishing_ = true;
   pipeline_->writer().end();
-  finishDeadline_ = g_timeout_add(static_cast<guint>(kFinishTime.count()), onFinishDeadline, this);
-}
-
-gboolean Camera::onFinishDeadline(gpointer data) {
-  auto* self = static_cast<Camera*>(data);
-  self->finishDeadline_ = 0;
-  logLine(self->name() + ": cut off after " + std::to_string(kFinishTime.count()) +
-          " ms (its last file is indexed as it is)");
-  self->tearDown();
-  return G_SOURCE_REMOVE;
 }
 
 void Camera::tearDown() {
-  if (finishDeadline_) g_source_remove(std::exchange(finishDeadline_, 0));
   if (busWatch_) g_source_remove(std::exchange(busWatch_, 0));
   if (GstElement* control = controller()) {
     // What the user set (following, the target) carries over to the next run.
@@ -154,7 +163,6 @@ void Camera::tearDown() {
   }
   report_.segment.clear();
   pipeline_.reset();
-  finishing_ = false;
   framesSeen_ = 0;
   statsTime_ = GST_CLOCK_TIME_NONE;
   earlierRuns_.frames += runCounts_.frames;
@@ -162,41 +170,24 @@ void Camera::tearDown() {
   earlierRuns_.bytes += runCounts_.bytes;
   earlierRuns_.commandsSent += runCounts_.commandsSent;
   runCounts_ = {};
-  if (stopping_) {
-    ended_ = true;
-    observer_.ended(*this);
-    return;
-  }
-  // A pipeline that ended by itself (no fault said so) failed too.
-  if (!health_.restartPending()) restartAt_ = health_.fault(CameraFault::kError, now());
-  auto delay = std::chrono::duration_cast<std::chrono::milliseconds>(restartAt_ - now());
-  restartTimer_ =
-      g_timeout_add(static_cast<guint>(std::max<int64_t>(0, delay.count())), onRestart, this);
 }
 
-gboolean Camera::onRestart(gpointer data) {
-  auto* self = static_cast<Camera*>(data);
-  self->restartTimer_ = 0;
-  auto pipeline =
-      CameraPipeline::build(self->plan_, self->files_, self->frames(), self->encodedFrames());
-  if (!pipeline) {
-    logLine(self->name() + ": " + pipeline.error());
-    return G_SOURCE_REMOVE;
-  }
-  self->pipeline_ = std::move(*pipeline);
-  if (GstElement* control = self->controller(); control && self->carriedControl_)
-    g_object_set(control, "enabled", self->carriedControl_->first ? TRUE : FALSE, "target-id",
-                 self->carriedControl_->second, nullptr);
+void Camera::rebuild() {
+  auto pipeline = build_(plan_, files_, frames(), encodedFrames());
+  if (!pipeline) return apply(machine_.buildFailed(pipeline.error(), now()));
+  pipeline_ = std::move(*pipeline);
+  if (GstElement* control = controller(); control && carriedControl_)
+    g_object_set(control, "enabled", carriedControl_->first ? TRUE : FALSE, "target-id",
+                 carriedControl_->second, nullptr);
   // What the last run left waiting opens this run's first file.
-  for (auto& line : std::exchange(self->carriedTelemetry_, {}))
-    self->pipeline_->telemetry().write(std::move(line.json), 0, line.unixMs);
-  self->health_.restarted(now());
-  self->report_.restarts = self->health_.restarts();
-  logLine(self->name() + ": pipeline started again (restart " +
-          std::to_string(self->health_.restarts()) + ")");
-  if (!self->play()) self->fault(CameraFault::kError, "its pipeline did not start");
-  self->followState();
-  return G_SOURCE_REMOVE;
+  for (auto& line : std::exchange(carriedTelemetry_, {}))
+    pipeline_->telemetry().write(std::move(line.json), 0, line.unixMs);
+  apply(machine_.built(now()));
+  report_.restarts = machine_.health().restarts();
+  if (!play()) {
+    logLine(name() + ": its pipeline did not start");
+    apply(machine_.pipelineError(now()));
+  }
 }
 
 void Camera::closed(const std::string& file) {
@@ -208,55 +199,25 @@ void Camera::closed(const std::string& file) {
     logLine(name() + ": " + file + " was not planned; not indexed");
 }
 
-void Camera::stop() {
-  if (stopping_) return;
-  stopping_ = true;
-  if (restartTimer_) g_source_remove(std::exchange(restartTimer_, 0));
-  if (!pipeline_) {
-    ended_ = true;
-    observer_.ended(*this);
-    return;
-  }
-  if (finishing_) return;  // a fault's finish is under way: its end is the end
-  finish(Then::kEnd);
-}
+void Camera::stop() { apply(machine_.stop(hasFrames(), now())); }
 
-void Camera::halt() {
-  if (ended_) return;
-  stopping_ = true;
-  if (restartTimer_) g_source_remove(std::exchange(restartTimer_, 0));
-  if (pipeline_)
-    tearDown();
-  else
-    ended_ = true;
-}
+void Camera::halt() { apply(machine_.halt(now())); }
 
 void Camera::handleError(GstMessage* message) {
   GError* error = nullptr;
   gchar* debug = nullptr;
   gst_message_parse_error(message, &error, &debug);
   bool diskFull = g_error_matches(error, GST_RESOURCE_ERROR, GST_RESOURCE_ERROR_NO_SPACE_LEFT);
-  std::string what = error->message;
-  logLine(std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + what + "\n" +
+  logLine(std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + error->message + "\n" +
           (debug ? debug : ""));
   g_error_free(error);
   g_free(debug);
   if (diskFull) {
     // This camera's file cannot be finished; the others may still be.
-    stopping_ = true;
     observer_.diskFull(*this);
-    tearDown();
-    return;
+    return apply(machine_.diskFull(now()));
   }
-  if (finishing_ || stopping_) {
-    tearDown();  // an error while finishing: what the file holds is what it holds
-    return;
-  }
-  // An error ends this run of the pipeline at once: EOS would not pass.
-  restartAt_ = health_.fault(CameraFault::kError, now());
-  logLine(name() + ": restarting its pipeline after the error above; the other cameras record on");
-  followState();
-  tearDown();
+  apply(machine_.pipelineError(now()));
 }
 
 gboolean Camera::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
@@ -281,7 +242,7 @@ gboolean Camera::onBusMessage(GstBus*, GstMessage* message, gpointer data) {
     case GST_MESSAGE_EOS:
       // Its files are finished (after a stop's or a fault's EOS).
       self->report_.segment.clear();
-      self->tearDown();
+      self->apply(self->machine_.endOfStream(now()));
       return G_SOURCE_REMOVE;
     default:
       break;

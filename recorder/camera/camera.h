@@ -6,19 +6,24 @@
 // A fault (a pipeline error, no video for the stall timeout, the device
 // lost while a file is open) closes the camera's open file at its last
 // frame (EOS, bounded by kFinishTime), tears its pipeline down and starts a
-// new one after CameraHealth's backoff. No other camera waits for any of it.
+// new one after CameraHealth's backoff; a build that fails is tried again
+// after the next backoff. CameraMachine decides all of it; this class is its
+// driver (the pipeline, its bus, one timer). No other camera waits for any
+// of it.
 #pragma once
 
 #include <gst/gst.h>
 
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
 #include "camera/camera_health.h"
+#include "camera/camera_machine.h"
 #include "camera/camera_pipeline.h"
 #include "camera/frame_tap.h"
 #include "camera/pipeline_plan.h"
@@ -47,14 +52,16 @@ class CameraObserver {
 
 class Camera {
  public:
-  // How long a stop or a fault waits for the open file to be finished.
-  static constexpr std::chrono::milliseconds kFinishTime{2500};
+  static constexpr std::chrono::milliseconds kFinishTime = CameraMachine::kFinishTime;
+  // Builds a run's pipeline (CameraPipeline::build; a test's may fail).
+  using PipelineBuilder = std::function<Expected<std::unique_ptr<CameraPipeline>, std::string>(
+      const StreamPlan&, const CameraFiles&, FrameTap* frames, FrameTap* encoded)>;
 
   // Builds its first pipeline (a bad description is an error here, not a
   // fault later). `liveFrames`: keep a FrameTap for the live outputs.
-  static Expected<std::unique_ptr<Camera>, std::string> create(StreamPlan plan, CameraFiles files,
-                                                               CameraHealth::Policy policy,
-                                                               CameraObserver& observer);
+  static Expected<std::unique_ptr<Camera>, std::string> create(
+      StreamPlan plan, CameraFiles files, CameraHealth::Policy policy, CameraObserver& observer,
+      PipelineBuilder build = CameraPipeline::build);
   ~Camera();
   Camera(const Camera&) = delete;
   Camera& operator=(const Camera&) = delete;
@@ -70,7 +77,8 @@ class Camera {
   // Stops for good at once, the open file indexed as it is (a second
   // signal, the stop's backstop).
   void halt();
-  bool ended() const { return ended_; }
+  bool ended() const { return machine_.phase() == CameraPhase::kEnded; }
+  CameraPhase phase() const { return machine_.phase(); }
   bool hasFrames() const { return pipeline_ && pipeline_->hasFrames(); }
   // Whether any run of it has recorded a frame.
   bool recordedAny() const { return filesClosed_ > 0 || hasFrames(); }
@@ -96,7 +104,8 @@ class Camera {
   void writeTelemetry(const nlohmann::json& line);
 
  private:
-  Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy, CameraObserver& observer);
+  Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy, CameraObserver& observer,
+         PipelineBuilder build);
 
   static gboolean onBusMessage(GstBus* bus, GstMessage* message, gpointer self);
   void watchBus();
@@ -108,38 +117,29 @@ class Camera {
   void writeTelemetry(nlohmann::json line, GstClockTime runningTime);
   // Tells the observer a file is done, as its planner knew it.
   void closed(const std::string& file);
-  // The pipeline is to go: its open file finished first, then a new one.
-  void fault(CameraFault fault, const std::string& why);
-  // Finishes the open file: for good (the waiting telemetry goes into it),
-  // or before a restart (the waiting telemetry goes into the next run's).
-  enum class Then { kEnd, kRestart };
-  void finish(Then then);
-  static gboolean onFinishDeadline(gpointer self);
-  // Tears the pipeline down, its open file indexed as it is; then the
-  // next start, or the end.
+  // Does what the machine says, then arms the timer for its next deadline.
+  void apply(CameraActions actions);
+  void endFile(bool forGood);
+  // Tears the pipeline down, its open files indexed as they are.
   void tearDown();
-
-  static gboolean onRestart(gpointer self);
+  void rebuild();
+  static gboolean onDeadline(gpointer self);
   bool play();
-  void followState();
+  void publishState();
 
   StreamPlan plan_;
   CameraFiles files_;
   CameraObserver& observer_;
-  CameraHealth health_;
+  CameraMachine machine_;
+  PipelineBuilder build_;
   FrameTap frames_;
   FrameTap encodedFrames_;
   std::unique_ptr<CameraPipeline> pipeline_;
   guint busWatch_ = 0;
-  guint finishDeadline_ = 0, restartTimer_ = 0;
-  CameraHealth::Clock::time_point restartAt_;  // of the pending restart
-  bool finishing_ = false;
-  bool stopping_ = false;
-  bool ended_ = false;
+  guint deadlineTimer_ = 0;  // at machine_.nextDeadline()
   uint64_t filesClosed_ = 0;
   uint64_t framesSeen_ = 0;                       // the planner's frames at the last tick
   GstClockTime statsTime_ = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
-  CameraState state_ = CameraState::kConnecting;  // as last said
   bool everLive_ = false;                         // logged in at least once
   struct Counts {
     uint64_t frames = 0, incomplete = 0, bytes = 0, commandsSent = 0;

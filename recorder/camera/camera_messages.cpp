@@ -17,7 +17,7 @@ constexpr size_t kTrailPositions = 600;
 
 void Camera::writeTelemetry(nlohmann::json line, GstClockTime time) {
   if (!pipeline_ || !GST_CLOCK_TIME_IS_VALID(time)) return;
-  if (finishing_ && !stopping_) {
+  if (machine_.betweenRuns()) {
     // Between a fault and the next run: for the next run's first file.
     carriedTelemetry_.push_back({std::move(line), 0, unixMsOf(pipeline_->pipeline(), time)});
     return;
@@ -76,15 +76,12 @@ void Camera::handleSession(const GstStructure* s, nlohmann::json line) {
   report_.linkReason = live ? "" : printableText(session.reason);
   if (live) {
     everLive_ = true;
-    health_.linkUp(CameraHealth::Clock::now());
+    apply(machine_.linkUp(CameraHealth::Clock::now()));
   } else if (everLive_) {
-    health_.linkDown(CameraHealth::Clock::now());
-    // Lost with a file open: the file ends at its last frame now, not when
-    // frames come back; the next one starts with the first frame back.
-    if (*session.state == "lost" && pipeline_->hasFrames())
-      fault(CameraFault::kLoss, "the device was lost");
+    // Lost with a file open: the machine ends the file at its last frame.
+    apply(machine_.linkLost(*session.state == "lost" && pipeline_->hasFrames(),
+                            CameraHealth::Clock::now()));
   }
-  followState();
 }
 
 void Camera::handleStats(const GstStructure* s, nlohmann::json line) {
@@ -161,7 +158,7 @@ void Camera::handleElementMessage(GstMessage* message) {
     std::string file = gst_structure_get_string(s, "location");
     // (Finished on a streaming thread: the next file may be open already.)
     if (file == report_.segment) report_.segment.clear();
-    pipeline_->writer().finished(file, !finishing_);
+    pipeline_->writer().finished(file, machine_.phase() == CameraPhase::kRunning);
     closed(file);
     return;
   }
