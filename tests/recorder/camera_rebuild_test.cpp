@@ -1,0 +1,107 @@
+// A camera in this process, driven by its own GLib main loop against the
+// simulator: the device goes away, the camera's pipeline is to be built
+// again, and that build fails once (injected). The camera tries again after
+// its backoff and records again when the device is back: no path leaves it
+// silent for good.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <thread>
+
+#include "app/recorder_options.h"
+#include "camera/camera.h"
+#include "simulated_device.h"
+#include "wait_for.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using namespace wircam::recorder;
+using namespace wircam::testing;
+using namespace std::chrono_literals;
+
+struct Observed : CameraObserver {
+  std::vector<std::string> closed;
+  bool over = false;
+  void segmentClosed(Camera&, const std::string& file, const PlannedSegment&) override {
+    closed.push_back(file);
+  }
+  void event(Camera&, const nlohmann::json&) override {}
+  void detections(Camera&, const nlohmann::json&, int64_t) override {}
+  void diskFull(Camera&) override {}
+  void ended(Camera&) override { over = true; }
+};
+
+// Runs the default main context until `done`, at most `limit`.
+bool runUntil(const std::function<bool()>& done, std::chrono::milliseconds limit) {
+  auto until = std::chrono::steady_clock::now() + limit;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    g_main_context_iteration(nullptr, FALSE);
+    std::this_thread::sleep_for(5ms);
+  }
+  return true;
+}
+
+TEST(CameraRebuild, ACameraWhoseRebuildFailsComesBackAndRecords) {
+  gst_registry_scan_path(gst_registry_get(), WIRCAM_PLUGIN_DIR);
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  uint16_t port = device->port();
+  fs::path out = fs::temp_directory_path() / ("camera-rebuild-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  std::vector<std::string> words = {"wirc-recorder", "--device",
+                                    "127.0.0.1:" + std::to_string(port), "--out", out.string()};
+  std::vector<char*> argv;
+  for (auto& word : words) argv.push_back(word.data());
+  auto options = parseOptions(static_cast<int>(argv.size()), argv.data());
+  ASSERT_TRUE(options) << options.error();
+  auto plan = planPipeline(*options);
+  ASSERT_EQ(plan.streams.size(), 1u);
+  CameraFiles files{.folder = out.string(), .extension = ".mkv", .limits = {.maxDuration = 0}};
+  int builds = 0;
+  auto failingOnce =
+      [&](const StreamPlan& stream, const CameraFiles& in, FrameTap* frames,
+          FrameTap* encoded) -> Expected<std::unique_ptr<CameraPipeline>, std::string> {
+    if (++builds == 2) return unexpected(std::string("injected: the build failed"));
+    return CameraPipeline::build(stream, in, frames, encoded);
+  };
+  Observed observed;
+  auto camera = Camera::create(plan.streams[0], files, {.stallTimeout = 2s}, observed, failingOnce);
+  ASSERT_TRUE(camera) << camera.error();
+  ASSERT_TRUE((*camera)->start());
+  guint ticks = g_timeout_add(
+      Camera::kTickIntervalMs,
+      [](gpointer c) -> gboolean {
+        static_cast<Camera*>(c)->tick();
+        return G_SOURCE_CONTINUE;
+      },
+      camera->get());
+  auto frames = [&] { return (*camera)->report().frames; };
+  ASSERT_TRUE(runUntil([&] { return frames() > 15; }, 10s));
+
+  // The device goes away: the file ends, the first rebuild fails.
+  device.reset();
+  ASSERT_TRUE(runUntil([&] { return builds >= 2; }, 10s)) << "no rebuild tried";
+  EXPECT_EQ((*camera)->phase(), CameraPhase::kRestarting);
+  device = startSequenceDevice(port);
+  ASSERT_TRUE(device);
+  uint64_t before = frames();
+  // Tried again after the backoff: it records again.
+  EXPECT_TRUE(runUntil([&] { return builds >= 3 && frames() > before + 15; }, 20s))
+      << builds << " builds, " << frames() << " frames";
+  EXPECT_EQ((*camera)->phase(), CameraPhase::kRunning);
+  EXPECT_GE((*camera)->report().restarts, 1u);
+
+  (*camera)->stop();
+  EXPECT_TRUE(runUntil([&] { return observed.over; }, 5s));
+  g_source_remove(ticks);
+  EXPECT_GE(observed.closed.size(), 2u);  // before the loss, and after it
+  camera->reset();
+  fs::remove_all(out);
+}
+
+}  // namespace
