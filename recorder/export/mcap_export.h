@@ -4,9 +4,10 @@
 //   /STREAM/tags       foxglove.ImageAnnotations: each detected tag's outline and id
 //   /STREAM/telemetry  every sidecar line, as it is (a JSON schema)
 //   /STREAM/log        foxglove.Log: the session's events
-// Messages are JSON with JSON schemas (the images' bytes in base64): the
-// encoding Foxglove reads without generated code, readable by any JSON
-// tool; zstd chunk compression takes back most of base64's third.
+// Images and tags are protobuf, with Foxglove's own schemas (their
+// FileDescriptorSet in the Schema records): a frame's bytes go into the file
+// as they are, at the speed of a copy. Telemetry and logs are JSON with JSON
+// schemas, readable by any JSON tool, in chunks zstd compresses.
 #pragma once
 
 #include <memory>

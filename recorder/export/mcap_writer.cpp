@@ -82,32 +82,41 @@ uint16_t McapWriter::addSchema(const std::string& name, const std::string& encod
   schemas_.push_back({id, name, encoding, data});
   // Inside the chunk, ahead of the messages that use it: a reader reading
   // straight through meets it first.
-  chunk_ += record(kSchema, Bytes().u16(id).str(name).str(encoding).str(data).out);
+  std::string schema = record(kSchema, Bytes().u16(id).str(name).str(encoding).str(data).out);
+  compressibleBytes_ += schema.size();
+  chunk_ += schema;
   return id;
 }
 
 uint16_t McapWriter::addChannel(uint16_t schema, const std::string& topic,
-                                const std::string& encoding) {
+                                const std::string& encoding, bool compressible) {
   auto id = static_cast<uint16_t>(channels_.size());
   channels_.push_back({id, schema, topic, encoding});
-  chunk_ += record(kChannel, Bytes().u16(id).u16(schema).str(topic).str(encoding).u32(0).out);
+  if (!compressible) incompressible_.insert(id);
+  std::string channel =
+      record(kChannel, Bytes().u16(id).u16(schema).str(topic).str(encoding).u32(0).out);
+  compressibleBytes_ += channel.size();
+  chunk_ += channel;
   return id;
 }
 
 void McapWriter::write(uint16_t channel, uint64_t logTime, uint64_t publishTime,
-                       const std::string& data) {
+                       std::string_view head, std::string_view body) {
   chunkMessages_[channel].emplace_back(logTime, chunk_.size());
+  size_t before = chunk_.size();
   // Straight into the chunk: a frame's bytes are copied once.
   constexpr size_t kFields = 2 + 4 + 8 + 8;
   chunk_ += Bytes()
                 .u8(kMessage)
-                .u64(kFields + data.size())
+                .u64(kFields + head.size() + body.size())
                 .u16(channel)
                 .u32(sequences_[channel]++)
                 .u64(logTime)
                 .u64(publishTime)
                 .out;
-  chunk_ += data;
+  chunk_ += head;
+  chunk_ += body;
+  if (!incompressible_.count(channel)) compressibleBytes_ += chunk_.size() - before;
   chunkStart_ = std::min(chunkStart_, logTime);
   chunkEnd_ = std::max(chunkEnd_, logTime);
   firstTime_ = std::min(firstTime_, logTime);
@@ -121,12 +130,18 @@ void McapWriter::flushChunk() {
   if (chunkMessages_.empty() && chunk_.empty()) return;
   if (chunkMessages_.empty()) chunkStart_ = chunkEnd_ = 0;  // schemas and channels only
   std::string compression;
-  // The buffer is kept from chunk to chunk: no fresh pages to fault in.
-  packed_.resize(ZSTD_compressBound(chunk_.size()));
-  // Level 1: JPEG does not compress, the base64 text of it does, by about a
-  // quarter, which the fastest level already finds.
-  size_t size = ZSTD_compress(packed_.data(), packed_.size(), chunk_.data(), chunk_.size(), 1);
-  bool pays = !ZSTD_isError(size) && size < chunk_.size() - chunk_.size() / 10;
+  // Compressed frames do not shrink: when the rest of the chunk is under a
+  // tenth of it, zstd could not save a tenth, and is not tried.
+  bool worthTrying = compressibleBytes_ >= chunk_.size() / 10;
+  compressibleBytes_ = 0;
+  size_t size = 0;
+  if (worthTrying) {
+    // The buffer is kept from chunk to chunk: no fresh pages to fault in.
+    packed_.resize(ZSTD_compressBound(chunk_.size()));
+    // Level 1: the fastest; telemetry's JSON text compresses at any level.
+    size = ZSTD_compress(packed_.data(), packed_.size(), chunk_.data(), chunk_.size(), 1);
+  }
+  bool pays = worthTrying && !ZSTD_isError(size) && size < chunk_.size() - chunk_.size() / 10;
   if (pays) {
     packed_.resize(size);
     compression = "zstd";

@@ -3,7 +3,8 @@
 // after each chunk and a summary section (schemas, channels, statistics,
 // chunk indexes) and summary offsets, so that a reader can seek; every CRC
 // filled in. A chunk is compressed with zstd when that saves a tenth of it
-// or more, and stored as it is otherwise.
+// or more, and stored as it is otherwise; one whose messages are nearly all
+// on incompressible channels (JPEG, H.264) is not even tried.
 //
 // Messages must be written in log-time order within a chunk for the index
 // to be sorted; the writer does not reorder.
@@ -13,7 +14,9 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/expected.h"
@@ -36,10 +39,15 @@ class McapWriter {
 
   // Ids for the messages' records (schemas from 1; 0 is "no schema").
   uint16_t addSchema(const std::string& name, const std::string& encoding, const std::string& data);
-  uint16_t addChannel(uint16_t schema, const std::string& topic, const std::string& encoding);
+  // `compressible`: false for channels of compressed media, which zstd
+  // cannot shrink.
+  uint16_t addChannel(uint16_t schema, const std::string& topic, const std::string& encoding,
+                      bool compressible = true);
 
-  // Times are nanoseconds since the Unix epoch.
-  void write(uint16_t channel, uint64_t logTime, uint64_t publishTime, const std::string& data);
+  // Times are nanoseconds since the Unix epoch. The message is `head`
+  // followed by `body` (a frame's bytes, copied once, into the chunk).
+  void write(uint16_t channel, uint64_t logTime, uint64_t publishTime, std::string_view head,
+             std::string_view body = {});
 
   // The last chunk, the data end, the summary and the footer; false (and
   // errno) when the disk refused any of it.
@@ -81,6 +89,8 @@ class McapWriter {
   // The open chunk: its records, and per channel (time, offset in it).
   std::string chunk_;
   std::string packed_;  // chunk_ compressed
+  std::set<uint16_t> incompressible_;
+  uint64_t compressibleBytes_ = 0;  // of chunk_: records and compressible messages
   uint64_t chunkStart_ = UINT64_MAX, chunkEnd_ = 0;
   std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunkMessages_;
   std::vector<ChunkIndex> chunkIndexes_;

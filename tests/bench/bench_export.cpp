@@ -102,26 +102,29 @@ int main(int argc, char** argv) {
   struct Way {
     const char* name;
     std::string command;
+    fs::path out;
   };
   std::vector<Way> ways = {
-      {"ffmpeg -f concat -c copy (mkv)", "ffmpeg -v error -y -f concat -safe 0 -i " +
-                                             (work / "concat.txt").string() + " -c copy " +
-                                             (work / "ffmpeg.mkv").string()},
+      {"ffmpeg -f concat -c copy (mkv)",
+       "ffmpeg -v error -y -f concat -safe 0 -i " + (work / "concat.txt").string() + " -c copy " +
+           (work / "ffmpeg.mkv").string(),
+       work / "ffmpeg.mkv"},
       {"wirc-export --format mkv",
-       exporter + " --format mkv --out " + (work / "export.mkv").string()},
+       exporter + " --format mkv --out " + (work / "export.mkv").string(), work / "export.mkv"},
       {"wirc-export --format mcap",
-       exporter + " --format mcap --out " + (work / "export.mcap").string()},
+       exporter + " --format mcap --out " + (work / "export.mcap").string(), work / "export.mcap"},
   };
-  std::printf("%-32s | %8s | %8s | %8s | %s\n", "way", "MB/s", "seconds", "peak MB",
-              "× ffmpeg's MB/s");
-  double stock = 0;
+  std::printf("%-32s | %8s | %8s | %8s | %15s | %s\n", "way", "MB/s", "seconds", "peak MB",
+              "× ffmpeg's MB/s", "size × ffmpeg's mkv");
+  double stock = 0, stockBytes = 0;
   for (const auto& way : ways) {
     auto run = measure(way.command);
     if (!run) return 1;
     double rate = megabytes / run->seconds;
-    if (stock == 0) stock = rate;
-    std::printf("%-32s | %8.1f | %8.2f | %8.1f | %.2f\n", way.name, rate, run->seconds,
-                static_cast<double>(run->maxRssKb) / 1024, rate / stock);
+    auto size = static_cast<double>(fs::file_size(way.out));
+    if (stock == 0) stock = rate, stockBytes = size;
+    std::printf("%-32s | %8.1f | %8.2f | %8.1f | %15.2f | %.3f\n", way.name, rate, run->seconds,
+                static_cast<double>(run->maxRssKb) / 1024, rate / stock, size / stockBytes);
   }
   fs::remove_all(work);
   return 0;

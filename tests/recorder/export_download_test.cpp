@@ -118,6 +118,11 @@ TEST_F(ExportDownload, ARangeWithAnOffsetAsTypedInTheAddressBarComesAsMcapWithTh
   auto result = nlohmann::json::parse(checked.output);
   EXPECT_EQ(result["invalid"], nlohmann::json::array()) << result["invalid"];
   EXPECT_GT(result["topics"]["/" + *camera_ + "/tags"].get<int>(), 5) << result["topics"];
+  // Decoded with Foxglove's protobuf definitions: an outline per tag seen,
+  // stamped with its frame's time.
+  EXPECT_EQ(result["encodings"]["/" + *camera_ + "/tags"], "protobuf");
+  EXPECT_GT(result["outlines"].get<int>(), 5);
+  EXPECT_EQ(result["annotationsOffTheirTime"], 0);
   EXPECT_EQ(std::to_string(result["topics"]["/" + *camera_ + "/image"].get<int>()),
             segment.headers["x-export-frames"]);
 }

@@ -195,6 +195,10 @@ TEST_F(Export, McapIsReadByMcapCoreWithEveryMessageValidAgainstFoxglovesSchemas)
     EXPECT_EQ(image["format"], "jpeg");
   }
   EXPECT_EQ(images, recorded);
+  // Images as Foxglove's protobuf, decoded with Foxglove's own definitions;
+  // telemetry as JSON.
+  EXPECT_EQ(result["encodings"][topic + "/image"], "protobuf");
+  EXPECT_EQ(result["encodings"][topic + "/telemetry"], "json");
   // Each line at its own time, those of the outage too (the loss, the
   // retries, the new login): log_time is the line's utc, and a Log's
   // timestamp its log_time.

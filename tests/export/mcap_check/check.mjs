@@ -3,8 +3,11 @@
 //   node check.mjs FILE.mcap
 // - @mcap/core's McapIndexedReader (chunk indexes, summary, CRCs) and
 //   McapStreamReader (every record in order, the data section's CRC);
-// - every message validated against Foxglove's own JSON schema for its
-//   type (@foxglove/schemas), with ajv;
+// - every JSON message validated against Foxglove's own JSON schema for its
+//   type (@foxglove/schemas), with ajv; every protobuf message decoded
+//   with Foxglove's own protobuf definitions (@foxglove/schemas' generated
+//   .proto, parsed by protobufjs), and the file's Schema record read as the
+//   FileDescriptorSet the MCAP spec asks for;
 // - a read from the middle (startTime), which the chunk index serves.
 import { readFile } from "node:fs/promises";
 import { createHash } from "node:crypto";
@@ -12,6 +15,26 @@ import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import * as foxglove from "@foxglove/schemas/jsonschema.js";
 import Ajv from "ajv";
 import { decompress } from "fzstd";
+import protobuf from "protobufjs";
+import descriptor from "protobufjs/ext/descriptor/index.js";
+import { createRequire } from "node:module";
+
+// Foxglove's protobuf definitions, as their package generates them.
+function foxgloveProtobuf() {
+  const require = createRequire(import.meta.url);
+  const { foxgloveMessageSchemas, foxgloveEnumSchemas, generateProto } =
+    require("@foxglove/schemas/internal");
+  const root = new protobuf.Root();
+  for (const file of ["google/protobuf/timestamp.proto", "google/protobuf/duration.proto"])
+    root.addJSON(protobuf.common.get(file).nested);
+  const enums = Object.values(foxgloveEnumSchemas ?? {});
+  for (const [name, schema] of Object.entries(foxgloveMessageSchemas))
+    protobuf.parse(generateProto(schema, enums.filter((e) => e.parentSchemaName === name)), root,
+                   { keepCase: true });
+  root.resolveAll();
+  return root;
+}
+const foxgloveTypes = foxgloveProtobuf();
 
 const bytes = new Uint8Array(await readFile(process.argv[2]));
 const decompressHandlers = { zstd: (data) => decompress(data) };
@@ -28,12 +51,30 @@ const foxgloveSchemas = {
   "foxglove.Log": foxglove.Log,
 };
 const validators = new Map();
+const descriptorProblems = [];
 for (const [id, channel] of reader.channelsById) {
   const schema = reader.schemasById.get(channel.schemaId);
+  if (channel.messageEncoding === "protobuf") {
+    // The file's own schema: a FileDescriptorSet that holds the type.
+    try {
+      const set = descriptor.FileDescriptorSet.decode(schema.data);
+      protobuf.Root.fromDescriptor(set).lookupType(schema.name);
+    } catch (error) {
+      descriptorProblems.push({ topic: channel.topic, error: String(error) });
+    }
+    validators.set(id, {
+      topic: channel.topic,
+      name: schema.name,
+      encoding: "protobuf",
+      type: foxgloveTypes.lookupType(schema.name),
+    });
+    continue;
+  }
   const ours = JSON.parse(new TextDecoder().decode(schema.data));
   validators.set(id, {
     topic: channel.topic,
     name: schema.name,
+    encoding: channel.messageEncoding,
     ours: ajv.compile(ours),
     theirs: foxgloveSchemas[schema.name] ? ajv.compile(foxgloveSchemas[schema.name]) : null,
   });
@@ -47,6 +88,9 @@ const result = {
   linesTimed: 0,
   linesOffTheirUtc: [],
   logsOffTheirTimestamp: 0,
+  encodings: {},
+  outlines: 0,
+  annotationsOffTheirTime: 0,
 };
 result.compression = [...new Set(reader.chunkIndexes.map((c) => c.compression))];
 result.statistics = reader.statistics
@@ -59,10 +103,31 @@ for await (const message of reader.readMessages()) {
   result.topics[v.topic] = (result.topics[v.topic] ?? 0) + 1;
   if (message.logTime < last) result.ordered = false;
   last = message.logTime;
-  const json = JSON.parse(new TextDecoder().decode(message.data));
-  for (const [who, check] of [["ours", v.ours], ["foxglove", v.theirs]]) {
-    if (check && !check(json) && result.invalid.length < 5)
-      result.invalid.push({ topic: v.topic, who, errors: check.errors });
+  let json;
+  if (v.type) {
+    try {
+      json = v.type.toObject(v.type.decode(message.data), { longs: Number, defaults: true });
+    } catch (error) {
+      if (result.invalid.length < 5)
+        result.invalid.push({ topic: v.topic, who: "foxglove protobuf", errors: String(error) });
+      continue;
+    }
+    const problem = v.type.verify(json);
+    if (problem && result.invalid.length < 5)
+      result.invalid.push({ topic: v.topic, who: "foxglove protobuf", errors: problem });
+    result.encodings[v.topic] = "protobuf";
+  } else {
+    json = JSON.parse(new TextDecoder().decode(message.data));
+    for (const [who, check] of [["ours", v.ours], ["foxglove", v.theirs]]) {
+      if (check && !check(json) && result.invalid.length < 5)
+        result.invalid.push({ topic: v.topic, who, errors: check.errors });
+    }
+    result.encodings[v.topic] = "json";
+  }
+  if (v.name === "foxglove.ImageAnnotations") {
+    result.outlines += json.points.length;
+    const stamp = BigInt(json.timestamp.seconds) * 1000000000n + BigInt(json.timestamp.nanos);
+    if (stamp !== message.logTime) result.annotationsOffTheirTime += 1;
   }
   // A telemetry line's log_time is its own utc (ms); a Log's timestamp is
   // its log_time.
@@ -77,7 +142,7 @@ for await (const message of reader.readMessages()) {
     if (stamp !== message.logTime) result.logsOffTheirTimestamp += 1;
   }
   if (v.name === "foxglove.CompressedImage") {
-    const data = Buffer.from(json.data, "base64");
+    const data = Buffer.from(json.data);
     result.images.push({
       logTime: message.logTime.toString(),
       md5: createHash("md5").update(data).digest("hex"),
@@ -109,4 +174,5 @@ try {
 } catch (error) {
   result.streamError = String(error);
 }
+if (descriptorProblems.length) result.invalid.push(...descriptorProblems);
 console.log(JSON.stringify(result));
