@@ -155,8 +155,7 @@ void Controller::Impl::onPhaseTimer() {
 
 void Controller::Impl::onPacerTimer() {
   auto now = Clock::now();
-  std::optional<link::Pulses> due;
-  Clock::time_point next;
+  link::PacedStep step;
   std::optional<SocketAddress> robot;
   bool commanded;
   {
@@ -164,20 +163,14 @@ void Controller::Impl::onPacerTimer() {
     robot = registration_.registeredRobot();
     if (!robot) return;
     commanded = pacer_.commanded();
-    if (commanded) {
-      due = pacer_.poll(now);
-      next = pacer_.nextDeadline(now);
-    }
+    if (commanded) step = link::PacedStep::poll(pacer_, now);
   }
   if (!commanded) {
     // Nothing worthwhile to send: IDLE tells the robot we are still here.
     send(Idle{}, *robot);
     return loop_.armIfEarlier(pacerTimer_, now + kIdlePeriod);
   }
-  if (due) send(ctrlOf(*due), *robot);
-  // Not arm(): a command set while this ran may have armed an earlier wake
-  // (computed after `next`), which must not be pushed back.
-  loop_.armIfEarlier(pacerTimer_, next);
+  step.carryOut([&](const link::Pulses& due) { send(ctrlOf(due), *robot); }, loop_, pacerTimer_);
 }
 
 void Controller::Impl::onReadable() {
@@ -222,18 +215,16 @@ Controller::~Controller() = default;
 
 void Controller::setCommand(const link::Pulses& pulses) {
   auto now = Clock::now();
-  std::optional<link::Pulses> due;
+  link::PacedStep step;
   std::optional<SocketAddress> robot;
-  Clock::time_point next;
   {
     std::lock_guard lock(impl_->mutex_);
-    due = impl_->pacer_.offer(pulses, now);
-    next = impl_->pacer_.nextDeadline(now);
+    step = link::PacedStep::offer(impl_->pacer_, pulses, now);
     robot = impl_->registration_.registeredRobot();
   }
   if (!robot) return;  // kept for when the robot is registered
-  if (due) impl_->send(impl_->ctrlOf(*due), *robot);
-  impl_->loop_.armIfEarlier(impl_->pacerTimer_, next);
+  step.carryOut([&](const link::Pulses& due) { impl_->send(impl_->ctrlOf(due), *robot); },
+                impl_->loop_, impl_->pacerTimer_);
 }
 
 void Controller::requestControl() {

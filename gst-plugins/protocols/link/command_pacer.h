@@ -56,4 +56,28 @@ class CommandPacer {
   std::optional<Clock::time_point> lastChangeTime_;  // the last send of a new value
 };
 
+// What the pacer decided under a link's lock: the pulses to send now, if
+// any, and when to look again. Every link (WiRC, RCOIP, BTEMP) sends its
+// commands the same way: decide under its lock, then carry out outside it.
+struct PacedStep {
+  std::optional<Pulses> due;
+  CommandPacer::Clock::time_point next{};
+
+  static PacedStep offer(CommandPacer& pacer, const Pulses& pulses,
+                         CommandPacer::Clock::time_point now) {
+    return {pacer.offer(pulses, now), pacer.nextDeadline(now)};
+  }
+  static PacedStep poll(CommandPacer& pacer, CommandPacer::Clock::time_point now) {
+    return {pacer.poll(now), pacer.nextDeadline(now)};
+  }
+  // Outside the lock: the send, then the pacer's timer armed at `next`, or
+  // earlier (armIfEarlier): a command set meanwhile, on another thread, may
+  // have armed an earlier wake that must not be pushed back.
+  template <typename Send, typename Loop, typename Timer>
+  void carryOut(Send&& send, Loop& loop, Timer timer) const {
+    if (due) send(*due);
+    loop.armIfEarlier(timer, next);
+  }
+};
+
 }  // namespace wircam::link

@@ -115,17 +115,12 @@ void Transmitter::Impl::send(const link::Pulses& pulses) {
 
 void Transmitter::Impl::onPacerTimer() {
   auto now = Clock::now();
-  std::optional<link::Pulses> due;
-  Clock::time_point next;
+  link::PacedStep step;
   {
     std::lock_guard lock(mutex_);
-    due = pacer_.poll(now);
-    next = pacer_.nextDeadline(now);
+    step = link::PacedStep::poll(pacer_, now);
   }
-  if (due) send(*due);
-  // Not arm(): a command set while this ran may have armed an earlier wake
-  // (computed after `next`), which must not be pushed back.
-  loop_.armIfEarlier(pacerTimer_, next);
+  step.carryOut([this](const link::Pulses& pulses) { send(pulses); }, loop_, pacerTimer_);
 }
 
 void Transmitter::Impl::onReadable() {
@@ -188,16 +183,14 @@ Transmitter::~Transmitter() = default;
 
 void Transmitter::setCommand(const link::Pulses& pulses) {
   auto now = Clock::now();
-  std::optional<link::Pulses> due;
-  Clock::time_point next;
+  link::PacedStep step;
   {
     std::lock_guard lock(impl_->mutex_);
-    due = impl_->pacer_.offer(pulses, now);
-    next = impl_->pacer_.nextDeadline(now);
+    step = link::PacedStep::offer(impl_->pacer_, pulses, now);
   }
   // A change leaves now, from this thread.
-  if (due) impl_->send(*due);
-  impl_->loop_.armIfEarlier(impl_->pacerTimer_, next);
+  step.carryOut([this](const link::Pulses& due) { impl_->send(due); }, impl_->loop_,
+                impl_->pacerTimer_);
 }
 
 void Transmitter::requestControl() {

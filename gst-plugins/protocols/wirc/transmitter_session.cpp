@@ -380,20 +380,15 @@ void TransmitterSession::Impl::onPsd() {
 
 void TransmitterSession::Impl::onPacerTimer() {
   auto now = Clock::now();
-  std::optional<link::Pulses> due;
-  Clock::time_point next;
+  link::PacedStep step;
   {
     std::lock_guard lock(mutex_);
     const auto& status = machine_.status();
     if (status.state != link::LinkState::Live || !status.hasControl || !machine_.controlAddress())
       return;
-    due = pacer_.poll(now);
-    next = pacer_.nextDeadline(now);
+    step = link::PacedStep::poll(pacer_, now);
   }
-  if (due) sendPcd(*due);
-  // Not arm(): a command set while this ran may have armed an earlier wake
-  // (computed after `next`), which must not be pushed back.
-  loop_.armIfEarlier(pacerTimer_, next);
+  step.carryOut([this](const link::Pulses& pulses) { sendPcd(pulses); }, loop_, pacerTimer_);
 }
 
 // ---------------------------------------------------------------------------
@@ -489,21 +484,19 @@ void TransmitterSession::stopStream(uint8_t camera) {
 
 void TransmitterSession::setCommand(const link::Pulses& pulses) {
   auto now = Clock::now();
-  std::optional<link::Pulses> due;
-  Clock::time_point next;
+  link::PacedStep step;
   bool steering;
   {
     std::lock_guard lock(impl_->mutex_);
-    due = impl_->pacer_.offer(pulses, now);
+    step = link::PacedStep::offer(impl_->pacer_, pulses, now);
     const auto& status = impl_->machine_.status();
     steering = status.state == link::LinkState::Live && status.hasControl &&
                impl_->machine_.controlAddress();
-    next = impl_->pacer_.nextDeadline(now);
   }
   if (!steering) return;  // kept for when the control right comes
   // A change leaves now, from this thread: no wait for a tick.
-  if (due) impl_->sendPcd(*due);
-  impl_->loop_.armIfEarlier(impl_->pacerTimer_, next);
+  step.carryOut([this](const link::Pulses& due) { impl_->sendPcd(due); }, impl_->loop_,
+                impl_->pacerTimer_);
 }
 
 void TransmitterSession::requestControl() {
