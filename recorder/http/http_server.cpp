@@ -215,7 +215,11 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* 
     // Over TLS a plain answer would be noise: the connection just closes.
     if (!self->connections_->tls())
       g_socket_send(socket, answer.data(), answer.size(), nullptr, nullptr);
-    g_socket_shutdown(socket, TRUE, TRUE, nullptr);
+    // Only our side: shutting the reading side with the client's body
+    // unread would send a reset, which can destroy the answer before the
+    // client reads it. The body is read and dropped (not kept) until the
+    // client stops; libsoup then finds the connection closed for writing.
+    g_socket_shutdown(socket, FALSE, TRUE, nullptr);
   }
   soup_server_message_set_status(message, SOUP_STATUS_BAD_REQUEST, nullptr);
 }
