@@ -43,12 +43,15 @@ CameraActions CameraMachine::published(CameraActions actions, Clock::time_point 
 
 void CameraMachine::restartLater(Clock::time_point now, CameraActions& actions) {
   actions.push_back(action(Kind::kTearDown));
+  if (phase_ == CameraPhase::kFinishing) deadline_ = restartAt_;  // the fault's backoff
   phase_ = CameraPhase::kRestarting;
   // A pipeline that ended by itself (no fault said so) failed too.
   if (!health_.restartPending()) deadline_ = health_.fault(CameraFault::kError, now);
 }
 
 void CameraMachine::end(CameraActions& actions) {
+  // A pipeline there is goes first; while restarting there is none.
+  if (phase_ != CameraPhase::kRestarting) actions.push_back(action(Kind::kTearDown));
   phase_ = CameraPhase::kEnded;
   actions.push_back(action(Kind::kEnded));
 }
@@ -109,10 +112,8 @@ CameraActions CameraMachine::tick(bool fileOpen, Clock::time_point now) {
       actions.push_back(logged("cut off after " + std::to_string(kFinishTime.count()) +
                                " ms (its last file is indexed as it is)"));
       if (phase_ == CameraPhase::kStopping) {
-        actions.push_back(action(Kind::kTearDown));
         end(actions);
       } else {
-        deadline_ = restartAt_;
         restartLater(now, actions);
       }
       break;
@@ -138,11 +139,9 @@ CameraActions CameraMachine::pipelineError(Clock::time_point now) {
       break;
     case CameraPhase::kFinishing:
       // What the file holds is what it holds.
-      deadline_ = restartAt_;
       restartLater(now, actions);
       break;
     case CameraPhase::kStopping:
-      actions.push_back(action(Kind::kTearDown));
       end(actions);
       break;
     case CameraPhase::kRestarting:
@@ -153,12 +152,8 @@ CameraActions CameraMachine::pipelineError(Clock::time_point now) {
 }
 
 CameraActions CameraMachine::diskFull(Clock::time_point now) {
-  CameraActions actions;
-  if (phase_ == CameraPhase::kEnded) return actions;
   // This camera's file cannot be finished; the others may still be.
-  if (phase_ != CameraPhase::kRestarting) actions.push_back(action(Kind::kTearDown));
-  end(actions);
-  return published(std::move(actions), now);
+  return halt(now);
 }
 
 CameraActions CameraMachine::endOfStream(Clock::time_point now) {
@@ -166,11 +161,9 @@ CameraActions CameraMachine::endOfStream(Clock::time_point now) {
   switch (phase_) {
     case CameraPhase::kRunning:  // ended by itself
     case CameraPhase::kFinishing:
-      if (phase_ == CameraPhase::kFinishing) deadline_ = restartAt_;
       restartLater(now, actions);
       break;
     case CameraPhase::kStopping:
-      actions.push_back(action(Kind::kTearDown));
       end(actions);
       break;
     case CameraPhase::kRestarting:
@@ -206,7 +199,6 @@ CameraActions CameraMachine::stop(bool fileOpen, Clock::time_point now) {
         phase_ = CameraPhase::kStopping;
         deadline_ = now + kFinishTime;
       } else {
-        actions.push_back(action(Kind::kTearDown));
         end(actions);
       }
       break;
@@ -227,7 +219,6 @@ CameraActions CameraMachine::stop(bool fileOpen, Clock::time_point now) {
 CameraActions CameraMachine::halt(Clock::time_point now) {
   CameraActions actions;
   if (phase_ == CameraPhase::kEnded) return actions;
-  if (phase_ != CameraPhase::kRestarting) actions.push_back(action(Kind::kTearDown));
   end(actions);
   return published(std::move(actions), now);
 }

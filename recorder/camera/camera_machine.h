@@ -85,7 +85,9 @@ class CameraMachine {
  private:
   void fault(CameraFault fault, const std::string& why, bool fileOpen, Clock::time_point now,
              CameraActions& actions);
+  // Tear down, then build again when the fault's backoff is over.
   void restartLater(Clock::time_point now, CameraActions& actions);
+  // Tear down (if there is a pipeline) and end for good.
   void end(CameraActions& actions);
   // Appends kPublishState when the state changed since it was last said.
   CameraActions published(CameraActions actions, Clock::time_point now);

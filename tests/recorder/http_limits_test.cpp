@@ -37,35 +37,26 @@ uint16_t portOf(const std::string& url) {
 }
 
 // Sends `request` on a fresh connection; the first line of the answer.
-std::string statusLine(uint16_t port, const std::string& request) {
+// The answer to `request`, up to the server's close (`whole`) or its status
+// line's end.
+std::string answerTo(uint16_t port, const std::string& request, bool whole = true) {
   auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(port));
   if (!fd) return "";
   ::send(fd->get(), request.data(), request.size(), MSG_NOSIGNAL);
   std::string answer;
   char chunk[512];
   pollfd p{fd->get(), POLLIN, 0};
-  while (answer.find("\r\n") == std::string::npos && ::poll(&p, 1, 5000) > 0) {
-    ssize_t n = ::recv(fd->get(), chunk, sizeof chunk, 0);
-    if (n <= 0) break;
-    answer.append(chunk, static_cast<size_t>(n));
-  }
-  return answer.substr(0, answer.find("\r\n"));
-}
-
-// The whole answer, up to the server's close.
-std::string answerTo(uint16_t port, const std::string& request) {
-  auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(port));
-  if (!fd) return "";
-  ::send(fd->get(), request.data(), request.size(), MSG_NOSIGNAL);
-  std::string answer;
-  char chunk[512];
-  pollfd p{fd->get(), POLLIN, 0};
-  while (::poll(&p, 1, 5000) > 0) {
+  while ((whole || answer.find("\r\n") == std::string::npos) && ::poll(&p, 1, 5000) > 0) {
     ssize_t n = ::recv(fd->get(), chunk, sizeof chunk, 0);
     if (n <= 0) break;
     answer.append(chunk, static_cast<size_t>(n));
   }
   return answer;
+}
+
+std::string statusLine(uint16_t port, const std::string& request) {
+  auto answer = answerTo(port, request, false);
+  return answer.substr(0, answer.find("\r\n"));
 }
 
 struct ServedRecorder {

@@ -80,6 +80,34 @@ nlohmann::json compare(const fs::path& recorded, const fs::path& replayed) {
   return nlohmann::json::parse(ran.output, nullptr, false);
 }
 
+// wirc-sim --replay of `recording` at 4× speed as users run it (its port read
+// from its first line), watched by a recorder until the replay's end: what
+// it printed after its first line; the recorder, still running.
+struct SimReplay {
+  std::string printed;
+  int exitStatus = -1;
+  std::unique_ptr<RecorderProcess> viewer;
+};
+SimReplay replayWithWircSim(const fs::path& recording) {
+  SimReplay run;
+  std::string command = std::string(WIRC_SIM) + " --port 0 --speed 4 --duration 60 --replay '" +
+                        recording.string() + "' 2>/dev/null";
+  FILE* sim = popen(command.c_str(), "r");
+  if (!sim) return run;
+  char line[512];
+  uint16_t port = 0;
+  constexpr std::string_view kListening = "wirc-sim: listening on 127.0.0.1:";
+  while (!port && std::fgets(line, sizeof line, sim))
+    if (std::string_view(line).starts_with(kListening))
+      port = static_cast<uint16_t>(std::atoi(line + kListening.size()));
+  if (port)
+    run.viewer =
+        std::make_unique<RecorderProcess>(port, std::vector<std::string>{"--duration", "60"});
+  while (std::fgets(line, sizeof line, sim)) run.printed += line;
+  run.exitStatus = pclose(sim);
+  return run;
+}
+
 // 5 s of the follow scene recorded with --follow, replayed once with the
 // same settings; for every test.
 class Replay : public ::testing::Test {
@@ -169,23 +197,13 @@ TEST_F(Replay, AHalvedSteeringGainSteersLess) {
 }
 
 TEST_F(Replay, WircSimReplaysTheDriveForARecorderAndStopsAtItsEndWithASummary) {
-  // As users run it: the binary, its port read from its first line, its
-  // summary when the drive is over (bounded by --duration should it not be).
-  std::string command = std::string(WIRC_SIM) + " --port 0 --speed 4 --duration 60 --replay '" +
-                        segmentOf(*original_).string() + "' 2>/dev/null";
-  FILE* sim = popen(command.c_str(), "r");
-  ASSERT_TRUE(sim);
-  char line[512];
-  uint16_t port = 0;
-  constexpr std::string_view kListening = "wirc-sim: listening on 127.0.0.1:";
-  while (!port && std::fgets(line, sizeof line, sim))
-    if (std::string_view(line).starts_with(kListening))
-      port = static_cast<uint16_t>(std::atoi(line + kListening.size()));
-  ASSERT_NE(port, 0);
-  RecorderProcess viewer(port, {"--duration", "60"});
-  std::string rest;
-  while (std::fgets(line, sizeof line, sim)) rest += line;
-  EXPECT_EQ(pclose(sim), 0) << rest;
+  // As users run it, its summary when the drive is over (bounded by
+  // --duration should it not be).
+  auto run = replayWithWircSim(segmentOf(*original_));
+  ASSERT_TRUE(run.viewer) << "no port from wirc-sim";
+  auto& viewer = *run.viewer;
+  const std::string& rest = run.printed;
+  EXPECT_EQ(run.exitStatus, 0) << rest;
   auto recorded = frameDigests(segmentOf(*original_));
   EXPECT_NE(rest.find("wirc-sim summary: (the replay ended)"), std::string::npos) << rest;
   EXPECT_NE(rest.find("replayed " + std::to_string(recorded.size()) + " frames of 1 segment"),
@@ -215,21 +233,11 @@ TEST_F(Replay, WircSimSaysWhatIsWrongWithAFileOfZerosAndThatACutFileEndsMidFrame
   fs::path cut = folder / ("cut-cam0" + segmentOf(*original_).extension().string());
   fs::copy(segmentOf(*original_), cut);
   fs::resize_file(cut, fs::file_size(cut) / 2);
-  std::string command = std::string(WIRC_SIM) + " --port 0 --speed 4 --duration 60 --replay '" +
-                        cut.string() + "' 2>/dev/null";
-  FILE* sim = popen(command.c_str(), "r");
-  ASSERT_TRUE(sim);
-  char line[512];
-  uint16_t port = 0;
-  constexpr std::string_view kListening = "wirc-sim: listening on 127.0.0.1:";
-  while (!port && std::fgets(line, sizeof line, sim))
-    if (std::string_view(line).starts_with(kListening))
-      port = static_cast<uint16_t>(std::atoi(line + kListening.size()));
-  ASSERT_NE(port, 0);
-  RecorderProcess viewer(port, {"--duration", "60"});
-  std::string rest;
-  while (std::fgets(line, sizeof line, sim)) rest += line;
-  EXPECT_EQ(pclose(sim), 0) << rest;
+  auto run = replayWithWircSim(cut);
+  ASSERT_TRUE(run.viewer) << "no port from wirc-sim";
+  auto& viewer = *run.viewer;
+  const std::string& rest = run.printed;
+  EXPECT_EQ(run.exitStatus, 0) << rest;
   viewer.signal(SIGINT);
   viewer.wait();
   EXPECT_NE(rest.find("cut-cam0.mkv: played "), std::string::npos) << rest;
