@@ -49,6 +49,13 @@ void CameraMachine::restartLater(Clock::time_point now, CameraActions& actions) 
   if (!health_.restartPending()) deadline_ = health_.fault(CameraFault::kError, now);
 }
 
+void CameraMachine::finished(Clock::time_point now, CameraActions& actions) {
+  if (phase_ == CameraPhase::kStopping)
+    end(actions);
+  else
+    restartLater(now, actions);
+}
+
 void CameraMachine::end(CameraActions& actions) {
   // A pipeline there is goes first; while restarting there is none.
   if (phase_ != CameraPhase::kRestarting) actions.push_back(action(Kind::kTearDown));
@@ -111,11 +118,7 @@ CameraActions CameraMachine::tick(bool fileOpen, Clock::time_point now) {
       if (now < deadline_) break;
       actions.push_back(logged("cut off after " + std::to_string(kFinishTime.count()) +
                                " ms (its last file is indexed as it is)"));
-      if (phase_ == CameraPhase::kStopping) {
-        end(actions);
-      } else {
-        restartLater(now, actions);
-      }
+      finished(now, actions);
       break;
     case CameraPhase::kRestarting:
       if (now >= deadline_) actions.push_back(action(Kind::kBuild));
@@ -138,11 +141,8 @@ CameraActions CameraMachine::pipelineError(Clock::time_point now) {
       restartLater(now, actions);
       break;
     case CameraPhase::kFinishing:
-      // What the file holds is what it holds.
-      restartLater(now, actions);
-      break;
     case CameraPhase::kStopping:
-      end(actions);
+      finished(now, actions);  // what the file holds is what it holds
       break;
     case CameraPhase::kRestarting:
     case CameraPhase::kEnded:
@@ -160,11 +160,11 @@ CameraActions CameraMachine::endOfStream(Clock::time_point now) {
   CameraActions actions;
   switch (phase_) {
     case CameraPhase::kRunning:  // ended by itself
-    case CameraPhase::kFinishing:
       restartLater(now, actions);
       break;
+    case CameraPhase::kFinishing:
     case CameraPhase::kStopping:
-      end(actions);
+      finished(now, actions);
       break;
     case CameraPhase::kRestarting:
     case CameraPhase::kEnded:

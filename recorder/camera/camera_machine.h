@@ -89,6 +89,8 @@ class CameraMachine {
   void restartLater(Clock::time_point now, CameraActions& actions);
   // Tear down (if there is a pipeline) and end for good.
   void end(CameraActions& actions);
+  // A finish is over (its EOS, its deadline, an error): the end, or the restart.
+  void finished(Clock::time_point now, CameraActions& actions);
   // Appends kPublishState when the state changed since it was last said.
   CameraActions published(CameraActions actions, Clock::time_point now);
   static std::string millisecondsUntil(Clock::time_point when, Clock::time_point now);
