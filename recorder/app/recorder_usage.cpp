@@ -116,7 +116,7 @@ file and exits 0.
                          one) with the segment's path and its sidecar's as
                          two more arguments, for each segment as it closes;
                          failures are retried with backoff (e.g. a script
-                         that runs rclone: README.md, "Fleets")
+                         that runs rclone: docs/recorder.md, "Segment hooks")
   --hook-timeout S       a hook running longer is stopped and retried (default 600)
   --hook-drain S         at exit, how long the hooks still queued get (default 15)
   --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>; without

@@ -1,6 +1,7 @@
 #include "export/export_range.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -12,6 +13,10 @@
 #include "record/segment_inspector.h"
 
 namespace wircam::recorder {
+
+// A segment file the index lacks, written to this recently, is taken for
+// the one a recorder is writing now.
+constexpr auto kStillWritten = std::chrono::seconds(30);
 
 namespace fs = std::filesystem;
 
@@ -116,15 +121,36 @@ Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
     if ((end && *begins > *end) || (start && *begins + lasts < *start)) continue;
     selection.segments.push_back({folder / entry.file, *begins, lasts, entry.frames});
   }
-  // A file of the camera the index lacks is still being written (the
-  // recorder indexes each as it closes), or, when the index was rebuilt
-  // just now, unreadable.
+  // A file of the camera the index lacks: still being written (the recorder
+  // indexes each as it closes, and writes the open one at least every
+  // cluster), unreadable when the index was rebuilt just now, or put there
+  // by hand or left by a recorder that was killed: read back like a rebuilt
+  // index's.
   for (const auto& file : fs::directory_iterator(folder, error)) {
-    auto name = parseSegmentName(file.path().filename().string());
-    if (name && name->camera == camera && !indexed.count(file.path().filename().string()))
-      selection.notes.push_back(file.path().filename().string() +
-                                (rebuilt ? " holds no readable frame: skipped"
-                                         : " is still being written: not exported"));
+    std::string filename = file.path().filename().string();
+    auto name = parseSegmentName(filename);
+    if (!name || name->camera != camera || indexed.count(filename)) continue;
+    if (rebuilt) {
+      selection.notes.push_back(filename + " holds no readable frame: skipped");
+      continue;
+    }
+    auto written = fs::last_write_time(file.path(), error);
+    if (!error && fs::file_time_type::clock::now() - written < kStillWritten) {
+      selection.notes.push_back(filename + " is still being written: not exported");
+      continue;
+    }
+    auto entry = inspectSegment(file.path());
+    auto begins = entry ? parseIsoTime(entry->startUtc) : std::nullopt;
+    if (!entry || !begins) {
+      selection.notes.push_back(filename + " holds no readable frame: skipped");
+      continue;
+    }
+    auto lasts = static_cast<int64_t>(entry->durationSeconds * 1e9);
+    if ((end && *begins > *end) || (start && *begins + lasts < *start)) continue;
+    cameras.insert(camera);
+    selection.segments.push_back({file.path(), *begins, lasts, entry->frames});
+    selection.notes.push_back(filename + " is not in " + std::string(RecordingIndex::kFileName) +
+                              ": read back and exported");
   }
   if (!cameras.count(camera)) {
     std::string known;

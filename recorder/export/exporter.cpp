@@ -154,16 +154,19 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
   std::vector<TimedLine> waiting;
   size_t nextLine = 0;
   uint64_t frames = 0;
+  bool whole = false;  // read to its end: its lines after the last frame belong to it
   while (true) {
     auto frame = (*reader)->next();
     if (!frame) {
-      notes.push_back(frames ? name + ": broken off after " + std::to_string(frames) + " frames (" +
-                                   frame.error() + "): the rest skipped"
-                             : name + ": skipped (" + frame.error() + ")");
+      notes.push_back(frames
+                          ? name + ": broken off after " + std::to_string(frames) + " frames (" +
+                                frame.error() + "): the rest skipped"
+                          : name + ": skipped (not a readable recording: " + frame.error() + ")");
       break;
     }
     if (!*frame) {
-      if (endsMidElement(segment.video))
+      whole = !endsMidElement(segment.video);
+      if (!whole)
         notes.push_back(name + ": " + std::to_string(frames) +
                         " whole frames; the file ends mid-frame");
       break;
@@ -189,8 +192,9 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
       if (auto problem = timeline.line(line)) return problem;
     waiting.clear();
   }
-  // The lines after the last frame, up to the segment's end.
-  if (timeline.started()) {
+  // The lines after the last frame, up to the segment's end; of a segment
+  // broken off or cut short, they tell of frames the export does not hold.
+  if (timeline.started() && whole) {
     for (; nextLine < lines.size(); ++nextLine)
       if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
     for (auto& line : waiting)
@@ -199,6 +203,9 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
   return std::nullopt;
 }
 
+// What an export's files are called until they are whole.
+constexpr const char* kPartial = ".partial";
+
 }  // namespace
 
 Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
@@ -206,13 +213,17 @@ Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
   using Kind = ExportError::Kind;
   auto selection = selectSegments(request.recordings, request.camera, request.start, request.end);
   if (!selection) return unexpected(ExportError{Kind::kNothing, selection.error()});
+  // Written beside under other names, and renamed only once whole: an
+  // export that fails or is stopped leaves the files of an earlier one as
+  // they were.
+  fs::path jsonlPath = fs::path(request.out).replace_extension(".jsonl");
+  fs::path writing = request.out.string() + kPartial, writingJsonl = jsonlPath.string() + kPartial;
   std::unique_ptr<ExportSink> sink;
   if (request.format == ExportFormat::kMcap)
-    sink = std::make_unique<McapExport>(request.out.string(), request.camera);
+    sink = std::make_unique<McapExport>(writing.string(), request.camera);
   else
-    sink = std::make_unique<MuxedExport>(request.out.string(), exportFormatName(request.format));
-  fs::path jsonlPath = fs::path(request.out).replace_extension(".jsonl");
-  std::ofstream jsonl(jsonlPath);
+    sink = std::make_unique<MuxedExport>(writing.string(), exportFormatName(request.format));
+  std::ofstream jsonl(writingJsonl);
   if (!jsonl) return unexpected(ExportError{Kind::kFailed, "cannot write " + jsonlPath.string()});
 
   Timeline timeline(*sink, jsonl, request);
@@ -222,13 +233,14 @@ Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
   std::optional<ExportError> problem;
   for (const auto& segment : selection->segments) {
     bool stopped = false;
+    uint64_t framesBefore = timeline.report.frames;
     problem = exportSegment(segment, timeline, caps, selection->notes, [&] {
       if (progress && ++done % 50 == 0 && !progress(done, total)) stopped = true;
       return !stopped;
     });
     if (stopped) problem = ExportError{Kind::kCancelled, "the export was stopped"};
     if (problem) break;
-    ++timeline.report.segments;
+    if (timeline.report.frames > framesBefore) ++timeline.report.segments;
   }
   if (caps) gst_caps_unref(caps);
   if (!problem && !timeline.started())
@@ -238,10 +250,17 @@ Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
     if (auto failed = sink->finish()) problem = ExportError{Kind::kFailed, *failed};
   sink.reset();
   jsonl.close();
+  std::error_code error;
+  if (!problem) {
+    fs::rename(writing, request.out, error);
+    if (!error) fs::rename(writingJsonl, jsonlPath, error);
+    if (error)
+      problem = ExportError{Kind::kFailed,
+                            "cannot write " + request.out.string() + ": " + error.message()};
+  }
   if (problem) {
-    std::error_code ignored;
-    fs::remove(request.out, ignored);
-    fs::remove(jsonlPath, ignored);
+    fs::remove(writing, error);
+    fs::remove(writingJsonl, error);
     return unexpected(*problem);
   }
   if (progress) progress(total, total);

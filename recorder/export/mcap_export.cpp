@@ -36,7 +36,8 @@ nlohmann::json telemetrySchema() {
   return {{"title", "wircam.Telemetry"},
           {"description",
            "One line of a recording's telemetry sidecar: battery, link and stream statistics, "
-           "detections, control commands, session events, positions (README: the sidecar)"},
+           "detections, control commands, session events, positions (docs/recorder.md, \"What it "
+           "writes\")"},
           {"type", "object"},
           {"properties",
            {{"type", {{"type", "string"}}},

@@ -75,6 +75,13 @@ std::optional<std::string> demuxerError(GstElement* pipeline) {
   return text;
 }
 
+bool endsWithJpegEnd(GstBuffer* buffer) {
+  gsize size = gst_buffer_get_size(buffer);
+  guint8 end[2] = {0, 0};
+  return size >= 4 && gst_buffer_extract(buffer, size - 2, end, 2) == 2 && end[0] == 0xFF &&
+         end[1] == 0xD9;
+}
+
 }  // namespace
 
 Expected<std::optional<SegmentFrame>, std::string> SegmentReader::next() {
@@ -103,6 +110,12 @@ Expected<std::optional<SegmentFrame>, std::string> SegmentReader::next() {
   frame.ptsNs = GST_CLOCK_TIME_IS_VALID(time) ? static_cast<int64_t>(time) : 0;
   frame.key = !GST_BUFFER_FLAG_IS_SET(frame.buffer, GST_BUFFER_FLAG_DELTA_UNIT);
   gst_sample_unref(sample);
+  // A recorded JPEG is whole (the source never emits another): one without
+  // its end marker was damaged in the file (zeros where a power loss left
+  // its last blocks), and is not passed on as a frame.
+  if (gst_structure_has_name(gst_caps_get_structure(caps_, 0), "image/jpeg") &&
+      !endsWithJpegEnd(frame.buffer))
+    return unexpected(std::string("a JPEG frame without its end marker (the file is damaged)"));
   return std::optional<SegmentFrame>(std::move(frame));
 }
 

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -280,6 +281,9 @@ TEST_F(Export, SegmentsOfZerosEmptyRandomOrTextAreSkippedInBoundedTimeAndSaid) {
   }
   fs::path text = copy / (files[0].stem().string() + "_9.mkv");
   std::ofstream(text) << "not a recording\n";
+  // Not in the index, and not written to for an hour: not the one a
+  // recorder is writing, so it is read, and skipped.
+  fs::last_write_time(text, fs::file_time_type::clock::now() - std::chrono::hours(1));
   fs::path out = output("damaged.mkv");
   auto started = std::chrono::steady_clock::now();
   auto ran = runCommand("timeout 30 " +
@@ -292,11 +296,24 @@ TEST_F(Export, SegmentsOfZerosEmptyRandomOrTextAreSkippedInBoundedTimeAndSaid) {
     EXPECT_NE(ran.output.find("wirc-export: " + name + ": skipped ("), std::string::npos)
         << name << "\n"
         << ran.output;
+  EXPECT_NE(ran.output.find(text.filename().string() + " holds no readable frame: skipped"),
+            std::string::npos)
+      << ran.output;
   std::vector<std::string> whole;
-  for (size_t i = 0; i < files.size(); ++i)
-    if (i < 1 || i > 3)
-      for (auto& digest : frameDigests(files[i])) whole.push_back(digest);
+  size_t wholeLines = 0;
+  for (size_t i = 0; i < files.size(); ++i) {
+    if (i >= 1 && i <= 3) continue;
+    for (auto& digest : frameDigests(files[i])) whole.push_back(digest);
+    std::ifstream sidecar(fs::path(files[i]).replace_extension(".jsonl"));
+    for (std::string line; std::getline(sidecar, line);) ++wholeLines;
+  }
   EXPECT_EQ(frameDigests(out), whole);
+  // The telemetry of the skipped segments is left out with their frames.
+  EXPECT_EQ(contentsOf(out).telemetry.size(), wholeLines);
+  EXPECT_NE(ran.output.find(std::to_string(whole.size()) + " frames from " +
+                            std::to_string(files.size() - 3) + " segments"),
+            std::string::npos)
+      << ran.output;
 
   // Nothing readable at all: exit 1, said, and no output left behind.
   fs::path none = output("nothing-readable");
@@ -309,6 +326,36 @@ TEST_F(Export, SegmentsOfZerosEmptyRandomOrTextAreSkippedInBoundedTimeAndSaid) {
                  exportCommand(none, *camera_, "--format mkv --out '" + nothing.string() + "'"));
   EXPECT_EQ(refused.exitCode, 1) << refused.output;
   EXPECT_FALSE(fs::exists(nothing));
+}
+
+TEST_F(Export, ASegmentWhoseLastBlocksAreZerosEndsAtItsLastWholeFrame) {
+  fs::path copy = output("zeroed");
+  fs::remove_all(copy);
+  fs::copy(recorder_->out(), copy);
+  auto files = recorder_->files(".mkv");
+  // A power loss: the second half of the longest file's blocks written as
+  // zeros.
+  auto longest = *std::max_element(files.begin(), files.end(), [](const auto& a, const auto& b) {
+    return fs::file_size(a) < fs::file_size(b);
+  });
+  fs::path zeroed = copy / longest.filename();
+  auto size = fs::file_size(zeroed);
+  {
+    std::fstream file(zeroed, std::ios::binary | std::ios::in | std::ios::out);
+    file.seekp(static_cast<std::streamoff>(size / 2));
+    file << std::string(size - size / 2, '\0');
+  }
+  fs::path out = output("zeroed.mkv");
+  auto ran = runCommand("timeout 30 " +
+                        exportCommand(copy, *camera_, "--format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
+  EXPECT_NE(ran.output.find(longest.filename().string() + ": broken off after "), std::string::npos)
+      << ran.output;
+  EXPECT_NE(ran.output.find("a JPEG frame without its end marker"), std::string::npos)
+      << ran.output;
+  // No frame of zeros reaches the export: every one decodes.
+  EXPECT_EQ(ffmpegDecodeErrors(out), "");
+  EXPECT_LT(frameDigests(out).size(), recordedDigests().size());
 }
 
 TEST_F(Export, ACutSegmentIsSaidToEndMidFrame) {
@@ -337,6 +384,9 @@ TEST_F(Export, SigintStopsAnExportAndLeavesNoFileBehind) {
   for (int i = 2; i < 1000; ++i)
     fs::create_hard_link(files[0], many / (stem + "_" + std::to_string(i) + ".mkv"));
   fs::path out = output("stopped.mkv"), said = output("stopped.txt");
+  // An earlier export under the same name stays as it was.
+  std::ofstream(out) << "the earlier export";
+  std::ofstream(fs::path(out).replace_extension(".jsonl")) << "its telemetry";
   std::string command = "exec " +
                         exportCommand(many, *camera_, "--format mkv --out '" + out.string() + "'") +
                         " > '" + said.string() + "' 2>&1";
@@ -345,7 +395,8 @@ TEST_F(Export, SigintStopsAnExportAndLeavesNoFileBehind) {
     execl("/bin/sh", "sh", "-c", command.c_str(), nullptr);
     _exit(127);
   }
-  ASSERT_TRUE(waitFor([&] { return fs::exists(out); }, milliseconds(30000)));
+  fs::path partial = out.string() + ".partial";
+  ASSERT_TRUE(waitFor([&] { return fs::exists(partial); }, milliseconds(30000)));
   kill(exporter, SIGINT);
   int status = 0;
   ASSERT_TRUE(
@@ -354,8 +405,36 @@ TEST_F(Export, SigintStopsAnExportAndLeavesNoFileBehind) {
   ASSERT_TRUE(WIFEXITED(status)) << output;
   EXPECT_EQ(WEXITSTATUS(status), 1) << output;
   EXPECT_NE(output.find("stopped"), std::string::npos) << output;
-  EXPECT_FALSE(fs::exists(out));
-  EXPECT_FALSE(fs::exists(fs::path(out).replace_extension(".jsonl")));
+  EXPECT_FALSE(fs::exists(partial));
+  EXPECT_EQ(contentsOfFile(out), "the earlier export");
+  EXPECT_EQ(contentsOfFile(fs::path(out).replace_extension(".jsonl")), "its telemetry");
+}
+
+TEST_F(Export, ASegmentMissingFromTheIndexIsReadBackUnlessItIsBeingWritten) {
+  fs::path copy = output("unindexed");
+  fs::remove_all(copy);
+  fs::copy(recorder_->out(), copy);
+  auto files = recorder_->files(".mkv");
+  // A recorder killed before it indexed its last file, long ago.
+  auto index = nlohmann::json::parse(std::ifstream(copy / "index.json"));
+  auto& entries = index["segments"];
+  std::string dropped = entries.back()["file"];
+  entries.erase(entries.size() - 1);
+  std::ofstream(copy / "index.json") << index.dump();
+  fs::last_write_time(copy / dropped, fs::file_time_type::clock::now() - std::chrono::hours(1));
+  fs::path out = output("unindexed.mkv");
+  auto ran = runCommand(exportCommand(copy, *camera_, "--format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
+  EXPECT_NE(ran.output.find(dropped + " is not in index.json: read back and exported"),
+            std::string::npos)
+      << ran.output;
+  EXPECT_EQ(frameDigests(out).size(), recordedDigests().size());
+  // Written to just now: the one a recorder is writing.
+  fs::last_write_time(copy / dropped, fs::file_time_type::clock::now());
+  auto open =
+      runCommand(exportCommand(copy, *camera_, "--format mkv --out '" + out.string() + "'"));
+  EXPECT_NE(open.output.find(dropped + " is still being written: not exported"), std::string::npos)
+      << open.output;
 }
 
 }  // namespace

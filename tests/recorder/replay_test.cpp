@@ -420,5 +420,21 @@ TEST(CompareCommands, ARecordingsFolderIsMatchedSegmentBySegment) {
   EXPECT_EQ(result["frames"], 10) << ran.output;
   EXPECT_EQ(result["steering_delta_us"]["max"], 0) << ran.output;
   EXPECT_EQ(result["direction_disagreements"], 0) << ran.output;
+  // The replay of another drive has no frame in common: said, not a match.
+  std::ofstream(folder / "other.jsonl")
+      << nlohmann::json{{"frame", 0},
+                        {"pts", 0},
+                        {"segment", "rover-cam0-20261125T100000Z.mkv"},
+                        {"channels", {1500, 1500}}}
+             .dump()
+      << "\n";
+  auto other = runCommand(std::string(WIRC_CLI) + " compare-commands '" + folder.string() + "' '" +
+                          (folder / "other.jsonl").string() + "'");
+  EXPECT_EQ(other.exitCode, 1) << other.output;
+  EXPECT_NE(other.output.find("is it the replay of this drive?"), std::string::npos)
+      << other.output;
+  auto missing = runCommand(std::string(WIRC_CLI) + " compare-commands '" + folder.string() +
+                            "' '" + (folder / "nope.jsonl").string() + "'");
+  EXPECT_EQ(missing.exitCode, 1) << missing.output;
   fs::remove_all(folder);
 }

@@ -29,7 +29,10 @@ int compareCommandFiles(const Options& o) {
   std::vector<std::string> recordedPaths(o.positional.begin(), o.positional.end() - 1);
   const std::string& replayedPath = o.positional.back();
   std::ifstream replayedFile(replayedPath);
-  if (!replayedFile) usageError("cannot read " + replayedPath);
+  if (!replayedFile) {
+    std::fprintf(stderr, "wirc-cli: cannot read %s\n", replayedPath.c_str());
+    return 1;
+  }
   auto recorded = recordedCommandsIn(recordedPaths);
   if (!recorded) {
     std::fprintf(stderr, "wirc-cli: %s\n", recorded.error().c_str());
@@ -41,6 +44,14 @@ int compareCommandFiles(const Options& o) {
     return 1;
   }
   auto comparison = compareCommands(*recorded, *replayed);
+  if (comparison.frames == 0) {
+    // Nothing to compare is no agreement: most likely the replay of another drive.
+    std::fprintf(stderr,
+                 "wirc-cli: no frame of %s is in the recording (the same segment and time): is "
+                 "it the replay of this drive?\n",
+                 replayedPath.c_str());
+    return 1;
+  }
   std::fputs(o.json ? (comparisonJson(comparison).dump() + "\n").c_str()
                     : comparisonText(comparison).c_str(),
              stdout);
