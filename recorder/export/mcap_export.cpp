@@ -92,7 +92,9 @@ std::optional<std::string> McapExport::line(const nlohmann::json& line, int64_t,
   write(telemetry_, utcNs, line);
   std::string type = line.value("type", "");
   if (type == "detections") writer_->write(tags_, time, time, imageAnnotationsOf(line, utcNs));
-  if (type == "session" || (type == "vehicle" && line.contains("event"))) {
+  // Events, not the vehicle's status reports (twice a second: telemetry).
+  bool vehicleEvent = type == "vehicle" && line.contains("event") && line["event"] != "status";
+  if (type == "session" || vehicleEvent) {
     std::string message = line.value("event", type);
     int level = message.find("lost") != std::string::npos ? 3 : 2;  // WARNING, INFO
     write(log_, utcNs,
