@@ -252,9 +252,16 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
     return self->deleteRecording(message, route.name);
   }
   if (route.kind == Route::Kind::CameraCommand) return self->serveCommand(message, route, query);
-  if (method == "POST")
+  if (method == "POST") {
+    // What this path does take (RFC 9110: a 405 says so in Allow).
+    bool deletable =
+        route.kind == Route::Kind::Recording || route.kind == Route::Kind::RecordingEntry;
+    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Allow",
+                                 deletable ? "GET, HEAD, DELETE" : "GET, HEAD");
     return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                            "POST is for /api/cameras/NAME/follow, /target and /request-control");
+                            "POST is for /api/cameras/NAME/follow, /target, /request-control and "
+                            "/whep");
+  }
   switch (route.kind) {
     case Route::Kind::RecordingEntry:
       return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,

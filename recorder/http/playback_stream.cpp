@@ -61,6 +61,15 @@ GstFlowReturn PlaybackStream::onSample(GstElement* sink, gpointer data) {
   GstSample* sample = nullptr;
   g_signal_emit_by_name(sink, "pull-sample", &sample);
   if (!sample) return GST_FLOW_EOS;
+  // After an accurate seek the demuxer starts at the key frame before the
+  // position; JPEG frames carry no duration, so the sink does not clip
+  // them: the ones before the position are left out here, not sent at once.
+  GstBuffer* buffer = gst_sample_get_buffer(sample);
+  const GstSegment* segment = gst_sample_get_segment(sample);
+  if (segment && GST_BUFFER_PTS_IS_VALID(buffer) && GST_BUFFER_PTS(buffer) < segment->start) {
+    gst_sample_unref(sample);
+    return GST_FLOW_OK;
+  }
   struct Delivery {
     PlaybackStream* stream;
     std::weak_ptr<bool> alive;

@@ -136,6 +136,14 @@ TEST(WircRecorderHttp, ListsAndServesTheRecordings) {
                      std::ios::binary);
   std::string onDisk((std::istreambuf_iterator<char>(file)), {});
   EXPECT_EQ(download.body, onDisk);
+  // Played from half a second in: the first frame is the one there, not the
+  // cluster's first before it (sent at once, ahead of real time).
+  auto played =
+      readStream(live.url + "play/" + (*finished)["name"].get<std::string>() + ".mjpg?from=0.5",
+                 [](const std::string& b) { return b.find("X-Position: ") != std::string::npos; });
+  auto at = played.find("X-Position: ");
+  ASSERT_NE(at, std::string::npos) << played.substr(0, 200);
+  EXPECT_GE(std::stod(played.substr(at + 12)), 0.499) << played.substr(at, 30);
   // Nothing outside the recordings folder, nothing but recordings: refused
   // by libsoup (400) or by the server (404).
   for (const char* path : {"recordings/..%2Fstderr.log", "recordings/%2Fetc%2Fpasswd",
@@ -143,7 +151,9 @@ TEST(WircRecorderHttp, ListsAndServesTheRecordings) {
     auto refused = fetch(live.url + path);
     EXPECT_TRUE(refused.status == 400u || refused.status == 404u) << path << refused.status;
   }
-  EXPECT_EQ(fetch(live.url + "api/status", "POST").status, 405u);
+  auto posted = fetch(live.url + "api/status", "POST");
+  EXPECT_EQ(posted.status, 405u);
+  EXPECT_EQ(posted.headers["allow"], "GET, HEAD");
 }
 
 TEST(WircRecorderHttp, AnUnknownRecordingIsA404InJson) {
