@@ -126,6 +126,7 @@ Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
   // cluster), unreadable when the index was rebuilt just now, or put there
   // by hand or left by a recorder that was killed: read back like a rebuilt
   // index's.
+  std::string beingWritten;
   for (const auto& file : fs::directory_iterator(folder, error)) {
     std::string filename = file.path().filename().string();
     auto name = parseSegmentName(filename);
@@ -137,6 +138,7 @@ Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
     auto written = fs::last_write_time(file.path(), error);
     if (!error && fs::file_time_type::clock::now() - written < kStillWritten) {
       selection.notes.push_back(filename + " is still being written: not exported");
+      beingWritten = filename;
       continue;
     }
     auto entry = inspectSegment(file.path());
@@ -152,6 +154,9 @@ Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
     selection.notes.push_back(filename + " is not in " + std::string(RecordingIndex::kFileName) +
                               ": read back and exported");
   }
+  if (!cameras.count(camera) && !beingWritten.empty())
+    return unexpected("camera " + camera + " has no finished segment yet: " + beingWritten +
+                      " is still being written");
   if (!cameras.count(camera)) {
     std::string known;
     for (const auto& name : cameras) known += (known.empty() ? "" : ", ") + name;

@@ -232,6 +232,20 @@ TEST_F(Export, SaysWhyWhenThereIsNothingToExport) {
   EXPECT_EQ(malformed.exitCode, 2);
   EXPECT_NE(malformed.output.find("--start 'yesterday' is not an ISO 8601 time"), std::string::npos)
       << malformed.output;
+  // A camera whose first segment is still being written is named as such.
+  fs::path starting = output("starting");
+  fs::remove_all(starting);
+  fs::create_directories(starting);
+  std::ofstream(starting / "index.json") << R"({"segments":[]})";
+  auto files = recorder_->files(".mkv");
+  fs::copy_file(files[0], starting / files[0].filename());
+  auto first =
+      runCommand(exportCommand(starting, *camera_, "--format mkv --out '" + out.string() + "'"));
+  EXPECT_EQ(first.exitCode, 1);
+  EXPECT_NE(first.output.find("camera " + *camera_ + " has no finished segment yet: " +
+                              files[0].filename().string() + " is still being written"),
+            std::string::npos)
+      << first.output;
   auto mp4 = runCommand(
       exportCommand(recorder_->out(), *camera_, "--format mp4 --out '" + out.string() + "'"));
   EXPECT_EQ(mp4.exitCode, 1);
