@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "http/server_address.h"
 #include "marvelmind/marvelmind_messages.h"
 
 namespace wircam::recorder {
@@ -44,14 +45,7 @@ struct DeviceTarget {
   std::optional<PositionSource> positions;  // resolved from the two above
 };
 
-// Where a server listens: "[HOST]:PORT"; no host means this machine only
-// (127.0.0.1; 0.0.0.0 for every interface), port 0 one the system picks
-// (the recorder prints it).
-struct ServerAddress {
-  std::string host;
-  uint16_t port = 0;
-  std::string listenHost() const { return host.empty() ? "127.0.0.1" : host; }
-};
+// "[HOST]:PORT" as the web, RTSP servers listen.
 std::optional<ServerAddress> parseServerAddress(const std::string& text);
 
 // How the frames are stored: as the camera sent them, or re-encoded.

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "app/pipeline_planner.h"
 #include "gst_scoped.h"
 #include "log_line.h"
 #include "record/segment_inspector.h"

@@ -17,7 +17,6 @@
 #include <string>
 #include <vector>
 
-#include "app/recorder_options.h"
 #include "camera/frame_tap.h"
 #include "common/expected.h"
 #include "fleet/fleet_command.h"
@@ -26,6 +25,7 @@
 #include "http/http_connections.h"
 #include "http/http_routes.h"
 #include "http/live_servers.h"
+#include "http/server_address.h"
 #include "webrtc/webrtc_service.h"
 
 namespace wircam::recorder {

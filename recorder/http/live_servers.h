@@ -19,10 +19,10 @@
 #include <utility>
 #include <vector>
 
-#include "app/recorder_options.h"
 #include "camera/frame_tap.h"
 #include "common/expected.h"
 #include "fleet/fleet_command.h"
+#include "http/server_address.h"
 #include "webrtc/ice_servers.h"
 
 namespace wircam::recorder {

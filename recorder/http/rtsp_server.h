@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "app/recorder_options.h"
 #include "camera/frame_tap.h"
 #include "common/expected.h"
 #include "http/live_servers.h"
+#include "http/server_address.h"
 
 namespace wircam::recorder {
 

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <thread>
 
-#include "app/recorder_options.h"
+#include "app/pipeline_planner.h"
 #include "camera/camera.h"
 #include "simulated_device.h"
 #include "wait_for.h"

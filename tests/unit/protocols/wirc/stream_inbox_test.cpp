@@ -1,10 +1,11 @@
-// StreamInbox on a real loopback socket: a frame's time is when its packet
-// reached the machine (the kernel's stamp), not when the thread read it.
+// StreamInbox: a frame's time is when its packet reached the machine (the
+// kernel's stamp), not when the thread read it.
 #include "wirc/stream_inbox.h"
 
 #include <gtest/gtest.h>
 
-#include <thread>
+#include <array>
+#include <cstring>
 
 #include "common/socket.h"
 
@@ -12,8 +13,40 @@ namespace wircam::wirc {
 namespace {
 
 using std::chrono::milliseconds;
+using Clock = StreamInbox::Clock;
 
-TEST(StreamInbox, AFramesTimeIsItsArrivalNotWhenItWasRead) {
+// A received message's control data holding the kernel's stamp `stamp`.
+struct StampedMessage {
+  std::array<char, CMSG_SPACE(sizeof(timespec))> control{};
+  msghdr message{};
+  explicit StampedMessage(std::optional<timespec> stamp) {
+    message.msg_control = control.data();
+    message.msg_controllen = stamp ? control.size() : 0;
+    if (!stamp) return;
+    cmsghdr* c = CMSG_FIRSTHDR(&message);
+    c->cmsg_level = SOL_SOCKET;
+    c->cmsg_type = SCM_TIMESTAMPNS;
+    c->cmsg_len = CMSG_LEN(sizeof(timespec));
+    std::memcpy(CMSG_DATA(c), &*stamp, sizeof(timespec));
+  }
+};
+
+TEST(StreamInbox, AReadLateDatagramKeepsTheTimeTheKernelStampedOnIt) {
+  auto now = Clock::time_point() + std::chrono::hours(1);
+  timespec wallNow{1764200000, 300000000};
+  // Read 200 ms after it arrived (a busy machine).
+  StampedMessage late(timespec{1764200000, 100000000});
+  EXPECT_EQ(StreamInbox::arrivalOf(late.message, now, wallNow), now - milliseconds(200));
+  // No stamp, or one the wall clock's step made nonsense of: read now.
+  StampedMessage unstamped(std::nullopt);
+  EXPECT_EQ(StreamInbox::arrivalOf(unstamped.message, now, wallNow), now);
+  StampedMessage future(timespec{1764200001, 0});
+  EXPECT_EQ(StreamInbox::arrivalOf(future.message, now, wallNow), now);
+  StampedMessage ancient(timespec{1764100000, 0});
+  EXPECT_EQ(StreamInbox::arrivalOf(ancient.message, now, wallNow), now);
+}
+
+TEST(StreamInbox, ASocketsFramesCarryTheKernelsArrivalTime) {
   StreamInbox inbox;
   ASSERT_EQ(inbox.open(0, {}), std::nullopt);
   auto sender = bindUdp(SocketAddress::loopback(0));
@@ -21,15 +54,16 @@ TEST(StreamInbox, AFramesTimeIsItsArrivalNotWhenItWasRead) {
   inbox.receiver().follow(SocketAddress::loopback(1984), 1);
   std::vector<uint8_t> jpeg = {0xFF, 0xD8, 0xFF, 0xD9};
   auto datagram = packetizeFrame(jpeg, 1, 1400).front();
-  auto sent = StreamInbox::Clock::now();
+  auto sent = Clock::now();
   ASSERT_TRUE(sendDatagram(sender->get(), SocketAddress::loopback(inbox.port()), datagram));
-  // A busy machine lets the reader run only later.
-  std::this_thread::sleep_for(milliseconds(200));
-  ASSERT_EQ(inbox.wait(StreamInbox::Clock::now() + milliseconds(1000)), StreamInbox::Wake::Frame);
+  ASSERT_EQ(inbox.wait(Clock::now() + milliseconds(1000)), StreamInbox::Wake::Frame);
+  auto read = Clock::now();
   auto frame = inbox.takeFrame();
   ASSERT_TRUE(frame);
-  EXPECT_LT(frame->firstPacketTime - sent, milliseconds(100));
+  // Between the send and the read (stamped, not taken as the read's time,
+  // as the test above shows).
   EXPECT_GE(frame->firstPacketTime, sent - milliseconds(1));
+  EXPECT_LE(frame->firstPacketTime, read);
 }
 
 }  // namespace

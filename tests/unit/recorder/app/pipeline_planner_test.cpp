@@ -1,6 +1,6 @@
 // The recorder's pipeline for each codec/container pair and option, as
 // parsed from a command line: what it names, what it holds, what it must not.
-#include "camera/pipeline_plan.h"
+#include "app/pipeline_planner.h"
 
 #include <gtest/gtest.h>
 

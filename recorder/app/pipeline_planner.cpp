@@ -1,0 +1,148 @@
+#include "app/pipeline_planner.h"
+
+#include <cctype>
+#include <cstdint>
+
+#include "telemetry/telemetry_track_flags.h"
+
+namespace wircam::recorder {
+
+namespace {
+
+// A file name part made of safe characters only.
+std::string fileSafe(std::string text) {
+  for (char& c : text)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
+  return text;
+}
+
+// Each file's muxer. Crash safety: Matroska clusters and MP4 fragments of
+// at most 0.5 s (the muxers write a cluster or fragment whole), so a killed
+// recorder leaves the open segment playable up to about its last second.
+// The text track's gaps (TelemetryTrack::heartbeat) reach matroskamux as
+// GAP events, for which it writes nothing, not even to the duration;
+// mp4mux (an aggregator, GStreamer 1.22) stalls on GAP events, and gets
+// empty buffers instead, as it did inside splitmuxsink.
+MuxerSpec muxerOf(Container container) {
+  if (container == Container::kMp4) return {"mp4mux", {{"fragment-duration", "500"}}, false};
+  return {"matroskamux", {{"max-cluster-duration", "500000000"}}, true};
+}
+
+// What the frames pass through on their way to the file, ending in the
+// element named `tail`.
+std::string encoder(const RecorderOptions& options, const std::string& tail) {
+  if (options.codec == Codec::kJpeg) return "";
+  // zerolatency: no B-frames and no look-ahead, so the live recording does
+  // not lag. The recorder asks for a key frame at each cut and every 0.5 s
+  // (SegmentWriter); key-int-max is only a backstop. The muxers take H.264
+  // as "avc" only, and the file is linked after the caps are settled. Main
+  // profile: what browsers decode over WebRTC (Chromium and Safari offer
+  // it), so the live view passes the recording's frames on as they are.
+  return "tjpegdec ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
+         std::to_string(options.h264Kbps) +
+         " key-int-max=60 ! h264parse ! capsfilter name=" + tail +
+         " caps=\"video/x-h264,stream-format=avc,alignment=au,profile=main\" ";
+}
+
+// wirccontrol's properties for the vehicle the device's tags steer: the
+// WiRC device itself, or the RCOIP receiver or BTEMP robot of control=.
+std::string controlOf(const DeviceTarget& device) {
+  if (!device.control)
+    return (device.host.empty() ? "" : " host=" + device.host) +
+           " port=" + std::to_string(device.port);
+  const auto& c = *device.control;
+  return " protocol=" + c.protocol + " host=" + c.host + " port=" + std::to_string(c.port);
+}
+
+// The element that joins the vehicle's Marvelmind positions to its frames.
+std::string positionsOf(const PositionSource& source, const std::string& name) {
+  return "marvelmindpositions name=" + name + " host=" + source.host +
+         " port=" + std::to_string(source.port) + " beacons=" + source.beacons + " ";
+}
+
+// The telemetry's appsrc, on to the files' text track. It never blocks the
+// main loop: past 1 MB waiting it drops. Its track is named by a stream tag
+// (in Matroska a placeholder, rewritten when the file is finished:
+// telemetry_track_flags.h).
+std::string telemetryTrack(const RecorderOptions& options, const StreamPlan& stream) {
+  std::string title(options.container == Container::kMatroska ? kTelemetryTrackPlaceholder
+                                                              : kTelemetryTrackName);
+  return "appsrc name=" + stream.telemetrySource +
+         " is-live=true format=time min-latency=0 max-latency=-1 max-bytes=1000000 "
+         "leaky-type=downstream "
+         "caps=\"text/x-raw,format=(string)utf8\" ! taginject name=" +
+         stream.telemetryTail + " tags=\"title=" + title + "\" ";
+}
+
+}  // namespace
+
+PipelinePlan planPipeline(const RecorderOptions& options) {
+  PipelinePlan plan;
+  plan.transcoded = options.codec != Codec::kJpeg;
+  // The live branch feeds the web server, RTSP and the discovery snapshots.
+  bool live = options.http || options.rtsp || options.mqttDiscovery;
+  size_t index = 0;
+  for (const auto& device : options.devices) {
+    bool controlled = false;
+    std::string host = device.host.empty() ? "" : " host=" + device.host;
+    std::string port = " port=" + std::to_string(device.port);
+    std::string login;  // what the login configures, when the user said
+    if (options.periods) login += " periods=" + *options.periods;
+    if (options.failsafe) login += " failsafe=" + *options.failsafe;
+    for (int camera : device.cameras) {
+      auto i = std::to_string(index++);
+      StreamPlan stream;
+      std::string& d = stream.description;
+      stream.device = fileSafe(device.label);
+      stream.camera = camera;
+      stream.name = stream.device + "-cam" + std::to_string(camera);
+      stream.source = "src" + i;
+      stream.muxer = muxerOf(options.container);
+      stream.muxer.text = options.telemetryTrack;
+      if (options.telemetryTrack) {
+        stream.telemetrySource = "tel" + i;
+        stream.telemetryTail = "teltag" + i;
+      }
+      if (!options.detectFamily.empty()) stream.detector = "det" + i;
+      if (!options.detectFamily.empty() && *device.follow && !controlled) {
+        stream.controller = "ctl" + i;
+        controlled = true;  // one controller per vehicle: the first camera's
+      }
+      if (live) stream.liveSink = "live" + i;
+      if (device.positions) stream.positions = "pos" + i;
+      bool branches = !stream.detector.empty() || live;
+      std::string tee = "t" + i;
+      // wait-for-device: a recorder started before its vehicle waits for it.
+      d += "wircsrc name=" + stream.source + host + port + login +
+           " camera=" + std::to_string(camera) + " wait-for-device=true ";
+      if (device.positions) d += "! " + positionsOf(*device.positions, stream.positions);
+      if (branches) d += "! tee name=" + tee + " ";
+      if (plan.transcoded) {
+        stream.videoTail = "enc" + i;
+        d += (branches ? tee + ". ! " : "! ") + encoder(options, stream.videoTail);
+      } else {
+        stream.videoTail = branches ? tee : device.positions ? stream.positions : stream.source;
+      }
+      if (options.telemetryTrack) d += telemetryTrack(options, stream);
+      if (!stream.detector.empty()) {
+        // Detection must never hold the recording back: its queue drops.
+        d += tee +
+             ". ! queue leaky=downstream max-size-buffers=2 ! tjpegdec ! apriltagdetect name=" +
+             stream.detector + " quad-decimate=1 family=" + options.detectFamily;
+        if (!stream.controller.empty())
+          d +=
+              " ! wirccontrol name=" + stream.controller + controlOf(device) + options.followTuning;
+        d += " ! fakesink sync=false async=false ";
+      }
+      if (!stream.liveSink.empty()) {
+        d += tee +
+             ". ! queue leaky=downstream max-size-buffers=2 ! appsink name=" + stream.liveSink +
+             " sync=false async=false max-buffers=2 drop=true ";
+      }
+      plan.streams.push_back(std::move(stream));
+    }
+  }
+  return plan;
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,23 @@
+// The recorder's options made into each camera's pipeline plan: the app
+// plans, each camera receives only its own StreamPlan.
+#pragma once
+
+#include "app/recorder_options.h"
+#include "camera/pipeline_plan.h"
+
+namespace wircam::recorder {
+
+// Each stream is a pipeline of its own, so that a camera that never sends a
+// frame, errors or stalls holds no other camera's preroll, EOS or stop.
+// Per stream: wircsrc → [marvelmindpositions →] [tee →] [decode → x264enc →]
+// (the file), an appsrc of telemetry text → (the same file, unless
+// --telemetry-track off) and, when asked
+// for, a leaky branch off the tee to AprilTag detection (→ wirccontrol) and
+// one to an appsink for the live view and RTSP. The files themselves (a
+// muxer and a filesink each) are not in the description: the recorder's
+// SegmentWriter puts each in at its first frame and takes it out when it is
+// finished. No queue where nothing branches: the frames reach the file on
+// the source's own thread.
+PipelinePlan planPipeline(const RecorderOptions& options);
+
+}  // namespace wircam::recorder

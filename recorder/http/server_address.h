@@ -1,0 +1,18 @@
+// Where a server listens: "[HOST]:PORT"; no host means this machine only
+// (127.0.0.1; 0.0.0.0 for every interface), port 0 one the system picks
+// (the recorder prints it). Read from the options by parseServerAddress
+// (app/recorder_options.h).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace wircam::recorder {
+
+struct ServerAddress {
+  std::string host;
+  uint16_t port = 0;
+  std::string listenHost() const { return host.empty() ? "127.0.0.1" : host; }
+};
+
+}  // namespace wircam::recorder
