@@ -38,7 +38,7 @@ std::optional<std::string> checkFamily(const std::string& family) {
   return "--detect " + family + ": not an AprilTag family (" + known + ")";
 }
 
-// A stop's own bound, past the cameras' kFinishTime: whatever a camera or
+// A stop's own bound, past the cameras' CameraMachine::kFinishTime: whatever a camera or
 // device does, the run ends within 3 s of it.
 constexpr guint kStopBoundMs = 2900;
 
@@ -213,7 +213,7 @@ void Supervisor::stop(const char* why) {
 }
 
 gboolean Supervisor::onStopDeadline(gpointer data) {
-  // Cameras cut themselves off at kFinishTime; this is the backstop.
+  // Cameras cut themselves off at CameraMachine::kFinishTime; this is the backstop.
   g_main_loop_quit(static_cast<Supervisor*>(data)->loop_);
   return G_SOURCE_REMOVE;
 }

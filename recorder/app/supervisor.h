@@ -2,7 +2,7 @@
 // its own, camera/camera.h), and what they share: the index and retention,
 // the disk guard, the status display, the web, RTSP and MQTT servers, the
 // segment hook. A camera's fault, silence or stall is its own; a stop ends
-// every camera within Camera::kFinishTime, cutting off (and naming) any
+// every camera within CameraMachine::kFinishTime, cutting off (and naming) any
 // that cannot finish.
 #pragma once
 

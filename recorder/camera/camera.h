@@ -5,7 +5,7 @@
 //
 // A fault (a pipeline error, no video for the stall timeout, the device
 // lost while a file is open) closes the camera's open file at its last
-// frame (EOS, bounded by kFinishTime), tears its pipeline down and starts a
+// frame (EOS, bounded by CameraMachine::kFinishTime), tears its pipeline down and starts a
 // new one after CameraHealth's backoff; a build that fails is tried again
 // after the next backoff. CameraMachine decides all of it; this class is its
 // driver (the pipeline, its bus, one timer). No other camera waits for any
@@ -52,7 +52,6 @@ class CameraObserver {
 
 class Camera {
  public:
-  static constexpr std::chrono::milliseconds kFinishTime = CameraMachine::kFinishTime;
   // Builds a run's pipeline (CameraPipeline::build; a test's may fail).
   using PipelineBuilder = std::function<Expected<std::unique_ptr<CameraPipeline>, std::string>(
       const StreamPlan&, const CameraFiles&, FrameTap* frames, FrameTap* encoded)>;
@@ -72,7 +71,7 @@ class Camera {
   // Called every kTickInterval: the stall check, state changes.
   void tick();
   static constexpr guint kTickIntervalMs = 250;
-  // Finishes the open file (bounded by kFinishTime) and stops for good.
+  // Finishes the open file (bounded by CameraMachine::kFinishTime) and stops for good.
   void stop();
   // Stops for good at once, the open file indexed as it is (a second
   // signal, the stop's backstop).

@@ -190,20 +190,17 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* 
   // The one body taken: a WebRTC offer, its length given and bounded (read
   // by libsoup into memory, so never more than kMaxOfferBytes).
   goffset length = soup_message_headers_get_content_length(headers);
-  if (method == "POST" && routeOf(path).kind == Route::Kind::Whep &&
-      soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CONTENT_LENGTH &&
-      length <= static_cast<goffset>(kMaxOfferBytes))
-    return;
+  bool offer = method == "POST" && routeOf(path).kind == Route::Kind::Whep;
+  bool sized = soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CONTENT_LENGTH;
+  if (offer && sized && length <= static_cast<goffset>(kMaxOfferBytes)) return;
   // libsoup would read the whole body before answering: answer on the
   // socket now, with the reason in JSON as every error of the API, and
   // close it. Nothing of this request was written yet.
-  std::string reason = !known ? "method " + method + " is not served: GET, HEAD, DELETE or POST"
-                       : routeOf(path).kind != Route::Kind::Whep
-                           ? std::string("this request takes no body")
-                       : soup_message_headers_get_encoding(headers) != SOUP_ENCODING_CONTENT_LENGTH
-                           ? std::string("the offer needs a Content-Length (no chunked body)")
-                           : "the offer is " + std::to_string(length) + " bytes; at most " +
-                                 std::to_string(kMaxOfferBytes);
+  std::string reason = !known   ? "method " + method + " is not served: GET, HEAD, DELETE or POST"
+                       : !offer ? std::string("this request takes no body")
+                       : !sized ? std::string("the offer needs a Content-Length (no chunked body)")
+                                : "the offer is " + std::to_string(length) + " bytes; at most " +
+                                      std::to_string(kMaxOfferBytes);
   std::string body = nlohmann::json{{"error", printableText(reason)}}.dump();
   std::string answer = !known
                            ? "HTTP/1.1 405 Method Not Allowed\r\nAllow: GET, HEAD, DELETE, POST\r\n"
