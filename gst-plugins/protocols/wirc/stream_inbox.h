@@ -54,13 +54,15 @@ class StreamInbox {
   Wake wait(Clock::time_point deadline);
   std::optional<AssembledFrame> takeFrame();
 
- private:
-  void receiveBatch();
-  // A datagram's arrival from the kernel's stamp on `message`; `now` if it
-  // has none (or an implausible one).
+  // A datagram's arrival from the kernel's stamp on `message`
+  // (SCM_TIMESTAMPNS, wall clock), carried onto the steady clock by its age
+  // at `now`/`wallNow`; `now` if it has none, or an implausible one.
   static Clock::time_point arrivalOf(const msghdr& message, Clock::time_point now,
                                      const timespec& wallNow);
   static constexpr auto kLongestPlausibleAge = std::chrono::seconds(5);
+
+ private:
+  void receiveBatch();
 
   UniqueFd socket_;
   UniqueFd interrupt_;
