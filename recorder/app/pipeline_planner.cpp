@@ -80,7 +80,7 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
   PipelinePlan plan;
   plan.transcoded = options.codec != Codec::kJpeg;
   // The live branch feeds the web server, RTSP and the discovery snapshots.
-  bool live = options.http || options.rtsp || options.mqttDiscovery;
+  bool live = options.http || options.rtsp || options.foxglove || options.mqttDiscovery;
   size_t index = 0;
   for (const auto& device : options.devices) {
     bool controlled = false;

@@ -128,10 +128,15 @@ std::optional<std::string> applyOption(RecorderOptions& o, const std::string& na
     auto kbps = number(value);
     if (!kbps || *kbps < 50 || *kbps > 100000) return "kbit/s, 50..100000";
     o.h264Kbps = static_cast<unsigned>(*kbps);
-  } else if (name == "http" || name == "rtsp") {
+  } else if (name == "http" || name == "rtsp" || name == "foxglove") {
     auto address = parseServerAddress(value);
     if (!address) return "[HOST]:PORT, as in :8080 or 127.0.0.1:8080";
-    (name == "http" ? o.http : o.rtsp) = *address;
+    (name == "http" ? o.http : name == "rtsp" ? o.rtsp : o.foxglove) = *address;
+  } else if (name == "foxglove-max-clients") {
+    auto clients = number(value);
+    if (!clients || *clients < 1 || *clients > 64 || *clients != static_cast<int>(*clients))
+      return "1..64";
+    o.foxgloveMaxClients = static_cast<unsigned>(*clients);
   } else if (name == "http-cert" || name == "http-key") {
     (name == "http-cert" ? o.httpCert : o.httpKey) = value;
   } else if (name == "webrtc") {
@@ -274,6 +279,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
                                    {"telemetry-track", required_argument, nullptr, kValue},
                                    {"http", required_argument, nullptr, kValue},
                                    {"rtsp", required_argument, nullptr, kValue},
+                                   {"foxglove", required_argument, nullptr, kValue},
+                                   {"foxglove-max-clients", required_argument, nullptr, kValue},
                                    {"http-idle-timeout", required_argument, nullptr, kValue},
                                    {"stall-timeout", required_argument, nullptr, kValue},
                                    {"http-token", required_argument, nullptr, kValue},
@@ -351,7 +358,8 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
     return unexpected("--mqtt-cafile is for a TLS broker: --mqtt mqtts://HOST[:PORT]");
   if (o.httpCert.empty() != o.httpKey.empty())
     return unexpected("--http-cert and --http-key go together: the certificate and its key");
-  if (!o.httpCert.empty() && !o.http) return unexpected("--http-cert needs --http [HOST]:PORT");
+  if (!o.httpCert.empty() && !o.http && !o.foxglove)
+    return unexpected("--http-cert needs --http [HOST]:PORT (or --foxglove)");
   if (o.keepEvents.count() > 0 && o.keepEvents <= o.maxAge)
     return unexpected(
         "--keep-events keeps segments with events longer than --max-age: give "
@@ -365,6 +373,11 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   if (o.http && o.httpToken.empty() && !o.http->host.empty() && o.http->host != "127.0.0.1" &&
       o.http->host != "localhost")
     return unexpected("--http " + o.http->host + ":" + std::to_string(o.http->port) +
+                      " would open the recorder beyond this machine without authentication: "
+                      "give --http-token T (or leave HOST out for 127.0.0.1 only)");
+  if (o.foxglove && o.httpToken.empty() && !o.foxglove->host.empty() &&
+      o.foxglove->host != "127.0.0.1" && o.foxglove->host != "localhost")
+    return unexpected("--foxglove " + o.foxglove->host + ":" + std::to_string(o.foxglove->port) +
                       " would open the recorder beyond this machine without authentication: "
                       "give --http-token T (or leave HOST out for 127.0.0.1 only)");
   if (o.devices.empty()) o.devices.push_back({"", 1984, "discovered"});

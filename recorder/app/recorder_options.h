@@ -74,12 +74,14 @@ struct RecorderOptions {
   double stallSeconds = 5;  // logged in without a frame this long: no-video, restarted
   uint64_t maxBytes = 0;    // retention: 0 = unlimited
   uint64_t minFree = 0;
-  std::chrono::seconds maxAge{0};      // retention by age: 0 = none
-  std::chrono::seconds keepEvents{0};  // segments with tags or commands kept this long
-  std::optional<ServerAddress> http;   // unset: no web server
-  std::optional<ServerAddress> rtsp;   // unset: no RTSP server
-  double httpIdleSeconds = 10;         // a connection silent this long is closed
-  std::string httpToken;               // empty: this machine only, no authentication
+  std::chrono::seconds maxAge{0};         // retention by age: 0 = none
+  std::chrono::seconds keepEvents{0};     // segments with tags or commands kept this long
+  std::optional<ServerAddress> http;      // unset: no web server
+  std::optional<ServerAddress> rtsp;      // unset: no RTSP server
+  std::optional<ServerAddress> foxglove;  // unset: no Foxglove WebSocket
+  unsigned foxgloveMaxClients = 8;
+  double httpIdleSeconds = 10;  // a connection silent this long is closed
+  std::string httpToken;        // empty: this machine only, no authentication
   // HTTPS: the server's certificate and key (PEM files), both or neither.
   std::string httpCert, httpKey;
   // The WebRTC live view beside MJPEG, with --http; its ICE servers (none:

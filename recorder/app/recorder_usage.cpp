@@ -121,13 +121,19 @@ file and exits 0.
   --hook-drain S         at exit, how long the hooks still queued get (default 15)
   --rtsp [HOST]:PORT     RTSP server: rtsp://HOST:PORT/<device>/cam<N>; without
                          HOST on 127.0.0.1 only
+  --foxglove [HOST]:PORT Foxglove WebSocket for Foxglove and Lichtblick: each
+                         camera's image, tags, telemetry, log and pose, and
+                         /STREAM/drive from their Teleop panel; without HOST
+                         on 127.0.0.1 only; token and TLS as for --http
+  --foxglove-max-clients N
+                         Foxglove clients at once (default 8, at most 64)
   -h, --help             this text
 
 Config file (GKeyFile/INI): a [recorder] group with the long options as keys
 (out, segment, segment-size, format, codec, bitrate, telemetry-track, detect,
 follow, follow-tuning, max-bytes, min-free, max-age, keep-events, status,
 stall-timeout, http, http-token, http-cert, http-key, http-idle-timeout, webrtc,
-webrtc-stun, webrtc-turn, webrtc-kbps, rtsp,
+webrtc-stun, webrtc-turn, webrtc-kbps, rtsp, foxglove, foxglove-max-clients,
 periods, failsafe, marvelmind, beacon, mqtt, mqtt-cafile, mqtt-prefix,
 mqtt-discovery, mqtt-snapshot-interval, mqtt-detections-rate,
 on-segment-closed, hook-timeout, hook-drain), and one [device NAME] group per

@@ -13,6 +13,7 @@
 #include "record/segment_inspector.h"
 #include "record/segment_planner.h"
 #include "status/camera_report.h"
+#include "status/event_text.h"
 #include "telemetry/telemetry_track_flags.h"
 
 namespace wircam::recorder {
@@ -106,6 +107,7 @@ Supervisor::~Supervisor() {
   // The servers first: they listen to the cameras' frames.
   http_.reset();
   rtsp_.reset();
+  foxglove_.reset();  // each client's vehicle sent neutral
   hook_.reset();
   fleet_.reset();  // says offline
   cameras_.clear();
@@ -163,14 +165,17 @@ void Supervisor::enforceRetention() {
 }
 
 void Supervisor::event(Camera& camera, const nlohmann::json& event) {
+  if (foxglove_) foxglove_->log(camera.name(), eventText(event), g_get_real_time() / 1000);
   if (!fleet_) return;
   nlohmann::json line = event;
   line["utc"] = SegmentPlanner::isoUtc(g_get_real_time() / 1000);
   fleet_->event(camera.name(), line);
 }
 
-void Supervisor::detections(Camera& camera, const nlohmann::json& line, int64_t unixMs) {
+void Supervisor::detections(Camera& camera, const nlohmann::json& line, int64_t unixMs,
+                            GstClockTime framePts) {
   if (http_) http_->publishDetections(camera.name(), line["detections"]);
+  if (foxglove_) foxglove_->detections(camera.name(), line, unixMs, framePts);
   if (fleet_)
     fleet_->detections(camera.name(),
                        {{"utc", SegmentPlanner::isoUtc(unixMs)},
@@ -238,7 +243,9 @@ gboolean Supervisor::onDurationOver(gpointer data) {
 }
 
 gboolean Supervisor::onCameraTick(gpointer data) {
-  for (auto& c : static_cast<Supervisor*>(data)->cameras_) c->tick();
+  auto* self = static_cast<Supervisor*>(data);
+  for (auto& c : self->cameras_) c->tick();
+  self->publishFoxglovePoses();
   return G_SOURCE_CONTINUE;
 }
 
@@ -320,6 +327,15 @@ nlohmann::json Supervisor::status() const {
                              {"max_age_s", options_.maxAge.count()},
                              {"keep_events_s", options_.keepEvents.count()}}},
                            {"streams", streams}};
+  if (foxglove_) {
+    auto served = foxglove_->stats();
+    result["foxglove"] = {{"url", foxglove_->url()},
+                          {"clients", served.clients},
+                          {"max_clients", options_.foxgloveMaxClients},
+                          {"refused", served.refused},
+                          {"sent", served.sent},
+                          {"dropped", served.dropped}};
+  }
   if (fleet_) {
     auto mqtt = fleet_->stats();
     result["mqtt"] = {{"connected", fleet_->connected()},
@@ -337,6 +353,13 @@ std::string Supervisor::metrics() const {
   m.recorded = recorded_;
   m.diskFreeBytes = disk_.free();
   m.httpConnections = http_ ? http_->openConnections() : 0;
+  if (foxglove_) {
+    auto served = foxglove_->stats();
+    m.foxglove = RecorderMetrics::Foxglove{.clients = served.clients,
+                                           .refused = served.refused,
+                                           .sent = served.sent,
+                                           .dropped = served.dropped};
+  }
   if (fleet_) {
     auto mqtt = fleet_->stats();
     m.mqttConnected = fleet_->connected();
@@ -378,6 +401,14 @@ int Supervisor::run() {
         1,
         [](gpointer self) -> gboolean {
           static_cast<Supervisor*>(self)->publishFleetStatus();
+          return G_SOURCE_CONTINUE;
+        },
+        this));
+  if (foxglove_)
+    timers_.push_back(g_timeout_add_seconds(
+        1,
+        [](gpointer self) -> gboolean {
+          static_cast<Supervisor*>(self)->publishFoxgloveStatus();
           return G_SOURCE_CONTINUE;
         },
         this));

@@ -50,7 +50,8 @@ class Supervisor : CameraObserver {
   void segmentClosed(Camera& camera, const std::string& file,
                      const PlannedSegment& planned) override;
   void event(Camera& camera, const nlohmann::json& event) override;
-  void detections(Camera& camera, const nlohmann::json& line, int64_t unixMs) override;
+  void detections(Camera& camera, const nlohmann::json& line, int64_t unixMs,
+                  GstClockTime framePts) override;
   void diskFull(Camera& camera) override;
   void ended(Camera& camera) override;
 
@@ -62,6 +63,8 @@ class Supervisor : CameraObserver {
   static gboolean onCameraTick(gpointer self);
   void quitWhenAllEnded();
   void publishFleetStatus(bool force = false);
+  void publishFoxgloveStatus();  // each camera's /STREAM/telemetry, once a second
+  void publishFoxglovePoses();   // each new position on /STREAM/pose
   // DELETE /api/recordings/FILE: the HTTP status and reason when it cannot.
   std::optional<std::pair<guint, std::string>> deleteSegment(const std::string& file);
   void updateIndex(const std::vector<std::string>& deleted);
@@ -84,11 +87,13 @@ class Supervisor : CameraObserver {
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Camera>> cameras_;
   CommandDispatcher commands_;
-  std::unique_ptr<WebServer> http_;        // with --http
-  std::unique_ptr<RtspService> rtsp_;      // with --rtsp
-  std::unique_ptr<FleetPublisher> fleet_;  // with --mqtt
-  std::unique_ptr<SegmentHook> hook_;      // with --on-segment-closed
-  std::vector<guint> timers_;              // the run's timeouts, removed when it ends
+  std::unique_ptr<WebServer> http_;            // with --http
+  std::unique_ptr<RtspService> rtsp_;          // with --rtsp
+  std::unique_ptr<FleetPublisher> fleet_;      // with --mqtt
+  std::unique_ptr<FoxgloveService> foxglove_;  // with --foxglove
+  std::map<std::string, int64_t> posesSent_;   // by camera: the last position's time
+  std::unique_ptr<SegmentHook> hook_;          // with --on-segment-closed
+  std::vector<guint> timers_;                  // the run's timeouts, removed when it ends
   bool stopping_ = false;
   bool stoppedBySignal_ = false;
   int exitCode_ = 0;

@@ -1,9 +1,10 @@
 // The servers a supervisor starts beside its cameras (web, MQTT, the
-// segment hook, RTSP), each fed from the supervisor's own state and
-// commands.
+// segment hook, RTSP, Foxglove), each fed from the supervisor's own state
+// and commands.
 #include "app/live_servers_module.h"
 #include "app/supervisor.h"
 #include "log_line.h"
+#include "record/segment_planner.h"
 #include "status/camera_report.h"
 
 namespace wircam::recorder {
@@ -80,6 +81,27 @@ std::optional<std::string> Supervisor::startServers() {
           if (Camera* c = cameraNamed(name)) event(*c, hookEvent);
         });
   }
+  if (options_.foxglove) {
+    auto servers = liveServers();
+    if (!servers) return servers.error();
+    FoxgloveContent content{.token = options_.httpToken,
+                            .certificateFile = options_.httpCert,
+                            .keyFile = options_.httpKey,
+                            .maxClients = options_.foxgloveMaxClients,
+                            .version = WIRCAM_VERSION};
+    for (auto& c : cameras_)
+      content.cameras.push_back(
+          {c->name(), c->frames(), c->encodedFrames(), !c->plan().positions.empty()});
+    content.drive = [this](const std::string& camera, double steering, double throttle) {
+      return commands_.drive(camera, steering, throttle);
+    };
+    auto server = (*servers)->startFoxglove(
+        *options_.foxglove, std::move(content),
+        std::chrono::milliseconds(static_cast<int64_t>(options_.httpIdleSeconds * 1000)));
+    if (!server) return server.error();
+    foxglove_ = std::move(*server);
+    logLine("Foxglove WebSocket at " + foxglove_->url());
+  }
   if (options_.rtsp) {
     auto servers = liveServers();
     if (!servers) return servers.error();
@@ -93,6 +115,29 @@ std::optional<std::string> Supervisor::startServers() {
     for (auto& camera : cameras) logLine("RTSP at " + rtsp_->url() + camera.path);
   }
   return std::nullopt;
+}
+
+void Supervisor::publishFoxgloveStatus() {
+  int64_t now = g_get_real_time() / 1000;
+  for (const auto& c : cameras_) {
+    nlohmann::json line = fleetStatusJson(c->report());
+    line["type"] = "status";
+    line["utc"] = SegmentPlanner::isoUtc(now);
+    foxglove_->telemetry(c->name(), line, now);
+  }
+}
+
+void Supervisor::publishFoxglovePoses() {
+  if (!foxglove_) return;
+  for (const auto& c : cameras_) {
+    const auto& trail = c->trail();
+    if (trail.empty()) continue;
+    const Position& newest = trail.back();
+    int64_t& sent = posesSent_[c->name()];
+    if (newest.unixMs == sent) continue;
+    sent = newest.unixMs;
+    foxglove_->pose(c->name(), newest.x, newest.y, newest.z, newest.unixMs);
+  }
 }
 
 }  // namespace wircam::recorder

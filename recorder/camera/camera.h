@@ -43,7 +43,8 @@ class CameraObserver {
   // A link change, a command, a segment: for MQTT's events.
   virtual void event(Camera& camera, const nlohmann::json& event) = 0;
   // A frame's detections, for the live view and MQTT.
-  virtual void detections(Camera& camera, const nlohmann::json& line, int64_t unixMs) = 0;
+  virtual void detections(Camera& camera, const nlohmann::json& line, int64_t unixMs,
+                          GstClockTime framePts) = 0;
   // A write failed for want of space: the recording must stop.
   virtual void diskFull(Camera& camera) = 0;
   // The camera stopped for good (after stop()).

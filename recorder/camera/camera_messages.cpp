@@ -191,7 +191,7 @@ void Camera::handleElementMessage(GstMessage* message) {
   line["type"] = detections ? "detections" : "control";
   GstClockTime pts = bus::frameTimestamp(s);
   line.erase("timestamp");
-  if (detections) observer_.detections(*this, line, unixMsOf(pipeline_->pipeline(), pts));
+  if (detections) observer_.detections(*this, line, unixMsOf(pipeline_->pipeline(), pts), pts);
   writeTelemetry(line, pts);
 }
 

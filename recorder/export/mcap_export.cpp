@@ -4,53 +4,11 @@
 #include <cstring>
 #include <utility>
 
-#include "export/foxglove_messages.h"
+#include "foxglove/foxglove_channels.h"
+#include "foxglove/foxglove_messages.h"
 #include "gst_scoped.h"
 
 namespace wircam::recorder {
-
-namespace {
-
-// JSON schemas of Foxglove's message types, from their documented fields.
-nlohmann::json timeSchema() {
-  return {{"type", "object"},
-          {"title", "time"},
-          {"properties",
-           {{"sec", {{"type", "integer"}, {"minimum", 0}}},
-            {"nsec", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999999}}}}}};
-}
-
-nlohmann::json logSchema() {
-  return {{"title", "foxglove.Log"},
-          {"type", "object"},
-          {"properties",
-           {{"timestamp", timeSchema()},
-            {"level", {{"type", "integer"}, {"enum", {0, 1, 2, 3, 4, 5}}}},
-            {"message", {{"type", "string"}}},
-            {"name", {{"type", "string"}}},
-            {"file", {{"type", "string"}}},
-            {"line", {{"type", "integer"}, {"minimum", 0}}}}}};
-}
-
-nlohmann::json telemetrySchema() {
-  return {{"title", "wircam.Telemetry"},
-          {"description",
-           "One line of a recording's telemetry sidecar: battery, link and stream statistics, "
-           "detections, control commands, session events, positions (docs/recorder.md, \"What it "
-           "writes\")"},
-          {"type", "object"},
-          {"properties",
-           {{"type", {{"type", "string"}}},
-            {"pts", {{"type", "integer"}, {"description", "ns on the export's timeline"}}},
-            {"utc", {{"type", "string"}}}}},
-          {"required", {"type", "utc"}}};
-}
-
-nlohmann::json timeOf(int64_t utcNs) {
-  return {{"sec", utcNs / 1000000000}, {"nsec", utcNs % 1000000000}};
-}
-
-}  // namespace
 
 McapExport::McapExport(std::string path, std::string stream)
     : path_(std::move(path)), stream_(std::move(stream)) {}
@@ -58,29 +16,54 @@ McapExport::McapExport(std::string path, std::string stream)
 std::optional<std::string> McapExport::start(GstCaps* caps) {
   std::string media = gst_structure_get_name(gst_caps_get_structure(caps, 0));
   format_ = media == "video/x-h264" ? "h264" : "jpeg";
+  if (format_ == "h264") {
+    // Foxglove decodes Annex B; the recordings hold "avc".
+    const GValue* record = gst_structure_get_value(gst_caps_get_structure(caps, 0), "codec_data");
+    if (record && GST_VALUE_HOLDS_BUFFER(record)) {
+      gst::ScopedBufferMap map(gst_value_get_buffer(record), GST_MAP_READ);
+      if (map) annexB_ = AnnexB::fromAvcC(map.view());
+      if (!annexB_) return "the H.264 stream's codec_data is not an avcC record";
+    }
+  }
   auto writer = McapWriter::create(path_);
   if (!writer) return writer.error();
   writer_ = std::move(*writer);
-  auto jsonChannel = [&](const char* topic, const std::string& schema, const nlohmann::json& json) {
-    uint16_t id = writer_->addSchema(schema, "jsonschema", json.dump());
-    return writer_->addChannel(id, "/" + stream_ + topic, "json");
-  };
-  std::string descriptors(foxgloveDescriptorSet());
-  image_ =
-      writer_->addChannel(writer_->addSchema("foxglove.CompressedImage", "protobuf", descriptors),
-                          "/" + stream_ + "/image", "protobuf", false);
-  tags_ =
-      writer_->addChannel(writer_->addSchema("foxglove.ImageAnnotations", "protobuf", descriptors),
-                          "/" + stream_ + "/tags", "protobuf");
-  telemetry_ = jsonChannel("/telemetry", "wircam.Telemetry", telemetrySchema());
-  log_ = jsonChannel("/log", "foxglove.Log", logSchema());
+  for (const auto& channel : foxgloveChannels(false)) {
+    uint16_t schema =
+        writer_->addSchema(channel.schemaName, channel.schemaEncoding, channel.schema);
+    uint16_t id = writer_->addChannel(schema, foxgloveTopicName(stream_, channel), channel.encoding,
+                                      channel.compressible);
+    switch (channel.topic) {
+      case FoxgloveTopic::Image:
+        image_ = id;
+        break;
+      case FoxgloveTopic::Tags:
+        tags_ = id;
+        break;
+      case FoxgloveTopic::Telemetry:
+        telemetry_ = id;
+        break;
+      case FoxgloveTopic::Log:
+        log_ = id;
+        break;
+      case FoxgloveTopic::Pose:
+        break;
+    }
+  }
   return std::nullopt;
 }
 
-std::optional<std::string> McapExport::frame(GstBuffer* buffer, int64_t, int64_t utcNs, bool) {
+std::optional<std::string> McapExport::frame(GstBuffer* buffer, int64_t, int64_t utcNs, bool key) {
   gst::ScopedBufferMap map(buffer, GST_MAP_READ);
   if (!map) return "an unreadable frame";
   auto time = static_cast<uint64_t>(std::max<int64_t>(utcNs, 0));
+  if (annexB_) {
+    auto frame = annexB_->convert(map.view(), key);
+    if (!frame) return "an H.264 frame whose NAL lengths run past its end";
+    writer_->write(image_, time, time, compressedImageHead(utcNs, stream_, format_, frame->size()),
+                   *frame);
+    return std::nullopt;
+  }
   // The message's fields, then the frame's bytes as they are.
   writer_->write(image_, time, time, compressedImageHead(utcNs, stream_, format_, map.size()),
                  {reinterpret_cast<const char*>(map.data()), map.size()});
@@ -96,14 +79,7 @@ std::optional<std::string> McapExport::line(const nlohmann::json& line, int64_t,
   bool vehicleEvent = type == "vehicle" && line.contains("event") && line["event"] != "status";
   if (type == "session" || vehicleEvent) {
     std::string message = line.value("event", type);
-    int level = message.find("lost") != std::string::npos ? 3 : 2;  // WARNING, INFO
-    write(log_, utcNs,
-          {{"timestamp", timeOf(utcNs)},
-           {"level", level},
-           {"message", message},
-           {"name", stream_},
-           {"file", ""},
-           {"line", 0}});
+    write(log_, utcNs, foxgloveLog(stream_, message, utcNs));
   }
   return std::nullopt;
 }

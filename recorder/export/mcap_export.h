@@ -1,9 +1,7 @@
-// An export into MCAP for robotics viewers (Foxglove, Lichtblick), on four
-// channels per camera STREAM:
-//   /STREAM/image      foxglove.CompressedImage, the camera's JPEG or H.264 bytes
-//   /STREAM/tags       foxglove.ImageAnnotations: each detected tag's outline and id
-//   /STREAM/telemetry  every sidecar line, as it is (a JSON schema)
-//   /STREAM/log        foxglove.Log: the session's events
+// An export into MCAP for robotics viewers (Foxglove, Lichtblick), on the
+// channels of foxglove/foxglove_channels.h (image, tags, telemetry: every
+// sidecar line as it is, log: the session's events), as the live Foxglove
+// WebSocket serves them.
 // Images and tags are protobuf, with Foxglove's own schemas (their
 // FileDescriptorSet in the Schema records): a frame's bytes go into the file
 // as they are, at the speed of a copy. Telemetry and logs are JSON with JSON
@@ -15,6 +13,7 @@
 
 #include "export/export_sink.h"
 #include "export/mcap_writer.h"
+#include "foxglove/annex_b.h"
 
 namespace wircam::recorder {
 
@@ -34,6 +33,7 @@ class McapExport : public ExportSink {
 
   std::string path_, stream_, format_;
   std::unique_ptr<McapWriter> writer_;
+  std::optional<AnnexB> annexB_;  // for H.264: Foxglove decodes Annex B
   uint16_t image_ = 0, tags_ = 0, telemetry_ = 0, log_ = 0;
 };
 

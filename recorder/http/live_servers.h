@@ -1,6 +1,7 @@
-// What wirc-recorder sees of its web and RTSP servers. Both live in a module
-// of their own (wirc-recorder-servers.so), which the recorder loads only for
-// --http or --rtsp (app/live_servers_module.h): their code and the libraries
+// What wirc-recorder sees of its web, RTSP and Foxglove servers. They live in
+// a module of their own (wirc-recorder-servers.so), which the recorder loads
+// only for --http, --rtsp or --foxglove (app/live_servers_module.h): their
+// code and the libraries
 // they bring (libsoup with krb5, sqlite, nghttp2 and psl; the RTSP server;
 // WebRTC), about 3 MB resident, stay out of a recorder that serves nothing.
 // The recorder links none of it: it starts the servers through the module's
@@ -94,6 +95,54 @@ class RtspService {
   virtual const std::string& url() const = 0;
 };
 
+struct FoxgloveCamera {
+  std::string name;
+  FrameTap* frames;             // borrowed; outlives the server
+  FrameTap* encoded = nullptr;  // the recording's H.264: then the image channel's
+  bool positions = false;       // with Marvelmind: a pose channel
+};
+
+// What the Foxglove WebSocket serves and obeys, from the supervisor.
+struct FoxgloveContent {
+  std::vector<FoxgloveCamera> cameras;
+  std::string token;                     // as for the web server
+  std::string certificateFile, keyFile;  // TLS, as for the web server
+  size_t maxClients = 8;
+  std::string version;  // in serverInfo's name
+  // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
+  std::function<std::optional<bool>(const std::string& camera, double steering, double throttle)>
+      drive;
+};
+
+// The Foxglove WebSocket server (foxglove.websocket.v1): each camera's
+// channels (foxglove/foxglove_channels.h) to Foxglove and Lichtblick, and
+// /STREAM/drive from them. Main thread only.
+class FoxgloveService {
+ public:
+  struct Stats {
+    size_t clients = 0;
+    uint64_t refused = 0;  // over the client limit
+    uint64_t sent = 0;     // messages
+    uint64_t dropped = 0;  // messages a slow client had no room for
+  };
+  virtual ~FoxgloveService() = default;
+  // "ws://HOST:PORT/" (wss:// with TLS), the port the system picked for 0.
+  virtual const std::string& url() const = 0;
+  virtual Stats stats() const = 0;
+  // Channels advertised to every client, and taken back.
+  virtual void addCamera(const FoxgloveCamera& camera) = 0;
+  virtual void removeCamera(const std::string& name) = 0;
+  // The camera's status each second (/STREAM/telemetry), a detections line
+  // (/STREAM/tags), an event (/STREAM/log), a position (/STREAM/pose).
+  virtual void telemetry(const std::string& camera, const nlohmann::json& line, int64_t unixMs) = 0;
+  // A frame's detections are stamped as the frame's image (`framePts`, its
+  // PTS): Foxglove draws annotations on the image of their timestamp.
+  virtual void detections(const std::string& camera, const nlohmann::json& line, int64_t unixMs,
+                          uint64_t framePts) = 0;
+  virtual void log(const std::string& camera, const std::string& message, int64_t unixMs) = 0;
+  virtual void pose(const std::string& camera, double x, double y, double z, int64_t unixMs) = 0;
+};
+
 // The module's table, which its one exported function (kLiveServersEntry)
 // returns.
 struct LiveServers {
@@ -103,6 +152,8 @@ struct LiveServers {
   Expected<std::unique_ptr<RtspService>, std::string> (*startRtsp)(const ServerAddress& address,
                                                                    std::vector<RtspCamera> cameras,
                                                                    const std::string& token);
+  Expected<std::unique_ptr<FoxgloveService>, std::string> (*startFoxglove)(
+      const ServerAddress& address, FoxgloveContent content, std::chrono::milliseconds idleTimeout);
 };
 
 inline constexpr const char* kLiveServersEntry = "wircam_live_servers";

@@ -2,6 +2,7 @@
 // (live_servers.h), which the recorder looks up when it loads the module.
 #include <gmodule.h>
 
+#include "http/foxglove_server.h"
 #include "http/http_server.h"
 #include "http/rtsp_server.h"
 
@@ -24,11 +25,18 @@ Expected<std::unique_ptr<RtspService>, std::string> startRtsp(const ServerAddres
   return std::unique_ptr<RtspService>(std::move(*server));
 }
 
+Expected<std::unique_ptr<FoxgloveService>, std::string> startFoxglove(
+    const ServerAddress& address, FoxgloveContent content, std::chrono::milliseconds idleTimeout) {
+  auto server = FoxgloveServer::start(address, std::move(content), idleTimeout);
+  if (!server) return unexpected(server.error());
+  return std::unique_ptr<FoxgloveService>(std::move(*server));
+}
+
 }  // namespace
 }  // namespace wircam::recorder
 
 extern "C" G_MODULE_EXPORT const wircam::recorder::LiveServers* wircam_live_servers() {
-  static const wircam::recorder::LiveServers servers{&wircam::recorder::startWeb,
-                                                     &wircam::recorder::startRtsp};
+  static const wircam::recorder::LiveServers servers{
+      &wircam::recorder::startWeb, &wircam::recorder::startRtsp, &wircam::recorder::startFoxglove};
   return &servers;
 }

@@ -138,6 +138,18 @@ std::string prometheusText(const RecorderMetrics& m) {
   out.sample("", m.diskFreeBytes);
   out.family("wircam_http_connections", "gauge", "Connections open to the web server.");
   out.sample("", m.httpConnections);
+  if (m.foxglove) {
+    out.family("wircam_foxglove_clients", "gauge", "Foxglove WebSocket clients connected.");
+    out.sample("", m.foxglove->clients);
+    out.family("wircam_foxglove_refused_total", "counter",
+               "Foxglove clients refused: as many as --foxglove-max-clients were connected.");
+    out.sample("", m.foxglove->refused);
+    out.family("wircam_foxglove_sent_total", "counter", "Messages sent to Foxglove clients.");
+    out.sample("", m.foxglove->sent);
+    out.family("wircam_foxglove_dropped_total", "counter",
+               "Messages a slow Foxglove client had no room for (dropped, never queued).");
+    out.sample("", m.foxglove->dropped);
+  }
   if (m.mqttConnected) {
     out.family("wircam_mqtt_connected", "gauge", "1 while the MQTT broker is connected.");
     out.sample("", uint64_t{*m.mqttConnected});

@@ -30,6 +30,12 @@ struct RecorderMetrics {
   std::optional<uint64_t> mqttPublished, mqttDropped;  // with --mqtt
   std::optional<bool> mqttConnected;
   uint64_t httpConnections = 0;
+  // With --foxglove: clients connected, refused over the limit, messages
+  // sent and dropped (a slow client's).
+  struct Foxglove {
+    uint64_t clients = 0, refused = 0, sent = 0, dropped = 0;
+  };
+  std::optional<Foxglove> foxglove;
 };
 
 std::string prometheusText(const RecorderMetrics& metrics);

@@ -29,7 +29,7 @@ struct Observed : CameraObserver {
     closed.push_back(file);
   }
   void event(Camera&, const nlohmann::json&) override {}
-  void detections(Camera&, const nlohmann::json&, int64_t) override {}
+  void detections(Camera&, const nlohmann::json&, int64_t, GstClockTime) override {}
   void diskFull(Camera&) override {}
   void ended(Camera&) override { over = true; }
 };

@@ -1,6 +1,8 @@
 // Reads an MCAP file with readers written by others and prints what it
 // found, as JSON, for the export tests to compare with the recordings:
-//   node check.mjs FILE.mcap
+//   node check.mjs FILE.mcap [--images-to FILE]
+// (--images-to: every image's data, one after the other, into FILE: an
+// H.264 export's images are then an elementary stream other decoders read)
 // - @mcap/core's McapIndexedReader (chunk indexes, summary, CRCs) and
 //   McapStreamReader (every record in order, the data section's CRC);
 // - every JSON message validated against Foxglove's own JSON schema for its
@@ -9,7 +11,7 @@
 //   .proto, parsed by protobufjs), and the file's Schema record read as the
 //   FileDescriptorSet the MCAP spec asks for;
 // - a read from the middle (startTime), which the chunk index serves.
-import { readFile } from "node:fs/promises";
+import { readFile, writeFile } from "node:fs/promises";
 import { createHash } from "node:crypto";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import * as foxglove from "@foxglove/schemas/jsonschema.js";
@@ -37,6 +39,8 @@ function foxgloveProtobuf() {
 const foxgloveTypes = foxgloveProtobuf();
 
 const bytes = new Uint8Array(await readFile(process.argv[2]));
+const imagesTo = process.argv[3] === "--images-to" ? process.argv[4] : null;
+const imageData = [];
 const decompressHandlers = { zstd: (data) => decompress(data) };
 const readable = {
   size: async () => BigInt(bytes.length),
@@ -143,6 +147,7 @@ for await (const message of reader.readMessages()) {
   }
   if (v.name === "foxglove.CompressedImage") {
     const data = Buffer.from(json.data);
+    imageData.push(data);
     result.images.push({
       logTime: message.logTime.toString(),
       md5: createHash("md5").update(data).digest("hex"),
@@ -175,4 +180,5 @@ try {
   result.streamError = String(error);
 }
 if (descriptorProblems.length) result.invalid.push(...descriptorProblems);
+if (imagesTo) await writeFile(imagesTo, Buffer.concat(imageData));
 console.log(JSON.stringify(result));

@@ -1,6 +1,6 @@
-#include "export/foxglove_messages.h"
+#include "foxglove/foxglove_messages.h"
 
-#include "export/protobuf_wire.h"
+#include "foxglove/protobuf_wire.h"
 
 namespace wircam::recorder {
 
@@ -24,6 +24,14 @@ std::string colorOf(double r, double g, double b, double a) {
 
 // foxglove.Point2
 std::string pointOf(double x, double y) { return ProtobufWriter().number(1, x).number(2, y).out(); }
+
+// foxglove.Vector3 and foxglove.Quaternion
+std::string vectorOf(double x, double y, double z) {
+  return ProtobufWriter().number(1, x).number(2, y).number(3, z).out();
+}
+std::string quaternionOf(double x, double y, double z, double w) {
+  return ProtobufWriter().number(1, x).number(2, y).number(3, z).number(4, w).out();
+}
 
 double numberIn(const nlohmann::json& value) { return value.is_number() ? value.get<double>() : 0; }
 
@@ -69,6 +77,26 @@ std::string imageAnnotationsOf(const nlohmann::json& line, int64_t utcNs) {
   }
   annotations.bytes(5, stamp);
   return annotations.out();
+}
+
+std::string poseInFrameOf(double x, double y, double z, int64_t utcNs, const std::string& frameId) {
+  // The identity rotation: an all-zero quaternion (protobuf's default) is none.
+  std::string pose =
+      ProtobufWriter().bytes(1, vectorOf(x, y, z)).bytes(2, quaternionOf(0, 0, 0, 1)).out();
+  return ProtobufWriter().bytes(1, timestampOf(utcNs)).bytes(2, frameId).bytes(3, pose).out();
+}
+
+nlohmann::json foxgloveLog(const std::string& stream, const std::string& message, int64_t utcNs) {
+  constexpr int kInfo = 2, kWarning = 3;
+  bool bad = message.find("lost") != std::string::npos ||
+             message.find("stale") != std::string::npos ||
+             message.find("fail") != std::string::npos || message.find("gave") != std::string::npos;
+  return {{"timestamp", {{"sec", utcNs / 1000000000}, {"nsec", utcNs % 1000000000}}},
+          {"level", bad ? kWarning : kInfo},
+          {"message", message},
+          {"name", stream},
+          {"file", ""},
+          {"line", 0}};
 }
 
 }  // namespace wircam::recorder

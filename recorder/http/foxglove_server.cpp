@@ -1,0 +1,473 @@
+#include "http/foxglove_server.h"
+
+#include <linux/sockios.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <mutex>
+
+#include "foxglove/annex_b.h"
+#include "foxglove/foxglove_messages.h"
+#include "gst_scoped.h"
+#include "http/http_responses.h"
+#include "http/http_routes.h"
+#include "log_line.h"
+
+namespace wircam::recorder {
+
+struct FoxgloveServer::Feed {
+  FoxgloveCamera camera;
+  bool h264 = false;  // its images are the recording's H.264
+  int listener = 0;
+  std::map<FoxgloveTopic, uint32_t> channels;
+  std::atomic<int> imageSubscribers{0};  // read on the streaming thread
+  std::map<uint64_t, int64_t> stamps;    // the recent frames' times (ns), by PTS
+};
+
+struct FoxgloveServer::Client {
+  FoxgloveServer* server;
+  SoupWebsocketConnection* connection;
+  GSocket* socket;  // its TCP socket (a reference; under TLS too), for the send queue
+  std::string peer;
+  FoxgloveSession session;
+  gulong messageHandler = 0, closedHandler = 0;
+  std::map<uint32_t, bool> decoding;  // H.264 channel -> it has had a key frame since a gap
+  uint64_t dropped = 0;
+};
+
+namespace {
+
+constexpr guint kHttpUpgradeRequired = 426;  // not among libsoup's names
+
+int64_t nsOf(int64_t unixMs) { return std::max<int64_t>(unixMs, 0) * 1000000; }
+
+}  // namespace
+
+FoxgloveServer::FoxgloveServer(FoxgloveContent content) : content_(std::move(content)) {}
+
+Expected<std::unique_ptr<FoxgloveServer>, std::string> FoxgloveServer::start(
+    const ServerAddress& address, FoxgloveContent content, std::chrono::milliseconds idleTimeout) {
+  std::unique_ptr<FoxgloveServer> self(new FoxgloveServer(std::move(content)));
+  self->server_ = soup_server_new("server-header", "wirc-recorder", nullptr);
+  // Its messages are JPEG and H.264: deflating them costs CPU for nothing.
+  soup_server_remove_websocket_extension(self->server_, SOUP_TYPE_WEBSOCKET_EXTENSION_DEFLATE);
+  GSocketAddress* socket =
+      g_inet_socket_address_new_from_string(address.listenHost().c_str(), address.port);
+  if (!socket) return unexpected("--foxglove: '" + address.host + "' is not an IP address");
+  GTlsCertificate* certificate = nullptr;
+  if (!self->content_.certificateFile.empty()) {
+    GError* error = nullptr;
+    certificate = g_tls_certificate_new_from_files(self->content_.certificateFile.c_str(),
+                                                   self->content_.keyFile.c_str(), &error);
+    if (!certificate) {
+      std::string text = error->message;
+      g_error_free(error);
+      g_object_unref(socket);
+      return unexpected("--http-cert " + self->content_.certificateFile + ", --http-key " +
+                        self->content_.keyFile + ": " + text);
+    }
+  }
+  // Room for a client over the limit to be told so, and for stray requests.
+  size_t slots = self->content_.maxClients + 4;
+  auto connections = HttpConnections::listen(
+      self->server_, socket, {.maxOpen = slots, .maxPerAddress = slots, .idleTimeout = idleTimeout},
+      certificate);
+  g_clear_object(&certificate);
+  g_object_unref(socket);
+  if (!connections)
+    return unexpected("--foxglove: cannot listen on port " + std::to_string(address.port) + ": " +
+                      connections.error());
+  self->connections_ = std::move(*connections);
+  self->url_ = std::string(self->connections_->tls() ? "wss://" : "ws://") + address.listenHost() +
+               ":" + std::to_string(self->connections_->port()) + "/";
+  // A client tells a restarted recorder by a new session id.
+  self->sessionId_ = std::to_string(g_get_real_time());
+
+  FoxgloveServer* raw = self.get();
+  soup_server_add_early_handler(
+      self->server_, nullptr,
+      [](SoupServer*, SoupServerMessage* message, const char*, GHashTable*, gpointer data) {
+        static_cast<FoxgloveServer*>(data)->connections_->requestStarted(message);
+      },
+      raw, nullptr);
+  soup_server_add_handler(self->server_, nullptr, onRequest, raw, nullptr);
+  const char* protocols[] = {kFoxgloveSubprotocol, nullptr};
+  soup_server_add_websocket_handler(self->server_, nullptr, nullptr, const_cast<char**>(protocols),
+                                    onWebSocket, raw, nullptr);
+  auto ended = +[](SoupServer*, SoupServerMessage* message, gpointer data) {
+    static_cast<FoxgloveServer*>(data)->connections_->requestEnded(message);
+  };
+  g_signal_connect(self->server_, "request-finished", G_CALLBACK(ended), raw);
+  g_signal_connect(self->server_, "request-aborted", G_CALLBACK(ended), raw);
+  for (const auto& camera : self->content_.cameras) self->addCamera(camera);
+  return self;
+}
+
+FoxgloveServer::~FoxgloveServer() {
+  alive_.reset();
+  for (const auto& feed : feeds_) feed->camera.frames->forget(feed->listener);
+  while (!clients_.empty()) {
+    Client& client = *clients_.back();
+    // Its vehicles are not left on a last command.
+    for (const auto& camera : client.session.drivenCameras()) content_.drive(camera, 0, 0);
+    if (soup_websocket_connection_get_state(client.connection) == SOUP_WEBSOCKET_STATE_OPEN)
+      soup_websocket_connection_close(client.connection, SOUP_WEBSOCKET_CLOSE_GOING_AWAY,
+                                      "the recorder stops");
+    drop(client);
+  }
+  if (server_) {
+    soup_server_disconnect(server_);
+    g_object_unref(server_);
+  }
+}
+
+FoxgloveService::Stats FoxgloveServer::stats() const {
+  return {.clients = clients_.size(), .refused = refused_, .sent = sent_, .dropped = dropped_};
+}
+
+bool FoxgloveServer::authorised(SoupServerMessage* message, GHashTable* query) const {
+  auto* headers = soup_server_message_get_request_headers(message);
+  if (carriesToken(soup_message_headers_get_one(headers, "Authorization"),
+                   soup_message_headers_get_one(headers, "Cookie"), content_.token))
+    return true;
+  // Foxglove and Lichtblick open a URL and send no header of their own:
+  // ws://HOST:PORT/?token=T
+  const char* token = queryValue(query, "token");
+  return token && carriesToken(("Bearer " + std::string(token)).c_str(), nullptr, content_.token);
+}
+
+void FoxgloveServer::onRequest(SoupServer*, SoupServerMessage* message, const char*,
+                               GHashTable* query, gpointer data) {
+  auto* self = static_cast<FoxgloveServer*>(data);
+  if (!self->authorised(message, query))
+    return respondJsonError(message, SOUP_STATUS_UNAUTHORIZED,
+                            "needs the access token: Authorization: Bearer T, or ?token=T in the "
+                            "URL");
+  auto* headers = soup_server_message_get_request_headers(message);
+  if (!soup_message_headers_header_contains(headers, "Upgrade", "websocket"))
+    return respondJsonError(message, kHttpUpgradeRequired,
+                            "a Foxglove WebSocket (foxglove.websocket.v1): open " + self->url_ +
+                                " in Foxglove or Lichtblick");
+  // Left unanswered: libsoup upgrades it (onWebSocket), or answers 400
+  // when the client does not offer foxglove.websocket.v1.
+  self->connections_->upgrading(message);
+}
+
+void FoxgloveServer::onWebSocket(SoupServer*, SoupServerMessage* message, const char*,
+                                 SoupWebsocketConnection* connection, gpointer data) {
+  auto* self = static_cast<FoxgloveServer*>(data);
+  GSocketAddress* remote = soup_server_message_get_remote_address(message);
+  gchar* peer = remote ? g_socket_connectable_to_string(G_SOCKET_CONNECTABLE(remote)) : nullptr;
+  std::string who = peer ? peer : "a client";
+  g_free(peer);
+  if (self->clients_.size() >= self->content_.maxClients) {
+    ++self->refused_;
+    std::string why = "this recorder serves at most " + std::to_string(self->content_.maxClients) +
+                      " Foxglove clients at once; try again later";
+    soup_websocket_connection_send_text(connection,
+                                        statusMessage(FoxgloveStatusLevel::Error, why).c_str());
+    // 1008: libsoup sends none of the codes after 1011 (1013 would say "try
+    // again later"); the status message before it says so.
+    soup_websocket_connection_close(connection, SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION,
+                                    "too many clients");
+    // Kept until its close handshake is over, so that the reason arrives.
+    g_signal_connect(g_object_ref(connection), "closed",
+                     G_CALLBACK(+[](SoupWebsocketConnection* closed, gpointer) {
+                       g_idle_add(
+                           [](gpointer c) {
+                             g_object_unref(c);
+                             return G_SOURCE_REMOVE;
+                           },
+                           closed);
+                     }),
+                     nullptr);
+    logLine("Foxglove: refused " + who + ": " + why);
+    return;
+  }
+  auto client = std::make_unique<Client>(Client{
+      .server = self,
+      .connection = SOUP_WEBSOCKET_CONNECTION(g_object_ref(connection)),
+      .socket = nullptr,
+      .peer = who,
+      .session = FoxgloveSession({
+          .isChannel = [self](uint32_t id) { return self->channels_.contains(id); },
+          .isCamera = [self](const std::string& name) { return self->feedNamed(name) != nullptr; },
+          .canDrive = !self->content_.token.empty(),
+      })});
+  if (GSocket* socket = self->connections_->socketOf(message))
+    client->socket = G_SOCKET(g_object_ref(socket));
+  soup_websocket_connection_set_max_incoming_payload_size(connection, kMaxIncoming);
+  Client* raw = client.get();
+  client->messageHandler = g_signal_connect(connection, "message", G_CALLBACK(onMessage), raw);
+  client->closedHandler = g_signal_connect(connection, "closed", G_CALLBACK(onClosed), raw);
+  std::vector<std::string> capabilities;
+  if (!self->content_.token.empty()) capabilities.push_back("clientPublish");
+  soup_websocket_connection_send_text(
+      connection, serverInfoMessage("wirc-recorder " + self->content_.version, capabilities,
+                                    {{"maxClients", std::to_string(self->content_.maxClients)},
+                                     {"clients", std::to_string(self->clients_.size() + 1)}},
+                                    self->sessionId_)
+                      .c_str());
+  std::vector<AdvertisedChannel> all;
+  for (const auto& feed : self->feeds_)
+    for (auto& channel : self->channelsOf(*feed)) all.push_back(channel);
+  if (!all.empty()) soup_websocket_connection_send_text(connection, advertiseMessage(all).c_str());
+  self->clients_.push_back(std::move(client));
+  logLine("Foxglove: " + who + " connected (" + std::to_string(self->clients_.size()) + " of " +
+          std::to_string(self->content_.maxClients) + ")");
+}
+
+void FoxgloveServer::onMessage(SoupWebsocketConnection*, gint type, GBytes* message,
+                               gpointer data) {
+  auto& client = *static_cast<Client*>(data);
+  gsize size = 0;
+  const char* bytes = static_cast<const char*>(g_bytes_get_data(message, &size));
+  std::string_view view(bytes, size);
+  client.server->obey(client, type == SOUP_WEBSOCKET_DATA_TEXT ? client.session.text(view)
+                                                               : client.session.binary(view));
+}
+
+void FoxgloveServer::obey(Client& client, const FoxgloveSession::Outcome& outcome) {
+  for (const auto& drive : outcome.drives) {
+    auto obeyed = content_.drive(drive.camera, drive.steering, drive.throttle);
+    if (!obeyed && !outcome.close)
+      soup_websocket_connection_send_text(
+          client.connection,
+          statusMessage(FoxgloveStatusLevel::Warning,
+                        drive.camera + "'s vehicle cannot be driven (no --follow or control)")
+              .c_str());
+  }
+  for (const auto& reply : outcome.replies)
+    soup_websocket_connection_send_text(client.connection, reply.c_str());
+  // Subscriptions to H.264 start at a key frame.
+  for (auto& [channel, decoding] : client.decoding)
+    if (!client.session.subscriptionTo(channel)) decoding = false;
+  if (outcome.close) {
+    logLine("Foxglove: closed " + client.peer + ": " + *outcome.close);
+    std::string reason = outcome.close->substr(0, 120);  // a close frame holds 123 bytes
+    soup_websocket_connection_close(client.connection, SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION,
+                                    reason.c_str());
+  }
+  countImageSubscribers();
+}
+
+void FoxgloveServer::countImageSubscribers() {
+  for (const auto& feed : feeds_) {
+    auto image = feed->channels.find(FoxgloveTopic::Image);
+    int subscribers = 0;
+    for (const auto& c : clients_)
+      if (image != feed->channels.end() && c->session.subscriptionTo(image->second)) ++subscribers;
+    feed->imageSubscribers = subscribers;
+  }
+}
+
+void FoxgloveServer::onClosed(SoupWebsocketConnection*, gpointer data) {
+  auto& client = *static_cast<Client*>(data);
+  FoxgloveServer* self = client.server;
+  for (const auto& camera : client.session.drivenCameras()) self->content_.drive(camera, 0, 0);
+  std::string dropped =
+      client.dropped ? " (" + std::to_string(client.dropped) + " messages it had no room for)" : "";
+  logLine("Foxglove: " + client.peer + " left" + dropped);
+  self->drop(client);
+  self->countImageSubscribers();
+}
+
+void FoxgloveServer::drop(Client& client) {
+  g_signal_handler_disconnect(client.connection, client.messageHandler);
+  g_signal_handler_disconnect(client.connection, client.closedHandler);
+  g_object_unref(client.connection);
+  g_clear_object(&client.socket);
+  std::erase_if(clients_, [&](const auto& c) { return c.get() == &client; });
+}
+
+FoxgloveServer::Feed* FoxgloveServer::feedNamed(const std::string& name) const {
+  for (const auto& feed : feeds_)
+    if (feed->camera.name == name) return feed.get();
+  return nullptr;
+}
+
+std::vector<AdvertisedChannel> FoxgloveServer::channelsOf(const Feed& feed) const {
+  std::vector<AdvertisedChannel> list;
+  for (const auto& [topic, id] : feed.channels) list.push_back(channels_.at(id));
+  return list;
+}
+
+void FoxgloveServer::addCamera(const FoxgloveCamera& camera) {
+  if (feedNamed(camera.name)) return;
+  auto feed = std::make_unique<Feed>();
+  feed->camera = camera;
+  feed->h264 = camera.encoded != nullptr;
+  if (feed->h264) feed->camera.frames = camera.encoded;
+  for (const auto& kind : kinds_) {
+    if (kind.topic == FoxgloveTopic::Pose && !camera.positions) continue;
+    uint32_t id = nextChannel_++;
+    channels_.emplace(id, AdvertisedChannel{id, foxgloveTopicName(camera.name, kind), &kind});
+    feed->channels[kind.topic] = id;
+  }
+  Feed* raw = feed.get();
+  // Frames come on the streaming thread; clients live on the main loop.
+  feed->listener = feed->camera.frames->listen([this, raw](GstSample* sample) {
+    if (raw->imageSubscribers.load() == 0) return;
+    struct Delivery {
+      FoxgloveServer* server;
+      Feed* feed;
+      GstSample* sample;
+      int64_t utcNs;
+      std::weak_ptr<bool> alive;
+    };
+    auto* delivery =
+        new Delivery{this, raw, gst_sample_ref(sample), g_get_real_time() * 1000, alive_};
+    g_main_context_invoke_full(
+        nullptr, G_PRIORITY_DEFAULT,
+        [](gpointer data) -> gboolean {
+          auto* d = static_cast<Delivery*>(data);
+          if (!d->alive.expired()) d->server->sendFrame(*d->feed, d->sample, d->utcNs);
+          return G_SOURCE_REMOVE;
+        },
+        delivery,
+        [](gpointer data) {
+          auto* d = static_cast<Delivery*>(data);
+          gst_sample_unref(d->sample);
+          delete d;
+        });
+  });
+  feeds_.push_back(std::move(feed));
+  auto advertisement = advertiseMessage(channelsOf(*raw));
+  for (const auto& client : clients_)
+    soup_websocket_connection_send_text(client->connection, advertisement.c_str());
+}
+
+void FoxgloveServer::removeCamera(const std::string& name) {
+  Feed* feed = feedNamed(name);
+  if (!feed) return;
+  feed->camera.frames->forget(feed->listener);
+  std::vector<uint32_t> ids;
+  for (const auto& [topic, id] : feed->channels) {
+    ids.push_back(id);
+    channels_.erase(id);
+    for (const auto& client : clients_) client->session.channelGone(id);
+  }
+  auto unadvertisement = unadvertiseMessage(ids);
+  for (const auto& client : clients_)
+    soup_websocket_connection_send_text(client->connection, unadvertisement.c_str());
+  // Frames already on their way to the main loop hold the feed: it goes
+  // with the server, not before (a camera removed is rare; its feed is small).
+  feed->imageSubscribers = 0;
+  feed->channels.clear();
+}
+
+bool FoxgloveServer::hasRoom(const Client& client, size_t bytes) const {
+  if (!client.socket) return true;
+  int fd = g_socket_get_fd(client.socket);
+  int queued = 0;
+  if (ioctl(fd, SIOCOUTQ, &queued) != 0 || queued == 0) return true;
+  // libsoup writes at once what the kernel takes and keeps the rest: a
+  // message goes only while the kernel has room for all of it, so libsoup
+  // never holds more than the one message that filled it.
+  int buffer = 0;
+  socklen_t length = sizeof buffer;
+  getsockopt(fd, SOL_SOCKET, SO_SNDBUF, &buffer, &length);
+  // SO_SNDBUF counts the kernel's bookkeeping too: about half is data.
+  size_t room = std::min<size_t>(static_cast<size_t>(buffer) / 2, kMaxUnsent);
+  return static_cast<size_t>(queued) + bytes <= room;
+}
+
+void FoxgloveServer::publish(uint32_t channel, std::string& frame, bool keyFrame, bool h264) {
+  for (const auto& client : clients_) {
+    auto subscription = client->session.subscriptionTo(channel);
+    if (!subscription ||
+        soup_websocket_connection_get_state(client->connection) != SOUP_WEBSOCKET_STATE_OPEN)
+      continue;
+    bool& decoding = client->decoding[channel];
+    if (h264 && !decoding && !keyFrame) continue;  // a decoder starts at a key frame
+    if (!hasRoom(*client, frame.size())) {
+      ++client->dropped;
+      ++dropped_;
+      decoding = false;  // H.264 after a gap waits for the next key frame
+      continue;
+    }
+    decoding = true;
+    setSubscriptionId(frame, *subscription);
+    soup_websocket_connection_send_binary(client->connection, frame.data(), frame.size());
+    ++sent_;
+  }
+}
+
+void FoxgloveServer::sendFrame(Feed& feed, GstSample* sample, int64_t utcNs) {
+  auto it = feed.channels.find(FoxgloveTopic::Image);
+  if (it == feed.channels.end()) return;
+  GstBuffer* buffer = gst_sample_get_buffer(sample);
+  gst::ScopedBufferMap map(buffer, GST_MAP_READ);
+  if (!map) return;
+  bool key = !GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_DELTA_UNIT);
+  utcNs = stampOf(feed, GST_BUFFER_PTS(buffer), utcNs);
+  std::string converted;
+  std::string_view data = map.view();
+  if (feed.h264) {
+    // Foxglove decodes Annex B; the recording's H.264 is "avc".
+    const GstStructure* caps = gst_caps_get_structure(gst_sample_get_caps(sample), 0);
+    const GValue* record = gst_structure_get_value(caps, "codec_data");
+    if (record && GST_VALUE_HOLDS_BUFFER(record)) {
+      gst::ScopedBufferMap codec(gst_value_get_buffer(record), GST_MAP_READ);
+      auto annexB = codec ? AnnexB::fromAvcC(codec.view()) : std::nullopt;
+      auto frame = annexB ? annexB->convert(data, key) : std::nullopt;
+      if (!frame) return;
+      converted = std::move(*frame);
+      data = converted;
+    }
+  }
+  std::string frame = messageDataHead(0, static_cast<uint64_t>(utcNs));
+  frame += compressedImageHead(utcNs, feed.camera.name, feed.h264 ? "h264" : "jpeg", data.size());
+  frame += data;
+  publish(it->second, frame, key, feed.h264);
+}
+
+void FoxgloveServer::publishBytes(const std::string& camera, FoxgloveTopic topic,
+                                  const std::string& message, int64_t timeNs) {
+  Feed* feed = feedNamed(camera);
+  if (!feed) return;
+  auto it = feed->channels.find(topic);
+  if (it == feed->channels.end()) return;
+  std::string frame = messageDataHead(0, static_cast<uint64_t>(timeNs)) + message;
+  publish(it->second, frame);
+}
+
+void FoxgloveServer::publishJson(const std::string& camera, FoxgloveTopic topic,
+                                 const nlohmann::json& message, int64_t unixMs) {
+  publishBytes(camera, topic,
+               message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+               nsOf(unixMs));
+}
+
+void FoxgloveServer::telemetry(const std::string& camera, const nlohmann::json& line,
+                               int64_t unixMs) {
+  publishJson(camera, FoxgloveTopic::Telemetry, line, unixMs);
+}
+
+int64_t FoxgloveServer::stampOf(Feed& feed, uint64_t pts, int64_t firstNs) {
+  constexpr size_t kFramesKept = 64;  // seconds of frames: the detector's lag and more
+  if (pts == GST_CLOCK_TIME_NONE) return firstNs;
+  auto [it, added] = feed.stamps.emplace(pts, firstNs);
+  if (added && feed.stamps.size() > kFramesKept) feed.stamps.erase(feed.stamps.begin());
+  return it->second;
+}
+
+void FoxgloveServer::detections(const std::string& camera, const nlohmann::json& line,
+                                int64_t unixMs, uint64_t framePts) {
+  Feed* feed = feedNamed(camera);
+  if (!feed) return;
+  int64_t ns = stampOf(*feed, framePts, nsOf(unixMs));
+  publishBytes(camera, FoxgloveTopic::Tags, imageAnnotationsOf(line, ns), ns);
+}
+
+void FoxgloveServer::log(const std::string& camera, const std::string& message, int64_t unixMs) {
+  publishJson(camera, FoxgloveTopic::Log, foxgloveLog(camera, message, nsOf(unixMs)), unixMs);
+}
+
+void FoxgloveServer::pose(const std::string& camera, double x, double y, double z, int64_t unixMs) {
+  publishBytes(camera, FoxgloveTopic::Pose, poseInFrameOf(x, y, z, nsOf(unixMs), "marvelmind"),
+               nsOf(unixMs));
+}
+
+}  // namespace wircam::recorder
