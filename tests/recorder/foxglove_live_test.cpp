@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
@@ -18,6 +19,7 @@
 #include "marvelmind_dashboard.h"
 #include "process_memory.h"
 #include "recorder_process.h"
+#include "shell_command.h"
 #include "signed_in_page.h"
 #include "simulated_device.h"
 #include "wait_for.h"
@@ -346,3 +348,82 @@ TEST(FoxgloveLive, AClientThatStopsReadingMissesFramesAndHoldsNothing) {
 }
 
 }  // namespace
+
+TEST(FoxgloveLive, AnH264RecordingIsServedAsFoxgloveDecodesIt) {
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess recorder(device->port(),
+                           {"--codec", "h264", "--foxglove", "127.0.0.1:0", "--duration", "60"});
+  std::string url = foxgloveUrl(recorder);
+  std::string topic = "/" + cameraOf(device->port()) + "/image";
+  fs::path stream = recorder.out().parent_path() / "live.h264";
+  FoxgloveClient client({"--url", url, "--save-images", stream.string()});
+  ASSERT_TRUE(client.next("advertise", 10s));
+  client.command({{"cmd", "subscribe"}, {"topics", {topic}}});
+  ASSERT_TRUE(client.next("subscribed", 10s));
+  ASSERT_TRUE(waitFor([&] { return countOf(client, topic) >= 45; }, 15s));
+  client.command({{"cmd", "close"}});
+  ASSERT_TRUE(client.next("close", 5s));
+  auto images = messagesOn(client, topic);
+  for (const auto& image : images) EXPECT_EQ(image["decoded"]["format"], "h264");
+  // Annex B from the first image on, which is a key frame with its SPS:
+  // the images alone are a stream ffmpeg decodes, every one a frame.
+  std::ifstream in(stream, std::ios::binary);
+  char head[5] = {};
+  in.read(head, 5);
+  EXPECT_EQ(std::string(head, 5), std::string("\0\0\0\1\x67", 5));
+  EXPECT_EQ(ffmpegDecodeErrors(stream), "");
+  EXPECT_EQ(runCommand("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                       "stream=nb_read_frames -of csv=p=0 '" +
+                       stream.string() + "'")
+                .output,
+            std::to_string(images.size()) + "\n");
+}
+
+// A minute of twenty Foxglove clients connecting, subscribing to every
+// channel and leaving after 0.2-1 s, as panels and tabs come and go.
+TEST(FoxgloveChurn, TwentyClientsComingAndGoingForAMinuteLeaveNothingBehind) {
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess recorder(device->port(), {"--foxglove", "127.0.0.1:0", "--foxglove-max-clients",
+                                            "32", "--duration", "120"});
+  std::string url = foxgloveUrl(recorder);
+  auto churn = [&](int seconds) {
+    FoxgloveClient clients(
+        {"churn", "--url", url, "--clients", "20", "--seconds", std::to_string(seconds)});
+    auto summary = clients.next("churn", std::chrono::seconds(seconds + 30));
+    EXPECT_EQ(clients.wait(5s), 0);
+    return summary.value_or(json::object());
+  };
+  // Warmed up: what the first clients start (libsoup's, GLib's) stays.
+  churn(3);
+  std::this_thread::sleep_for(1s);
+  auto first = processCounts(recorder.pid());
+  long residentFirst = residentKb(recorder.pid());
+  auto summary = churn(60);
+  EXPECT_GT(summary.value("connections", 0), 500) << summary;
+  EXPECT_GT(summary.value("messages", 0), 5000) << summary;
+  EXPECT_EQ(summary.value("errors", json::array()), json::array()) << summary;
+  // Each client's socket went with it (the recording's files may be
+  // between two segments: a descriptor more or less).
+  auto log = recorder.log();
+  auto count = [&](const std::string& text) {
+    size_t n = 0;
+    for (size_t at = log.find(text); at != std::string::npos; at = log.find(text, at + 1)) ++n;
+    return n;
+  };
+  ASSERT_TRUE(waitFor([&] { return processCounts(recorder.pid()).sockets <= first.sockets; }, 5s))
+      << processCounts(recorder.pid()).sockets << " sockets, " << first.sockets << " before; "
+      << count(" connected (") << " clients connected, " << count(" left") << " left";
+  auto last = processCounts(recorder.pid());
+  EXPECT_LE(last.descriptors, first.descriptors + 1);
+  EXPECT_LE(last.threads, first.threads);
+  long residentLast = residentKb(recorder.pid());
+  std::cerr << "[ measured ] " << summary.value("connections", 0)
+            << " Foxglove connections: recorder " << residentFirst / 1024 << " → "
+            << residentLast / 1024 << " MB, " << first.threads << " → " << last.threads
+            << " threads, " << first.descriptors << " → " << last.descriptors << " descriptors\n";
+  if (!kAddressSanitizer) {
+    EXPECT_LT(residentLast - residentFirst, 8 * 1024);
+  }
+}

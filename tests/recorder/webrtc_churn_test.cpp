@@ -48,22 +48,6 @@ std::string roundScript(const std::string& camera, int viewers) {
          "fetch(where, {method: 'DELETE'}); } return all.filter(([up]) => up).length; })()";
 }
 
-struct Counts {
-  size_t threads = 0, descriptors = 0;
-};
-
-// A process's threads and open file descriptors, from /proc.
-Counts countOf(pid_t pid) {
-  namespace fs = std::filesystem;
-  std::string proc = "/proc/" + std::to_string(pid);
-  Counts counts;
-  for (const auto& entry : fs::directory_iterator(proc + "/task"))
-    counts.threads += !entry.path().empty();
-  for (const auto& entry : fs::directory_iterator(proc + "/fd"))
-    counts.descriptors += !entry.path().empty();
-  return counts;
-}
-
 TEST(WebRtcChurn, TwentyViewersComingAndGoingForAMinuteLeaveNothingBehind) {
   if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
   FollowedCar car;
@@ -83,7 +67,7 @@ TEST(WebRtcChurn, TwentyViewersComingAndGoingForAMinuteLeaveNothingBehind) {
   };
   int rounds = 0;
   long afterFirst = 0;
-  Counts first;
+  ProcessCounts first;
   for (auto end = Clock::now() + std::chrono::seconds(60); Clock::now() < end; ++rounds) {
     // Chromium counts closed peer connections until they are collected
     // (500 a renderer at most).
@@ -100,7 +84,7 @@ TEST(WebRtcChurn, TwentyViewersComingAndGoingForAMinuteLeaveNothingBehind) {
     ASSERT_TRUE(allGone()) << signedIn.recorder.log();
     if (rounds == 0) {
       afterFirst = residentKb(signedIn.recorder.pid());
-      first = countOf(signedIn.recorder.pid());
+      first = processCounts(signedIn.recorder.pid());
     }
   }
   // Back where it was once the last viewer's memory went back (the log
@@ -113,7 +97,7 @@ TEST(WebRtcChurn, TwentyViewersComingAndGoingForAMinuteLeaveNothingBehind) {
     atEnd = residentKb(signedIn.recorder.pid());
     return atEnd - afterFirst < boundKb;
   });
-  Counts last = countOf(signedIn.recorder.pid());
+  ProcessCounts last = processCounts(signedIn.recorder.pid());
   // Every viewer's threads and sockets went with it (a leak would be 2 and
   // 16 a viewer); idle pool threads come and go, and the browser keeps up
   // to 6 HTTP connections open or not.

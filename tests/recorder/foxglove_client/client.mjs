@@ -6,6 +6,9 @@
 //
 // Interactive mode, driven by a GoogleTest through pipes:
 //   node client.mjs --url ws://127.0.0.1:PORT/ [--token T] [--no-message-events]
+//                   [--save-images FILE]
+// (--save-images: each image's data appended to FILE as it comes, so that
+// H.264 images are an elementary stream other decoders can read)
 // stdout: one JSON object per line, each with "event" and "t" (Date.now() ms):
 //   open, serverInfo, status, removeStatus, advertise, unadvertise, message,
 //   decodeError, subscribed, unsubscribed, advertised, published, repeating,
@@ -24,6 +27,7 @@
 // prints one line {"event":"churn","connections","failed","messages","errors"}
 // and exits 0, or 1 when a connection failed to open.
 import { createHash } from "node:crypto";
+import { appendFileSync } from "node:fs";
 import { createRequire } from "node:module";
 import { createInterface } from "node:readline";
 import wsProtocol from "@foxglove/ws-protocol";
@@ -65,6 +69,7 @@ function parseArguments(argv) {
     if (arg === "--url") options.url = args.shift();
     else if (arg === "--token") options.token = args.shift();
     else if (arg === "--no-message-events") options.messageEvents = false;
+    else if (arg === "--save-images") options.saveImages = args.shift();
     else if (arg === "--clients") options.clients = Number(args.shift());
     else if (arg === "--seconds") options.seconds = Number(args.shift());
     else throw new Error(`unknown argument ${arg}`);
@@ -189,6 +194,8 @@ function decode(channel, bytes) {
   const [ours, theirs] = results.map((r) => JSON.stringify(r));
   if (ours !== theirs)
     throw new Error(`the advertised schema and Foxglove's disagree: ${ours} vs ${theirs}`);
+  if (options.saveImages && channel.schemaName === "foxglove.CompressedImage")
+    appendFileSync(options.saveImages, channel.foxgloveType.decode(bytes).data);
   return results[0];
 }
 
