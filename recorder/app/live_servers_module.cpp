@@ -17,7 +17,7 @@ Expected<const LiveServers*, std::string> open() {
   g_free(executable);
   GModule* module = g_module_open(path.c_str(), G_MODULE_BIND_LOCAL);
   if (!module)
-    return unexpected("the web and RTSP servers cannot be loaded: " +
+    return unexpected("the web, RTSP and Foxglove servers cannot be loaded: " +
                       std::string(g_module_error()));
   gpointer entry = nullptr;
   if (!g_module_symbol(module, kLiveServersEntry, &entry) || !entry)

@@ -93,7 +93,20 @@ std::optional<std::string> Supervisor::startServers() {
       content.cameras.push_back(
           {c->name(), c->frames(), c->encodedFrames(), !c->plan().positions.empty()});
     content.drive = [this](const std::string& camera, double steering, double throttle) {
+      // What the page does before it drives: left following, the car would
+      // go back to the tag as soon as the driver let go.
+      Camera* c = cameraNamed(camera);
+      if (c && (steering != 0 || throttle != 0)) {
+        auto control = c->report().control;
+        if (control && control->following)
+          commands_.apply({.kind = FleetCommand::Kind::kFollow, .stream = camera, .follow = false},
+                          "Foxglove");
+      }
       return commands_.drive(camera, steering, throttle);
+    };
+    content.drivable = [this](const std::string& camera) {
+      Camera* c = cameraNamed(camera);
+      return c && c->controller();
     };
     auto server = (*servers)->startFoxglove(
         *options_.foxglove, std::move(content),
@@ -101,6 +114,11 @@ std::optional<std::string> Supervisor::startServers() {
     if (!server) return server.error();
     foxglove_ = std::move(*server);
     logLine("Foxglove WebSocket at " + foxglove_->url());
+    std::string host = options_.foxglove->listenHost();
+    if (!options_.httpToken.empty() && options_.httpCert.empty() && host != "127.0.0.1" &&
+        host != "localhost" && host != "::1")
+      logLine("the access token travels in clear over ws:// on " + host +
+              ": anyone on the network can read it; give --http-cert and --http-key for wss://");
   }
   if (options_.rtsp) {
     auto servers = liveServers();

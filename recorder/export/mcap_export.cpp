@@ -28,7 +28,7 @@ std::optional<std::string> McapExport::start(GstCaps* caps) {
   auto writer = McapWriter::create(path_);
   if (!writer) return writer.error();
   writer_ = std::move(*writer);
-  for (const auto& channel : foxgloveChannels(false)) {
+  for (const auto& channel : foxgloveChannels({.video = format_ == "h264"})) {
     uint16_t schema =
         writer_->addSchema(channel.schemaName, channel.schemaEncoding, channel.schema);
     uint16_t id = writer_->addChannel(schema, foxgloveTopicName(stream_, channel), channel.encoding,
@@ -60,7 +60,7 @@ std::optional<std::string> McapExport::frame(GstBuffer* buffer, int64_t, int64_t
   if (annexB_) {
     auto frame = annexB_->convert(map.view(), key);
     if (!frame) return "an H.264 frame whose NAL lengths run past its end";
-    writer_->write(image_, time, time, compressedImageHead(utcNs, stream_, format_, frame->size()),
+    writer_->write(image_, time, time, compressedVideoHead(utcNs, stream_, format_, frame->size()),
                    *frame);
     return std::nullopt;
   }

@@ -1,4 +1,4 @@
-// H.264 as Foxglove decodes it (foxglove.CompressedImage, format "h264"):
+// H.264 as Foxglove decodes it (foxglove.CompressedVideo, format "h264"):
 // Annex B, NAL units after start codes, each key frame led by its SPS and
 // PPS. The recorder's H.264 is "avc" (what the muxers take): NAL units
 // after their lengths, the parameter sets in the caps' codec_data.

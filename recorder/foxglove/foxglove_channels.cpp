@@ -46,18 +46,19 @@ nlohmann::json telemetrySchema() {
 
 }  // namespace
 
-std::vector<FoxgloveChannel> foxgloveChannels(bool withPose) {
+std::vector<FoxgloveChannel> foxgloveChannels(FoxgloveChannelSet set) {
   std::string descriptors(foxgloveDescriptorSet());
+  // Foxglove shows JPEG as an image, and H.264 only as video.
+  std::string image = set.video ? "foxglove.CompressedVideo" : "foxglove.CompressedImage";
   std::vector<FoxgloveChannel> channels = {
-      {FoxgloveTopic::Image, "/image", "protobuf", "foxglove.CompressedImage", "protobuf",
-       descriptors, false},
+      {FoxgloveTopic::Image, "/image", "protobuf", image, "protobuf", descriptors, false},
       {FoxgloveTopic::Tags, "/tags", "protobuf", "foxglove.ImageAnnotations", "protobuf",
        descriptors, true},
       {FoxgloveTopic::Telemetry, "/telemetry", "json", "wircam.Telemetry", "jsonschema",
        telemetrySchema().dump(), true},
       {FoxgloveTopic::Log, "/log", "json", "foxglove.Log", "jsonschema", logSchema().dump(), true},
   };
-  if (withPose)
+  if (set.positions)
     channels.push_back({FoxgloveTopic::Pose, "/pose", "protobuf", "foxglove.PoseInFrame",
                         "protobuf", descriptors, true});
   return channels;

@@ -51,6 +51,16 @@ std::string compressedImageHead(int64_t utcNs, const std::string& frameId,
       .out();
 }
 
+std::string compressedVideoHead(int64_t utcNs, const std::string& frameId,
+                                const std::string& format, size_t dataBytes) {
+  return ProtobufWriter()
+      .bytes(1, timestampOf(utcNs))
+      .bytes(2, frameId)
+      .bytes(4, format)
+      .lengthOnly(3, dataBytes)
+      .out();
+}
+
 std::string imageAnnotationsOf(const nlohmann::json& line, int64_t utcNs) {
   constexpr uint64_t kLineLoop = 2;
   ProtobufWriter annotations;

@@ -13,7 +13,8 @@
 
 namespace wircam::recorder {
 
-// foxglove.CompressedImage, ImageAnnotations and PoseInFrame with every file
+// foxglove.CompressedImage, CompressedVideo, ImageAnnotations and PoseInFrame
+// with every file
 // they import: what a protobuf channel's schema holds (an MCAP Schema
 // record's data; base64 in the WebSocket's advertisement).
 std::string_view foxgloveDescriptorSet();
@@ -21,6 +22,10 @@ std::string_view foxgloveDescriptorSet();
 // A foxglove.CompressedImage up to its data's bytes (their key and length
 // included): the frame follows as it is, never copied into the message.
 std::string compressedImageHead(int64_t utcNs, const std::string& frameId,
+                                const std::string& format, size_t dataBytes);
+// The same for a foxglove.CompressedVideo (one frame of "h264": Annex B,
+// each key frame with its SPS and PPS).
+std::string compressedVideoHead(int64_t utcNs, const std::string& frameId,
                                 const std::string& format, size_t dataBytes);
 
 // A detections line's tags as foxglove.ImageAnnotations: each outline a

@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <mutex>
+#include <set>
 
+#include "common/printable_text.h"
 #include "foxglove/annex_b.h"
 #include "foxglove/foxglove_messages.h"
 #include "gst_scoped.h"
@@ -34,6 +36,7 @@ struct FoxgloveServer::Client {
   gulong messageHandler = 0, closedHandler = 0;
   std::map<uint32_t, bool> decoding;  // H.264 channel -> it has had a key frame since a gap
   uint64_t dropped = 0;
+  std::set<std::string> disobeyed;  // cameras whose vehicle did not obey it, told so
 };
 
 namespace {
@@ -145,12 +148,20 @@ void FoxgloveServer::onRequest(SoupServer*, SoupServerMessage* message, const ch
                             "needs the access token: Authorization: Bearer T, or ?token=T in the "
                             "URL");
   auto* headers = soup_server_message_get_request_headers(message);
-  if (!soup_message_headers_header_contains(headers, "Upgrade", "websocket"))
-    return respondJsonError(message, kHttpUpgradeRequired,
-                            "a Foxglove WebSocket (foxglove.websocket.v1): open " + self->url_ +
-                                " in Foxglove or Lichtblick");
-  // Left unanswered: libsoup upgrades it (onWebSocket), or answers 400
-  // when the client does not offer foxglove.websocket.v1.
+  if (!soup_message_headers_header_contains(headers, "Upgrade", "websocket")) {
+    respondJsonError(message, kHttpUpgradeRequired,
+                     std::string("a Foxglove WebSocket (") + kFoxgloveSubprotocol + "): open " +
+                         self->url_ + " in Foxglove or Lichtblick");
+    soup_server_message_set_status(message, kHttpUpgradeRequired, "Upgrade Required");
+    return;
+  }
+  // libsoup would take a client that offers no subprotocol at all.
+  if (!soup_message_headers_header_contains(headers, "Sec-WebSocket-Protocol",
+                                            kFoxgloveSubprotocol))
+    return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
+                            std::string("this server speaks the ") + kFoxgloveSubprotocol +
+                                " subprotocol only: offer it (Sec-WebSocket-Protocol)");
+  // Left unanswered: libsoup upgrades it (onWebSocket).
   self->connections_->upgrading(message);
 }
 
@@ -163,8 +174,9 @@ void FoxgloveServer::onWebSocket(SoupServer*, SoupServerMessage* message, const 
   g_free(peer);
   if (self->clients_.size() >= self->content_.maxClients) {
     ++self->refused_;
-    std::string why = "this recorder serves at most " + std::to_string(self->content_.maxClients) +
-                      " Foxglove clients at once; try again later";
+    size_t most = self->content_.maxClients;
+    std::string why = "this recorder serves at most " + std::to_string(most) + " Foxglove client" +
+                      (most == 1 ? "" : "s") + " at once; try again later";
     soup_websocket_connection_send_text(connection,
                                         statusMessage(FoxgloveStatusLevel::Error, why).c_str());
     // 1008: libsoup sends none of the codes after 1011 (1013 would say "try
@@ -193,6 +205,7 @@ void FoxgloveServer::onWebSocket(SoupServer*, SoupServerMessage* message, const 
       .session = FoxgloveSession({
           .isChannel = [self](uint32_t id) { return self->channels_.contains(id); },
           .isCamera = [self](const std::string& name) { return self->feedNamed(name) != nullptr; },
+          .isDrivable = [self](const std::string& name) { return self->content_.drivable(name); },
           .canDrive = !self->content_.token.empty(),
       })});
   if (GSocket* socket = self->connections_->socketOf(message))
@@ -230,13 +243,18 @@ void FoxgloveServer::onMessage(SoupWebsocketConnection*, gint type, GBytes* mess
 
 void FoxgloveServer::obey(Client& client, const FoxgloveSession::Outcome& outcome) {
   for (const auto& drive : outcome.drives) {
-    auto obeyed = content_.drive(drive.camera, drive.steering, drive.throttle);
-    if (!obeyed && !outcome.close)
-      soup_websocket_connection_send_text(
-          client.connection,
-          statusMessage(FoxgloveStatusLevel::Warning,
-                        drive.camera + "'s vehicle cannot be driven (no --follow or control)")
-              .c_str());
+    bool obeyed = content_.drive(drive.camera, drive.steering, drive.throttle).value_or(false);
+    // Said once, until the vehicle obeys again: not ten times a second.
+    bool told = client.disobeyed.contains(drive.camera);
+    if (obeyed) client.disobeyed.erase(drive.camera);
+    if (obeyed || told || outcome.close) continue;
+    client.disobeyed.insert(drive.camera);
+    soup_websocket_connection_send_text(
+        client.connection,
+        statusMessage(FoxgloveStatusLevel::Warning,
+                      drive.camera + "'s vehicle does not obey: the recorder does not hold its "
+                                     "control right (request-control: docs/foxglove.md)")
+            .c_str());
   }
   for (const auto& reply : outcome.replies)
     soup_websocket_connection_send_text(client.connection, reply.c_str());
@@ -244,7 +262,7 @@ void FoxgloveServer::obey(Client& client, const FoxgloveSession::Outcome& outcom
   for (auto& [channel, decoding] : client.decoding)
     if (!client.session.subscriptionTo(channel)) decoding = false;
   if (outcome.close) {
-    logLine("Foxglove: closed " + client.peer + ": " + *outcome.close);
+    logLine("Foxglove: closed " + client.peer + ": " + printableText(*outcome.close));
     std::string reason = outcome.close->substr(0, 120);  // a close frame holds 123 bytes
     soup_websocket_connection_close(client.connection, SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION,
                                     reason.c_str());
@@ -302,7 +320,9 @@ void FoxgloveServer::addCamera(const FoxgloveCamera& camera) {
   for (const auto& kind : kinds_) {
     if (kind.topic == FoxgloveTopic::Pose && !camera.positions) continue;
     uint32_t id = nextChannel_++;
-    channels_.emplace(id, AdvertisedChannel{id, foxgloveTopicName(camera.name, kind), &kind});
+    const FoxgloveChannel* channel =
+        kind.topic == FoxgloveTopic::Image && feed->h264 ? &video_ : &kind;
+    channels_.emplace(id, AdvertisedChannel{id, foxgloveTopicName(camera.name, kind), channel});
     feed->channels[kind.topic] = id;
   }
   Feed* raw = feed.get();
@@ -418,7 +438,8 @@ void FoxgloveServer::sendFrame(Feed& feed, GstSample* sample, int64_t utcNs) {
     }
   }
   std::string frame = messageDataHead(0, static_cast<uint64_t>(utcNs));
-  frame += compressedImageHead(utcNs, feed.camera.name, feed.h264 ? "h264" : "jpeg", data.size());
+  frame += feed.h264 ? compressedVideoHead(utcNs, feed.camera.name, "h264", data.size())
+                     : compressedImageHead(utcNs, feed.camera.name, "jpeg", data.size());
   frame += data;
   publish(it->second, frame, key, feed.h264);
 }

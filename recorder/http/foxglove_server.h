@@ -89,7 +89,9 @@ class FoxgloveServer : public FoxgloveService {
   static int64_t stampOf(Feed& feed, uint64_t pts, int64_t firstNs);
 
   FoxgloveContent content_;
-  const std::vector<FoxgloveChannel> kinds_ = foxgloveChannels(true);
+  // Every channel a camera may have, for the advertisements to point at.
+  const std::vector<FoxgloveChannel> kinds_ = foxgloveChannels({.positions = true});
+  const FoxgloveChannel video_ = foxgloveChannels({.video = true}).front();
   SoupServer* server_ = nullptr;
   std::unique_ptr<HttpConnections> connections_;
   std::string url_, sessionId_;

@@ -31,7 +31,14 @@ Expected<DriveCommand, std::string> driveIn(std::string_view payload) {
     nlohmann::json asDrive = {{"steering", angular.value("z", nlohmann::json())},
                               {"throttle", linear.value("x", nlohmann::json())}};
     auto command = parseDriveCommand(asDrive.dump());
-    if (!command) return unexpected("a Twist: " + command.error());
+    if (!command) {
+      // Named as the Twist names them.
+      std::string why = command.error();
+      for (auto [ours, theirs] : {std::pair("'steering'", "angular.z"), {"'throttle'", "linear.x"}})
+        if (auto at = why.find(ours); at != std::string::npos)
+          why.replace(at, std::string_view(ours).size(), theirs);
+      return unexpected("a Twist's " + why);
+    }
     return command;
   }
   return parseDriveCommand(payload);
@@ -89,6 +96,9 @@ void FoxgloveSession::advertise(const ClientAdvertise& message, Outcome& outcome
     else if (!camera || !server_.isCamera(*camera))
       refusal = "only /STREAM/drive is published here, STREAM a camera; not '" +
                 channel.topic.substr(0, 80) + "'";
+    else if (!server_.isDrivable(*camera))
+      refusal = *camera +
+                "'s vehicle cannot be driven: the recorder steers a camera's vehicle with --follow";
     else if (channel.encoding != "json")
       refusal = channel.topic + " takes JSON, not '" + channel.encoding.substr(0, 40) + "'";
     else if (driveChannels_.contains(channel.id))

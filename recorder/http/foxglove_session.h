@@ -27,6 +27,7 @@ class FoxgloveSession {
   struct Server {
     std::function<bool(uint32_t channelId)> isChannel;
     std::function<bool(const std::string& camera)> isCamera;
+    std::function<bool(const std::string& camera)> isDrivable;  // it steers a vehicle
     bool canDrive = false;  // with the access token only, as the web page's drive mode
   };
   struct Drive {

@@ -112,6 +112,8 @@ struct FoxgloveContent {
   // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
   std::function<std::optional<bool>(const std::string& camera, double steering, double throttle)>
       drive;
+  // Whether the camera steers a vehicle (--follow), for a drive channel.
+  std::function<bool(const std::string& camera)> drivable;
 };
 
 // The Foxglove WebSocket server (foxglove.websocket.v1): each camera's

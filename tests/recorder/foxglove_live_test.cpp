@@ -174,6 +174,11 @@ TEST(FoxgloveLive, AClientSeesTheCameraAsRecordedAndDrivesTheCar) {
     auto pulses = car.device->outputs().pulses;
     return pulses[kThrottle] > 1500 && pulses[kSteering] < 1500;
   }));
+  // Driving took the car from the follower, as the web page's drive mode
+  // does: it stays where the driver leaves it.
+  size_t statuses = countOf(client, topic + "/telemetry");
+  ASSERT_TRUE(waitFor([&] { return countOf(client, topic + "/telemetry") > statuses; }, 3s));
+  EXPECT_EQ(messagesOn(client, topic + "/telemetry").back()["decoded"]["following"], false);
   // The client falls silent, its socket open: the dead-man stops the car.
   client.command({{"cmd", "stopRepeat"}});
   ASSERT_TRUE(client.next("stoppedRepeat", 5s));
@@ -366,6 +371,15 @@ TEST(FoxgloveLive, AnH264RecordingIsServedAsFoxgloveDecodesIt) {
   ASSERT_TRUE(client.next("close", 5s));
   auto images = messagesOn(client, topic);
   for (const auto& image : images) EXPECT_EQ(image["decoded"]["format"], "h264");
+  // Foxglove shows H.264 as video, not as an image.
+  auto advertised = client.events();
+  for (const auto& event : advertised) {
+    if (event["event"] != "advertise") continue;
+    for (const auto& channel : event["channels"])
+      if (channel["topic"] == topic) {
+        EXPECT_EQ(channel["schemaName"], "foxglove.CompressedVideo");
+      }
+  }
   // Annex B from the first image on, which is a key frame with its SPS:
   // the images alone are a stream ffmpeg decodes, every one a frame.
   std::ifstream in(stream, std::ios::binary);

@@ -51,6 +51,7 @@ const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers
 const ajv = new Ajv({ strict: false });
 const foxgloveSchemas = {
   "foxglove.CompressedImage": foxglove.CompressedImage,
+  "foxglove.CompressedVideo": foxglove.CompressedVideo,
   "foxglove.ImageAnnotations": foxglove.ImageAnnotations,
   "foxglove.Log": foxglove.Log,
 };
@@ -145,7 +146,7 @@ for await (const message of reader.readMessages()) {
     const stamp = BigInt(json.timestamp.sec) * 1000000000n + BigInt(json.timestamp.nsec);
     if (stamp !== message.logTime) result.logsOffTheirTimestamp += 1;
   }
-  if (v.name === "foxglove.CompressedImage") {
+  if (v.name === "foxglove.CompressedImage" || v.name === "foxglove.CompressedVideo") {
     const data = Buffer.from(json.data);
     imageData.push(data);
     result.images.push({

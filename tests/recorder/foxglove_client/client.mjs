@@ -124,6 +124,7 @@ function stamp(timestamp) {
 function summarize(schemaName, m) {
   switch (schemaName) {
     case "foxglove.CompressedImage":
+    case "foxglove.CompressedVideo":
       return {
         format: m.format,
         frame_id: m.frame_id,
@@ -194,7 +195,7 @@ function decode(channel, bytes) {
   const [ours, theirs] = results.map((r) => JSON.stringify(r));
   if (ours !== theirs)
     throw new Error(`the advertised schema and Foxglove's disagree: ${ours} vs ${theirs}`);
-  if (options.saveImages && channel.schemaName === "foxglove.CompressedImage")
+  if (options.saveImages && channel.schemaName.startsWith("foxglove.Compressed"))
     appendFileSync(options.saveImages, channel.foxgloveType.decode(bytes).data);
   return results[0];
 }

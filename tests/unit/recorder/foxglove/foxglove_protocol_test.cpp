@@ -14,7 +14,7 @@ using namespace std::string_literals;
 using nlohmann::json;
 
 TEST(FoxgloveProtocol, AProtobufChannelIsAdvertisedWithItsDescriptorsInBase64) {
-  auto channels = foxgloveChannels(true);
+  auto channels = foxgloveChannels({.positions = true});
   ASSERT_EQ(channels.size(), 5u);
   auto message = json::parse(
       advertiseMessage({{7, foxgloveTopicName("rover-cam0", channels[0]), &channels[0]},
@@ -35,7 +35,8 @@ TEST(FoxgloveProtocol, AProtobufChannelIsAdvertisedWithItsDescriptorsInBase64) {
   EXPECT_EQ(telemetry["schemaEncoding"], "jsonschema");
   EXPECT_EQ(json::parse(telemetry["schema"].get<std::string>())["title"], "wircam.Telemetry");
   EXPECT_EQ(channels[4].schemaName, "foxglove.PoseInFrame");
-  EXPECT_EQ(foxgloveChannels(false).size(), 4u);
+  EXPECT_EQ(foxgloveChannels({}).size(), 4u);
+  EXPECT_EQ(foxgloveChannels({.video = true})[0].schemaName, "foxglove.CompressedVideo");
 }
 
 TEST(FoxgloveProtocol, MessageDataIsLittleEndianAndItsSubscriptionCanBeRewritten) {

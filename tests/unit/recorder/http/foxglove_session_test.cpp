@@ -10,11 +10,14 @@ namespace {
 using namespace std::string_literals;
 using nlohmann::json;
 
-// A recorder with one camera, "rover-cam0", whose channels are 1..5.
+// A recorder with two cameras, "rover-cam0" (channels 1..5), which steers
+// its vehicle, and "rover-cam1", which does not.
 FoxgloveSession sessionOf(bool canDrive = true) {
-  return FoxgloveSession({.isChannel = [](uint32_t id) { return id >= 1 && id <= 5; },
-                          .isCamera = [](const std::string& name) { return name == "rover-cam0"; },
-                          .canDrive = canDrive});
+  return FoxgloveSession(
+      {.isChannel = [](uint32_t id) { return id >= 1 && id <= 5; },
+       .isCamera = [](const std::string& name) { return name.starts_with("rover-cam"); },
+       .isDrivable = [](const std::string& name) { return name == "rover-cam0"; },
+       .canDrive = canDrive});
 }
 
 std::string publish(uint32_t channel, const std::string& payload) {
