@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "common/expected.h"
-#include "http/server_address.h"
+#include "live/server_address.h"
 #include "marvelmind/marvelmind_messages.h"
 
 namespace wircam::recorder {

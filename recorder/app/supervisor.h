@@ -20,7 +20,7 @@
 #include "camera/camera.h"
 #include "common/expected.h"
 #include "fleet/fleet_publisher.h"
-#include "http/live_servers.h"
+#include "live/live_servers.h"
 #include "record/disk_guard.h"
 #include "record/recording_index.h"
 #include "record/retention.h"

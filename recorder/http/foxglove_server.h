@@ -26,8 +26,8 @@
 #include "foxglove/foxglove_protocol.h"
 #include "http/foxglove_session.h"
 #include "http/http_connections.h"
-#include "http/live_servers.h"
-#include "http/server_address.h"
+#include "live/live_servers.h"
+#include "live/server_address.h"
 
 namespace wircam::recorder {
 

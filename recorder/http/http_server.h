@@ -24,8 +24,8 @@
 #include "http/export_downloads.h"
 #include "http/http_connections.h"
 #include "http/http_routes.h"
-#include "http/live_servers.h"
-#include "http/server_address.h"
+#include "live/live_servers.h"
+#include "live/server_address.h"
 #include "webrtc/webrtc_service.h"
 
 namespace wircam::recorder {

@@ -13,8 +13,8 @@
 
 #include "camera/frame_tap.h"
 #include "common/expected.h"
-#include "http/live_servers.h"
-#include "http/server_address.h"
+#include "live/live_servers.h"
+#include "live/server_address.h"
 
 namespace wircam::recorder {
 

@@ -20,7 +20,7 @@
 
 #include "common/expected.h"
 #include "webrtc/camera_encoder.h"
-#include "webrtc/ice_servers.h"
+#include "live/ice_servers.h"
 #include "webrtc/whep_sdp.h"
 
 namespace wircam::recorder {

@@ -23,8 +23,8 @@
 #include "camera/frame_tap.h"
 #include "common/expected.h"
 #include "fleet/fleet_command.h"
-#include "http/server_address.h"
-#include "webrtc/ice_servers.h"
+#include "live/server_address.h"
+#include "live/ice_servers.h"
 
 namespace wircam::recorder {
 
