@@ -78,7 +78,7 @@ TEST(RecorderFootprint, WithoutItsServersModuleTheWebServerIsRefusedWithTheReaso
                  (folder / "recordings").string() + "' --http 127.0.0.1:0 --duration 10 2>&1");
   EXPECT_EQ(run.exitCode, 1) << run.output;
   // Where it looked: lib/ beside the folder of the executable.
-  EXPECT_NE(run.output.find("the web and RTSP servers cannot be loaded: " +
+  EXPECT_NE(run.output.find("the web, RTSP and Foxglove servers cannot be loaded: " +
                             (folder.parent_path() / "lib").string()),
             std::string::npos)
       << run.output;
