@@ -53,12 +53,12 @@ std::optional<std::string> McapExport::start(GstCaps* caps) {
   return std::nullopt;
 }
 
-std::optional<std::string> McapExport::frame(GstBuffer* buffer, int64_t, int64_t utcNs, bool key) {
+std::optional<std::string> McapExport::frame(GstBuffer* buffer, int64_t, int64_t utcNs, bool) {
   gst::ScopedBufferMap map(buffer, GST_MAP_READ);
   if (!map) return "an unreadable frame";
   auto time = static_cast<uint64_t>(std::max<int64_t>(utcNs, 0));
   if (annexB_) {
-    auto frame = annexB_->convert(map.view(), key);
+    auto frame = annexB_->convert(map.view());
     if (!frame) return "an H.264 frame whose NAL lengths run past its end";
     writer_->write(image_, time, time, compressedVideoHead(utcNs, stream_, format_, frame->size()),
                    *frame);

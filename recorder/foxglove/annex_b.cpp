@@ -1,5 +1,8 @@
 #include "foxglove/annex_b.h"
 
+#include <algorithm>
+#include <vector>
+
 namespace wircam::recorder {
 
 namespace {
@@ -30,20 +33,33 @@ std::optional<AnnexB> AnnexB::fromAvcC(std::string_view record) {
   return converter;
 }
 
-std::optional<std::string> AnnexB::convert(std::string_view accessUnit, bool keyFrame) const {
-  std::string out;
-  out.reserve(accessUnit.size() + (keyFrame ? parameterSets_.size() : 0) + 16);
-  if (keyFrame) out.append(parameterSets_);
-  size_t at = 0;
-  while (at < accessUnit.size()) {
+std::optional<std::string> AnnexB::convert(std::string_view accessUnit) const {
+  // The NAL units first, then the access unit in its order.
+  std::vector<std::string_view> units;
+  for (size_t at = 0; at < accessUnit.size();) {
     if (at + lengthSize_ > accessUnit.size()) return std::nullopt;
     size_t length = 0;
     for (size_t i = 0; i < lengthSize_; ++i)
       length = length << 8 | static_cast<uint8_t>(accessUnit[at + i]);
     at += lengthSize_;
     if (length > accessUnit.size() - at) return std::nullopt;
-    out.append(kStartCode).append(accessUnit.substr(at, length));
+    units.push_back(accessUnit.substr(at, length));
     at += length;
+  }
+  auto typeOf = [](std::string_view unit) { return unit.empty() ? 0 : unit[0] & 0x1f; };
+  constexpr int kIdr = 5, kSps = 7, kDelimiter = 9;
+  bool idr = std::any_of(units.begin(), units.end(), [&](auto u) { return typeOf(u) == kIdr; });
+  bool sps = std::any_of(units.begin(), units.end(), [&](auto u) { return typeOf(u) == kSps; });
+  bool withSets = idr && !sps;
+  std::string out;
+  out.reserve(accessUnit.size() + parameterSets_.size() + 4 * units.size());
+  for (size_t i = 0; i < units.size(); ++i) {
+    bool delimiter = i == 0 && typeOf(units[i]) == kDelimiter;
+    if (withSets && !delimiter) {
+      out.append(parameterSets_);
+      withSets = false;
+    }
+    out.append(kStartCode).append(units[i]);
   }
   return out;
 }

@@ -210,7 +210,7 @@ void FoxgloveServer::onWebSocket(SoupServer*, SoupServerMessage* message, const 
       })});
   if (GSocket* socket = self->connections_->socketOf(message))
     client->socket = G_SOCKET(g_object_ref(socket));
-  soup_websocket_connection_set_max_incoming_payload_size(connection, kMaxIncoming);
+  soup_websocket_connection_set_max_incoming_payload_size(connection, kMaxBuffered);
   Client* raw = client.get();
   client->messageHandler = g_signal_connect(connection, "message", G_CALLBACK(onMessage), raw);
   client->closedHandler = g_signal_connect(connection, "closed", G_CALLBACK(onClosed), raw);
@@ -237,6 +237,15 @@ void FoxgloveServer::onMessage(SoupWebsocketConnection*, gint type, GBytes* mess
   gsize size = 0;
   const char* bytes = static_cast<const char*>(g_bytes_get_data(message, &size));
   std::string_view view(bytes, size);
+  if (size > kMaxIncoming) {
+    std::string why =
+        "a message of " + std::to_string(size) + " bytes; at most " + std::to_string(kMaxIncoming);
+    logLine("Foxglove: closed " + client.peer + ": " + why);
+    for (const auto& camera : client.session.drivenCameras())
+      client.server->content_.drive(camera, 0, 0);
+    soup_websocket_connection_close(client.connection, SOUP_WEBSOCKET_CLOSE_TOO_BIG, why.c_str());
+    return;
+  }
   client.server->obey(client, type == SOUP_WEBSOCKET_DATA_TEXT ? client.session.text(view)
                                                                : client.session.binary(view));
 }
@@ -286,7 +295,12 @@ void FoxgloveServer::onClosed(SoupWebsocketConnection*, gpointer data) {
   for (const auto& camera : client.session.drivenCameras()) self->content_.drive(camera, 0, 0);
   std::string dropped =
       client.dropped ? " (" + std::to_string(client.dropped) + " messages it had no room for)" : "";
-  logLine("Foxglove: " + client.peer + " left" + dropped);
+  // How it ended, as libsoup saw it: 1006 when the connection just went.
+  gushort code = soup_websocket_connection_get_close_code(client.connection);
+  const char* reason = soup_websocket_connection_get_close_data(client.connection);
+  std::string how = code == 0 ? "" : ", " + std::to_string(code);
+  if (reason && *reason) how += " " + printableText(reason);
+  logLine("Foxglove: " + client.peer + " left" + how + dropped);
   self->drop(client);
   self->countImageSubscribers();
 }
@@ -431,7 +445,7 @@ void FoxgloveServer::sendFrame(Feed& feed, GstSample* sample, int64_t utcNs) {
     if (record && GST_VALUE_HOLDS_BUFFER(record)) {
       gst::ScopedBufferMap codec(gst_value_get_buffer(record), GST_MAP_READ);
       auto annexB = codec ? AnnexB::fromAvcC(codec.view()) : std::nullopt;
-      auto frame = annexB ? annexB->convert(data, key) : std::nullopt;
+      auto frame = annexB ? annexB->convert(data) : std::nullopt;
       if (!frame) return;
       converted = std::move(*frame);
       data = converted;

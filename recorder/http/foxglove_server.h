@@ -53,8 +53,11 @@ class FoxgloveServer : public FoxgloveService {
   // a few frames of 720p, so that a viewer that keeps up never misses one.
   static constexpr size_t kMaxUnsent = 512 * 1024;
   // What a client may send in one message (a subscription to every channel
-  // of 256 cameras fits).
+  // of 256 cameras fits): a bigger one closes it with 1009 and the reason.
+  // libsoup holds a message whole before it hands it on: past
+  // kMaxBuffered it drops the connection itself, without a close frame.
   static constexpr size_t kMaxIncoming = 256 * 1024;
+  static constexpr size_t kMaxBuffered = 1024 * 1024;
 
  private:
   struct Feed;    // a camera: its channels and its frames

@@ -105,14 +105,17 @@ void FoxgloveSession::advertise(const ClientAdvertise& message, Outcome& outcome
       refusal = "client channel id " + std::to_string(channel.id) + " is in use";
     if (!refusal.empty()) {
       outcome.replies.push_back(statusMessage(FoxgloveStatusLevel::Error, refusal));
+      refused_.insert(channel.id);
       continue;
     }
+    refused_.erase(channel.id);
     driveChannels_[channel.id] = *camera;
   }
 }
 
 void FoxgloveSession::unadvertise(const ClientUnadvertise& message, Outcome& outcome) {
   for (uint32_t id : message.channelIds) {
+    refused_.erase(id);
     auto it = driveChannels_.find(id);
     if (it == driveChannels_.end()) continue;
     std::string camera = it->second;
@@ -129,6 +132,8 @@ FoxgloveSession::Outcome FoxgloveSession::binary(std::string_view bytes) {
   auto message = parseClientBinary(bytes);
   if (!message) {
     outcome.close = message.error();
+  } else if (refused_.contains(message->channelId)) {
+    // Told so when it advertised the channel: dropped.
   } else if (auto it = driveChannels_.find(message->channelId); it == driveChannels_.end()) {
     outcome.close = "a message on channel " + std::to_string(message->channelId) +
                     ", which this client did not advertise";

@@ -6,7 +6,9 @@
 // and publishing {"steering": S, "throttle": T}, or a Twist as Foxglove's
 // Teleop panel sends it (linear.x the throttle, angular.z the steering),
 // each in -1..1. Junk (not JSON, an unknown op or channel, a value out of
-// range) closes the client: its vehicles go to neutral at once.
+// range) closes the client: its vehicles go to neutral at once. Messages
+// on a channel whose advertisement was refused (with a status) are dropped:
+// a Teleop panel pointed at the wrong topic is told once, not cut off.
 #pragma once
 
 #include <cstdint>
@@ -63,6 +65,7 @@ class FoxgloveSession {
   Server server_;
   std::map<uint32_t, uint32_t> subscriptions_;     // subscription id -> channel id
   std::map<uint32_t, std::string> driveChannels_;  // the client's channel id -> camera
+  std::set<uint32_t> refused_;  // channels it advertised and was told it cannot publish on
   std::set<std::string> driven_;
 };
 

@@ -18,8 +18,8 @@
 #include <tuple>
 #include <vector>
 
+#include "devices/wirc/device.h"
 #include "follow_scene.h"
-#include "wirc/device.h"
 
 namespace {
 

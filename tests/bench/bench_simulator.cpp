@@ -6,8 +6,8 @@
 #include <benchmark/benchmark.h>
 #include <gst/gst.h>
 
+#include "devices/wirc/stream_sender.h"
 #include "follow_scene.h"
-#include "wirc/stream_sender.h"
 
 namespace {
 

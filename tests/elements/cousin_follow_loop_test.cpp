@@ -6,10 +6,10 @@
 
 #include <thread>
 
+#include "devices/wirc/device.h"
 #include "follow_scene.h"
 #include "vehicle_control.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 
 namespace {
 

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "devices/wirc/device.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 #include "wirc_tag_meta.h"
 
 namespace wircam::testing {

@@ -5,9 +5,9 @@
 
 #include <thread>
 
+#include "devices/wirc/device.h"
 #include "follow_scene.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 
 namespace {
 

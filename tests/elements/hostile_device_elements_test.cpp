@@ -7,12 +7,12 @@
 #include <atomic>
 #include <thread>
 
+#include "devices/wirc/device.h"
 #include "jpeg_sequence_scene.h"
 #include "misbehaving_peers.h"
 #include "pipelines.h"
 #include "scene_frames.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 
 namespace {
 

@@ -5,11 +5,11 @@
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
+#include "devices/wirc/device.h"
 #include "misbehaving_peers.h"
 #include "pipelines.h"
 #include "vehicle_control.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 #include "wirc/transmitter_session.h"
 #include "wirc_tag_meta.h"
 

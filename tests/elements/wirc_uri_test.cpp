@@ -8,10 +8,10 @@
 #include <regex>
 #include <thread>
 
+#include "devices/wirc/device.h"
 #include "jpeg_sequence_scene.h"
 #include "pipelines.h"
 #include "scene_frames.h"
-#include "wirc/device.h"
 
 namespace wircam {
 namespace {

@@ -7,11 +7,11 @@
 #include <thread>
 
 #include "buffer_bytes.h"
+#include "devices/wirc/device.h"
 #include "jpeg_sequence_scene.h"
 #include "pipelines.h"
 #include "scene_frames.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 #include "wirc/transmitter_session.h"
 
 namespace {

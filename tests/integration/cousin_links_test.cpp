@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "btemp/btemp_controller.h"
-#include "btemp/btemp_robot.h"
 #include "common/socket.h"
-#include "rcoip/rcoip_receiver.h"
+#include "devices/btemp/btemp_robot.h"
+#include "devices/rcoip/rcoip_receiver.h"
 #include "rcoip/rcoip_transmitter.h"
 #include "wait_for.h"
 

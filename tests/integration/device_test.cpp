@@ -1,6 +1,6 @@
 // wirc-sim's device against raw sockets on loopback: every rule of the WiRC
 // protocol the simulator promises, checked without any GStreamer.
-#include "wirc/device.h"
+#include "devices/wirc/device.h"
 
 #include <gtest/gtest.h>
 

@@ -9,14 +9,14 @@
 #include <memory>
 
 #include "btemp/btemp_controller.h"
-#include "btemp/btemp_robot.h"
+#include "devices/btemp/btemp_robot.h"
+#include "devices/rcoip/rcoip_receiver.h"
+#include "devices/wirc/device.h"
 #include "link/event_loop.h"
 #include "marvelmind/position_client.h"
 #include "marvelmind_dashboard.h"
-#include "rcoip/rcoip_receiver.h"
 #include "rcoip/rcoip_transmitter.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 #include "wirc/transmitter_session.h"
 
 namespace wircam {

@@ -6,10 +6,10 @@
 
 #include <mutex>
 
+#include "devices/wirc/device.h"
 #include "misbehaving_peers.h"
 #include "raw_transmitter.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 #include "wirc/discovery.h"
 
 namespace wircam::wirc {

@@ -8,13 +8,13 @@
 #include <sstream>
 #include <string>
 
-#include "btemp/btemp_robot.h"
+#include "devices/btemp/btemp_robot.h"
+#include "devices/rcoip/rcoip_receiver.h"
+#include "devices/wirc/device.h"
 #include "marvelmind_dashboard.h"
 #include "misbehaving_peers.h"
-#include "rcoip/rcoip_receiver.h"
 #include "shell_command.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 #include "wirc/transmitter_session.h"
 
 namespace wircam::wirc {

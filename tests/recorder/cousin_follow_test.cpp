@@ -8,10 +8,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "devices/wirc/device.h"
 #include "follow_scene.h"
 #include "recorder_process.h"
 #include "vehicle_control.h"
-#include "wirc/device.h"
 
 namespace {
 

@@ -7,13 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "devices/wirc/device.h"
 #include "follow_scene.h"
 #include "headless_chromium.h"
 #include "http_fetch.h"
 #include "marvelmind_dashboard.h"
 #include "recorder_process.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 
 namespace {
 

@@ -9,12 +9,12 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "devices/wirc/device.h"
 #include "mqtt_broker.h"
 #include "recorder_process.h"
 #include "simulated_device.h"
 #include "test_certificates.h"
 #include "wait_for.h"
-#include "wirc/device.h"
 
 namespace {
 

@@ -11,10 +11,10 @@
 #include <utility>
 #include <vector>
 
+#include "devices/wirc/device.h"
 #include "devtools_page.h"
 #include "follow_scene.h"
 #include "recorder_process.h"
-#include "wirc/device.h"
 
 namespace wircam::testing {
 

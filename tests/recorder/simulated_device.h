@@ -4,10 +4,10 @@
 
 #include <memory>
 
+#include "devices/wirc/device.h"
 #include "follow_scene.h"
 #include "jpeg_sequence_scene.h"
 #include "scene_frames.h"
-#include "wirc/device.h"
 
 namespace wircam::testing {
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "devices/wirc/device.h"
 #include "tag_family.h"
-#include "wirc/device.h"
 
 namespace wircam::sim {
 

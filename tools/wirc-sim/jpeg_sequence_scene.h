@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "common/expected.h"
-#include "wirc/device.h"
+#include "devices/wirc/device.h"
 
 namespace wircam::sim {
 

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "devices/wirc/device.h"
 #include "follow_scene.h"
 #include "jpeg_sequence_scene.h"
 #include "marvelmind/position_client.h"
@@ -21,7 +22,6 @@
 #include "replay/replay_scene.h"
 #include "sim_usage.h"
 #include "vehicle_control.h"
-#include "wirc/device.h"
 
 using namespace wircam;
 

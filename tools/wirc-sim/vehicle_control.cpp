@@ -1,7 +1,7 @@
 #include "vehicle_control.h"
 
-#include "btemp/btemp_robot.h"
-#include "rcoip/rcoip_receiver.h"
+#include "devices/btemp/btemp_robot.h"
+#include "devices/rcoip/rcoip_receiver.h"
 
 namespace wircam::sim {
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "common/expected.h"
-#include "wirc/device.h"
+#include "devices/wirc/device.h"
 
 namespace wircam::sim {
 

@@ -13,8 +13,8 @@
 #include <optional>
 #include <string>
 
+#include "devices/wirc/device.h"
 #include "replay/recorded_drive.h"
-#include "wirc/device.h"
 
 namespace wircam::sim {
 

@@ -134,10 +134,14 @@ TEST(FoxgloveSession, OnlyACameraDriveChannelInJsonWithTheTokenIsTaken) {
           sessionOf(),
           R"({"op":"advertise","channels":[{"id":1,"topic":"/rover-cam0/drive","encoding":"ros1"}]})"),
       "/rover-cam0/drive takes JSON, not 'ros1'");
-  // A refused channel is not one to publish on.
+  // What is published on a refused channel goes nowhere, and the client
+  // stays: it was told when it advertised.
   auto session = sessionOf(false);
   session.text(kAdvertiseDrive);
-  EXPECT_TRUE(session.binary(publish(7, R"({"steering":0,"throttle":1})")).close);
+  auto outcome = session.binary(publish(7, R"({"steering":0,"throttle":1})"));
+  EXPECT_FALSE(outcome.close);
+  EXPECT_TRUE(outcome.drives.empty());
+  EXPECT_TRUE(outcome.replies.empty());
 }
 
 }  // namespace

@@ -14,8 +14,8 @@
 
 #include "common/expected.h"
 #include "common/socket.h"
+#include "devices/wirc/stream_sender.h"
 #include "wirc/messages.h"
-#include "wirc/stream_sender.h"
 
 namespace wircam::wirc {
 

@@ -13,7 +13,7 @@
 #include <optional>
 #include <thread>
 
-#include "wirc/device.h"
+#include "devices/wirc/device.h"
 #include "wirc/message_stream_parser.h"
 #include "wirc/mjpeg_packet.h"
 

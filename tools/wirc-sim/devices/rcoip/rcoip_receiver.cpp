@@ -1,4 +1,4 @@
-#include "rcoip/rcoip_receiver.h"
+#include "devices/rcoip/rcoip_receiver.h"
 
 #include <sys/epoll.h>
 #include <sys/socket.h>

@@ -1,4 +1,4 @@
-#include "wirc/stream_sender.h"
+#include "devices/wirc/stream_sender.h"
 
 #include <algorithm>
 

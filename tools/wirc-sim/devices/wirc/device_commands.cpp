@@ -1,7 +1,7 @@
 // What each message of a transmitter does to the device: the login (TL,
 // CCFG, FCFG, then WST), configuration, the control right, streams,
 // EXTOUT.
-#include "wirc/device_impl.h"
+#include "devices/wirc/device_impl.h"
 
 namespace wircam::wirc {
 

@@ -1,4 +1,4 @@
-#include "btemp/btemp_robot.h"
+#include "devices/btemp/btemp_robot.h"
 
 #include <sys/epoll.h>
 #include <sys/socket.h>

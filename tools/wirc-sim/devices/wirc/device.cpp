@@ -13,7 +13,7 @@
 #include <mutex>
 #include <thread>
 
-#include "wirc/device_impl.h"
+#include "devices/wirc/device_impl.h"
 #include "wirc/message_stream_parser.h"
 #include "wirc/mjpeg_packet.h"
 
