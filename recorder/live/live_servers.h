@@ -23,8 +23,8 @@
 #include "camera/frame_tap.h"
 #include "common/expected.h"
 #include "fleet/fleet_command.h"
-#include "live/server_address.h"
 #include "live/ice_servers.h"
+#include "live/server_address.h"
 
 namespace wircam::recorder {
 

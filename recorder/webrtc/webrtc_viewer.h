@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "common/expected.h"
-#include "webrtc/camera_encoder.h"
 #include "live/ice_servers.h"
+#include "webrtc/camera_encoder.h"
 #include "webrtc/whep_sdp.h"
 
 namespace wircam::recorder {
