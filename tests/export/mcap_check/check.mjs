@@ -20,23 +20,11 @@ import { decompress } from "fzstd";
 import protobuf from "protobufjs";
 import descriptor from "protobufjs/ext/descriptor/index.js";
 import { createRequire } from "node:module";
+import { foxgloveProtobuf } from "../../support/foxglove_protobuf.mjs";
 
 // Foxglove's protobuf definitions, as their package generates them.
-function foxgloveProtobuf() {
-  const require = createRequire(import.meta.url);
-  const { foxgloveMessageSchemas, foxgloveEnumSchemas, generateProto } =
-    require("@foxglove/schemas/internal");
-  const root = new protobuf.Root();
-  for (const file of ["google/protobuf/timestamp.proto", "google/protobuf/duration.proto"])
-    root.addJSON(protobuf.common.get(file).nested);
-  const enums = Object.values(foxgloveEnumSchemas ?? {});
-  for (const [name, schema] of Object.entries(foxgloveMessageSchemas))
-    protobuf.parse(generateProto(schema, enums.filter((e) => e.parentSchemaName === name)), root,
-                   { keepCase: true });
-  root.resolveAll();
-  return root;
-}
-const foxgloveTypes = foxgloveProtobuf();
+const foxgloveTypes = foxgloveProtobuf(
+  protobuf, createRequire(import.meta.url)("@foxglove/schemas/internal"));
 
 const bytes = new Uint8Array(await readFile(process.argv[2]));
 const imagesTo = process.argv[3] === "--images-to" ? process.argv[4] : null;

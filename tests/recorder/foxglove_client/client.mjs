@@ -34,6 +34,7 @@ import wsProtocol from "@foxglove/ws-protocol";
 import protobuf from "protobufjs";
 import descriptor from "protobufjs/ext/descriptor/index.js";
 import WebSocket from "ws";
+import { foxgloveProtobuf } from "../../support/foxglove_protobuf.mjs";
 
 // The package is CommonJS, and Node's named-export detection misses
 // FoxgloveClient (a tslib getter): take it from the default export.
@@ -93,20 +94,9 @@ function connect({ url, token }) {
 // protobuf message, independent of the schema the server advertised.
 let foxgloveRoot = null;
 function foxgloveTypes() {
-  if (foxgloveRoot) return foxgloveRoot;
-  const require = createRequire(import.meta.url);
-  const { foxgloveMessageSchemas, foxgloveEnumSchemas, generateProto } =
-    require("@foxglove/schemas/internal");
-  const root = new protobuf.Root();
-  for (const file of ["google/protobuf/timestamp.proto", "google/protobuf/duration.proto"])
-    root.addJSON(protobuf.common.get(file).nested);
-  const enums = Object.values(foxgloveEnumSchemas ?? {});
-  for (const [name, schema] of Object.entries(foxgloveMessageSchemas))
-    protobuf.parse(generateProto(schema, enums.filter((e) => e.parentSchemaName === name)), root,
-                   { keepCase: true });
-  root.resolveAll();
-  foxgloveRoot = root;
-  return root;
+  foxgloveRoot ??= foxgloveProtobuf(
+    protobuf, createRequire(import.meta.url)("@foxglove/schemas/internal"));
+  return foxgloveRoot;
 }
 
 // A channel's schema as bytes: base64 for protobuf (a FileDescriptorSet),
