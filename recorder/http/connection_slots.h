@@ -47,6 +47,7 @@ class ConnectionSlots {
   std::vector<Id> expired(Clock::time_point now);
 
   size_t open() const { return connections_.size(); }
+  const Limits& limits() const { return limits_; }
   size_t openFrom(const std::string& address) const;
   uint64_t refused() const { return refused_; }
 

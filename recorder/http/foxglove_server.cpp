@@ -55,32 +55,13 @@ Expected<std::unique_ptr<FoxgloveServer>, std::string> FoxgloveServer::start(
   self->server_ = soup_server_new("server-header", "wirc-recorder", nullptr);
   // Its messages are JPEG and H.264: deflating them costs CPU for nothing.
   soup_server_remove_websocket_extension(self->server_, SOUP_TYPE_WEBSOCKET_EXTENSION_DEFLATE);
-  GSocketAddress* socket =
-      g_inet_socket_address_new_from_string(address.listenHost().c_str(), address.port);
-  if (!socket) return unexpected("--foxglove: '" + address.host + "' is not an IP address");
-  GTlsCertificate* certificate = nullptr;
-  if (!self->content_.certificateFile.empty()) {
-    GError* error = nullptr;
-    certificate = g_tls_certificate_new_from_files(self->content_.certificateFile.c_str(),
-                                                   self->content_.keyFile.c_str(), &error);
-    if (!certificate) {
-      std::string text = error->message;
-      g_error_free(error);
-      g_object_unref(socket);
-      return unexpected("--http-cert " + self->content_.certificateFile + ", --http-key " +
-                        self->content_.keyFile + ": " + text);
-    }
-  }
   // Room for a client over the limit to be told so, and for stray requests.
   size_t slots = self->content_.maxClients + 4;
   auto connections = HttpConnections::listen(
-      self->server_, socket, {.maxOpen = slots, .maxPerAddress = slots, .idleTimeout = idleTimeout},
-      certificate);
-  g_clear_object(&certificate);
-  g_object_unref(socket);
-  if (!connections)
-    return unexpected("--foxglove: cannot listen on port " + std::to_string(address.port) + ": " +
-                      connections.error());
+      self->server_, address,
+      {.maxOpen = slots, .maxPerAddress = slots, .idleTimeout = idleTimeout},
+      {self->content_.certificateFile, self->content_.keyFile}, "--foxglove");
+  if (!connections) return unexpected(connections.error());
   self->connections_ = std::move(*connections);
   self->url_ = std::string(self->connections_->tls() ? "wss://" : "ws://") + address.listenHost() +
                ":" + std::to_string(self->connections_->port()) + "/";

@@ -43,38 +43,61 @@ HttpConnections::HttpConnections(SoupServer* server, ConnectionSlots::Limits lim
                  1000))) {}
 
 Expected<std::unique_ptr<HttpConnections>, std::string> HttpConnections::listen(
-    SoupServer* server, GSocketAddress* address, ConnectionSlots::Limits limits,
-    GTlsCertificate* certificate) {
+    SoupServer* server, const ServerAddress& address, ConnectionSlots::Limits limits,
+    const Tls& tls, const std::string& option) {
   std::unique_ptr<HttpConnections> self(new HttpConnections(server, limits));
-  if (certificate) self->certificate_ = G_TLS_CERTIFICATE(g_object_ref(certificate));
-  self->service_ = g_socket_service_new();
+  if (!tls.certificateFile.empty()) {
+    GError* error = nullptr;
+    self->certificate_ =
+        g_tls_certificate_new_from_files(tls.certificateFile.c_str(), tls.keyFile.c_str(), &error);
+    if (!self->certificate_) {
+      std::string text = error->message;
+      g_error_free(error);
+      return unexpected("--http-cert " + tls.certificateFile + ", --http-key " + tls.keyFile +
+                        ": " + text);
+    }
+  }
+  GSocketAddress* socket =
+      g_inet_socket_address_new_from_string(address.listenHost().c_str(), address.port);
+  if (!socket) return unexpected(option + ": '" + address.host + "' is not an IP address");
+  auto problem = self->listenOn(socket);
+  g_object_unref(socket);
+  if (problem)
+    return unexpected(option + ": cannot listen on port " + std::to_string(address.port) + ": " +
+                      *problem);
+  return self;
+}
+
+std::optional<std::string> HttpConnections::listenOn(GSocketAddress* address) {
+  service_ = g_socket_service_new();
   // GLib's default backlog (10) drops the SYNs of a burst of clients, who
   // then wait seconds to retry: let a whole cap's worth queue.
-  g_socket_listener_set_backlog(G_SOCKET_LISTENER(self->service_),
-                                static_cast<int>(limits.maxOpen));
+  g_socket_listener_set_backlog(G_SOCKET_LISTENER(service_),
+                                static_cast<int>(slots_.limits().maxOpen));
   GSocketAddress* bound = nullptr;
   GError* error = nullptr;
-  if (!g_socket_listener_add_address(G_SOCKET_LISTENER(self->service_), address,
-                                     G_SOCKET_TYPE_STREAM, G_SOCKET_PROTOCOL_TCP, nullptr, &bound,
-                                     &error)) {
+  if (!g_socket_listener_add_address(G_SOCKET_LISTENER(service_), address, G_SOCKET_TYPE_STREAM,
+                                     G_SOCKET_PROTOCOL_TCP, nullptr, &bound, &error)) {
     std::string text = error->message;
     g_error_free(error);
-    return unexpected(text);
+    return text;
   }
-  self->port_ = g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(bound));
+  port_ = g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(bound));
   g_object_unref(bound);
-  g_signal_connect(self->service_, "incoming", G_CALLBACK(onIncoming), self.get());
-  g_socket_service_start(self->service_);
-  self->sweep_ = g_timeout_add(static_cast<guint>(kSweepInterval.count()), onSweep, self.get());
-  return self;
+  g_signal_connect(service_, "incoming", G_CALLBACK(onIncoming), this);
+  g_socket_service_start(service_);
+  sweep_ = g_timeout_add(static_cast<guint>(kSweepInterval.count()), onSweep, this);
+  return std::nullopt;
 }
 
 HttpConnections::~HttpConnections() {
   alive_.reset();
   if (sweep_) g_source_remove(sweep_);
-  g_socket_service_stop(service_);
-  g_socket_listener_close(G_SOCKET_LISTENER(service_));
-  g_object_unref(service_);
+  if (service_) {
+    g_socket_service_stop(service_);
+    g_socket_listener_close(G_SOCKET_LISTENER(service_));
+    g_object_unref(service_);
+  }
   g_clear_object(&certificate_);
 }
 

@@ -16,18 +16,23 @@
 
 #include "common/expected.h"
 #include "http/connection_slots.h"
+#include "live/server_address.h"
 
 namespace wircam::recorder {
 
 class HttpConnections {
  public:
+  // PEM files of a server's certificate and its key; empty: plain HTTP.
+  struct Tls {
+    std::string certificateFile, keyFile;
+  };
   // Listens on `address` for `server`; the port bound comes with it. With
-  // a certificate (and its key) every connection is TLS: the handshake
-  // first, then HTTP inside it; a client that speaks plain HTTP fails the
-  // handshake and is closed.
+  // a certificate every connection is TLS: the handshake first, then HTTP
+  // inside it; a client that speaks plain HTTP fails the handshake and is
+  // closed. Why not, in the words of the `option` that asked ("--http").
   static Expected<std::unique_ptr<HttpConnections>, std::string> listen(
-      SoupServer* server, GSocketAddress* address, ConnectionSlots::Limits limits,
-      GTlsCertificate* certificate = nullptr);
+      SoupServer* server, const ServerAddress& address, ConnectionSlots::Limits limits,
+      const Tls& tls, const std::string& option);
   ~HttpConnections();
   HttpConnections(const HttpConnections&) = delete;
   HttpConnections& operator=(const HttpConnections&) = delete;
@@ -51,6 +56,8 @@ class HttpConnections {
 
  private:
   HttpConnections(SoupServer* server, ConnectionSlots::Limits limits);
+  // The listening itself, once the address and certificate are read.
+  std::optional<std::string> listenOn(GSocketAddress* address);
   static gboolean onIncoming(GSocketService*, GSocketConnection* connection, GObject*,
                              gpointer self);
   static void onConnectionGone(gpointer data, GObject* connection);

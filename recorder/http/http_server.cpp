@@ -26,32 +26,13 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     const ServerAddress& address, Content content, std::chrono::milliseconds idleTimeout) {
   std::unique_ptr<HttpServer> self(new HttpServer(std::move(content)));
   self->server_ = soup_server_new("server-header", "wirc-recorder", nullptr);
-  GSocketAddress* socket =
-      g_inet_socket_address_new_from_string(address.listenHost().c_str(), address.port);
-  if (!socket) return unexpected("--http: '" + address.host + "' is not an IP address");
-  GTlsCertificate* certificate = nullptr;
-  if (!self->content_.certificateFile.empty()) {
-    GError* error = nullptr;
-    certificate = g_tls_certificate_new_from_files(self->content_.certificateFile.c_str(),
-                                                   self->content_.keyFile.c_str(), &error);
-    if (!certificate) {
-      std::string text = error->message;
-      g_error_free(error);
-      g_object_unref(socket);
-      return unexpected("--http-cert " + self->content_.certificateFile + ", --http-key " +
-                        self->content_.keyFile + ": " + text);
-    }
-  }
-  auto connections = HttpConnections::listen(self->server_, socket,
-                                             {.maxOpen = kMaxConnections,
-                                              .maxPerAddress = kMaxConnectionsPerAddress,
-                                              .idleTimeout = idleTimeout},
-                                             certificate);
-  g_clear_object(&certificate);
-  g_object_unref(socket);
-  if (!connections)
-    return unexpected("--http: cannot listen on port " + std::to_string(address.port) + ": " +
-                      connections.error());
+  auto connections =
+      HttpConnections::listen(self->server_, address,
+                              {.maxOpen = kMaxConnections,
+                               .maxPerAddress = kMaxConnectionsPerAddress,
+                               .idleTimeout = idleTimeout},
+                              {self->content_.certificateFile, self->content_.keyFile}, "--http");
+  if (!connections) return unexpected(connections.error());
   self->connections_ = std::move(*connections);
   self->exports_ = std::make_unique<ExportDownloads>(
       self->content_.recordingsFolder,
