@@ -21,8 +21,9 @@ namespace wircam::testing {
 class DevToolsPage {
  public:
   // Starts chromium with a fresh profile in `profile` (removed at the end)
-  // and `extraFlags`, and attaches to its first tab; nullptr (with the
-  // reason on stderr) if it cannot.
+  // and `extraFlags`, attaches to its first tab and loads a first page on a
+  // start-up budget of its own (45 s), apart from what the test then
+  // bounds; nullptr (with the reason on stderr) if it cannot.
   static std::unique_ptr<DevToolsPage> launch(const std::filesystem::path& profile, int width,
                                               int height,
                                               const std::vector<std::string>& extraFlags = {});
@@ -56,6 +57,8 @@ class DevToolsPage {
  private:
   DevToolsPage() = default;
   bool attach(const std::string& webSocketUrl);
+  // Loads a first page with its own start-up budget (DevToolsPage::launch).
+  bool warmUp();
 
   std::filesystem::path profile_;
   pid_t chromium_ = -1;
