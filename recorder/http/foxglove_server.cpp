@@ -295,8 +295,10 @@ void FoxgloveServer::drop(Client& client) {
 }
 
 FoxgloveServer::Feed* FoxgloveServer::feedNamed(const std::string& name) const {
+  // A removed camera's feed stays (frames may be on their way to it) with
+  // no channels: it is not that camera any more.
   for (const auto& feed : feeds_)
-    if (feed->camera.name == name) return feed.get();
+    if (feed->camera.name == name && !feed->channels.empty()) return feed.get();
   return nullptr;
 }
 
