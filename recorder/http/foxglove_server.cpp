@@ -160,10 +160,6 @@ void FoxgloveServer::onWebSocket(SoupServer*, SoupServerMessage* message, const 
                       (most == 1 ? "" : "s") + " at once; try again later";
     soup_websocket_connection_send_text(connection,
                                         statusMessage(FoxgloveStatusLevel::Error, why).c_str());
-    // 1008: libsoup sends none of the codes after 1011 (1013 would say "try
-    // again later"); the status message before it says so.
-    soup_websocket_connection_close(connection, SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION,
-                                    "too many clients");
     // Kept until its close handshake is over, so that the reason arrives.
     g_signal_connect(g_object_ref(connection), "closed",
                      G_CALLBACK(+[](SoupWebsocketConnection* closed, gpointer) {
@@ -175,6 +171,10 @@ void FoxgloveServer::onWebSocket(SoupServer*, SoupServerMessage* message, const 
                            closed);
                      }),
                      nullptr);
+    // 1008: libsoup sends none of the codes after 1011 (1013 would say "try
+    // again later"); the status message before it says so.
+    soup_websocket_connection_close(connection, SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION,
+                                    "too many clients");
     logLine("Foxglove: refused " + who + ": " + why);
     return;
   }

@@ -44,24 +44,24 @@ struct Client {
           client->connection =
               soup_session_websocket_connect_finish(SOUP_SESSION(source), result, nullptr);
           if (!client->connection) return;
-          g_signal_connect(client->connection, "message",
-                           G_CALLBACK(+[](SoupWebsocketConnection*, gint type, GBytes* bytes,
-                                          gpointer data) {
-                             if (type != SOUP_WEBSOCKET_DATA_TEXT) return;
-                             gsize size = 0;
-                             auto* text = static_cast<const char*>(g_bytes_get_data(bytes, &size));
-                             static_cast<Client*>(data)->received.push_back(
-                                 json::parse(std::string(text, size), nullptr, false));
-                           }),
-                           self);
+          g_signal_connect(
+              client->connection, "message",
+              G_CALLBACK(+[](SoupWebsocketConnection*, gint type, GBytes* bytes, gpointer data) {
+                if (type != SOUP_WEBSOCKET_DATA_TEXT) return;
+                gsize size = 0;
+                auto* text = static_cast<const char*>(g_bytes_get_data(bytes, &size));
+                static_cast<Client*>(data)->received.push_back(
+                    json::parse(std::string(text, size), nullptr, false));
+              }),
+              self);
         },
         this);
     g_object_unref(message);
   }
   ~Client() {
     if (connection) {
-      g_signal_handlers_disconnect_matched(connection, G_SIGNAL_MATCH_DATA, 0, 0, nullptr,
-                                           nullptr, this);
+      g_signal_handlers_disconnect_matched(connection, G_SIGNAL_MATCH_DATA, 0, 0, nullptr, nullptr,
+                                           this);
       g_object_unref(connection);
     }
     g_object_unref(session);
