@@ -126,7 +126,10 @@ TEST(WhepPeers, AnOfferTheViewerCannotAnswerInTimeIsAnsweredAllTheSame) {
   // idle timeout: the viewer is let go, and its offer gets a 503, not a
   // request left hanging.
   UdpListener silentStun("127.0.0.1");
-  WhepRecorder whep({"--http-idle-timeout", "1", "--webrtc-stun",
+  // 2 s: past what it takes to start gathering under load (1 s let the
+  // viewer go before it asked the STUN server, once beside two busy loops),
+  // short of the 3 s that gathering is given.
+  WhepRecorder whep({"--http-idle-timeout", "2", "--webrtc-stun",
                      "stun://127.0.0.1:" + std::to_string(silentStun.port())});
   ASSERT_FALSE(whep.url.empty()) << whep.recorder.log();
   auto started = Clock::now();
