@@ -138,8 +138,8 @@ TEST(WhepPeers, AnOfferTheViewerCannotAnswerInTimeIsAnsweredAllTheSame) {
   // Whether it got as far as asking the STUN server depends on the load:
   // beside two busy loops the idle second can pass before (and a longer one
   // lets libnice give up on the STUN server, and the viewer answer).
-  std::cerr << "[ measured ] STUN requests before the viewer was let go: "
-            << silentStun.received() << "\n";
+  std::cerr << "[ measured ] STUN requests before the viewer was let go: " << silentStun.received()
+            << "\n";
   EXPECT_TRUE(whep.recorder.waitForText("viewer gone", milliseconds(1000)));
 }
 
