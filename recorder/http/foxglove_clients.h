@@ -7,9 +7,11 @@
 
 #include <atomic>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 
+#include "foxglove/annex_b.h"
 #include "http/foxglove_server.h"
 #include "http/foxglove_session.h"
 #include "live/live_servers.h"
@@ -23,6 +25,10 @@ struct FoxgloveServer::Feed {
   std::map<FoxgloveTopic, uint32_t> channels;
   std::atomic<int> imageSubscribers{0};  // read on the streaming thread
   std::map<uint64_t, int64_t> stamps;    // the recent frames' times (ns), by PTS
+  // H.264 to Annex B, from the caps it was read from (main loop).
+  GstCaps* annexBCaps = nullptr;
+  std::optional<AnnexB> annexB;
+  ~Feed() { gst_clear_caps(&annexBCaps); }
 };
 
 struct FoxgloveServer::Client {

@@ -37,6 +37,11 @@ bool FoxgloveServer::hasRoom(const Client& client, size_t bytes) const {
   return static_cast<size_t>(queued) + bytes <= room;
 }
 
+bool FoxgloveServer::watched(uint32_t channel) const {
+  return std::any_of(clients_.begin(), clients_.end(),
+                     [&](const auto& c) { return c->session.subscriptionTo(channel).has_value(); });
+}
+
 void FoxgloveServer::publish(uint32_t channel, std::string& frame, bool keyFrame, bool h264) {
   for (const auto& client : clients_) {
     auto subscription = client->session.subscriptionTo(channel);
@@ -69,13 +74,20 @@ void FoxgloveServer::sendFrame(Feed& feed, GstSample* sample, int64_t utcNs) {
   std::string converted;
   std::string_view data = map.view();
   if (feed.h264) {
-    // Foxglove decodes Annex B; the recording's H.264 is "avc".
-    const GstStructure* caps = gst_caps_get_structure(gst_sample_get_caps(sample), 0);
-    const GValue* record = gst_structure_get_value(caps, "codec_data");
-    if (record && GST_VALUE_HOLDS_BUFFER(record)) {
-      gst::ScopedBufferMap codec(gst_value_get_buffer(record), GST_MAP_READ);
-      auto annexB = codec ? AnnexB::fromAvcC(codec.view()) : std::nullopt;
-      auto frame = annexB ? annexB->convert(data) : std::nullopt;
+    // Foxglove decodes Annex B; the recording's H.264 is "avc", its SPS and
+    // PPS in the caps' codec_data, read again only when the caps change.
+    GstCaps* caps = gst_sample_get_caps(sample);
+    if (caps != feed.annexBCaps) {
+      gst_caps_replace(&feed.annexBCaps, caps);
+      feed.annexB.reset();
+      const GValue* record = gst_structure_get_value(gst_caps_get_structure(caps, 0), "codec_data");
+      if (record && GST_VALUE_HOLDS_BUFFER(record)) {
+        gst::ScopedBufferMap codec(gst_value_get_buffer(record), GST_MAP_READ);
+        if (codec) feed.annexB = AnnexB::fromAvcC(codec.view());
+      }
+    }
+    if (feed.annexB) {
+      auto frame = feed.annexB->convert(data);
       if (!frame) return;
       converted = std::move(*frame);
       data = converted;
@@ -122,6 +134,8 @@ void FoxgloveServer::detections(const std::string& camera, const nlohmann::json&
                                 int64_t unixMs, uint64_t framePts) {
   Feed* feed = feedNamed(camera);
   if (!feed) return;
+  // Built only for a client that shows them, not for every frame detected.
+  if (!watched(feed->channels.at(FoxgloveTopic::Tags))) return;
   int64_t ns = stampOf(*feed, framePts, nsOf(unixMs));
   publishBytes(camera, FoxgloveTopic::Tags, imageAnnotationsOf(line, ns), ns);
 }

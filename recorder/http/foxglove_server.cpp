@@ -7,6 +7,7 @@
 #include "http/http_responses.h"
 #include "http/http_routes.h"
 #include "log_line.h"
+#include "webrtc/main_loop_call.h"
 
 namespace wircam::recorder {
 
@@ -295,28 +296,10 @@ void FoxgloveServer::addCamera(const FoxgloveCamera& camera) {
   // Frames come on the streaming thread; clients live on the main loop.
   feed->listener = feed->camera.frames->listen([this, raw](GstSample* sample) {
     if (raw->imageSubscribers.load() == 0) return;
-    struct Delivery {
-      FoxgloveServer* server;
-      Feed* feed;
-      GstSample* sample;
-      int64_t utcNs;
-      std::weak_ptr<bool> alive;
-    };
-    auto* delivery =
-        new Delivery{this, raw, gst_sample_ref(sample), g_get_real_time() * 1000, alive_};
-    g_main_context_invoke_full(
-        nullptr, G_PRIORITY_DEFAULT,
-        [](gpointer data) -> gboolean {
-          auto* d = static_cast<Delivery*>(data);
-          if (!d->alive.expired()) d->server->sendFrame(*d->feed, d->sample, d->utcNs);
-          return G_SOURCE_REMOVE;
-        },
-        delivery,
-        [](gpointer data) {
-          auto* d = static_cast<Delivery*>(data);
-          gst_sample_unref(d->sample);
-          delete d;
-        });
+    std::shared_ptr<GstSample> held(gst_sample_ref(sample), gst_sample_unref);
+    int64_t arrivedNs = g_get_real_time() * 1000;
+    callOnMainLoop(alive_,
+                   [this, raw, held, arrivedNs] { sendFrame(*raw, held.get(), arrivedNs); });
   });
   feeds_.push_back(std::move(feed));
   auto advertisement = advertiseMessage(channelsOf(*raw));

@@ -87,6 +87,7 @@ class FoxgloveServer : public FoxgloveService {
                     int64_t timeNs);
   void sendFrame(Feed& feed, GstSample* sample, int64_t utcNs);
   bool hasRoom(const Client& client, size_t bytes) const;
+  bool watched(uint32_t channel) const;  // a client subscribes to it
   // The time a frame is stamped with, the same for its image and its tags:
   // whichever of the two comes first stamps it.
   static int64_t stampOf(Feed& feed, uint64_t pts, int64_t firstNs);

@@ -1,5 +1,6 @@
 #include "http/foxglove_session.h"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "http/drive_command.h"
@@ -55,7 +56,7 @@ FoxgloveSession::Outcome FoxgloveSession::text(std::string_view text) {
     subscribe(*subscription, outcome);
   } else if (auto* unsubscription = std::get_if<ClientUnsubscribe>(&*message)) {
     for (uint32_t id : unsubscription->subscriptionIds)
-      if (!subscriptions_.erase(id))
+      if (!std::erase_if(subscriptions_, [&](const auto& s) { return s.second == id; }))
         outcome.replies.push_back(statusMessage(
             FoxgloveStatusLevel::Warning, "no subscription " + std::to_string(id) + " to end"));
   } else if (auto* advertisement = std::get_if<ClientAdvertise>(&*message)) {
@@ -70,7 +71,9 @@ FoxgloveSession::Outcome FoxgloveSession::text(std::string_view text) {
 
 void FoxgloveSession::subscribe(const ClientSubscribe& message, Outcome& outcome) {
   for (auto [id, channel] : message.subscriptions) {
-    if (subscriptions_.contains(id)) {
+    bool idInUse = std::any_of(subscriptions_.begin(), subscriptions_.end(),
+                               [&](const auto& s) { return s.second == id; });
+    if (idInUse) {
       outcome.replies.push_back(statusMessage(
           FoxgloveStatusLevel::Error, "subscription id " + std::to_string(id) + " is in use"));
     } else if (!server_.isChannel(channel)) {
@@ -82,7 +85,7 @@ void FoxgloveSession::subscribe(const ClientSubscribe& message, Outcome& outcome
           statusMessage(FoxgloveStatusLevel::Warning,
                         "already subscribed to channel " + std::to_string(channel)));
     } else {
-      subscriptions_[id] = channel;
+      subscriptions_[channel] = id;
     }
   }
 }
@@ -149,14 +152,12 @@ FoxgloveSession::Outcome FoxgloveSession::binary(std::string_view bytes) {
 }
 
 std::optional<uint32_t> FoxgloveSession::subscriptionTo(uint32_t channelId) const {
-  for (auto [id, channel] : subscriptions_)
-    if (channel == channelId) return id;
-  return std::nullopt;
+  auto it = subscriptions_.find(channelId);
+  if (it == subscriptions_.end()) return std::nullopt;
+  return it->second;
 }
 
-void FoxgloveSession::channelGone(uint32_t channelId) {
-  std::erase_if(subscriptions_, [&](const auto& s) { return s.second == channelId; });
-}
+void FoxgloveSession::channelGone(uint32_t channelId) { subscriptions_.erase(channelId); }
 
 std::set<std::string> FoxgloveSession::drivenCameras() const {
   // A camera whose drive channel was advertised is neutralised too, even

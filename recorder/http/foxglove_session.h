@@ -63,7 +63,9 @@ class FoxgloveSession {
   void unadvertise(const ClientUnadvertise& message, Outcome& outcome);
 
   Server server_;
-  std::map<uint32_t, uint32_t> subscriptions_;     // subscription id -> channel id
+  // Channel id -> the client's subscription id: looked up by channel for
+  // every message sent (per frame), by id only when the client asks.
+  std::map<uint32_t, uint32_t> subscriptions_;
   std::map<uint32_t, std::string> driveChannels_;  // the client's channel id -> camera
   std::set<uint32_t> refused_;  // channels it advertised and was told it cannot publish on
   std::set<std::string> driven_;

@@ -1,7 +1,7 @@
 // Where a server listens: "[HOST]:PORT"; no host means this machine only
 // (127.0.0.1; 0.0.0.0 for every interface), port 0 one the system picks
-// (the recorder prints it). Read from the options by parseServerAddress
-// (app/recorder_options.h).
+// (the recorder prints it). The recorder's options read it from the
+// command line and the config file.
 #pragma once
 
 #include <cstdint>
