@@ -9,6 +9,21 @@
 
 namespace wircam::recorder {
 
+namespace {
+
+// A token that would cross the network in clear is said so, with the way out.
+void warnIfTokenInClear(const RecorderOptions& options, const ServerAddress& address,
+                        const char* plain, const char* secure) {
+  std::string host = address.listenHost();
+  if (options.httpToken.empty() || !options.httpCert.empty() || host == "127.0.0.1" ||
+      host == "localhost" || host == "::1")
+    return;
+  logLine("the access token travels in clear over " + std::string(plain) + " on " + host +
+          ": anyone on the network can read it; give --http-cert and --http-key for " + secure);
+}
+
+}  // namespace
+
 std::optional<std::string> Supervisor::startServers() {
   if (options_.http) {
     auto servers = liveServers();
@@ -48,11 +63,7 @@ std::optional<std::string> Supervisor::startServers() {
     if (!server) return server.error();
     http_ = std::move(*server);
     logLine("live view at " + http_->url());
-    std::string host = options_.http->listenHost();
-    if (!options_.httpToken.empty() && options_.httpCert.empty() && host != "127.0.0.1" &&
-        host != "localhost" && host != "::1")
-      logLine("the access token travels in clear over plain HTTP on " + host +
-              ": anyone on the network can read it; give --http-cert and --http-key for HTTPS");
+    warnIfTokenInClear(options_, *options_.http, "plain HTTP", "HTTPS");
   }
   if (options_.mqtt) {
     FleetPublisher::Settings settings{.url = *parseMqttUrl(*options_.mqtt),
@@ -114,11 +125,7 @@ std::optional<std::string> Supervisor::startServers() {
     if (!server) return server.error();
     foxglove_ = std::move(*server);
     logLine("Foxglove WebSocket at " + foxglove_->url());
-    std::string host = options_.foxglove->listenHost();
-    if (!options_.httpToken.empty() && options_.httpCert.empty() && host != "127.0.0.1" &&
-        host != "localhost" && host != "::1")
-      logLine("the access token travels in clear over ws:// on " + host +
-              ": anyone on the network can read it; give --http-cert and --http-key for wss://");
+    warnIfTokenInClear(options_, *options_.foxglove, "ws://", "wss://");
   }
   if (options_.rtsp) {
     auto servers = liveServers();

@@ -227,6 +227,14 @@ std::string ffmpegDecodeErrors(const fs::path& file) {
       .output;
 }
 
+std::string decodedFrameCount(const fs::path& file) {
+  return runCommand(
+             "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+             "stream=nb_read_frames -of csv=p=0 '" +
+             file.string() + "'")
+      .output;
+}
+
 Contents contentsOf(const fs::path& file) {
   const char* demuxer = file.extension() == ".mp4" ? "qtdemux" : "matroskademux";
   std::string description =

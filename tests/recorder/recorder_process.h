@@ -76,5 +76,7 @@ std::vector<std::string> frameDigests(const std::filesystem::path& file);
 // arrived a few milliseconds apart (the burst after a stall) share a tick
 // and it calls that a non-monotonic timestamp.
 std::string ffmpegDecodeErrors(const std::filesystem::path& file);
+// How many frames ffprobe decodes of `file`'s video, as it prints it ("45\n").
+std::string decodedFrameCount(const std::filesystem::path& file);
 
 }  // namespace wircam::testing
