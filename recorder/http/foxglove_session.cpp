@@ -70,7 +70,9 @@ FoxgloveSession::Outcome FoxgloveSession::text(std::string_view text) {
 }
 
 void FoxgloveSession::subscribe(const ClientSubscribe& message, Outcome& outcome) {
-  for (auto [id, channel] : message.subscriptions) {
+  for (auto subscription : message.subscriptions) {
+    // Named, not bound: clang 14 lets no lambda capture a structured binding.
+    uint32_t id = subscription.first, channel = subscription.second;
     bool idInUse = std::any_of(subscriptions_.begin(), subscriptions_.end(),
                                [&](const auto& s) { return s.second == id; });
     if (idInUse) {
