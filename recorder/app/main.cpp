@@ -3,6 +3,8 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "app/recorder_options.h"
 #include "app/slice_allocator.h"
@@ -11,10 +13,19 @@
 int main(int argc, char** argv) {
   using namespace wircam::recorder;
   useMallocForSlices(argv);
+  // A reload parses the same command line again (gst_init takes its own
+  // options out of argv, so a copy).
+  std::vector<std::string> words(argv, argv + argc);
+  auto reread = [words]() mutable {
+    std::vector<char*> again;
+    for (auto& word : words) again.push_back(word.data());
+    again.push_back(nullptr);
+    return parseOptions(static_cast<int>(words.size()), again.data());
+  };
   auto options = parseOptions(argc, argv);
   if (!options) {
     if (options.error() == "help") {
-      std::fputs(usage(), stdout);
+      std::fputs(usage().c_str(), stdout);
       return 0;
     }
     std::fprintf(stderr, "wirc-recorder: %s (see wirc-recorder --help)\n", options.error().c_str());
@@ -29,7 +40,7 @@ int main(int argc, char** argv) {
     g_setenv("GST_PLUGIN_PATH", joined.c_str(), TRUE);
   }
   gst_init(&argc, &argv);
-  auto supervisor = Supervisor::create(*options);
+  auto supervisor = Supervisor::create(*options, reread);
   if (!supervisor) {
     std::fprintf(stderr, "wirc-recorder: %s\n", supervisor.error().c_str());
     return 1;

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,7 @@ struct DeviceTarget {
   std::optional<std::string> marvelmind;  // HOST[:PORT] of the dashboard
   std::optional<std::string> beacons;
   std::optional<PositionSource> positions;  // resolved from the two above
+  bool operator==(const DeviceTarget&) const = default;
 };
 
 // "[HOST]:PORT" as the web, RTSP servers listen.
@@ -107,15 +109,26 @@ struct RecorderOptions {
   // Marvelmind positions of every device that names none of its own.
   std::optional<std::string> marvelmind;  // HOST[:PORT]
   std::optional<std::string> beacons;
+  // Each option's values as given (command line and config file), by name:
+  // what a reload compares to find the changes it cannot take.
+  std::map<std::string, std::vector<std::string>> given;
+  bool operator==(const RecorderOptions&) const = default;
 };
 
 // The file name extension of a container, with its dot.
 const char* extensionOf(Container container);
 
 // The options, or an error message naming the bad argument; --help text in
-// `usage()`. `--config FILE` reads a GKeyFile first; options given on the
-// command line after it override its [recorder] group.
+// `usage()`. `--config FILE` reads a GKeyFile where it stands: options
+// given on the command line after it override its [recorder] group. Every
+// option is declared once, in app/option_table.h.
 Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv);
-const char* usage();
+std::string usage();
+
+// What a reload (the config file read again) cannot take without a restart
+// of the recorder: the first option whose values changed and is not
+// reloadable, with the reason; nothing if the new options may be applied.
+std::optional<std::string> reloadRefusal(const RecorderOptions& running,
+                                         const RecorderOptions& reread);
 
 }  // namespace wircam::recorder

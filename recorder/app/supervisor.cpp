@@ -20,8 +20,14 @@ namespace wircam::recorder {
 
 namespace {
 
-// --detect FAMILY against the families apriltagdetect knows (its GEnum).
-std::optional<std::string> checkFamily(const std::string& family) {
+// A stop's own bound, past the cameras' CameraMachine::kFinishTime: whatever a camera or
+// device does, the run ends within 3 s of it.
+constexpr guint kStopBoundMs = 2900;
+
+}  // namespace
+
+// Its GEnum's values.
+std::optional<std::string> Supervisor::checkFamily(const std::string& family) {
   if (family.empty()) return std::nullopt;
   GstElement* detector = gst_element_factory_make("apriltagdetect", nullptr);
   if (!detector) return "--detect needs apriltagdetect: are the wircam plugins on GST_PLUGIN_PATH?";
@@ -39,20 +45,30 @@ std::optional<std::string> checkFamily(const std::string& family) {
   return "--detect " + family + ": not an AprilTag family (" + known + ")";
 }
 
-// A stop's own bound, past the cameras' CameraMachine::kFinishTime: whatever a camera or
-// device does, the run ends within 3 s of it.
-constexpr guint kStopBoundMs = 2900;
+CameraFiles Supervisor::filesOf(const RecorderOptions& options, const PipelinePlan& plan) {
+  return {.folder = options.outDir,
+          .extension = extensionOf(options.container),
+          .limits = {.maxDuration = static_cast<uint64_t>(options.segmentSeconds * GST_SECOND),
+                     .maxBytes = options.segmentBytes},
+          .transcoded = plan.transcoded};
+}
 
-}  // namespace
+CameraHealth::Policy Supervisor::healthOf(const RecorderOptions& options) {
+  return {.stallTimeout =
+              std::chrono::milliseconds(static_cast<int64_t>(options.stallSeconds * 1000))};
+}
 
-Supervisor::Supervisor(RecorderOptions options)
+RetentionLimits Supervisor::retentionOf(const RecorderOptions& options) {
+  return {.maxBytes = options.maxBytes,
+          .minFree = options.minFree,
+          .maxAge = options.maxAge,
+          .keepEvents = options.keepEvents};
+}
+
+Supervisor::Supervisor(RecorderOptions options, Reread reread)
     : options_(std::move(options)),
-      retention_(options_.outDir,
-                 {.maxBytes = options_.maxBytes,
-                  .minFree = options_.minFree,
-                  .maxAge = options_.maxAge,
-                  .keepEvents = options_.keepEvents},
-                 logLine),
+      reread_(std::move(reread)),
+      retention_(options_.outDir, retentionOf(options_), logLine),
       disk_(options_.outDir),
       index_(options_.outDir),
       commands_([this](const std::string& name) { return cameraNamed(name); },
@@ -62,7 +78,7 @@ Supervisor::Supervisor(RecorderOptions options)
                 }) {}
 
 Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
-    const RecorderOptions& options) {
+    const RecorderOptions& options, Reread reread) {
   std::error_code error;
   std::filesystem::create_directories(options.outDir, error);
   if (error) return unexpected("cannot create '" + options.outDir + "': " + error.message());
@@ -75,7 +91,7 @@ Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
         "(tools/install-deps installs it)");
   if (auto problem = checkFamily(options.detectFamily)) return unexpected(*problem);
 
-  std::unique_ptr<Supervisor> supervisor(new Supervisor(options));
+  std::unique_ptr<Supervisor> supervisor(new Supervisor(options, std::move(reread)));
   // Segments the index lacks (a crash's last one, or a lost index).
   auto inspect = [](const std::filesystem::path& file) {
     markTelemetryTrack(file);  // a file the recorder did not finish
@@ -86,16 +102,8 @@ Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
             supervisor->index_.path().string());
   supervisor->index_.save();
   auto plan = planPipeline(options);
-  CameraFiles files{
-      .folder = options.outDir,
-      .extension = extensionOf(options.container),
-      .limits = {.maxDuration = static_cast<uint64_t>(options.segmentSeconds * GST_SECOND),
-                 .maxBytes = options.segmentBytes},
-      .transcoded = plan.transcoded};
-  CameraHealth::Policy health{
-      .stallTimeout = std::chrono::milliseconds(static_cast<int64_t>(options.stallSeconds * 1000))};
   for (auto& stream : plan.streams) {
-    auto camera = Camera::create(stream, files, health, *supervisor);
+    auto camera = Camera::create(stream, filesOf(options, plan), healthOf(options), *supervisor);
     if (!camera) return unexpected(camera.error());
     supervisor->cameras_.push_back(std::move(*camera));
   }
@@ -116,8 +124,15 @@ Supervisor::~Supervisor() {
 
 Camera* Supervisor::cameraNamed(const std::string& name) {
   for (auto& c : cameras_)
-    if (c->name() == name) return c.get();
+    if (c->name() == name && !removing_.count(c.get())) return c.get();
   return nullptr;
+}
+
+std::vector<std::string> Supervisor::cameraNames() const {
+  std::vector<std::string> names;
+  for (const auto& c : cameras_)
+    if (!removing_.count(c.get())) names.push_back(c->name());
+  return names;
 }
 
 void Supervisor::segmentClosed(Camera& camera, const std::string& file,
@@ -192,7 +207,16 @@ void Supervisor::diskFull(Camera&) {
   stop(nullptr);
 }
 
-void Supervisor::ended(Camera&) { quitWhenAllEnded(); }
+void Supervisor::ended(Camera& camera) {
+  if (removing_.count(&camera))  // not from inside its own call
+    g_idle_add(
+        [](gpointer self) -> gboolean {
+          static_cast<Supervisor*>(self)->forgetEndedCameras();
+          return G_SOURCE_REMOVE;
+        },
+        this);
+  quitWhenAllEnded();
+}
 
 void Supervisor::quitWhenAllEnded() {
   if (stopping_ &&
@@ -422,17 +446,16 @@ int Supervisor::run() {
         },
         this));
   // Segments age whether or not any camera closes one: --max-age is looked
-  // at now and every minute.
-  if (options_.maxAge.count() > 0) {
-    enforceRetention();
-    timers_.push_back(g_timeout_add_seconds(
-        60,
-        [](gpointer self) -> gboolean {
-          static_cast<Supervisor*>(self)->enforceRetention();
-          return G_SOURCE_CONTINUE;
-        },
-        this));
-  }
+  // at now and every minute (a reload may set it).
+  if (options_.maxAge.count() > 0) enforceRetention();
+  timers_.push_back(g_timeout_add_seconds(
+      60,
+      [](gpointer self) -> gboolean {
+        static_cast<Supervisor*>(self)->enforceRetention();
+        return G_SOURCE_CONTINUE;
+      },
+      this));
+  if (reread_) timers_.push_back(g_unix_signal_add(SIGHUP, onReloadSignal, this));
   for (auto& c : cameras_)
     if (!c->start()) return kExitError;
   g_main_loop_run(loop_);

@@ -8,10 +8,12 @@
 
 #include <gst/gst.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -35,16 +37,37 @@ inline constexpr int kExitDiskFull = 3;
 
 class Supervisor : CameraObserver {
  public:
-  static Expected<std::unique_ptr<Supervisor>, std::string> create(const RecorderOptions& options);
+  // The options as a reload reads them again (the command line re-parsed,
+  // with the config file's present text).
+  using Reread = std::function<Expected<RecorderOptions, std::string>()>;
+  static Expected<std::unique_ptr<Supervisor>, std::string> create(const RecorderOptions& options,
+                                                                   Reread reread = nullptr);
   ~Supervisor() override;
 
   // Records until SIGINT/SIGTERM, --duration, a full disk or an error;
   // every file is finished (or cut off) before it returns. The exit code.
   int run();
 
+  // SIGHUP, POST /api/config/reload (supervisor_reload.cpp): the cameras
+  // added, removed, restarted and unchanged, or why nothing changed.
+  Expected<nlohmann::json, std::string> reload();
+
  private:
-  explicit Supervisor(RecorderOptions options);
+  Supervisor(RecorderOptions options, Reread reread);
   std::optional<std::string> startServers();  // the problem, if any
+  // What the options make of each camera: its files and health policy.
+  static CameraFiles filesOf(const RecorderOptions& options, const PipelinePlan& plan);
+  static CameraHealth::Policy healthOf(const RecorderOptions& options);
+  static RetentionLimits retentionOf(const RecorderOptions& options);
+  // --detect FAMILY against the families apriltagdetect knows.
+  static std::optional<std::string> checkFamily(const std::string& family);
+  // A camera a reload removed: out of the servers, its file finished, then
+  // forgotten once it has ended.
+  void removeCamera(Camera& camera);
+  void forgetEndedCameras();
+  void addToServers(Camera& camera);
+  void removeFromServers(const std::string& name);
+  static gboolean onReloadSignal(gpointer self);  // SIGHUP
 
   // CameraObserver
   void segmentClosed(Camera& camera, const std::string& file,
@@ -77,15 +100,18 @@ class Supervisor : CameraObserver {
   std::string metrics() const;  // GET /metrics
   nlohmann::json trails() const;
   std::vector<std::string> openSegments() const;
-  Camera* cameraNamed(const std::string& name);
+  Camera* cameraNamed(const std::string& name);  // not one a reload removed
+  std::vector<std::string> cameraNames() const;  // likewise
 
   RecorderOptions options_;
+  Reread reread_;
   Retention retention_;
   DiskGuard disk_;
   RecordingIndex index_;
   std::map<std::string, RecordedTotals> recorded_;  // by camera, since the start
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Camera>> cameras_;
+  std::set<Camera*> removing_;  // removed by a reload, finishing their file
   CommandDispatcher commands_;
   std::unique_ptr<WebServer> http_;            // with --http
   std::unique_ptr<RtspService> rtsp_;          // with --rtsp

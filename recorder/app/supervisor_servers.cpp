@@ -22,15 +22,43 @@ void warnIfTokenInClear(const RecorderOptions& options, const ServerAddress& add
           ": anyone on the network can read it; give --http-cert and --http-key for " + secure);
 }
 
+WebCamera webCameraOf(Camera& c) { return {c.name(), c.frames(), c.encodedFrames()}; }
+
+FoxgloveCamera foxgloveCameraOf(Camera& c) {
+  return {c.name(), c.frames(), c.encodedFrames(), !c.plan().positions.empty()};
+}
+
+RtspCamera rtspCameraOf(Camera& c) {
+  return {"/" + c.plan().device + "/cam" + std::to_string(c.plan().camera), c.frames()};
+}
+
 }  // namespace
+
+void Supervisor::addToServers(Camera& camera) {
+  if (http_) http_->addCamera(webCameraOf(camera));
+  if (foxglove_) foxglove_->addCamera(foxgloveCameraOf(camera));
+  if (rtsp_) {
+    auto mount = rtspCameraOf(camera);
+    rtsp_->addCamera(mount);
+    logLine("RTSP at " + rtsp_->url() + mount.path);
+  }
+  if (fleet_) fleet_->setStreams(cameraNames());
+}
+
+void Supervisor::removeFromServers(const std::string& name) {
+  Camera* camera = cameraNamed(name);
+  if (http_) http_->removeCamera(name);
+  if (foxglove_) foxglove_->removeCamera(name);
+  if (rtsp_ && camera) rtsp_->removeCamera(rtspCameraOf(*camera).path);
+  if (fleet_) fleet_->setStreams(cameraNames());
+}
 
 std::optional<std::string> Supervisor::startServers() {
   if (options_.http) {
     auto servers = liveServers();
     if (!servers) return servers.error();
     WebContent content;
-    for (auto& c : cameras_)
-      content.cameras.push_back({c->name(), c->frames(), c->encodedFrames()});
+    for (auto& c : cameras_) content.cameras.push_back(webCameraOf(*c));
     content.recordingsFolder = options_.outDir;
     content.token = options_.httpToken;
     content.certificateFile = options_.httpCert;
@@ -54,6 +82,7 @@ std::optional<std::string> Supervisor::startServers() {
     };
     content.openSegments = [this] { return openSegments(); };
     content.command = [this](const FleetCommand& c) { return commands_.apply(c, "web"); };
+    content.reload = [this] { return reload(); };
     content.drive = [this](const std::string& camera, double steering, double throttle) {
       return commands_.drive(camera, steering, throttle);
     };
@@ -100,9 +129,7 @@ std::optional<std::string> Supervisor::startServers() {
                             .keyFile = options_.httpKey,
                             .maxClients = options_.foxgloveMaxClients,
                             .version = WIRCAM_VERSION};
-    for (auto& c : cameras_)
-      content.cameras.push_back(
-          {c->name(), c->frames(), c->encodedFrames(), !c->plan().positions.empty()});
+    for (auto& c : cameras_) content.cameras.push_back(foxgloveCameraOf(*c));
     content.drive = [this](const std::string& camera, double steering, double throttle) {
       // What the page does before it drives: left following, the car would
       // go back to the tag as soon as the driver let go.
@@ -131,9 +158,7 @@ std::optional<std::string> Supervisor::startServers() {
     auto servers = liveServers();
     if (!servers) return servers.error();
     std::vector<RtspCamera> cameras;
-    for (auto& c : cameras_)
-      cameras.push_back(
-          {"/" + c->plan().device + "/cam" + std::to_string(c->plan().camera), c->frames()});
+    for (auto& c : cameras_) cameras.push_back(rtspCameraOf(*c));
     auto server = (*servers)->startRtsp(*options_.rtsp, cameras, options_.httpToken);
     if (!server) return server.error();
     rtsp_ = std::move(*server);

@@ -14,6 +14,7 @@ Camera::Camera(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy,
                CameraObserver& observer, PipelineBuilder build)
     : plan_(std::move(plan)),
       files_(std::move(files)),
+      policy_(policy),
       observer_(observer),
       machine_(policy, now()),
       build_(std::move(build)) {
@@ -172,7 +173,19 @@ void Camera::tearDown() {
   runCounts_ = {};
 }
 
+void Camera::replan(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy) {
+  nextPlan_ = std::move(plan);
+  nextFiles_ = std::move(files);
+  policy_ = policy;
+  apply(machine_.replan(policy, hasFrames(), now()));
+}
+
 void Camera::rebuild() {
+  if (nextPlan_) {
+    plan_ = *std::exchange(nextPlan_, std::nullopt);
+    files_ = *std::exchange(nextFiles_, std::nullopt);
+    report_.positions = !plan_.positions.empty();
+  }
   auto pipeline = build_(plan_, files_, frames(), encodedFrames());
   if (!pipeline) return apply(machine_.buildFailed(pipeline.error(), now()));
   pipeline_ = std::move(*pipeline);

@@ -72,6 +72,13 @@ class Camera {
   // Called every kTickInterval: the stall check, state changes.
   void tick();
   static constexpr guint kTickIntervalMs = 250;
+  // New settings (a reload): the open file finished, then a pipeline built
+  // with them at once. Its frame taps stay: the live servers keep their feed.
+  void replan(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy);
+  // What it was last given (a reload compares them).
+  const CameraFiles& files() const { return nextFiles_ ? *nextFiles_ : files_; }
+  const StreamPlan& plannedNext() const { return nextPlan_ ? *nextPlan_ : plan_; }
+  const CameraHealth::Policy& policy() const { return policy_; }
   // Finishes the open file (bounded by CameraMachine::kFinishTime) and stops for good.
   void stop();
   // Stops for good at once, the open file indexed as it is (a second
@@ -129,6 +136,10 @@ class Camera {
 
   StreamPlan plan_;
   CameraFiles files_;
+  // A reload's, taken at the next build.
+  std::optional<StreamPlan> nextPlan_;
+  std::optional<CameraFiles> nextFiles_;
+  CameraHealth::Policy policy_;
   CameraObserver& observer_;
   CameraMachine machine_;
   PipelineBuilder build_;

@@ -1,6 +1,7 @@
 #include "camera/camera_health.h"
 
 #include <algorithm>
+#include <utility>
 
 namespace wircam::recorder {
 
@@ -86,11 +87,18 @@ CameraHealth::Clock::time_point CameraHealth::fault(CameraFault fault, Clock::ti
   return now + backoff();
 }
 
+void CameraHealth::replan(Policy policy, Clock::time_point now) {
+  if (!restartPending_) stateAtFault_ = state(now);
+  policy_ = policy;
+  restartPending_ = true;
+  replanned_ = true;
+}
+
 void CameraHealth::restarted(Clock::time_point now) {
   restartPending_ = false;
   linkLive_ = false;
   startedAt_ = now;
-  ++restarts_;
+  if (!std::exchange(replanned_, false)) ++restarts_;
 }
 
 CameraState CameraHealth::state(Clock::time_point now) const {

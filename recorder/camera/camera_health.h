@@ -31,6 +31,7 @@ class CameraHealth {
     Clock::duration firstBackoff = std::chrono::milliseconds(500);
     Clock::duration maxBackoff = std::chrono::seconds(30);
     Clock::duration healthyAfter = std::chrono::seconds(10);
+    bool operator==(const Policy&) const = default;
   };
 
   explicit CameraHealth(Policy policy, Clock::time_point now);
@@ -43,6 +44,10 @@ class CameraHealth {
   bool stalled(Clock::time_point now) const;
   // The pipeline is to go: when to start the next one.
   Clock::time_point fault(CameraFault fault, Clock::time_point now);
+  // New settings: the pipeline is to go and the next one start with them,
+  // at once (not a fault: no backoff, not counted as a restart).
+  void replan(Policy policy, Clock::time_point now);
+  void setPolicy(Policy policy) { policy_ = policy; }
   // The next pipeline started (its link not up yet).
   void restarted(Clock::time_point now);
 
@@ -50,6 +55,7 @@ class CameraHealth {
   unsigned restarts() const { return restarts_; }
   const Policy& policy() const { return policy_; }
   bool restartPending() const { return restartPending_; }
+  bool replanned() const { return replanned_; }
 
  private:
   Clock::duration backoff() const;
@@ -63,6 +69,7 @@ class CameraHealth {
   bool stallReported_ = false;
   bool noVideo_ = false;  // the last fault was a stall, and no frame came since
   bool restartPending_ = false;
+  bool replanned_ = false;  // the pending restart is new settings', not a fault's
   CameraState stateAtFault_ = CameraState::kConnecting;
   unsigned consecutiveFaults_ = 0;
   unsigned restarts_ = 0;

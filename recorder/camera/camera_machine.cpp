@@ -175,10 +175,13 @@ CameraActions CameraMachine::endOfStream(Clock::time_point now) {
 
 CameraActions CameraMachine::built(Clock::time_point now) {
   if (phase_ != CameraPhase::kRestarting) return {};
+  bool replanned = health_.replanned();
   health_.restarted(now);
   phase_ = CameraPhase::kRunning;
-  return published(
-      {logged("pipeline started again (restart " + std::to_string(health_.restarts()) + ")")}, now);
+  return published({logged(replanned ? "pipeline started with the new settings"
+                                     : "pipeline started again (restart " +
+                                           std::to_string(health_.restarts()) + ")")},
+                   now);
 }
 
 CameraActions CameraMachine::buildFailed(const std::string& why, Clock::time_point now) {
@@ -188,6 +191,39 @@ CameraActions CameraMachine::buildFailed(const std::string& why, Clock::time_poi
   return published({logged("its pipeline could not be built (" + why + "): trying again in " +
                            millisecondsUntil(deadline_, now))},
                    now);
+}
+
+CameraActions CameraMachine::replan(CameraHealth::Policy policy, bool fileOpen,
+                                    Clock::time_point now) {
+  CameraActions actions;
+  switch (phase_) {
+    case CameraPhase::kRunning:
+      health_.replan(policy, now);
+      actions.push_back(
+          logged("its settings changed: closing its file and starting again "
+                 "with the new ones"));
+      if (fileOpen) {
+        actions.push_back({Kind::kEndFile, false, ""});
+        phase_ = CameraPhase::kFinishing;
+        restartAt_ = now;
+        deadline_ = now + kFinishTime;
+      } else {
+        actions.push_back(action(Kind::kTearDown));
+        phase_ = CameraPhase::kRestarting;
+        deadline_ = now;
+      }
+      break;
+    case CameraPhase::kFinishing:
+    case CameraPhase::kRestarting:
+      // A fault's restart is under way: it builds with the new settings,
+      // after the fault's backoff still.
+      health_.setPolicy(policy);
+      break;
+    case CameraPhase::kStopping:
+    case CameraPhase::kEnded:
+      break;
+  }
+  return published(std::move(actions), now);
 }
 
 CameraActions CameraMachine::stop(bool fileOpen, Clock::time_point now) {

@@ -10,6 +10,8 @@
 //      │◄────────────── started ◄── (build when due; failed: backoff) ◄──────┘
 //      └──stop, file open──► stopping ──EOS / deadline / error──► ended
 //   (stop with no file, stop while restarting, halt, a full disk: ended)
+//   New settings (replan) go the fault's way with no backoff: finishing,
+//   then restarting, built at once.
 //
 // The words users see (connecting, live, no-video, offline) are
 // CameraHealth's; the phase is the lifecycle's own.
@@ -70,6 +72,9 @@ class CameraMachine {
   // What became of a kBuild.
   CameraActions built(Clock::time_point now);
   CameraActions buildFailed(const std::string& why, Clock::time_point now);
+  // New settings: the open file finished (bounded by kFinishTime), then a
+  // pipeline built with them at once; the settings' stall timeout from now.
+  CameraActions replan(CameraHealth::Policy policy, bool fileOpen, Clock::time_point now);
   // Finish the open file (bounded by kFinishTime) and end; halt: end now.
   CameraActions stop(bool fileOpen, Clock::time_point now);
   CameraActions halt(Clock::time_point now);

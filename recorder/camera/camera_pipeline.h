@@ -27,6 +27,7 @@ struct CameraFiles {
   std::string extension;  // ".mkv", ".mp4"
   SegmentLimits limits;
   bool transcoded = false;  // frames pass an encoder that makes key frames on request
+  bool operator==(const CameraFiles&) const = default;
 };
 
 class CameraPipeline {

@@ -18,6 +18,7 @@ struct MuxerSpec {
   // it), or as an empty buffer (mp4mux stalls on GAP events).
   bool textGapEvents = false;
   bool text = true;  // the file has the telemetry text track
+  bool operator==(const MuxerSpec&) const = default;
 };
 
 // One device camera: its own pipeline, and the names of its elements
@@ -36,6 +37,7 @@ struct StreamPlan {
   std::string controller;       // wirccontrol, on the first camera of a following device
   std::string liveSink;         // appsink of the frames as they arrive, with --http/--rtsp
   std::string positions;        // marvelmindpositions, with --marvelmind
+  bool operator==(const StreamPlan&) const = default;
 };
 
 struct PipelinePlan {

@@ -10,8 +10,34 @@
 namespace wircam::recorder {
 
 FleetPublisher::FleetPublisher(Settings settings, std::function<void(const FleetCommand&)> apply)
-    : settings_(std::move(settings)), apply_(std::move(apply)) {
+    : settings_(std::move(settings)), apply_(std::move(apply)), names_(settings_.streams) {
   for (const auto& stream : settings_.streams) streams_[stream];
+}
+
+std::vector<std::string> FleetPublisher::streamNames() const {
+  std::lock_guard lock(namesMutex_);
+  return names_;
+}
+
+void FleetPublisher::setStreams(const std::vector<std::string>& streams) {
+  auto before = streamNames();
+  {
+    std::lock_guard lock(namesMutex_);
+    names_ = streams;
+  }
+  for (const auto& stream : streams) streams_[stream];
+  if (!settings_.discovery || !client_) return;
+  // Home Assistant learns of a camera added, and forgets one removed.
+  for (const auto& stream : streams)
+    if (std::find(before.begin(), before.end(), stream) == before.end())
+      for (const auto& [configTopic, config] : discoveryConfigs(*settings_.discovery, stream))
+        client_->publish(configTopic, config, true, 1);
+  for (const auto& stream : before)
+    if (std::find(streams.begin(), streams.end(), stream) == streams.end()) {
+      streams_.erase(stream);
+      for (const auto& [configTopic, config] : discoveryConfigs(*settings_.discovery, stream))
+        client_->publish(configTopic, "", true, 1);
+    }
 }
 
 Expected<std::unique_ptr<FleetPublisher>, std::string> FleetPublisher::start(
@@ -54,7 +80,7 @@ void FleetPublisher::republish(MqttClient& client) {
   client.subscribe(settings_.prefix + "/+/follow/set");
   client.subscribe(settings_.prefix + "/+/target/set");
   if (settings_.discovery) {
-    for (const auto& stream : settings_.streams)
+    for (const auto& stream : streamNames())
       for (const auto& [configTopic, config] : discoveryConfigs(*settings_.discovery, stream))
         client.publish(configTopic, config, true, 1);
     // Our earlier configs come back retained: those of cameras gone are cleared.
@@ -67,7 +93,7 @@ void FleetPublisher::republish(MqttClient& client) {
 bool FleetPublisher::clearedStaleConfig(const std::string& topicName, const std::string& payload) {
   if (!settings_.discovery || !topicName.starts_with(settings_.discovery->discoveryPrefix + "/"))
     return false;
-  if (!payload.empty() && isStaleConfig(*settings_.discovery, topicName, settings_.streams)) {
+  if (!payload.empty() && isStaleConfig(*settings_.discovery, topicName, streamNames())) {
     sessionClient_->publish(topicName, "", true, 1);
     logLine("cleared the Home Assistant config " + printableText(topicName) +
             " (a camera no longer here)");
@@ -92,8 +118,8 @@ void FleetPublisher::onMessage(const std::string& topicName, const std::string& 
     return;
   }
   auto parsed = parseFleetCommand(stream, command, payload);
-  if (parsed && std::find(settings_.streams.begin(), settings_.streams.end(), stream) ==
-                    settings_.streams.end())
+  auto names = streamNames();
+  if (parsed && std::find(names.begin(), names.end(), stream) == names.end())
     parsed = unexpected("no stream '" + printableText(stream) + "' here");
   if (!parsed) {
     logLine("MQTT " + printableText(topicName) + ": " + parsed.error() + "; ignored");

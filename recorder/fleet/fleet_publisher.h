@@ -49,6 +49,8 @@ class FleetPublisher {
   void event(const std::string& stream, const nlohmann::json& event);
   // A camera's newest frame (JPEG bytes), retained on PREFIX/STREAM/snapshot.
   void snapshot(const std::string& stream, const std::string& jpeg);
+  // The cameras a reload left (Home Assistant's configs follow).
+  void setStreams(const std::vector<std::string>& streams);
   MqttClient::Stats stats() const { return client_->stats(); }
   bool connected() const { return client_->connected(); }
 
@@ -66,8 +68,12 @@ class FleetPublisher {
   // Whether the message was a discovery config (cleared if stale).
   bool clearedStaleConfig(const std::string& topic, const std::string& payload);
 
-  const Settings settings_;
+  std::vector<std::string> streamNames() const;
+
+  const Settings settings_;  // its streams: the first ones
   const std::function<void(const FleetCommand&)> apply_;
+  mutable std::mutex namesMutex_;  // the MQTT thread reads the names
+  std::vector<std::string> names_;
   std::unique_ptr<MqttClient> client_;
   // The client as the MQTT thread knows it (from its first connection on):
   // messages may come before start() has stored client_.

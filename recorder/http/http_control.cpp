@@ -52,6 +52,19 @@ void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GH
   respond(message, SOUP_STATUS_OK, "application/json", "{}");
 }
 
+void HttpServer::serveReload(SoupServerMessage* message) {
+  if (std::string(soup_server_message_get_method(message)) != "POST") {
+    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Allow",
+                                 "POST");
+    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED, "POST /api/config/reload");
+  }
+  if (refusedWithoutToken(message, "reloading the config")) return;
+  auto changed = content_.reload ? content_.reload()
+                                 : unexpected(std::string("this recorder has no config to reload"));
+  if (!changed) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, changed.error());
+  respond(message, SOUP_STATUS_OK, "application/json", changed->dump());
+}
+
 void HttpServer::refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera) {
   if (refusedWithoutToken(message, "driving")) return;
   if (std::none_of(feeds_.begin(), feeds_.end(),

@@ -106,8 +106,11 @@ void HttpServer::serveLive(SoupServerMessage* message, const std::string& camera
   (*feed)->clientCount = static_cast<int>((*feed)->clients.size());
 }
 
-void HttpServer::sendFrame(size_t camera, GstBuffer* jpeg) {
-  auto& feed = *feeds_[camera];
+void HttpServer::sendFrame(const std::string& camera, GstBuffer* jpeg) {
+  auto found =
+      std::find_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f->name == camera; });
+  if (found == feeds_.end()) return;  // removed by a reload meanwhile
+  auto& feed = **found;
   feed.clientCount = static_cast<int>(feed.clients.size());
   if (feed.clients.empty()) return;
   GBytes* chunk = multipartFrame(jpeg, "");

@@ -25,6 +25,7 @@ Route routeOf(std::string_view path) {
   if (path == "/api/cameras") return {Kind::Cameras, ""};
   if (path == "/api/recordings") return {Kind::RecordingIndex, ""};
   if (path == "/api/export") return {Kind::Export, ""};
+  if (path == "/api/config/reload") return {Kind::ConfigReload, ""};
   if (path == "/metrics") return {Kind::Metrics, ""};
   constexpr std::string_view kRecordingEntry = "/api/recordings/";
   if (path.starts_with(kRecordingEntry) && path.size() > kRecordingEntry.size())

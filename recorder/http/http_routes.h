@@ -26,6 +26,7 @@ struct Route {
     WhepSession,     // DELETE /api/cameras/NAME/whep/SESSION: its end
     Playback,        // GET /play/FILE.mjpg?from=SECONDS: a recording replayed as MJPEG
     Export,          // GET /api/export?camera=&start=&end=&format=: a range as one file
+    ConfigReload,    // POST /api/config/reload: the config file read again
     Metrics,         // GET /metrics: Prometheus's text format
     ApiNotFound,     // any other /api/ path: 404 with JSON
     NotFound

@@ -49,51 +49,6 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
                                     self.get(), nullptr);
   g_signal_connect(self->server_, "request-finished", G_CALLBACK(onRequestEnded), self.get());
   g_signal_connect(self->server_, "request-aborted", G_CALLBACK(onRequestEnded), self.get());
-  for (size_t i = 0; i < self->content_.cameras.size(); ++i) {
-    auto feed = std::make_unique<CameraFeed>();
-    feed->name = self->content_.cameras[i].name;
-    feed->frames = self->content_.cameras[i].frames;
-    CameraFeed* raw = feed.get();
-    HttpServer* server = self.get();
-    // Frames come on the streaming thread; clients live on the main loop.
-    feed->listener = feed->frames->listen([server, raw, i](GstSample* sample) {
-      // wircsrc puts the frame size (from the JPEG's SOF) in the caps.
-      const GstStructure* caps = gst_caps_get_structure(gst_sample_get_caps(sample), 0);
-      int width = 0, height = 0;
-      if (gst_structure_get_int(caps, "width", &width) &&
-          gst_structure_get_int(caps, "height", &height)) {
-        raw->width = width;
-        raw->height = height;
-      }
-      GstBuffer* jpeg = gst_sample_get_buffer(sample);
-      {
-        std::lock_guard lock(raw->latestMutex);
-        gst_buffer_replace(&raw->latest, jpeg);
-      }
-      if (raw->clientCount.load() == 0) return;
-      struct Delivery {
-        HttpServer* server;
-        size_t camera;
-        GstBuffer* jpeg;
-        std::weak_ptr<bool> alive;
-      };
-      auto* delivery = new Delivery{server, i, gst_buffer_ref(jpeg), server->alive_};
-      g_main_context_invoke_full(
-          nullptr, G_PRIORITY_DEFAULT,
-          [](gpointer data) -> gboolean {
-            auto* d = static_cast<Delivery*>(data);
-            if (!d->alive.expired()) d->server->sendFrame(d->camera, d->jpeg);
-            return G_SOURCE_REMOVE;
-          },
-          delivery,
-          [](gpointer data) {
-            auto* d = static_cast<Delivery*>(data);
-            gst_buffer_unref(d->jpeg);
-            delete d;
-          });
-    });
-    self->feeds_.push_back(std::move(feed));
-  }
   auto missing = WebRtcService::missingElements();
   if (self->content_.webrtc && !missing.empty()) {
     std::string names;
@@ -118,12 +73,83 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     settings.neutral = [server](const std::string& camera) {
       if (!server->content_.token.empty()) server->content_.drive(camera, 0, 0);
     };
-    std::vector<WebRtcService::Camera> cameras;
-    for (const auto& camera : self->content_.cameras)
-      cameras.push_back({camera.name, camera.frames, camera.encoded});
-    self->webrtc_ = std::make_unique<WebRtcService>(std::move(cameras), std::move(settings));
+    self->webrtc_ =
+        std::make_unique<WebRtcService>(std::vector<WebRtcService::Camera>{}, std::move(settings));
   }
+  for (const auto& camera : self->content_.cameras) self->addCamera(camera);
   return self;
+}
+
+void HttpServer::addCamera(const WebCamera& camera) {
+  auto feed = std::make_unique<CameraFeed>();
+  feed->name = camera.name;
+  feed->frames = camera.frames;
+  CameraFeed* raw = feed.get();
+  // Frames come on the streaming thread; clients live on the main loop,
+  // where the feed is looked up again by name (a reload may have removed it).
+  feed->listener = feed->frames->listen([this, raw](GstSample* sample) {
+    // wircsrc puts the frame size (from the JPEG's SOF) in the caps.
+    const GstStructure* caps = gst_sample_get_caps(sample)
+                                   ? gst_caps_get_structure(gst_sample_get_caps(sample), 0)
+                                   : nullptr;
+    int width = 0, height = 0;
+    if (caps && gst_structure_get_int(caps, "width", &width) &&
+        gst_structure_get_int(caps, "height", &height)) {
+      raw->width = width;
+      raw->height = height;
+    }
+    GstBuffer* jpeg = gst_sample_get_buffer(sample);
+    {
+      std::lock_guard lock(raw->latestMutex);
+      gst_buffer_replace(&raw->latest, jpeg);
+    }
+    if (raw->clientCount.load() == 0) return;
+    struct Delivery {
+      HttpServer* server;
+      std::string camera;
+      GstBuffer* jpeg;
+      std::weak_ptr<bool> alive;
+    };
+    auto* delivery = new Delivery{this, raw->name, gst_buffer_ref(jpeg), alive_};
+    g_main_context_invoke_full(
+        nullptr, G_PRIORITY_DEFAULT,
+        [](gpointer data) -> gboolean {
+          auto* d = static_cast<Delivery*>(data);
+          if (!d->alive.expired()) d->server->sendFrame(d->camera, d->jpeg);
+          return G_SOURCE_REMOVE;
+        },
+        delivery,
+        [](gpointer data) {
+          auto* d = static_cast<Delivery*>(data);
+          gst_buffer_unref(d->jpeg);
+          delete d;
+        });
+  });
+  feeds_.push_back(std::move(feed));
+  if (webrtc_) webrtc_->addCamera({camera.name, camera.frames, camera.encoded});
+}
+
+void HttpServer::removeCamera(const std::string& name) {
+  auto found =
+      std::find_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f->name == name; });
+  if (found == feeds_.end()) return;
+  CameraFeed& feed = **found;
+  // The listener is gone once forget() returns: no frame touches the feed after.
+  feed.frames->forget(feed.listener);
+  gst_buffer_replace(&feed.latest, nullptr);
+  endStreams(feed.clients);
+  feeds_.erase(found);
+  if (webrtc_) webrtc_->removeCamera(name);
+}
+
+void HttpServer::endStreams(std::vector<std::unique_ptr<Client>>& clients) {
+  for (auto& client : clients) {
+    g_signal_handler_disconnect(client->message, client->wroteHandler);
+    g_signal_handler_disconnect(client->message, client->finishedHandler);
+    soup_message_body_complete(soup_server_message_get_response_body(client->message));
+    soup_server_message_unpause(client->message);
+  }
+  clients.clear();
 }
 
 HttpServer::~HttpServer() {
@@ -230,6 +256,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
     return self->deleteRecording(message, route.name);
   }
   if (route.kind == Route::Kind::CameraCommand) return self->serveCommand(message, route, query);
+  if (route.kind == Route::Kind::ConfigReload) return self->serveReload(message);
   if (method == "POST") {
     // What this path does take (RFC 9110: a 405 says so in Allow).
     bool deletable =
@@ -237,8 +264,8 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
     soup_message_headers_replace(soup_server_message_get_response_headers(message), "Allow",
                                  deletable ? "GET, HEAD, DELETE" : "GET, HEAD");
     return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                            "POST is for /api/cameras/NAME/follow, /target, /request-control and "
-                            "/whep");
+                            "POST is for /api/cameras/NAME/follow, /target, /request-control, "
+                            "/whep and /api/config/reload");
   }
   switch (route.kind) {
     case Route::Kind::RecordingEntry:
@@ -279,6 +306,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       // Left unanswered when allowed: libsoup then upgrades it (onWebSocket).
       return self->refuseDriveUnlessAllowed(message, route.name);
     case Route::Kind::CameraCommand:
+    case Route::Kind::ConfigReload:
     case Route::Kind::Whep:
     case Route::Kind::WhepSession:
       return;  // answered above
@@ -288,7 +316,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                               "/api/cameras/NAME/snapshot.jpg, /api/cameras/NAME/follow, "
                               "/api/cameras/NAME/target, /api/cameras/NAME/request-control, "
                               "/api/cameras/NAME/drive, /api/cameras/NAME/whep, /api/recordings, "
-                              "/api/export");
+                              "/api/export, /api/config/reload");
     case Route::Kind::NotFound:
       return respondError(
           message, SOUP_STATUS_NOT_FOUND,

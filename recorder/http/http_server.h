@@ -54,6 +54,8 @@ class HttpServer : public WebServer {
   const std::string& url() const override { return url_; }
   size_t openConnections() const override { return connections_->open(); }
   void publishDetections(const std::string& camera, const nlohmann::json& detections) override;
+  void addCamera(const WebCamera& camera) override;
+  void removeCamera(const std::string& name) override;
 
  private:
   struct Client;
@@ -93,7 +95,10 @@ class HttpServer : public WebServer {
   void send(std::vector<std::unique_ptr<Client>>& clients, GBytes* chunk);
   // Skipped for a client kMaxFramesInFlight chunks behind.
   void sendTo(Client& client, GBytes* chunk);
-  void sendFrame(size_t camera, GstBuffer* jpeg);
+  void sendFrame(const std::string& camera, GstBuffer* jpeg);
+  void serveReload(SoupServerMessage* message);  // http_control.cpp
+  // Ends these streaming responses (their camera removed) and forgets them.
+  void endStreams(std::vector<std::unique_ptr<Client>>& clients);
 
   Content content_;
   SoupServer* server_ = nullptr;

@@ -15,6 +15,7 @@ struct RtspServer::Mount {
   int listener = 0;
   Mutex mutex;  // the streaming thread pushes into the sources
   std::vector<GstElement*> sources WIRCAM_GUARDED_BY(mutex);
+  bool removed = false;  // by a reload: no feed, no mount point
 };
 
 namespace {
@@ -35,35 +36,8 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
   self->server_ = gst_rtsp_server_new();
   gst_rtsp_server_set_address(self->server_, address.listenHost().c_str());
   gst_rtsp_server_set_service(self->server_, std::to_string(address.port).c_str());
-  GstRTSPMountPoints* mounts = gst_rtsp_server_get_mount_points(self->server_);
-  for (auto& camera : cameras) {
-    auto mount = std::make_unique<Mount>();
-    mount->camera = camera;
-    GstRTSPMediaFactory* factory = gst_rtsp_media_factory_new();
-    gst_rtsp_media_factory_set_launch(factory, kMediaLaunch);
-    gst_rtsp_media_factory_set_shared(factory, TRUE);
-    if (!token.empty())
-      gst_rtsp_media_factory_add_role(factory, kRtspViewerRole, GST_RTSP_PERM_MEDIA_FACTORY_ACCESS,
-                                      G_TYPE_BOOLEAN, TRUE, GST_RTSP_PERM_MEDIA_FACTORY_CONSTRUCT,
-                                      G_TYPE_BOOLEAN, TRUE, nullptr);
-    g_signal_connect(factory, "media-configure", G_CALLBACK(onMediaConfigure), mount.get());
-    gst_rtsp_mount_points_add_factory(mounts, camera.path.c_str(), factory);
-    Mount* raw = mount.get();
-    mount->listener = camera.frames->listen([raw](GstSample* sample) {
-      MutexLock lock(raw->mutex);
-      if (raw->sources.empty()) return;
-      // Same memory, fresh metadata: the appsrc stamps it. The caps carry
-      // the frame size, which rtpjpegpay needs.
-      GstBuffer* jpeg =
-          gst_buffer_copy_region(gst_sample_get_buffer(sample), GST_BUFFER_COPY_MEMORY, 0, -1);
-      GstSample* fresh = gst_sample_new(jpeg, gst_sample_get_caps(sample), nullptr, nullptr);
-      gst_buffer_unref(jpeg);
-      for (GstElement* source : raw->sources) gst_app_src_push_sample(GST_APP_SRC(source), fresh);
-      gst_sample_unref(fresh);
-    });
-    self->mounts_.push_back(std::move(mount));
-  }
-  g_object_unref(mounts);
+  self->token_ = token;
+  for (auto& camera : cameras) self->addCamera(camera);
   if (!token.empty()) {
     GstRTSPAuth* auth = rtspTokenAuth(token);
     gst_rtsp_server_set_auth(self->server_, auth);
@@ -85,9 +59,55 @@ Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const Serve
   return self;
 }
 
+void RtspServer::addCamera(const RtspCamera& camera) {
+  auto mount = std::make_unique<Mount>();
+  mount->camera = camera;
+  GstRTSPMediaFactory* factory = gst_rtsp_media_factory_new();
+  gst_rtsp_media_factory_set_launch(factory, kMediaLaunch);
+  gst_rtsp_media_factory_set_shared(factory, TRUE);
+  if (!token_.empty())
+    gst_rtsp_media_factory_add_role(factory, kRtspViewerRole, GST_RTSP_PERM_MEDIA_FACTORY_ACCESS,
+                                    G_TYPE_BOOLEAN, TRUE, GST_RTSP_PERM_MEDIA_FACTORY_CONSTRUCT,
+                                    G_TYPE_BOOLEAN, TRUE, nullptr);
+  g_signal_connect(factory, "media-configure", G_CALLBACK(onMediaConfigure), mount.get());
+  GstRTSPMountPoints* mounts = gst_rtsp_server_get_mount_points(server_);
+  gst_rtsp_mount_points_add_factory(mounts, camera.path.c_str(), factory);
+  g_object_unref(mounts);
+  Mount* raw = mount.get();
+  mount->listener = camera.frames->listen([raw](GstSample* sample) {
+    MutexLock lock(raw->mutex);
+    if (raw->sources.empty()) return;
+    // Same memory, fresh metadata: the appsrc stamps it. The caps carry
+    // the frame size, which rtpjpegpay needs.
+    GstBuffer* jpeg =
+        gst_buffer_copy_region(gst_sample_get_buffer(sample), GST_BUFFER_COPY_MEMORY, 0, -1);
+    GstSample* fresh = gst_sample_new(jpeg, gst_sample_get_caps(sample), nullptr, nullptr);
+    gst_buffer_unref(jpeg);
+    for (GstElement* source : raw->sources) gst_app_src_push_sample(GST_APP_SRC(source), fresh);
+    gst_sample_unref(fresh);
+  });
+  mounts_.push_back(std::move(mount));
+}
+
+void RtspServer::removeCamera(const std::string& path) {
+  auto found = std::find_if(mounts_.begin(), mounts_.end(),
+                            [&](const auto& m) { return !m->removed && m->camera.path == path; });
+  if (found == mounts_.end()) return;
+  Mount& mount = **found;
+  GstRTSPMountPoints* mounts = gst_rtsp_server_get_mount_points(server_);
+  gst_rtsp_mount_points_remove_factory(mounts, path.c_str());
+  g_object_unref(mounts);
+  mount.camera.frames->forget(mount.listener);
+  // Its viewers see the stream end. The mount stays (without a feed): a
+  // media still playing holds it in its callbacks until the server goes.
+  MutexLock lock(mount.mutex);
+  for (GstElement* source : mount.sources) gst_app_src_end_of_stream(GST_APP_SRC(source));
+  mount.removed = true;
+}
+
 RtspServer::~RtspServer() {
   for (auto& mount : mounts_) {
-    mount->camera.frames->forget(mount->listener);
+    if (!mount->removed) mount->camera.frames->forget(mount->listener);
     MutexLock lock(mount->mutex);
     for (GstElement* source : mount->sources) gst_object_unref(source);
     mount->sources.clear();

@@ -29,6 +29,8 @@ class RtspServer : public RtspService {
   ~RtspServer() override;
 
   const std::string& url() const override { return url_; }
+  void addCamera(const RtspCamera& camera) override;
+  void removeCamera(const std::string& path) override;
 
  private:
   struct Mount;
@@ -38,6 +40,7 @@ class RtspServer : public RtspService {
   GstRTSPServer* server_ = nullptr;
   guint source_ = 0;
   std::string url_;
+  std::string token_;
   std::vector<std::unique_ptr<Mount>> mounts_;
 };
 

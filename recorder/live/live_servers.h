@@ -65,6 +65,9 @@ struct WebContent {
   // Drive mode: whether the camera's vehicle obeys (nullopt: no control).
   std::function<std::optional<bool>(const std::string& camera, double steering, double throttle)>
       drive;
+  // POST /api/config/reload: what changed ({added, removed, restarted,
+  // unchanged}), or why nothing did.
+  std::function<Expected<nlohmann::json, std::string>()> reload;
   // The WebRTC live view (WHEP at /api/cameras/NAME/whep), with these ICE
   // servers and each camera's VP8 rate.
   bool webrtc = false;
@@ -81,6 +84,9 @@ class WebServer {
   virtual size_t openConnections() const = 0;
   // Sends one camera's detections to every open page (main thread).
   virtual void publishDetections(const std::string& camera, const nlohmann::json& detections) = 0;
+  // A camera a reload added, or removed (its viewers' streams end).
+  virtual void addCamera(const WebCamera& camera) = 0;
+  virtual void removeCamera(const std::string& name) = 0;
 };
 
 struct RtspCamera {
@@ -93,6 +99,9 @@ class RtspService {
   virtual ~RtspService() = default;
   // "rtsp://HOST:PORT", the port the system picked for port 0.
   virtual const std::string& url() const = 0;
+  // A camera a reload added, or removed (its clients' streams end).
+  virtual void addCamera(const RtspCamera& camera) = 0;
+  virtual void removeCamera(const std::string& path) = 0;
 };
 
 struct FoxgloveCamera {

@@ -13,6 +13,7 @@ struct ServerAddress {
   std::string host;
   uint16_t port = 0;
   std::string listenHost() const { return host.empty() ? "127.0.0.1" : host; }
+  bool operator==(const ServerAddress&) const = default;
 };
 
 }  // namespace wircam::recorder

@@ -51,6 +51,7 @@ class Retention {
     return limits_.maxBytes > 0 || limits_.minFree > 0 || limits_.maxAge.count() > 0;
   }
   const RetentionLimits& limits() const { return limits_; }
+  void setLimits(RetentionLimits limits) { limits_ = limits; }  // a reload's
 
  private:
   bool hasEvents(const std::filesystem::path& video);

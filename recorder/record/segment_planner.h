@@ -37,6 +37,7 @@ struct SegmentLimits {
   uint64_t maxDuration = 0;       // ns; 0 = none
   uint64_t maxBytes = 0;          // 0 = none
   uint64_t maxGap = 500'000'000;  // ns between two frames inside one file
+  bool operator==(const SegmentLimits&) const = default;
 };
 
 class SegmentPlanner {

@@ -67,6 +67,16 @@ WebRtcService::~WebRtcService() {
   encoders_.clear();
 }
 
+void WebRtcService::addCamera(Camera camera) { cameras_.push_back(std::move(camera)); }
+
+void WebRtcService::removeCamera(const std::string& name) {
+  std::vector<std::string> sessions;
+  for (const auto& [session, viewer] : viewers_)
+    if (viewer.camera == name) sessions.push_back(session);
+  for (const auto& session : sessions) remove(session);
+  std::erase_if(cameras_, [&](const Camera& c) { return c.name == name; });
+}
+
 const WebRtcService::Camera* WebRtcService::cameraNamed(const std::string& name) const {
   for (const auto& camera : cameras_)
     if (camera.name == name) return &camera;

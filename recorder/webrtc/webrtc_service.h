@@ -68,6 +68,9 @@ class WebRtcService {
   // loop, maybe before this returns.
   void offer(const std::string& camera, std::string_view sdp, const std::string& viewerAddress,
              Done done);
+  // A camera a reload added, or removed (its viewers let go).
+  void addCamera(Camera camera);
+  void removeCamera(const std::string& name);
   // Ends a session (WHEP's DELETE); false if there is none such.
   bool end(const std::string& camera, const std::string& session);
   size_t viewers() const { return viewers_.size(); }

@@ -202,3 +202,48 @@ TEST_F(MachineTest, AFullDiskOrAHaltEndsAtOnce) {
 }
 
 }  // namespace
+
+// New settings (a reload): the file finished, a pipeline with them built at
+// once, with no backoff and no restart counted; the new stall timeout holds.
+TEST_F(MachineTest, NewSettingsFinishTheFileThenBuildAtOnceWithoutAFault) {
+  CameraHealth::Policy quicker{.stallTimeout = 2s};
+  auto replanned = machine.replan(quicker, true, t0 + 1s);
+  EXPECT_EQ(kindsOf(replanned), std::vector<Kind>{Kind::kEndFile});
+  EXPECT_FALSE(replanned.front().forGood);
+  EXPECT_NE(logOf(replanned).find("settings changed"), std::string::npos);
+  EXPECT_EQ(machine.phase(), CameraPhase::kFinishing);
+  // The file's EOS: torn down and due for a build now, not after a backoff.
+  auto finished = machine.endOfStream(t0 + 1200ms);
+  EXPECT_EQ(kindsOf(finished), std::vector<Kind>{Kind::kTearDown});
+  EXPECT_EQ(machine.nextDeadline(), t0 + 1s);
+  EXPECT_EQ(kindsOf(machine.tick(false, t0 + 1200ms)), std::vector<Kind>{Kind::kBuild});
+  machine.built(t0 + 1300ms);
+  EXPECT_EQ(machine.phase(), CameraPhase::kRunning);
+  EXPECT_EQ(machine.health().restarts(), 0u);
+  machine.linkUp(t0 + 1400ms);
+  machine.frame(t0 + 1500ms);
+  EXPECT_TRUE(kindsOf(machine.tick(true, t0 + 3400ms)).empty());
+  EXPECT_EQ(kindsOf(machine.tick(true, t0 + 3600ms)), std::vector<Kind>{Kind::kEndFile});
+}
+
+TEST_F(MachineTest, NewSettingsWithNoFileOpenRebuildAtOnce) {
+  auto replanned = machine.replan({}, false, t0 + 1s);
+  EXPECT_EQ(kindsOf(replanned), std::vector<Kind>{Kind::kTearDown});
+  EXPECT_EQ(kindsOf(machine.tick(false, t0 + 1s)), std::vector<Kind>{Kind::kBuild});
+}
+
+TEST_F(MachineTest, NewSettingsDuringAFaultsRestartKeepItsBackoffAndCountIt) {
+  stall();
+  machine.endOfStream(t0 + 6100ms);
+  EXPECT_TRUE(machine.replan({}, false, t0 + 6200ms).empty());
+  EXPECT_TRUE(kindsOf(machine.tick(false, t0 + 6300ms)).empty());  // backoff: 500 ms
+  EXPECT_EQ(kindsOf(machine.tick(false, t0 + 6600ms)), std::vector<Kind>{Kind::kBuild});
+  machine.built(t0 + 6700ms);
+  EXPECT_EQ(machine.health().restarts(), 1u);
+}
+
+TEST_F(MachineTest, NewSettingsAfterAStopChangeNothing) {
+  machine.stop(true, t0 + 1s);
+  EXPECT_TRUE(machine.replan({}, true, t0 + 1100ms).empty());
+  EXPECT_EQ(machine.phase(), CameraPhase::kStopping);
+}
