@@ -32,17 +32,22 @@ nlohmann::json entryNamed(const nlohmann::json& list, const std::string& name) {
 }
 }  // namespace
 
-nlohmann::json cameraEntry(const std::string& url, const std::string& camera) {
-  return entryNamed(nlohmann::json::parse(fetch(url + "api/cameras").body, nullptr, false), camera);
+nlohmann::json cameraEntry(const std::string& url, const std::string& camera,
+                           const Headers& headers) {
+  return entryNamed(
+      nlohmann::json::parse(fetch(url + "api/cameras", "GET", headers).body, nullptr, false),
+      camera);
 }
 
-nlohmann::json streamEntry(const std::string& url, const std::string& camera) {
-  auto status = nlohmann::json::parse(fetch(url + "api/status").body, nullptr, false);
+nlohmann::json streamEntry(const std::string& url, const std::string& camera,
+                           const Headers& headers) {
+  auto status =
+      nlohmann::json::parse(fetch(url + "api/status", "GET", headers).body, nullptr, false);
   return status.is_object() ? entryNamed(status["streams"], camera) : nullptr;
 }
 
-uint64_t framesOf(const std::string& url, const std::string& camera) {
-  auto stream = streamEntry(url, camera);
+uint64_t framesOf(const std::string& url, const std::string& camera, const Headers& headers) {
+  auto stream = streamEntry(url, camera, headers);
   return stream.is_object() ? stream["frames"].get<uint64_t>() : 0;
 }
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "http_fetch.h"
 #include "misbehaving_peers.h"
 #include "recorder_process.h"
 
@@ -28,14 +29,17 @@ std::string cameraName(uint16_t port);
 // The frames of `camera` in the index's (finished) segments.
 uint64_t indexedFrames(const std::filesystem::path& out, const std::string& camera);
 
-// /api/cameras' entry of `camera` from the recorder at `url`, or null.
-nlohmann::json cameraEntry(const std::string& url, const std::string& camera);
+// /api/cameras' entry of `camera` from the recorder at `url`, or null
+// (`headers`: a token's, say).
+nlohmann::json cameraEntry(const std::string& url, const std::string& camera,
+                           const Headers& headers = {});
 
 // /api/status's stream entry of `camera`, or null.
-nlohmann::json streamEntry(const std::string& url, const std::string& camera);
+nlohmann::json streamEntry(const std::string& url, const std::string& camera,
+                           const Headers& headers = {});
 
 // /api/status's frames of `camera`: 0 until it is listed.
-uint64_t framesOf(const std::string& url, const std::string& camera);
+uint64_t framesOf(const std::string& url, const std::string& camera, const Headers& headers = {});
 
 // SIGINT ends the recorder with exit 0 within 3 s, `meanwhile` done just
 // after the signal.

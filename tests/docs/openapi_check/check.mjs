@@ -261,6 +261,9 @@ try {
   await check("target, unknown", "POST", `${urlA}api/cameras/nope-cam0/target?id=1`,
     { headers: bearer, expect: 404 });
   await check("follow without token", "POST", command("follow?on=true"), { expect: 401 });
+  // Started without --config: the command line read again changes nothing.
+  await check("reload", "POST", urlA + "api/config/reload", { headers: bearer, expect: 200 });
+  await check("reload without token", "POST", urlA + "api/config/reload", { expect: 401 });
 
   // Drive: the WebSocket and its refusals
   await check("drive, not a handshake", "GET", command("drive"), { headers: bearer, expect: 400 });
@@ -379,6 +382,7 @@ try {
     { expect: 403 });
   await check("B drive, no token set", "GET", `${urlB}api/cameras/${enc(cameraB)}/drive`, { expect: 403 });
   await check("B delete, no token set", "DELETE", urlB + "api/recordings/x.mkv", { expect: 403 });
+  await check("B reload, no token set", "POST", urlB + "api/config/reload", { expect: 403 });
   await check("B whep, WebRTC off", "POST", `${urlB}api/cameras/${enc(cameraB)}/whep`, {
     headers: { "Content-Type": "application/sdp" }, body: offer, expect: 404 });
 
