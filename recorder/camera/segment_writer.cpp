@@ -241,7 +241,10 @@ gboolean SegmentWriter::onTextDrainTick(gpointer self) {
 void SegmentWriter::endFrames() {
   // Not gst_element_send_event(EOS): basesrc takes the stream lock for it,
   // and would hold the main loop for as long as a frame is held downstream.
-  g_signal_emit_by_name(parts_.source, "end-of-stream");
+  // wircsrc's signal returns nothing; appsrc's (a test's source) a flow
+  // return, which needs somewhere to go (an extra argument is ignored).
+  GstFlowReturn ignored = GST_FLOW_OK;
+  g_signal_emit_by_name(parts_.source, "end-of-stream", &ignored);
 }
 
 void SegmentWriter::finished(const std::string& path, bool release) {

@@ -1,0 +1,206 @@
+// A camera in the test process, fed by an appsrc of recorded JPEG frames on
+// a GstTestClock: its driver (Camera), pipeline and segment writer cut the
+// files where the planner says (the segment length, a gap), each file holds
+// its frames byte for byte and in order, and the supervisor hears of each
+// as it closes. No device, no socket, no real time in the frames.
+#include <gst/app/gstappsink.h>
+#include <gst/app/gstappsrc.h>
+#include <gst/check/gsttestclock.h>
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "camera/camera.h"
+#include "scene_frames.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam::recorder;
+using namespace std::chrono_literals;
+
+struct Observed : CameraObserver {
+  std::vector<std::pair<std::string, PlannedSegment>> closed;
+  bool over = false;
+  void segmentClosed(Camera&, const std::string& file, const PlannedSegment& planned) override {
+    closed.emplace_back(file, planned);
+  }
+  void event(Camera&, const nlohmann::json&) override {}
+  void detections(Camera&, const nlohmann::json&, int64_t, GstClockTime) override {}
+  void diskFull(Camera&) override {}
+  void ended(Camera&) override { over = true; }
+};
+
+bool runUntil(const std::function<bool()>& done, std::chrono::milliseconds limit) {
+  auto until = std::chrono::steady_clock::now() + limit;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    if (!g_main_context_iteration(nullptr, FALSE)) std::this_thread::sleep_for(1ms);
+  }
+  return true;
+}
+
+std::string md5Of(const uint8_t* data, size_t size) {
+  gchar* md5 = g_compute_checksum_for_data(G_CHECKSUM_MD5, data, size);
+  std::string text = md5;
+  g_free(md5);
+  return text;
+}
+
+// Each video frame of a Matroska file: its bytes' MD5 and its PTS.
+std::vector<std::pair<std::string, GstClockTime>> framesOf(const fs::path& file) {
+  std::string description =
+      "filesrc location=\"" + file.string() + "\" ! matroskademux ! appsink name=sink sync=false";
+  GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
+  GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  std::vector<std::pair<std::string, GstClockTime>> frames;
+  while (GstSample* sample = gst_app_sink_try_pull_sample(GST_APP_SINK(sink), 5 * GST_SECOND)) {
+    GstBuffer* buffer = gst_sample_get_buffer(sample);
+    GstMapInfo map;
+    if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+      frames.emplace_back(md5Of(map.data, map.size), GST_BUFFER_PTS(buffer));
+      gst_buffer_unmap(buffer, &map);
+    }
+    gst_sample_unref(sample);
+  }
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(sink);
+  gst_object_unref(pipeline);
+  return frames;
+}
+
+class CameraFilesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    gst_init(nullptr, nullptr);
+    folder_ = fs::temp_directory_path() / ("camera-files-" + std::to_string(getpid()));
+    fs::remove_all(folder_);
+    fs::create_directories(folder_);
+  }
+  void TearDown() override {
+    if (source_) gst_object_unref(source_);
+    fs::remove_all(folder_);
+  }
+
+  // The recorder's plan for a camera without a device: the appsrc is the
+  // source and the tail (nothing branches), no text track.
+  StreamPlan plan() const {
+    StreamPlan p;
+    p.description =
+        "appsrc name=src format=time caps=image/jpeg,width=352,height=288,framerate=15/1";
+    p.device = "bench";
+    p.name = "bench-cam0";
+    p.source = p.videoTail = "src";
+    p.muxer = {.factory = "matroskamux", .text = false};
+    return p;
+  }
+
+  // Builds as the recorder does, then puts the pipeline on a test clock.
+  Camera::PipelineBuilder onTestClock() {
+    return [this](const StreamPlan& stream, const CameraFiles& files, FrameTap* frames,
+                  FrameTap* encoded) {
+      auto pipeline = CameraPipeline::build(stream, files, frames, encoded);
+      if (pipeline) {
+        clock_ = gst_test_clock_new();
+        gst_pipeline_use_clock(GST_PIPELINE((*pipeline)->pipeline()), clock_);
+        gst_object_unref(clock_);
+        if (source_) gst_object_unref(source_);
+        source_ = (*pipeline)->element("src");
+        gst_object_ref(source_);
+        ++builds_;
+      }
+      return pipeline;
+    };
+  }
+
+  // Scene frame `index` at `pts`.
+  void push(size_t index, GstClockTime pts) {
+    const auto& jpeg =
+        wircam::testing::sceneFrames()[index % wircam::testing::sceneFrames().size()];
+    GstBuffer* buffer = gst_buffer_new_memdup(jpeg.data(), jpeg.size());
+    GST_BUFFER_PTS(buffer) = GST_BUFFER_DTS(buffer) = pts;
+    GST_BUFFER_DURATION(buffer) = GST_SECOND / 15;
+    pushed_.push_back(md5Of(jpeg.data(), jpeg.size()));
+    ASSERT_EQ(gst_app_src_push_buffer(GST_APP_SRC(source_), buffer), GST_FLOW_OK);
+  }
+
+  fs::path folder_;
+  GstClock* clock_ = nullptr;
+  GstElement* source_ = nullptr;
+  std::vector<std::string> pushed_;
+  int builds_ = 0;
+};
+
+TEST_F(CameraFilesTest, FilesAreCutAtTheSegmentLengthAndAtAGapAndHoldEveryFrameInOrder) {
+  Observed observed;
+  CameraFiles files{
+      .folder = folder_.string(), .extension = ".mkv", .limits = {.maxDuration = 2 * GST_SECOND}};
+  auto camera = Camera::create(plan(), files, {}, observed, onTestClock());
+  ASSERT_TRUE(camera) << camera.error();
+  ASSERT_TRUE((*camera)->start());
+  // 6 s at 15 fps, then 1 s with no frame (a gap: > 0.5 s), then 1 s more.
+  auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
+  for (size_t i = 0; i < 90; ++i) push(i, at(i));
+  for (size_t i = 0; i < 15; ++i) push(90 + i, 7 * GST_SECOND + at(i));
+  ASSERT_TRUE(runUntil([&] { return observed.closed.size() >= 3; }, 10s))
+      << observed.closed.size() << " files closed";
+  (*camera)->stop();
+  ASSERT_TRUE(runUntil([&] { return observed.over; }, 10s));
+
+  // 0-2 s, 2-4 s, 4-6 s, and the frames after the gap.
+  ASSERT_EQ(observed.closed.size(), 4u);
+  std::vector<uint64_t> planned;
+  std::vector<std::string> recorded;
+  for (const auto& [file, segment] : observed.closed) {
+    planned.push_back(segment.frames);
+    auto frames = framesOf(file);
+    EXPECT_EQ(frames.size(), segment.frames) << file;
+    ASSERT_FALSE(frames.empty()) << file;
+    EXPECT_EQ(frames.front().second, 0u) << file << " starts at 0";
+    for (size_t i = 1; i < frames.size(); ++i)
+      EXPECT_GT(frames[i].second, frames[i - 1].second) << file;
+    for (const auto& frame : frames) recorded.push_back(frame.first);
+  }
+  EXPECT_EQ(planned, (std::vector<uint64_t>{30, 30, 30, 15}));
+  EXPECT_EQ(recorded, pushed_) << "every frame, once, in order";
+  // Named by the wall-clock time of their first frame, in order.
+  for (size_t i = 1; i < observed.closed.size(); ++i)
+    EXPECT_LT(observed.closed[i - 1].first, observed.closed[i].first);
+}
+
+}  // namespace
+
+namespace {
+
+// A reload's new settings: the open file ends at its last frame, a pipeline
+// with the new segment length is built at once, and its files follow it.
+TEST_F(CameraFilesTest, NewSettingsEndTheFileAndTheNextPipelineRecordsWithThem) {
+  Observed observed;
+  CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = {}};
+  auto camera = Camera::create(plan(), files, {}, observed, onTestClock());
+  ASSERT_TRUE(camera) << camera.error();
+  ASSERT_TRUE((*camera)->start());
+  auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
+  for (size_t i = 0; i < 20; ++i) push(i, at(i));
+  ASSERT_TRUE(runUntil([&] { return (*camera)->hasFrames(); }, 5s));
+  CameraFiles shorter = files;
+  shorter.limits.maxDuration = GST_SECOND;
+  (*camera)->replan(plan(), shorter, {});
+  ASSERT_TRUE(runUntil([&] { return builds_ == 2 && observed.closed.size() == 1; }, 5s))
+      << builds_ << " builds, " << observed.closed.size() << " files closed";
+  EXPECT_EQ((*camera)->report().restarts, 0u) << "new settings are not a fault";
+  for (size_t i = 0; i < 30; ++i) push(20 + i, at(i));
+  ASSERT_TRUE(runUntil([&] { return observed.closed.size() >= 2; }, 5s));
+  (*camera)->stop();
+  ASSERT_TRUE(runUntil([&] { return observed.over; }, 5s));
+  std::vector<uint64_t> planned;
+  for (const auto& [file, segment] : observed.closed) planned.push_back(segment.frames);
+  EXPECT_EQ(planned, (std::vector<uint64_t>{20, 15, 15}));
+}
+
+}  // namespace
