@@ -277,6 +277,23 @@ std::vector<OptionSpec> makeTable() {
                "machine)",
        .apply = onOff(&RecorderOptions::telemetryTrack),
        .example = "off"},
+      {.name = "record-queue",
+       .value = "SIZE",
+       .fallback = "8M",
+       .section = kFiles,
+       .reloadable = true,
+       .help = "how much of a camera's video may wait for a slow disk (`100K`..`1G`); past "
+               "it the newest frames are dropped from the file, counted in `/api/status` "
+               "(`recording_dropped`), `/metrics` and the log, while the live view, detection "
+               "and following go on",
+       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
+         auto bytes = byteSize(value);
+         if (!bytes || *bytes < 100'000 || *bytes > 1'000'000'000)
+           return "a size of 100K..1G, like 8M";
+         o.recordQueueBytes = *bytes;
+         return std::nullopt;
+       },
+       .example = "16M"},
       {.name = "duration",
        .value = "S",
        .fallback = "none",

@@ -117,11 +117,17 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
            " camera=" + std::to_string(camera) + " wait-for-device=true ";
       if (device.positions) d += "! " + positionsOf(*device.positions, stream.positions);
       if (branches) d += "! tee name=" + tee + " ";
+      // The file's own queue: a slow disk holds up neither the source nor
+      // the other branches; past its bound it drops (camera/queue_drops.h).
+      stream.recordQueue = "rq" + i;
+      d += (branches ? tee + ". ! " : "! ") + "queue name=" + stream.recordQueue +
+           " max-size-buffers=0 max-size-time=0 max-size-bytes=" +
+           std::to_string(options.recordQueueBytes) + " ";
       if (plan.transcoded) {
         stream.videoTail = "enc" + i;
-        d += (branches ? tee + ". ! " : "! ") + encoder(options, stream.videoTail);
+        d += "! " + encoder(options, stream.videoTail);
       } else {
-        stream.videoTail = branches ? tee : device.positions ? stream.positions : stream.source;
+        stream.videoTail = stream.recordQueue;
       }
       if (options.telemetryTrack) d += telemetryTrack(options, stream);
       if (!stream.detector.empty()) {

@@ -65,6 +65,9 @@ struct RecorderOptions {
   // The telemetry as a text track in each file too (always in the sidecar).
   // Without it a stream is one thread and no hand-off per frame.
   bool telemetryTrack = true;
+  // Each camera's recording queue: what waits for a slow disk, in bytes;
+  // past it frames are dropped (and counted).
+  uint64_t recordQueueBytes = 8'000'000;
   unsigned h264Kbps = 2000;
   std::string detectFamily;  // empty: no detection
   bool follow = false;       // needs detectFamily

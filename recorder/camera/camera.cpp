@@ -77,9 +77,10 @@ GstElement* Camera::controller() const {
 void Camera::tick() {
   CameraActions actions;
   if (pipeline_ && machine_.phase() == CameraPhase::kRunning) {
-    uint64_t frames = pipeline_->framesPlanned();
+    uint64_t frames = pipeline_->framesArrived();
     if (frames != framesSeen_) actions = machine_.frame(now());
     framesSeen_ = frames;
+    reportDrops();
   }
   auto due = machine_.tick(hasFrames(), now());
   actions.insert(actions.end(), due.begin(), due.end());
@@ -161,6 +162,7 @@ void Camera::tearDown() {
     // A file EOS did not finish is still playable (Matroska written in
     // clusters, fragmented MP4): indexed like any other.
     for (const auto& file : pipeline_->writer().unfinished()) closed(file);
+    reportDrops();  // its last count, before it goes
   }
   report_.segment.clear();
   pipeline_.reset();
@@ -171,6 +173,19 @@ void Camera::tearDown() {
   earlierRuns_.bytes += runCounts_.bytes;
   earlierRuns_.commandsSent += runCounts_.commandsSent;
   runCounts_ = {};
+  earlierDropped_ = report_.recordingDropped;
+}
+
+void Camera::reportDrops() {
+  uint64_t dropped = earlierDropped_ + pipeline_->framesDropped();
+  if (dropped == report_.recordingDropped) return;
+  report_.recordingDropped = dropped;
+  // Never silent, and not a line per frame: once, then every 10 s.
+  auto at = now();
+  if (dropLogged_ && at - *dropLogged_ < std::chrono::seconds(10)) return;
+  dropLogged_ = at;
+  logLine(name() + ": its file is behind (a slow or stalled disk): " + std::to_string(dropped) +
+          " frame(s) dropped from the recording so far; the live view and following go on");
 }
 
 void Camera::replan(StreamPlan plan, CameraFiles files, CameraHealth::Policy policy) {

@@ -133,6 +133,8 @@ class Camera {
   static gboolean onDeadline(gpointer self);
   bool play();
   void publishState();
+  // The recording queue's drops: into the report, and the log.
+  void reportDrops();
 
   StreamPlan plan_;
   CameraFiles files_;
@@ -149,7 +151,9 @@ class Camera {
   guint busWatch_ = 0;
   guint deadlineTimer_ = 0;  // at machine_.nextDeadline()
   uint64_t filesClosed_ = 0;
-  uint64_t framesSeen_ = 0;                       // the planner's frames at the last tick
+  uint64_t framesSeen_ = 0;      // the frames that came for the files, at the last tick
+  uint64_t earlierDropped_ = 0;  // by the recording queues of past runs
+  std::optional<CameraHealth::Clock::time_point> dropLogged_;
   GstClockTime statsTime_ = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
   bool everLive_ = false;                         // logged in at least once
   struct Counts {

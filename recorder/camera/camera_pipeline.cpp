@@ -30,6 +30,7 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
   camera->writer_ = std::make_unique<SegmentWriter>(
       SegmentWriter::Parts{.pipeline = camera->pipeline_,
                            .source = camera->element(plan.source),
+                           .planPoint = camera->element(plan.recordQueue),
                            .videoTail = camera->element(plan.videoTail),
                            .textTail = camera->element(plan.telemetryTail),
                            .muxer = plan.muxer,
@@ -38,6 +39,8 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
         self->telemetry_->onFrame();
         self->framesPlanned_.fetch_add(1, std::memory_order_relaxed);
       });
+  if (GstElement* queue = camera->element(plan.recordQueue))
+    camera->drops_ = std::make_unique<QueueDrops>(queue);
   if (frames && !plan.liveSink.empty()) {
     frames->attach(camera->element(plan.liveSink));
     camera->frames_ = frames;
@@ -58,6 +61,7 @@ CameraPipeline::~CameraPipeline() {
   if (encoded_) encoded_->detach();
   // The writer holds the elements' pads: before the pipeline goes.
   writer_.reset();
+  drops_.reset();
   telemetry_.reset();
   track_.reset();
   gst_object_unref(pipeline_);

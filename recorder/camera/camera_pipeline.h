@@ -14,6 +14,7 @@
 
 #include "camera/frame_tap.h"
 #include "camera/pipeline_plan.h"
+#include "camera/queue_drops.h"
 #include "camera/segment_writer.h"
 #include "common/expected.h"
 #include "record/segment_planner.h"
@@ -54,6 +55,12 @@ class CameraPipeline {
   bool hasFrames() const { return planner_->current().has_value(); }
   // Frames that reached the files' planner so far (any thread).
   uint64_t framesPlanned() const { return framesPlanned_.load(); }
+  // The frames the recording queue dropped for want of room (its file
+  // behind), this run.
+  uint64_t framesDropped() const { return drops_ ? drops_->dropped() : 0; }
+  // The frames that came for the files: the camera's health counts these,
+  // not the ones written (a slow disk is not a camera without video).
+  uint64_t framesArrived() const { return drops_ ? drops_->arrived() : framesPlanned(); }
 
  private:
   CameraPipeline() = default;
@@ -65,6 +72,7 @@ class CameraPipeline {
   std::unique_ptr<TelemetryTrack> track_;
   std::unique_ptr<TelemetryRouter> telemetry_;
   std::unique_ptr<SegmentWriter> writer_;
+  std::unique_ptr<QueueDrops> drops_;
   std::atomic<uint64_t> framesPlanned_{0};
 };
 

@@ -27,8 +27,11 @@ struct StreamPlan {
   std::string description;  // gst-launch syntax
   std::string device;       // the device's label, made safe for file names
   int camera = 0;
-  std::string name;             // "<device>-cam<N>", also in file names and the live view
-  std::string source;           // wircsrc
+  std::string name;    // "<device>-cam<N>", also in file names and the live view
+  std::string source;  // wircsrc
+  // The recording branch's queue (bounded in bytes, camera/queue_drops.h):
+  // frames are planned into files as they leave it. Empty: at the source.
+  std::string recordQueue;
   std::string videoTail;        // the last element before the files' muxer (a tee: a new pad)
   std::string telemetrySource;  // appsrc of the files' text track (empty: no track)
   std::string telemetryTail;    // the last element before the muxer on the text track

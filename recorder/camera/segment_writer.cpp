@@ -56,7 +56,8 @@ SegmentWriter::SegmentWriter(Parts parts, SegmentPlanner& planner, TelemetryTrac
       afterFrame_(std::move(afterFrame)) {
   gst_segment_init(&sourceSegment_, GST_FORMAT_TIME);
   gst_segment_init(&videoSegment_, GST_FORMAT_TIME);
-  sourcePad_ = gst_element_get_static_pad(parts_.source, "src");
+  sourcePad_ =
+      gst_element_get_static_pad(parts_.planPoint ? parts_.planPoint : parts_.source, "src");
   videoPad_ = gst_element_get_static_pad(parts_.videoTail, "src");
   if (!videoPad_) {  // a tee: the file's branch is a pad of its own
     videoPad_ = gst_element_request_pad_simple(parts_.videoTail, "src_%u");

@@ -1,7 +1,8 @@
 // Writes one stream's frames and telemetry into the files the
 // SegmentPlanner plans, each file a muxer and a filesink of its own
 // (SegmentFile), with no queue and no thread of its own:
-// - a probe where the frames leave the source shows each to the planner;
+// - a probe where the frames leave the recording queue (or the source)
+//   shows each to the planner;
 //   at a cut it opens the next file there and then (forcing a key frame
 //   first when the stream is transcoded, as every 0.5 s), and after each
 //   frame it sends the text track's heartbeat;
@@ -34,7 +35,10 @@ class SegmentWriter {
  public:
   struct Parts {
     GstElement* pipeline;
-    GstElement* source;     // wircsrc: frames are planned as they leave it
+    GstElement* source;  // wircsrc: its end ends the recording
+    // Frames are planned as they leave it (the recording queue, so that a
+    // frame it drops is never planned); null: the source.
+    GstElement* planPoint;
     GstElement* videoTail;  // frames leave it for the file (a tee: by a pad of their own)
     GstElement* textTail;   // the telemetry leaves it for the file (null: no text track)
     MuxerSpec muxer;

@@ -42,6 +42,7 @@ nlohmann::json statusJson(const CameraReport& c, const std::string& rtsp) {
                            {"link_reason", c.linkReason},
                            {"restarts", c.restarts},
                            {"frames", c.frames},
+                           {"recording_dropped", c.recordingDropped},
                            {"fps", c.fps},
                            {"loss_percent", lossPercent(c)},
                            {"kbps", c.kbps},

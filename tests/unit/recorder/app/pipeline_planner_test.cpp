@@ -32,11 +32,12 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   const auto& d = plan.description();
   EXPECT_TRUE(has(d, "wircsrc name=" + s.source + " host=10.0.0.2 port=1984"));
   EXPECT_TRUE(has(d, "wait-for-device=true"));
-  // The frames reach the file straight from the source: no tee, no queue,
-  // no thread between (the SegmentWriter puts each file in itself).
-  EXPECT_EQ(s.videoTail, s.source);
+  // The frames reach the file through its own bounded queue (a slow disk
+  // holds up nothing else), no tee (the SegmentWriter puts each file in).
+  EXPECT_EQ(s.videoTail, s.recordQueue);
+  EXPECT_TRUE(has(d, "! queue name=" + s.recordQueue +
+                         " max-size-buffers=0 max-size-time=0 max-size-bytes=8000000"));
   EXPECT_FALSE(has(d, "tee"));
-  EXPECT_FALSE(has(d, "queue"));
   EXPECT_FALSE(has(d, "splitmuxsink"));
   EXPECT_EQ(s.muxer.factory, "matroskamux");
   EXPECT_TRUE(s.muxer.text);
@@ -67,7 +68,7 @@ TEST(PipelinePlan, WithoutTheTelemetryTrackAStreamIsItsSourceAlone) {
   EXPECT_TRUE(s.telemetrySource.empty() && s.telemetryTail.empty());
   EXPECT_FALSE(has(plan.description(), "appsrc"));
   EXPECT_FALSE(has(plan.description(), "taginject"));
-  EXPECT_EQ(s.videoTail, s.source);  // one element: the camera's one thread
+  EXPECT_EQ(s.videoTail, s.recordQueue);  // the source, then the file's queue
 }
 
 PipelinePlan twoFollowedDevicesOfTwoCameras() {
@@ -88,8 +89,10 @@ TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
   EXPECT_EQ(names.size(), 4u);  // element names do not collide
   EXPECT_FALSE(plan.streams[0].controller.empty());
   EXPECT_TRUE(plan.streams[1].controller.empty());
-  // Branches: the file's frames leave the tee by a pad of their own.
-  EXPECT_TRUE(has(plan.streams[0].description, "tee name=" + plan.streams[0].videoTail));
+  // Branches: the file's frames leave the tee by a pad of their own, into
+  // their queue.
+  EXPECT_TRUE(has(plan.streams[0].description,
+                  "tee name=t0 t0. ! queue name=" + plan.streams[0].recordQueue));
   EXPECT_FALSE(plan.streams[2].controller.empty());
   EXPECT_TRUE(has(plan.description(), "family=tag36h11"));
 }

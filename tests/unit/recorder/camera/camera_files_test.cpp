@@ -16,6 +16,8 @@
 
 #include "camera/camera.h"
 #include "scene_frames.h"
+#include "status/camera_report.h"
+#include "status/prometheus_metrics.h"
 
 namespace {
 
@@ -111,6 +113,7 @@ class CameraFilesTest : public ::testing::Test {
         gst_object_unref(clock_);
         if (source_) gst_object_unref(source_);
         source_ = (*pipeline)->element("src");
+        pipeline_ = (*pipeline)->pipeline();
         gst_object_ref(source_);
         ++builds_;
       }
@@ -134,6 +137,7 @@ class CameraFilesTest : public ::testing::Test {
   GstElement* source_ = nullptr;
   std::vector<std::string> pushed_;
   int builds_ = 0;
+  GstElement* pipeline_ = nullptr;  // the camera's current one
 };
 
 TEST_F(CameraFilesTest, FilesAreCutAtTheSegmentLengthAndAtAGapAndHoldEveryFrameInOrder) {
@@ -201,6 +205,85 @@ TEST_F(CameraFilesTest, NewSettingsEndTheFileAndTheNextPipelineRecordsWithThem) 
   std::vector<uint64_t> planned;
   for (const auto& [file, segment] : observed.closed) planned.push_back(segment.frames);
   EXPECT_EQ(planned, (std::vector<uint64_t>{20, 15, 15}));
+}
+
+}  // namespace
+
+namespace {
+
+// The file's muxer, once the first file is open.
+GstElement* muxerIn(GstElement* pipeline) {
+  GstElement* found = nullptr;
+  GstIterator* it = gst_bin_iterate_recurse(GST_BIN(pipeline));
+  GValue item = G_VALUE_INIT;
+  while (!found && gst_iterator_next(it, &item) == GST_ITERATOR_OK) {
+    auto* element = GST_ELEMENT(g_value_get_object(&item));
+    GstElementFactory* factory = gst_element_get_factory(element);
+    if (factory && std::string(GST_OBJECT_NAME(factory)) == "matroskamux")
+      found = GST_ELEMENT(gst_object_ref(element));
+    g_value_reset(&item);
+  }
+  g_value_unset(&item);
+  gst_iterator_free(it);
+  return found;
+}
+
+// A disk that stops taking data: the muxer's output blocked by a pad probe.
+// The recording queue fills to its bound, then drops and counts; the live
+// branch (and detection, hence following) keeps getting every new frame.
+TEST_F(CameraFilesTest,
+       AStalledMuxerFillsTheBoundedQueueWhichDropsAndCountsWhileTheLiveViewGoesOn) {
+  StreamPlan p = plan();
+  p.description +=
+      " ! tee name=t t. ! queue name=rq max-size-buffers=0 max-size-time=0 "
+      "max-size-bytes=150000 t. ! queue max-size-buffers=1000 ! appsink name=live "
+      "sync=false async=false";
+  p.recordQueue = p.videoTail = "rq";
+  p.liveSink = "live";
+  Observed observed;
+  CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = {}};
+  auto camera = Camera::create(p, files, {}, observed, onTestClock());
+  ASSERT_TRUE(camera) << camera.error();
+  std::atomic<int> live{0};
+  (*camera)->frames()->listen([&](GstSample*) { ++live; });
+  ASSERT_TRUE((*camera)->start());
+  auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
+  push(0, at(0));
+  GstElement* muxer = nullptr;
+  ASSERT_TRUE(runUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
+  GstPad* output = gst_element_get_static_pad(muxer, "src");
+  gulong stall = gst_pad_add_probe(
+      output, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
+      [](GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
+  const size_t kFrames = 120;
+  for (size_t i = 1; i < kFrames; ++i) push(i, at(i));
+  // Every frame reaches the live branch: the source never waits for the disk.
+  ASSERT_TRUE(runUntil([&] { return live.load() == static_cast<int>(kFrames); }, 5s))
+      << live.load() << " of " << kFrames << " frames reached the live view";
+  ASSERT_TRUE(runUntil(
+      [&] {
+        (*camera)->tick();
+        return (*camera)->report().recordingDropped > 0;
+      },
+      5s));
+  // The disk comes back: what waited is written, the rest stays counted.
+  gst_pad_remove_probe(output, stall);
+  gst_object_unref(output);
+  gst_object_unref(muxer);
+  (*camera)->stop();
+  ASSERT_TRUE(runUntil([&] { return observed.over; }, 10s));
+  uint64_t recorded = 0;
+  for (const auto& [file, segment] : observed.closed) recorded += segment.frames;
+  CameraReport report = (*camera)->report();
+  EXPECT_GT(report.recordingDropped, kFrames / 2) << "a 150 KB bound holds a few frames";
+  EXPECT_EQ(recorded + report.recordingDropped, kFrames) << "every frame recorded or counted";
+  // And users see the count: /api/status and /metrics.
+  EXPECT_EQ(statusJson(report, "")["recording_dropped"], report.recordingDropped);
+  std::string metrics = prometheusText({.version = "test", .cameras = {report}});
+  EXPECT_NE(metrics.find("wircam_recording_dropped_frames_total{stream=\"bench-cam0\"} " +
+                         std::to_string(report.recordingDropped)),
+            std::string::npos)
+      << metrics;
 }
 
 }  // namespace
