@@ -128,6 +128,14 @@ OptionProblem commandLine(RecorderOptions& o, const char* value) {
   return std::nullopt;
 }
 
+// A flag's value in the config file (the command line's flag says true).
+std::optional<bool> trueOrFalse(const char* value) {
+  std::string v = value;
+  if (v == "true" || v == "1") return true;
+  if (v == "false" || v == "0") return false;
+  return std::nullopt;
+}
+
 constexpr const char* kDevices = "Devices and cameras";
 constexpr const char* kFiles = "Files";
 constexpr const char* kRetention = "Retention";
@@ -285,11 +293,12 @@ std::vector<OptionSpec> makeTable() {
        .help = "how much of a camera's video may wait for a slow disk (`100K`..`1G`); past "
                "it the newest frames are dropped from the file, counted in `/api/status` "
                "(`recording_dropped`), `/metrics` and the log, while the live view, detection "
-               "and following go on",
+               "and following go on. `0`: no queue, a thread less per camera, but a disk that "
+               "stalls then stalls the camera's source and branches too",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          auto bytes = byteSize(value);
-         if (!bytes || *bytes < 100'000 || *bytes > 1'000'000'000)
-           return "a size of 100K..1G, like 8M";
+         if (!bytes || (*bytes != 0 && (*bytes < 100'000 || *bytes > 1'000'000'000)))
+           return "0, or a size of 100K..1G, like 8M";
          o.recordQueueBytes = *bytes;
          return std::nullopt;
        },
@@ -383,7 +392,9 @@ std::vector<OptionSpec> makeTable() {
        .deviceKey = "follow",
        .help = "steer the vehicle after the largest tag (needs `--detect`)",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         o.follow = std::string(value) != "false" && std::string(value) != "0";
+         auto on = trueOrFalse(value);
+         if (!on) return "true or false";
+         o.follow = *on;
          return std::nullopt;
        },
        .example = "true",
@@ -697,7 +708,9 @@ std::vector<DeviceKeySpec> makeDeviceKeys() {
        .value = "true|false",
        .help = "whether it follows, instead of `--follow`",
        .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         d.follow = value == "true" || value == "1";
+         auto on = trueOrFalse(value.c_str());
+         if (!on) return "true or false";
+         d.follow = *on;
          return std::nullopt;
        }},
       {.key = "control",

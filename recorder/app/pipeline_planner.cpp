@@ -2,6 +2,8 @@
 
 #include <cctype>
 #include <cstdint>
+#include <optional>
+#include <set>
 
 #include "telemetry/telemetry_track_flags.h"
 
@@ -81,7 +83,6 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
   plan.transcoded = options.codec != Codec::kJpeg;
   // The live branch feeds the web server, RTSP and the discovery snapshots.
   bool live = options.http || options.rtsp || options.foxglove || options.mqttDiscovery;
-  size_t index = 0;
   for (const auto& device : options.devices) {
     bool controlled = false;
     std::string host = device.host.empty() ? "" : " host=" + device.host;
@@ -90,28 +91,31 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
     if (options.periods) login += " periods=" + *options.periods;
     if (options.failsafe) login += " failsafe=" + *options.failsafe;
     for (int camera : device.cameras) {
-      auto i = std::to_string(index++);
+      // Each stream is a pipeline of its own (named after the stream): its
+      // elements' names need not differ from another's, and a camera's
+      // plan does not change with its place in the config (a reload
+      // compares plans).
       StreamPlan stream;
       std::string& d = stream.description;
       stream.device = fileSafe(device.label);
       stream.camera = camera;
       stream.name = stream.device + "-cam" + std::to_string(camera);
-      stream.source = "src" + i;
+      stream.source = "src";
       stream.muxer = muxerOf(options.container);
       stream.muxer.text = options.telemetryTrack;
       if (options.telemetryTrack) {
-        stream.telemetrySource = "tel" + i;
-        stream.telemetryTail = "teltag" + i;
+        stream.telemetrySource = "tel";
+        stream.telemetryTail = "teltag";
       }
-      if (!options.detectFamily.empty()) stream.detector = "det" + i;
+      if (!options.detectFamily.empty()) stream.detector = "det";
       if (!options.detectFamily.empty() && *device.follow && !controlled) {
-        stream.controller = "ctl" + i;
+        stream.controller = "ctl";
         controlled = true;  // one controller per vehicle: the first camera's
       }
-      if (live) stream.liveSink = "live" + i;
-      if (device.positions) stream.positions = "pos" + i;
+      if (live) stream.liveSink = "live";
+      if (device.positions) stream.positions = "pos";
       bool branches = !stream.detector.empty() || live;
-      std::string tee = "t" + i;
+      const std::string tee = "t";
       // wait-for-device: a recorder started before its vehicle waits for it.
       d += "wircsrc name=" + stream.source + host + port + login +
            " camera=" + std::to_string(camera) + " wait-for-device=true ";
@@ -119,15 +123,23 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       if (branches) d += "! tee name=" + tee + " ";
       // The file's own queue: a slow disk holds up neither the source nor
       // the other branches; past its bound it drops (camera/queue_drops.h).
-      stream.recordQueue = "rq" + i;
-      d += (branches ? tee + ". ! " : "! ") + "queue name=" + stream.recordQueue +
-           " max-size-buffers=0 max-size-time=0 max-size-bytes=" +
-           std::to_string(options.recordQueueBytes) + " ";
+      // Without it (--record-queue 0) the frames reach the file on the
+      // source's thread: a thread less per camera.
+      std::string toFile = branches ? tee + ". ! " : "! ";
+      if (options.recordQueueBytes > 0) {
+        stream.recordQueue = "rq";
+        d += toFile + "queue name=" + stream.recordQueue +
+             " max-size-buffers=0 max-size-time=0 max-size-bytes=" +
+             std::to_string(options.recordQueueBytes) + " ";
+        toFile = "! ";
+      }
       if (plan.transcoded) {
-        stream.videoTail = "enc" + i;
-        d += "! " + encoder(options, stream.videoTail);
-      } else {
+        stream.videoTail = "enc";
+        d += toFile + encoder(options, stream.videoTail);
+      } else if (!stream.recordQueue.empty()) {
         stream.videoTail = stream.recordQueue;
+      } else {
+        stream.videoTail = branches ? tee : device.positions ? stream.positions : stream.source;
       }
       if (options.telemetryTrack) d += telemetryTrack(options, stream);
       if (!stream.detector.empty()) {
@@ -149,6 +161,16 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
     }
   }
   return plan;
+}
+
+std::optional<std::string> sameNamedStreams(const PipelinePlan& plan) {
+  std::set<std::string> names;
+  for (const auto& stream : plan.streams)
+    if (!names.insert(stream.name).second)
+      return "two cameras would both be named " + stream.name +
+             " (device names that differ only in characters a file name cannot hold, or a "
+             "camera listed twice): rename one";
+  return std::nullopt;
 }
 
 }  // namespace wircam::recorder

@@ -2,6 +2,9 @@
 // plans, each camera receives only its own StreamPlan.
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include "app/recorder_options.h"
 #include "camera/pipeline_plan.h"
 
@@ -20,5 +23,10 @@ namespace wircam::recorder {
 // (camera/queue_drops.h): a slow disk holds up neither the source nor the
 // live and detection branches (hence following).
 PipelinePlan planPipeline(const RecorderOptions& options);
+
+// Two streams of one name (devices whose names differ only in what a file
+// name cannot hold, "a b" and "a_b"; a camera listed twice) would write
+// each other's files: why the plan cannot be recorded, if so.
+std::optional<std::string> sameNamedStreams(const PipelinePlan& plan);
 
 }  // namespace wircam::recorder

@@ -61,6 +61,11 @@ Expected<DeviceTarget, std::string> readDevice(GKeyFile* file, const std::string
 }
 
 std::optional<std::string> loadConfig(const char* path, RecorderOptions& o) {
+  // Not a FIFO or a device: reading one would wait for a writer, and a
+  // reload reads on the main loop.
+  if (!g_file_test(path, G_FILE_TEST_IS_REGULAR))
+    return std::string("cannot read --config ") + path +
+           (g_file_test(path, G_FILE_TEST_EXISTS) ? ": not a regular file" : ": no such file");
   KeyFile file(g_key_file_new(), g_key_file_free);
   GError* error = nullptr;
   if (!g_key_file_load_from_file(file.get(), path, G_KEY_FILE_NONE, &error)) {
@@ -183,13 +188,19 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
 
 std::optional<std::string> reloadRefusal(const RecorderOptions& running,
                                          const RecorderOptions& reread) {
+  // An option's effect, alone: its values (none: its default) applied to
+  // the defaults. Given or not, written twice or once, the same effect is
+  // no change.
+  auto effectOf = [](const OptionSpec& spec, const RecorderOptions& options) {
+    RecorderOptions alone;
+    auto values = options.given.find(spec.name);
+    if (values != options.given.end())
+      for (const auto& value : values->second) spec.apply(alone, value.c_str());
+    return alone;
+  };
   for (const auto& spec : optionTable()) {
     if (spec.reloadable || spec.commandLineOnly) continue;
-    auto before = running.given.find(spec.name);
-    auto after = reread.given.find(spec.name);
-    bool same = (before == running.given.end()) == (after == reread.given.end()) &&
-                (before == running.given.end() || before->second == after->second);
-    if (!same)
+    if (!(effectOf(spec, running) == effectOf(spec, reread)))
       return std::string(spec.name) +
              " changed, which takes a restart of the recorder (a reload changes the devices, "
              "cameras, files, detection and retention)";

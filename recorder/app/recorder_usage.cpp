@@ -45,8 +45,8 @@ Reload: SIGHUP (or POST /api/config/reload with --http) reads the config
 file again. Cameras added start, cameras removed finish their file and stop,
 cameras whose settings changed restart alone; the others record on. A file
 that does not validate, or that changes an option marked "restart" in
-docs/recorder.md (the servers, --out, --codec), is refused and nothing
-changes.
+docs/recorder.md (the servers, --out, --codec, --status, --duration, the
+MQTT and hook options), is refused and nothing changes.
 
 Files: DIR/<device>-cam<N>-YYYYMMDDTHHMMSSZ.mkv (or .mp4), named by the UTC
 time of their first frame, each starting at 0 on a key frame; a segment also

@@ -102,6 +102,7 @@ Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
             supervisor->index_.path().string());
   supervisor->index_.save();
   auto plan = planPipeline(options);
+  if (auto problem = sameNamedStreams(plan)) return unexpected(*problem);
   for (auto& stream : plan.streams) {
     auto camera = Camera::create(stream, filesOf(options, plan), healthOf(options), *supervisor);
     if (!camera) return unexpected(camera.error());

@@ -66,7 +66,7 @@ class Supervisor : CameraObserver {
   void removeCamera(Camera& camera);
   void forgetEndedCameras();
   void addToServers(Camera& camera);
-  void removeFromServers(const std::string& name);
+  void removeFromServers(Camera& camera);
   static gboolean onReloadSignal(gpointer self);  // SIGHUP
 
   // CameraObserver

@@ -25,6 +25,7 @@ Expected<nlohmann::json, std::string> Supervisor::reload() {
   if (auto problem = checkFamily(reread->detectFamily)) return refuse(*problem);
 
   auto plan = planPipeline(*reread);
+  if (auto problem = sameNamedStreams(plan)) return refuse(*problem);
   CameraFiles files = filesOf(*reread, plan);
   CameraHealth::Policy health = healthOf(*reread);
   // The new cameras are built first: one that cannot be refuses the reload
@@ -75,7 +76,7 @@ Expected<nlohmann::json, std::string> Supervisor::reload() {
 
 void Supervisor::removeCamera(Camera& camera) {
   removing_.insert(&camera);
-  removeFromServers(camera.name());
+  removeFromServers(camera);
   camera.stop();  // ended() takes it out once its file is finished
 }
 

@@ -45,11 +45,10 @@ void Supervisor::addToServers(Camera& camera) {
   if (fleet_) fleet_->setStreams(cameraNames());
 }
 
-void Supervisor::removeFromServers(const std::string& name) {
-  Camera* camera = cameraNamed(name);
-  if (http_) http_->removeCamera(name);
-  if (foxglove_) foxglove_->removeCamera(name);
-  if (rtsp_ && camera) rtsp_->removeCamera(rtspCameraOf(*camera).path);
+void Supervisor::removeFromServers(Camera& camera) {
+  if (http_) http_->removeCamera(camera.name());
+  if (foxglove_) foxglove_->removeCamera(camera.name());
+  if (rtsp_) rtsp_->removeCamera(rtspCameraOf(camera).path);
   if (fleet_) fleet_->setStreams(cameraNames());
 }
 

@@ -98,7 +98,12 @@ void CameraHealth::restarted(Clock::time_point now) {
   restartPending_ = false;
   linkLive_ = false;
   startedAt_ = now;
-  if (!std::exchange(replanned_, false)) ++restarts_;
+  // New settings: connecting with them (maybe to another device), not a
+  // device lost; a fault's restart counts.
+  if (std::exchange(replanned_, false))
+    everLive_ = false;
+  else
+    ++restarts_;
 }
 
 CameraState CameraHealth::state(Clock::time_point now) const {

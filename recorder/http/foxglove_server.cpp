@@ -60,7 +60,9 @@ Expected<std::unique_ptr<FoxgloveServer>, std::string> FoxgloveServer::start(
 
 FoxgloveServer::~FoxgloveServer() {
   alive_.reset();
-  for (const auto& feed : feeds_) feed->camera.frames->forget(feed->listener);
+  // A removed camera's feed forgot its frames already (they may be gone).
+  for (const auto& feed : feeds_)
+    if (!feed->channels.empty()) feed->camera.frames->forget(feed->listener);
   while (!clients_.empty()) {
     Client& client = *clients_.back();
     // Its vehicles are not left on a last command.

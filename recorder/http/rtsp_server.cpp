@@ -100,9 +100,29 @@ void RtspServer::removeCamera(const std::string& path) {
   mount.camera.frames->forget(mount.listener);
   // Its viewers see the stream end. The mount stays (without a feed): a
   // media still playing holds it in its callbacks until the server goes.
-  MutexLock lock(mount.mutex);
-  for (GstElement* source : mount.sources) gst_app_src_end_of_stream(GST_APP_SRC(source));
-  mount.removed = true;
+  {
+    MutexLock lock(mount.mutex);
+    for (GstElement* source : mount.sources) gst_app_src_end_of_stream(GST_APP_SRC(source));
+    mount.removed = true;
+  }
+  // And its clients' sessions end (a client would otherwise sit on a
+  // stream that never sends again).
+  gst_rtsp_server_client_filter(
+      server_,
+      [](GstRTSPServer*, GstRTSPClient* client, gpointer mountPath) {
+        gst_rtsp_client_session_filter(
+            client,
+            [](GstRTSPClient*, GstRTSPSession* session, gpointer pathOfMount) {
+              gint matched = 0;
+              bool watching = gst_rtsp_session_get_media(
+                                  session, static_cast<const char*>(pathOfMount), &matched) &&
+                              matched > 0;
+              return watching ? GST_RTSP_FILTER_REMOVE : GST_RTSP_FILTER_KEEP;
+            },
+            mountPath);
+        return GST_RTSP_FILTER_KEEP;
+      },
+      const_cast<char*>(path.c_str()));
 }
 
 RtspServer::~RtspServer() {

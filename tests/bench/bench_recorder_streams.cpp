@@ -1,7 +1,8 @@
 // How many CIF/15 fps streams one recorder process records, and its CPU and
 // memory per stream, beside the stock alternative receiving the same frames.
 //   wircam: N × wirc-sim --frames DIR  →  one wirc-recorder with N --device
-//   (again with --telemetry-track off: the telemetry in the sidecar only)
+//   (again with --telemetry-track off: the telemetry in the sidecar only;
+//   and with --record-queue 0 too: no queue before the file)
 //   stock:  N × multifilesrc ! rtpjpegpay ! udpsink  →  one gst-launch with
 //           N × (udpsrc ! rtpjpegdepay ! matroskamux ! filesink)
 // Senders are separate processes; the receiving process's CPU (user + system)
@@ -279,15 +280,19 @@ int main(int argc, char** argv) {
   }
   int basePort = 21000 + getpid() % 20000;
 
-  std::printf("%-8s | %-68s | %-68s | %-68s\n", "streams",
+  std::printf("%-8s | %-68s | %-68s | %-68s | %-68s\n", "streams",
               "wirc-recorder: lost, CPU life / recording, memory (private), threads",
-              "--telemetry-track off: same", "udpsrc ! rtpjpegdepay ! matroskamux: same");
+              "--telemetry-track off: same", "... and --record-queue 0: same",
+              "udpsrc ! rtpjpegdepay ! matroskamux: same");
   for (int n : counts) {
     Run track = recordWithWircam(work, bin, basePort, n, seconds, "");
     Run sidecarOnly = recordWithWircam(work, bin, basePort, n, seconds, " --telemetry-track off");
+    // One thread a camera, as a stock pipeline: the source's.
+    Run lean = recordWithWircam(work, bin, basePort, n, seconds,
+                                " --telemetry-track off --record-queue 0");
     Run stock = recordWithStock(work, basePort, n, seconds);
-    std::printf("%-8d | %s | %s | %s\n", n, track.row(n).c_str(), sidecarOnly.row(n).c_str(),
-                stock.row(n).c_str());
+    std::printf("%-8d | %s | %s | %s | %s\n", n, track.row(n).c_str(), sidecarOnly.row(n).c_str(),
+                lean.row(n).c_str(), stock.row(n).c_str());
     std::fflush(stdout);
   }
   fs::remove_all(work);

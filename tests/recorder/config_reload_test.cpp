@@ -14,6 +14,7 @@
 #include "camera_checks.h"
 #include "http_fetch.h"
 #include "scene_frames.h"
+#include "shell_command.h"
 #include "simulated_device.h"
 #include "wait_for.h"
 
@@ -91,10 +92,21 @@ TEST(ConfigReload, CamerasComeGoAndRestartAloneWhileTheOthersRecordEveryFrame) {
   std::map<std::string, uint16_t> recorded = {
       {"a", port("a")}, {"b", port("b")}, {"c", port("c")}, {"d", port("d")}};
   config.write(recorderGroup, recorded);
-  RecorderProcess recorder(
-      0, {"--config", config.path(), "--http", "127.0.0.1:0", "--http-token", kToken});
+  // With every server whose cameras come and go: the web's, RTSP's and
+  // Foxglove's (a removed camera's RTSP mount once crashed the stop).
+  RecorderProcess recorder(0, {"--config", config.path(), "--http", "127.0.0.1:0", "--http-token",
+                               kToken, "--rtsp", "127.0.0.1:0", "--foxglove", "127.0.0.1:0"});
   auto url = recorder.waitForLog("http://", 5000ms);
   ASSERT_TRUE(url) << recorder.log();
+  auto rtsp = recorder.waitForLog("rtsp://", 5000ms);
+  ASSERT_TRUE(rtsp) << recorder.log();
+  std::string rtspServer = rtsp->substr(0, rtsp->find('/', 7));  // rtsp://HOST:PORT
+  // Five frames of a camera's RTSP mount, as a client we did not write.
+  auto playRtsp = [&](const std::string& path) {
+    return runCommand("timeout 20 gst-launch-1.0 -q rtspsrc location='rtsp://viewer:" +
+                      std::string(kToken) + "@" + rtspServer.substr(7) + path +
+                      "' protocols=tcp ! rtpjpegdepay ! jpegdec ! fakesink num-buffers=5 2>&1");
+  };
   for (const char* camera : {"a-cam0", "b-cam0", "c-cam0", "d-cam0"})
     ASSERT_TRUE(waitFor([&] { return framesOf(*url, camera, kAuthorized) > 5; }, 10s))
         << camera << "\n"
@@ -119,6 +131,8 @@ TEST(ConfigReload, CamerasComeGoAndRestartAloneWhileTheOthersRecordEveryFrame) {
   ASSERT_TRUE(recorder.waitForText("reloaded: 1 camera(s) added, 0 removed, 0 restarted", 5s))
       << recorder.log();
   progress({"a-cam0", "e-cam0"});
+  auto added = playRtsp("/e/cam0");
+  EXPECT_EQ(added.exitCode, 0) << added.output;
 
   // 2. Device d moved to another vehicle: d-cam0 alone restarts, with it.
   recorded["d"] = port("f");
@@ -142,6 +156,9 @@ TEST(ConfigReload, CamerasComeGoAndRestartAloneWhileTheOthersRecordEveryFrame) {
   ASSERT_TRUE(waitFor([&] { return indexedFrames(out, "e-cam0") > 5; }, 5s)) << recorder.log();
   // Gone from the API once it has ended (just after its file is indexed).
   EXPECT_TRUE(waitFor([&] { return cameraEntry(*url, "e-cam0", kAuthorized).is_null(); }, 5s));
+  auto gone = playRtsp("/e/cam0");
+  EXPECT_NE(gone.exitCode, 0);
+  EXPECT_NE(gone.output.find("Not Found"), std::string::npos) << gone.output;
   progress({"a-cam0"});
 
   // 4. A value that does not validate: 400 with the reason, nothing changed.

@@ -171,6 +171,23 @@ TEST(OptionTable, AReloadRefusesWhatTakesARestartAndTakesTheRest) {
   EXPECT_EQ(reloadRefusal(*running, *server)->rfind("http changed", 0), 0u);
   ASSERT_TRUE(reloadRefusal(*running, *added));
   EXPECT_EQ(reloadRefusal(*running, *added)->rfind("codec changed", 0), 0u);
+  // What an option does, not how it was written: its default written out,
+  // or a value given twice, is no change.
+  auto spelledOut = parse({"--out", "x", "--http", ":8080", "--http", ":8080", "--segment", "60",
+                           "--codec", "jpeg", "--status", "1"});
+  ASSERT_TRUE(spelledOut);
+  EXPECT_EQ(reloadRefusal(*running, *spelledOut), std::nullopt);
+}
+
+TEST(OptionTable, AFlagInTheConfigFileIsTrueOrFalseAndNothingElse) {
+  ConfigFile no("[recorder]\nout=x\ndetect=tag36h11\nfollow=no\n");
+  auto recorderWide = parse({"--config", no.path()});
+  ASSERT_FALSE(recorderWide);
+  EXPECT_NE(recorderWide.error().find("follow: true or false"), std::string::npos);
+  ConfigFile device("[recorder]\nout=x\n[device rover]\nhost=h\nfollow=yes\n");
+  auto perDevice = parse({"--config", device.path()});
+  ASSERT_FALSE(perDevice);
+  EXPECT_NE(perDevice.error().find("follow: true or false"), std::string::npos);
 }
 
 }  // namespace

@@ -69,6 +69,12 @@ TEST(PipelinePlan, WithoutTheTelemetryTrackAStreamIsItsSourceAlone) {
   EXPECT_FALSE(has(plan.description(), "appsrc"));
   EXPECT_FALSE(has(plan.description(), "taginject"));
   EXPECT_EQ(s.videoTail, s.recordQueue);  // the source, then the file's queue
+  // Without the queue: the camera's one thread, the source's.
+  auto lean = planPipeline(optionsOf({"--device", "10.0.0.2", "--out", "/rec", "--telemetry-track",
+                                      "off", "--record-queue", "0"}));
+  EXPECT_EQ(lean.streams[0].videoTail, lean.streams[0].source);
+  EXPECT_TRUE(lean.streams[0].recordQueue.empty());
+  EXPECT_FALSE(has(lean.description(), "queue"));
 }
 
 PipelinePlan twoFollowedDevicesOfTwoCameras() {
@@ -82,19 +88,26 @@ TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
   ASSERT_EQ(plan.streams.size(), 4u);
   std::set<std::string> names;
   for (const auto& s : plan.streams) {
-    names.insert(s.source);
+    names.insert(s.name);
     EXPECT_FALSE(s.detector.empty());
     EXPECT_FALSE(s.liveSink.empty());
   }
-  EXPECT_EQ(names.size(), 4u);  // element names do not collide
+  EXPECT_EQ(names.size(), 4u);
   EXPECT_FALSE(plan.streams[0].controller.empty());
   EXPECT_TRUE(plan.streams[1].controller.empty());
   // Branches: the file's frames leave the tee by a pad of their own, into
   // their queue.
   EXPECT_TRUE(has(plan.streams[0].description,
-                  "tee name=t0 t0. ! queue name=" + plan.streams[0].recordQueue));
+                  "tee name=t t. ! queue name=" + plan.streams[0].recordQueue));
   EXPECT_FALSE(plan.streams[2].controller.empty());
   EXPECT_TRUE(has(plan.description(), "family=tag36h11"));
+}
+
+// A reload compares plans: a camera's must not change with its place.
+TEST(PipelinePlan, ACamerasPlanIsTheSameWhereverItsDeviceStands) {
+  auto first = planPipeline(optionsOf({"--device", "a", "--device", "b", "--out", "/rec"}));
+  auto second = planPipeline(optionsOf({"--device", "b", "--out", "/rec"}));
+  EXPECT_TRUE(first.streams[1] == second.streams[0]);
 }
 
 TEST(PipelinePlan, AControlUriSteersItsVehicle) {
@@ -107,15 +120,14 @@ TEST(PipelinePlan, EachCameraIsAPipelineOfItsOwn) {
   auto plan = twoFollowedDevicesOfTwoCameras();
   ASSERT_EQ(plan.streams.size(), 4u);
   for (const auto& stream : plan.streams) {
-    // Everything it names is in its own description, nothing another names.
+    // Everything it names is in its own description; it records its own
+    // device and camera.
     for (const auto* name : {&stream.source, &stream.telemetrySource, &stream.telemetryTail,
                              &stream.detector, &stream.liveSink}) {
       EXPECT_TRUE(has(stream.description, "name=" + *name)) << *name;
     }
-    for (const auto& other : plan.streams) {
-      if (&other == &stream) continue;
-      EXPECT_FALSE(has(stream.description, "name=" + other.source + " ")) << other.source;
-    }
+    EXPECT_TRUE(has(stream.description, "host=" + stream.device + " "));
+    EXPECT_TRUE(has(stream.description, "camera=" + std::to_string(stream.camera) + " "));
   }
 }
 

@@ -247,3 +247,10 @@ TEST_F(MachineTest, NewSettingsAfterAStopChangeNothing) {
   EXPECT_TRUE(machine.replan({}, true, t0 + 1100ms).empty());
   EXPECT_EQ(machine.phase(), CameraPhase::kStopping);
 }
+
+TEST_F(MachineTest, ACameraStartedWithNewSettingsIsConnectingNotOffline) {
+  machine.replan({}, false, t0 + 1s);
+  machine.tick(false, t0 + 1s);
+  machine.built(t0 + 1100ms);
+  EXPECT_EQ(machine.health().state(t0 + 1200ms), CameraState::kConnecting);
+}
