@@ -111,7 +111,8 @@ class Supervisor : CameraObserver {
   std::map<std::string, RecordedTotals> recorded_;  // by camera, since the start
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Camera>> cameras_;
-  std::set<Camera*> removing_;  // removed by a reload, finishing their file
+  std::set<Camera*> removing_;    // removed by a reload, finishing their file
+  std::set<Camera*> startLater_;  // added again: started once their namesake has ended
   CommandDispatcher commands_;
   std::unique_ptr<WebServer> http_;            // with --http
   std::unique_ptr<RtspService> rtsp_;          // with --rtsp

@@ -61,10 +61,18 @@ Expected<nlohmann::json, std::string> Supervisor::reload() {
   retention_.setLimits(retentionOf(options_));
   for (auto& camera : added) {
     result["added"].push_back(camera->name());
-    Camera& started = *camera;
+    Camera& fresh = *camera;
     cameras_.push_back(std::move(camera));
-    if (!started.start()) logLine(started.name() + ": its pipeline did not start");
-    addToServers(started);
+    addToServers(fresh);
+    // Its namesake, removed a moment ago, may still be finishing its file
+    // on the same device connection: it stops its stream when it ends,
+    // which would stop this one's. This one starts after it.
+    bool namesakeFinishing = std::any_of(removing_.begin(), removing_.end(),
+                                         [&](Camera* c) { return c->name() == fresh.name(); });
+    if (namesakeFinishing)
+      startLater_.insert(&fresh);
+    else if (!fresh.start())
+      logLine(fresh.name() + ": its pipeline did not start");
   }
   enforceRetention();
   logLine("reloaded: " + std::to_string(result["added"].size()) + " camera(s) added, " +
@@ -84,9 +92,21 @@ void Supervisor::forgetEndedCameras() {
   std::erase_if(cameras_, [this](const std::unique_ptr<Camera>& c) {
     if (!c->ended() || !removing_.count(c.get())) return false;
     removing_.erase(c.get());
+    startLater_.erase(c.get());  // removed again before it could start
     logLine(c->name() + ": removed by the reload");
     return true;
   });
+  for (auto it = startLater_.begin(); it != startLater_.end();) {
+    Camera* waiting = *it;
+    bool namesakeFinishing = std::any_of(removing_.begin(), removing_.end(),
+                                         [&](Camera* c) { return c->name() == waiting->name(); });
+    if (namesakeFinishing || stopping_) {
+      ++it;
+      continue;
+    }
+    it = startLater_.erase(it);
+    if (!waiting->start()) logLine(waiting->name() + ": its pipeline did not start");
+  }
 }
 
 gboolean Supervisor::onReloadSignal(gpointer data) {
