@@ -37,7 +37,9 @@ GstPadProbeReturn QueueDrops::onQuery(GstPad*, GstPadProbeInfo* info, gpointer) 
   // source's allocation query, after each file is linked (its RECONFIGURE),
   // would hold the source, and every other branch, until the queue drained.
   // Refused here: the source allocates as it would alone.
-  if (GST_QUERY_IS_SERIALIZED(GST_PAD_PROBE_INFO_QUERY(info))) return GST_PAD_PROBE_DROP;
+  // (GST_QUERY_IS_SERIALIZED mixes two enums, which C++20 deprecates.)
+  auto type = static_cast<unsigned>(GST_QUERY_TYPE(GST_PAD_PROBE_INFO_QUERY(info)));
+  if (type & static_cast<unsigned>(GST_QUERY_TYPE_SERIALIZED)) return GST_PAD_PROBE_DROP;
   return GST_PAD_PROBE_OK;
 }
 
