@@ -103,7 +103,7 @@ TEST(ConfigReload, CamerasComeGoAndRestartAloneWhileTheOthersRecordEveryFrame) {
   std::string rtspServer = rtsp->substr(0, rtsp->find('/', 7));  // rtsp://HOST:PORT
   // Five frames of a camera's RTSP mount, as a client we did not write.
   auto playRtsp = [&](const std::string& path) {
-    return runCommand("timeout 20 gst-launch-1.0 -q rtspsrc location='rtsp://viewer:" +
+    return runCommand("timeout 40 gst-launch-1.0 -q rtspsrc location='rtsp://viewer:" +
                       std::string(kToken) + "@" + rtspServer.substr(7) + path +
                       "' protocols=tcp ! rtpjpegdepay ! jpegdec ! fakesink num-buffers=5 2>&1");
   };

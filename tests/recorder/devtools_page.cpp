@@ -206,9 +206,13 @@ nlohmann::json DevToolsPage::call(const std::string& method, nlohmann::json para
 }
 
 bool DevToolsPage::navigate(const std::string& url) {
-  auto result = call("Page.navigate", {{"url", url}});
+  auto result = call("Page.navigate", {{"url", url}}, std::chrono::seconds(20));
   if (result.contains("error") || result.contains("errorText")) return false;
-  return waitUntil("document.readyState === 'complete'");
+  // The document parsed and its scripts run: what the tests drive. Not
+  // every subresource loaded ('complete'): the live view's MJPEG fallback is
+  // an image that never finishes, and a loaded machine may fall back to it
+  // before the load event.
+  return waitUntil("document.readyState !== 'loading'", std::chrono::seconds(20));
 }
 
 nlohmann::json DevToolsPage::evaluate(const std::string& expression) {

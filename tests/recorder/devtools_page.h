@@ -36,7 +36,7 @@ class DevToolsPage {
   // patience() in wait_for.h).
   nlohmann::json call(const std::string& method, nlohmann::json params = nlohmann::json::object(),
                       std::chrono::milliseconds timeout = std::chrono::seconds(10));
-  // Loads `url` and waits for its load event.
+  // Loads `url` and waits until its document is parsed and its scripts run.
   bool navigate(const std::string& url);
   // The value of a JavaScript expression (promises awaited), or null.
   nlohmann::json evaluate(const std::string& expression);

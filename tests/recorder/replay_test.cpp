@@ -141,27 +141,32 @@ TEST_F(Replay, EveryFrameArrivesByteForByteAtItsRecordedInterval) {
   EXPECT_NE(same_->summary.find("replayed " + std::to_string(recorded.size()) + " frames"),
             std::string::npos)
       << same_->summary;
-  // Both files keep whole milliseconds; the receiver stamps arrivals.
+  // Both files keep whole milliseconds; the receiver stamps arrivals. Each
+  // frame's replayed time against its recorded one, less the typical
+  // difference (the two runs' clocks start apart): a frame the loaded
+  // machine delivered late is off once. (Measured as intervals, it was off
+  // twice: late after the one before, and the next one early after it.)
   auto before = contentsOf(segmentOf(*original_)).framePts;
   auto after = contentsOf(segmentOf(*same_->recorder)).framePts;
   ASSERT_EQ(before.size(), after.size());
+  std::vector<int64_t> shifts;
+  for (size_t i = 0; i < before.size(); ++i)
+    shifts.push_back(static_cast<int64_t>(after[i]) - static_cast<int64_t>(before[i]));
+  std::vector<int64_t> sorted = shifts;
+  std::sort(sorted.begin(), sorted.end());
+  int64_t typical = sorted[sorted.size() / 2];
   std::vector<int64_t> offs;
-  for (size_t i = 1; i < before.size(); ++i) {
-    auto recordedInterval = static_cast<int64_t>(before[i] - before[i - 1]);
-    auto replayedInterval = static_cast<int64_t>(after[i] - after[i - 1]);
-    offs.push_back(std::llabs(recordedInterval - replayedInterval));
-  }
+  for (int64_t shift : shifts) offs.push_back(std::llabs(shift - typical));
   auto within = static_cast<size_t>(
       std::count_if(offs.begin(), offs.end(), [](int64_t off) { return off <= 2 * GST_MSECOND; }));
   std::sort(offs.begin(), offs.end());
   int64_t median = offs[offs.size() / 2], worst = offs.back();
-  RecordProperty("intervals within 2 ms", std::to_string(within) + " of " +
-                                              std::to_string(offs.size()) + ", median " +
-                                              std::to_string(median / 1000) + " us, worst " +
-                                              std::to_string(worst / 1000) + " us");
-  // On an idle machine 95–100 % are within 2 ms; a loaded one (the suite
-  // runs two at a time, beside the WebRTC soak) delays some arrivals, and
-  // the frame after one comes early by as much: the typical interval must
+  RecordProperty("frames within 2 ms of their time",
+                 std::to_string(within) + " of " + std::to_string(offs.size()) + ", median " +
+                     std::to_string(median / 1000) + " us, worst " + std::to_string(worst / 1000) +
+                     " us");
+  // On an idle machine all are within 2 ms; a loaded one (six suites and
+  // two busy loops on two cores) delivers some late: the typical frame must
   // stay exact, and most of them.
   EXPECT_LE(median, 2 * GST_MSECOND);
   EXPECT_GE(within, offs.size() * 80 / 100) << within << " of " << offs.size();
