@@ -11,6 +11,7 @@
 
 #include "app/pipeline_planner.h"
 #include "camera/camera.h"
+#include "camera_events.h"
 #include "simulated_device.h"
 #include "wait_for.h"
 
@@ -22,28 +23,8 @@ using namespace wircam::recorder;
 using namespace wircam::testing;
 using namespace std::chrono_literals;
 
-struct Observed : CameraObserver {
-  std::vector<std::string> closed;
-  bool over = false;
-  void segmentClosed(Camera&, const std::string& file, const PlannedSegment&) override {
-    closed.push_back(file);
-  }
-  void event(Camera&, const nlohmann::json&) override {}
-  void detections(Camera&, const nlohmann::json&, int64_t, GstClockTime) override {}
-  void diskFull(Camera&) override {}
-  void ended(Camera&) override { over = true; }
-};
-
-// Runs the default main context until `done`, at most `limit`.
-bool runUntil(const std::function<bool()>& done, std::chrono::milliseconds limit) {
-  auto until = std::chrono::steady_clock::now() + limit;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    g_main_context_iteration(nullptr, FALSE);
-    std::this_thread::sleep_for(5ms);
-  }
-  return true;
-}
+using Observed = wircam::testing::CameraEvents;
+using wircam::testing::runMainLoopUntil;
 
 TEST(CameraRebuild, ACameraWhoseRebuildFailsComesBackAndRecords) {
   gst_registry_scan_path(gst_registry_get(), WIRCAM_PLUGIN_DIR);
@@ -81,23 +62,23 @@ TEST(CameraRebuild, ACameraWhoseRebuildFailsComesBackAndRecords) {
       },
       camera->get());
   auto frames = [&] { return (*camera)->report().frames; };
-  ASSERT_TRUE(runUntil([&] { return frames() > 15; }, 10s));
+  ASSERT_TRUE(runMainLoopUntil([&] { return frames() > 15; }, 10s));
 
   // The device goes away: the file ends, the first rebuild fails.
   device.reset();
-  ASSERT_TRUE(runUntil([&] { return builds >= 2; }, 10s)) << "no rebuild tried";
+  ASSERT_TRUE(runMainLoopUntil([&] { return builds >= 2; }, 10s)) << "no rebuild tried";
   EXPECT_EQ((*camera)->phase(), CameraPhase::kRestarting);
   device = startSequenceDevice(port);
   ASSERT_TRUE(device);
   uint64_t before = frames();
   // Tried again after the backoff: it records again.
-  EXPECT_TRUE(runUntil([&] { return builds >= 3 && frames() > before + 15; }, 20s))
+  EXPECT_TRUE(runMainLoopUntil([&] { return builds >= 3 && frames() > before + 15; }, 20s))
       << builds << " builds, " << frames() << " frames";
   EXPECT_EQ((*camera)->phase(), CameraPhase::kRunning);
   EXPECT_GE((*camera)->report().restarts, 1u);
 
   (*camera)->stop();
-  EXPECT_TRUE(runUntil([&] { return observed.over; }, 5s));
+  EXPECT_TRUE(runMainLoopUntil([&] { return observed.over; }, 5s));
   g_source_remove(ticks);
   EXPECT_GE(observed.closed.size(), 2u);  // before the loss, and after it
   camera->reset();

@@ -12,17 +12,10 @@
 #include <sstream>
 
 #include "app/recorder_options.h"
+#include "command_line.h"
 
 namespace wircam::recorder {
 namespace {
-
-Expected<RecorderOptions, std::string> parse(std::vector<std::string> words) {
-  words.insert(words.begin(), "wirc-recorder");
-  std::vector<char*> argv;
-  for (auto& word : words) argv.push_back(word.data());
-  argv.push_back(nullptr);
-  return parseOptions(static_cast<int>(words.size()), argv.data());
-}
 
 class ConfigFile {
  public:

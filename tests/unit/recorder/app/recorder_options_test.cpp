@@ -3,16 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include "command_line.h"
+
 namespace wircam::recorder {
 namespace {
-
-Expected<RecorderOptions, std::string> parse(std::vector<std::string> words) {
-  words.insert(words.begin(), "wirc-recorder");
-  std::vector<char*> argv;
-  for (auto& word : words) argv.push_back(word.data());
-  argv.push_back(nullptr);
-  return parseOptions(static_cast<int>(words.size()), argv.data());
-}
 
 TEST(RecorderOptions, ServersListenOnThisMachineUnlessAHostIsGiven) {
   auto options = parse({"--out", "x", "--http", ":8080", "--rtsp", "0.0.0.0:8554"});

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "camera/camera.h"
+#include "camera_events.h"
 #include "scene_frames.h"
 #include "status/camera_report.h"
 #include "status/prometheus_metrics.h"
@@ -25,26 +26,8 @@ namespace fs = std::filesystem;
 using namespace wircam::recorder;
 using namespace std::chrono_literals;
 
-struct Observed : CameraObserver {
-  std::vector<std::pair<std::string, PlannedSegment>> closed;
-  bool over = false;
-  void segmentClosed(Camera&, const std::string& file, const PlannedSegment& planned) override {
-    closed.emplace_back(file, planned);
-  }
-  void event(Camera&, const nlohmann::json&) override {}
-  void detections(Camera&, const nlohmann::json&, int64_t, GstClockTime) override {}
-  void diskFull(Camera&) override {}
-  void ended(Camera&) override { over = true; }
-};
-
-bool runUntil(const std::function<bool()>& done, std::chrono::milliseconds limit) {
-  auto until = std::chrono::steady_clock::now() + limit;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    if (!g_main_context_iteration(nullptr, FALSE)) std::this_thread::sleep_for(1ms);
-  }
-  return true;
-}
+using Observed = wircam::testing::CameraEvents;
+using wircam::testing::runMainLoopUntil;
 
 std::string md5Of(const uint8_t* data, size_t size) {
   gchar* md5 = g_compute_checksum_for_data(G_CHECKSUM_MD5, data, size);
@@ -151,10 +134,10 @@ TEST_F(CameraFilesTest, FilesAreCutAtTheSegmentLengthAndAtAGapAndHoldEveryFrameI
   auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
   for (size_t i = 0; i < 90; ++i) push(i, at(i));
   for (size_t i = 0; i < 15; ++i) push(90 + i, 7 * GST_SECOND + at(i));
-  ASSERT_TRUE(runUntil([&] { return observed.closed.size() >= 3; }, 10s))
+  ASSERT_TRUE(runMainLoopUntil([&] { return observed.closed.size() >= 3; }, 10s))
       << observed.closed.size() << " files closed";
   (*camera)->stop();
-  ASSERT_TRUE(runUntil([&] { return observed.over; }, 10s));
+  ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 10s));
 
   // 0-2 s, 2-4 s, 4-6 s, and the frames after the gap.
   ASSERT_EQ(observed.closed.size(), 4u);
@@ -191,17 +174,17 @@ TEST_F(CameraFilesTest, NewSettingsEndTheFileAndTheNextPipelineRecordsWithThem) 
   ASSERT_TRUE((*camera)->start());
   auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
   for (size_t i = 0; i < 20; ++i) push(i, at(i));
-  ASSERT_TRUE(runUntil([&] { return (*camera)->hasFrames(); }, 5s));
+  ASSERT_TRUE(runMainLoopUntil([&] { return (*camera)->hasFrames(); }, 5s));
   CameraFiles shorter = files;
   shorter.limits.maxDuration = GST_SECOND;
   (*camera)->replan(plan(), shorter, {});
-  ASSERT_TRUE(runUntil([&] { return builds_ == 2 && observed.closed.size() == 1; }, 5s))
+  ASSERT_TRUE(runMainLoopUntil([&] { return builds_ == 2 && observed.closed.size() == 1; }, 5s))
       << builds_ << " builds, " << observed.closed.size() << " files closed";
   EXPECT_EQ((*camera)->report().restarts, 0u) << "new settings are not a fault";
   for (size_t i = 0; i < 30; ++i) push(20 + i, at(i));
-  ASSERT_TRUE(runUntil([&] { return observed.closed.size() >= 2; }, 5s));
+  ASSERT_TRUE(runMainLoopUntil([&] { return observed.closed.size() >= 2; }, 5s));
   (*camera)->stop();
-  ASSERT_TRUE(runUntil([&] { return observed.over; }, 5s));
+  ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 5s));
   std::vector<uint64_t> planned;
   for (const auto& [file, segment] : observed.closed) planned.push_back(segment.frames);
   EXPECT_EQ(planned, (std::vector<uint64_t>{20, 15, 15}));
@@ -250,7 +233,7 @@ TEST_F(CameraFilesTest,
   auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
   push(0, at(0));
   GstElement* muxer = nullptr;
-  ASSERT_TRUE(runUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
+  ASSERT_TRUE(runMainLoopUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
   GstPad* output = gst_element_get_static_pad(muxer, "src");
   gulong stall = gst_pad_add_probe(
       output, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
@@ -258,9 +241,9 @@ TEST_F(CameraFilesTest,
   const size_t kFrames = 120;
   for (size_t i = 1; i < kFrames; ++i) push(i, at(i));
   // Every frame reaches the live branch: the source never waits for the disk.
-  ASSERT_TRUE(runUntil([&] { return live.load() == static_cast<int>(kFrames); }, 5s))
+  ASSERT_TRUE(runMainLoopUntil([&] { return live.load() == static_cast<int>(kFrames); }, 5s))
       << live.load() << " of " << kFrames << " frames reached the live view";
-  ASSERT_TRUE(runUntil(
+  ASSERT_TRUE(runMainLoopUntil(
       [&] {
         (*camera)->tick();
         return (*camera)->report().recordingDropped > 0;
@@ -271,7 +254,7 @@ TEST_F(CameraFilesTest,
   gst_object_unref(output);
   gst_object_unref(muxer);
   (*camera)->stop();
-  ASSERT_TRUE(runUntil([&] { return observed.over; }, 10s));
+  ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 10s));
   uint64_t recorded = 0;
   for (const auto& [file, segment] : observed.closed) recorded += segment.frames;
   CameraReport report = (*camera)->report();
