@@ -1,151 +1,22 @@
-// The rows of optionTable() and deviceKeyTable(): each option once, with
-// what it reads and refuses.
+// The option table: the recording's own rows here (devices and cameras,
+// files, retention, detection and following), the servers' in
+// server_options.cpp, the [device NAME] keys in device_keys.cpp.
 #include "app/option_table.h"
 
-#include <glib.h>
-
 #include <cmath>
-#include <memory>
 
+#include "app/option_rows.h"
 #include "app/option_values.h"
-#include "fleet/mqtt_url.h"
-#include "record/retention.h"
-#include "wirc/channel_list.h"
 
 namespace wircam::recorder {
 
+using namespace option_rows;
+
 namespace {
 
-using Apply = std::function<OptionProblem(RecorderOptions&, const char*)>;
-
-// Readers for the common kinds of value, each checking its range and saying
-// it the same way.
-Apply seconds(double RecorderOptions::*field, double low, double high) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    auto s = number(value);
-    if (!s || *s < low || *s > high) {
-      char range[64];
-      g_snprintf(range, sizeof range, "seconds, %g..%g", low, high);
-      return range;
-    }
-    o.*field = *s;
-    return std::nullopt;
-  };
-}
-
-Apply wholeNumber(unsigned RecorderOptions::*field, double low, double high, const char* unit) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    auto n = number(value);
-    if (!n || *n < low || *n > high || *n != std::floor(*n)) {
-      char range[64];
-      g_snprintf(range, sizeof range, "%s%s%g..%g", unit, *unit ? ", " : "", low, high);
-      return range;
-    }
-    o.*field = static_cast<unsigned>(*n);
-    return std::nullopt;
-  };
-}
-
-Apply onOff(bool RecorderOptions::*field) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    std::string on = value;
-    if (on != "on" && on != "off") return "on or off";
-    o.*field = on == "on";
-    return std::nullopt;
-  };
-}
-
-Apply text(std::string RecorderOptions::*field) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    o.*field = value;
-    return std::nullopt;
-  };
-}
-
-Apply optionalText(std::optional<std::string> RecorderOptions::*field) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    o.*field = value;
-    return std::nullopt;
-  };
-}
-
-Apply serverAddress(std::optional<ServerAddress> RecorderOptions::*field) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    auto address = parseServerAddress(value);
-    if (!address) return "[HOST]:PORT, as in :8080 or 127.0.0.1:8080";
-    o.*field = *address;
-    return std::nullopt;
-  };
-}
-
-Apply size(uint64_t RecorderOptions::*field) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    auto bytes = byteSize(value);
-    if (!bytes) return "a size like 500M or 20G";
-    o.*field = *bytes;
-    return std::nullopt;
-  };
-}
-
-Apply duration(std::chrono::seconds RecorderOptions::*field) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    auto d = parseDuration(value);
-    if (!d || d->count() == 0) return "a duration like 7d, 12h, 30m or 90s";
-    o.*field = *d;
-    return std::nullopt;
-  };
-}
-
-Apply channels(std::optional<std::string> RecorderOptions::*field, bool periods) {
-  return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    auto list = wirc::parseChannelList(value);
-    if (!list) return list.error();
-    auto invalid = periods ? wirc::validate(wirc::Ccfg{*list}) : wirc::validate(wirc::Fcfg{*list});
-    if (invalid) return invalid->message();
-    o.*field = value;
-    return std::nullopt;
-  };
-}
-
-// A topic prefix: no wildcards, no empty level at either end.
-OptionProblem topicPrefix(const std::string& prefix, const char* example) {
-  if (prefix.empty() || prefix.find_first_of("+# ") != std::string::npos || prefix.front() == '/' ||
-      prefix.back() == '/')
-    return std::string("a topic prefix without + # or a leading or trailing /, like ") + example;
-  return std::nullopt;
-}
-
-OptionProblem commandLine(RecorderOptions& o, const char* value) {
-  gchar** argv = nullptr;
-  GError* error = nullptr;
-  if (!g_shell_parse_argv(value, nullptr, &argv, &error)) {
-    std::string problem = error->message;
-    g_error_free(error);
-    return "cannot split the command: " + problem;
-  }
-  o.onSegmentClosed.assign(argv, argv + g_strv_length(argv));
-  g_strfreev(argv);
-  return std::nullopt;
-}
-
-// A flag's value in the config file (the command line's flag says true).
-std::optional<bool> trueOrFalse(const char* value) {
-  std::string v = value;
-  if (v == "true" || v == "1") return true;
-  if (v == "false" || v == "0") return false;
-  return std::nullopt;
-}
-
-constexpr const char* kDevices = "Devices and cameras";
-constexpr const char* kFiles = "Files";
-constexpr const char* kRetention = "Retention";
-constexpr const char* kDetection = "Detection and following";
-constexpr const char* kWeb = "Web server";
-constexpr const char* kFoxglove = "Foxglove";
-constexpr const char* kFleet = "MQTT and hooks";
-constexpr const char* kOther = "Other";
-
-std::vector<OptionSpec> makeTable() {
+// The recording's own options: devices and cameras, files, retention,
+// detection and following.
+std::vector<OptionSpec> recordingRows() {
   return {
       {.name = "device",
        .value = "HOST[:PORT][,control=URI]",
@@ -437,313 +308,18 @@ std::vector<OptionSpec> makeTable() {
        .apply = optionalText(&RecorderOptions::beacons),
        .example = "5,6",
        .needs = {"marvelmind", "192.168.1.50"}},
-
-      {.name = "http",
-       .value = "[HOST]:PORT",
-       .fallback = "off",
-       .section = kWeb,
-       .help = "the web page and HTTP API ([web-interface.md](web-interface.md)); without HOST "
-               "on 127.0.0.1 only; `:0` picks a free port (logged as `live view at http://…`). "
-               "Another HOST (e.g. `0.0.0.0`) needs `--http-token`",
-       .apply = serverAddress(&RecorderOptions::http),
-       .example = ":8081"},
-      {.name = "http-token",
-       .value = "T",
-       .fallback = "none",
-       .section = kWeb,
-       .help = "every request needs the token (Bearer, Basic with T as the password, or the "
-               "sign-in cookie); 16 characters at least, no spaces, quotes, commas or "
-               "semicolons (e.g. `openssl rand -hex 16`). RTSP and the Foxglove WebSocket ask "
-               "for it too. Control, driving, deleting and reloading are refused without it",
-       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         std::string token = value;
-         if (token.size() < 16 || token.find_first_of(" ;,\"\\") != std::string::npos)
-           return "at least 16 characters, no spaces, quotes, commas or semicolons (e.g. from "
-                  "openssl rand -hex 16)";
-         o.httpToken = token;
-         return std::nullopt;
-       },
-       .example = "0123456789abcdef0123"},
-      {.name = "http-cert",
-       .value = "FILE",
-       .fallback = "none",
-       .section = kWeb,
-       .help = "serve HTTPS with this PEM certificate (and `wss://` with `--foxglove`); with "
-               "`--http-key`",
-       .apply = text(&RecorderOptions::httpCert),
-       .example = "cert.pem",
-       .needs = {"http-key", "key.pem", "http", ":8081"}},
-      {.name = "http-key",
-       .value = "FILE",
-       .fallback = "none",
-       .section = kWeb,
-       .help = "the certificate's PEM key",
-       .apply = text(&RecorderOptions::httpKey),
-       .example = "key.pem",
-       .needs = {"http-cert", "cert.pem", "http", ":8081"}},
-      {.name = "http-idle-timeout",
-       .value = "S",
-       .fallback = "10",
-       .section = kWeb,
-       .help = "close a connection with no request in progress (silent, idle, or still sending "
-               "its headers) for S seconds (0.1..3600)",
-       .apply = seconds(&RecorderOptions::httpIdleSeconds, 0.1, 3600),
-       .example = "30"},
-      {.name = "webrtc",
-       .value = "on|off",
-       .fallback = "on",
-       .section = kWeb,
-       .help = "the page's live view over WebRTC, WHEP at `/api/cameras/NAME/whep` "
-               "([webrtc.md](webrtc.md))",
-       .apply = onOff(&RecorderOptions::webrtc),
-       .example = "off"},
-      {.name = "webrtc-stun",
-       .value = "stun://HOST:PORT",
-       .fallback = "none",
-       .section = kWeb,
-       .help = "a STUN server for viewers across NAT (none is contacted unless set)",
-       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         if (!g_str_has_prefix(value, "stun://") ||
-             !g_uri_is_valid(value, G_URI_FLAGS_NONE, nullptr))
-           return "a STUN server as stun://HOST:PORT";
-         o.webrtcStun = value;
-         return std::nullopt;
-       },
-       .example = "stun://192.168.1.2:3478"},
-      {.name = "webrtc-turn",
-       .value = "turn://USER:PASSWORD@HOST:PORT",
-       .fallback = "none",
-       .section = kWeb,
-       .help = "a TURN server (`turns://` for TLS)",
-       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         if ((!g_str_has_prefix(value, "turn://") && !g_str_has_prefix(value, "turns://")) ||
-             !g_uri_is_valid(value, G_URI_FLAGS_HAS_PASSWORD, nullptr))
-           return "a TURN server as turn://USER:PASSWORD@HOST:PORT (or turns://)";
-         o.webrtcTurn = value;
-         return std::nullopt;
-       },
-       .example = "turn://me:secret@192.168.1.2:3478"},
-      {.name = "webrtc-kbps",
-       .value = "N",
-       .fallback = "600",
-       .section = kWeb,
-       .help = "each camera's VP8 bitrate for WebRTC, 50..20000",
-       .apply = wholeNumber(&RecorderOptions::webrtcKbps, 50, 20000, "kbit/s"),
-       .example = "800"},
-      {.name = "rtsp",
-       .value = "[HOST]:PORT",
-       .fallback = "off",
-       .section = kWeb,
-       .help = "RTSP server: `rtsp://HOST:PORT/<device>/cam<N>` ([rtsp.md](rtsp.md)); without "
-               "HOST on 127.0.0.1 only",
-       .apply = serverAddress(&RecorderOptions::rtsp),
-       .example = ":8554"},
-
-      {.name = "foxglove",
-       .value = "[HOST]:PORT",
-       .fallback = "off",
-       .section = kFoxglove,
-       .help = "a Foxglove WebSocket (`foxglove.websocket.v1`) for Foxglove and Lichtblick: each "
-               "camera's image, tags, telemetry, log and pose, and `/STREAM/drive` from their "
-               "Teleop panel ([foxglove.md](foxglove.md)); logged as `Foxglove WebSocket at "
-               "ws://…`. Without HOST on 127.0.0.1 only; another HOST needs `--http-token`. "
-               "Token and TLS (`wss://`) as for `--http`",
-       .apply = serverAddress(&RecorderOptions::foxglove),
-       .example = ":8765"},
-      {.name = "foxglove-max-clients",
-       .value = "N",
-       .fallback = "8",
-       .section = kFoxglove,
-       .help = "Foxglove clients at once, 1..64; the next is told why and closed",
-       .apply = wholeNumber(&RecorderOptions::foxgloveMaxClients, 1, 64, ""),
-       .example = "4"},
-
-      {.name = "mqtt",
-       .value = "mqtt://[USER:PASS@]HOST[:PORT]",
-       .fallback = "off",
-       .section = kFleet,
-       .help = "publish status, detections and events and take commands ([mqtt.md](mqtt.md)); "
-               "`mqtts://` for TLS (port 8883)",
-       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         auto url = parseMqttUrl(value);
-         if (!url) return url.error();
-         o.mqtt = value;
-         return std::nullopt;
-       },
-       .example = "mqtt://192.168.1.3"},
-      {.name = "mqtt-cafile",
-       .value = "FILE",
-       .fallback = "system CAs",
-       .section = kFleet,
-       .help = "the CA (PEM) that signed the broker's certificate",
-       .apply = text(&RecorderOptions::mqttCaFile),
-       .example = "ca.pem",
-       .needs = {"mqtt", "mqtts://192.168.1.3"}},
-      {.name = "mqtt-prefix",
-       .value = "P",
-       .fallback = "wircam",
-       .section = kFleet,
-       .help = "topic prefix (no `+`, `#`, leading or trailing `/`)",
-       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         if (auto problem = topicPrefix(value, "wircam or lab/rovers")) return problem;
-         o.mqttPrefix = value;
-         return std::nullopt;
-       },
-       .example = "lab/rovers"},
-      {.name = "mqtt-discovery",
-       .value = "[PREFIX]",
-       .fallback = "off",
-       .section = kFleet,
-       .help = "Home Assistant MQTT discovery under PREFIX (`homeassistant`); "
-               "`--mqtt-discovery=PREFIX` works too; in the config file `true` or a prefix",
-       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         // Alone (or =true in the config file): Home Assistant's own prefix.
-         std::string prefix = value;
-         if (prefix == "true") prefix = "homeassistant";
-         if (prefix == "false") return std::nullopt;
-         if (auto problem = topicPrefix(prefix, "homeassistant")) return problem;
-         o.mqttDiscovery = prefix;
-         return std::nullopt;
-       },
-       .example = "ha",
-       .needs = {"mqtt", "mqtt://192.168.1.3"},
-       .optionalValue = true},
-      {.name = "mqtt-snapshot-interval",
-       .value = "S",
-       .fallback = "10",
-       .section = kFleet,
-       .help = "with discovery: each camera's newest JPEG every S seconds (0.5..3600)",
-       .apply = seconds(&RecorderOptions::mqttSnapshotSeconds, 0.5, 3600),
-       .example = "20"},
-      {.name = "mqtt-detections-rate",
-       .value = "HZ",
-       .fallback = "0",
-       .section = kFleet,
-       .help = "at most HZ detection messages a second per stream (0: every frame with tags)",
-       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         auto rate = number(value);
-         if (!rate || *rate < 0 || *rate > 1000)
-           return "messages per second, 0..1000 (0: every frame)";
-         o.mqttDetectionsRate = *rate;
-         return std::nullopt;
-       },
-       .example = "2"},
-      {.name = "on-segment-closed",
-       .value = "CMD",
-       .fallback = "none",
-       .section = kFleet,
-       .help = "run CMD (split as a shell would, never through one) with the segment's path and "
-               "its sidecar's as two more arguments, for each segment as it closes; failures are "
-               "retried with backoff ([below](#segment-hooks))",
-       .apply = commandLine,
-       .example = "upload --fast"},
-      {.name = "hook-timeout",
-       .value = "S",
-       .fallback = "600",
-       .section = kFleet,
-       .help = "a hook running longer is stopped (its whole process group) and retried "
-               "(1..86400)",
-       .apply = seconds(&RecorderOptions::hookTimeoutSeconds, 1, 86400),
-       .example = "60"},
-      {.name = "hook-drain",
-       .value = "S",
-       .fallback = "15",
-       .section = kFleet,
-       .help = "at exit, how long the hooks still queued get (0..3600)",
-       .apply = seconds(&RecorderOptions::hookDrainSeconds, 0, 3600),
-       .example = "5"},
-
-      {.name = "help",
-       .value = nullptr,
-       .fallback = "",
-       .section = kOther,
-       .help = "the option list, config keys, file names, MQTT topics and exit codes",
-       .commandLineOnly = true},
-  };
-}
-
-Expected<int, std::string> cameraNumber(const std::string& text) {
-  auto camera = number(text.c_str());
-  if (!camera || *camera < 0 || *camera > 255 || *camera != std::floor(*camera))
-    return unexpected(std::string("cameras 0..255, as in 0;1"));
-  return static_cast<int>(*camera);
-}
-
-std::vector<DeviceKeySpec> makeDeviceKeys() {
-  return {
-      {.key = "host",
-       .value = "HOST",
-       .help = "its address (needed)",
-       .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         d.host = value;
-         return std::nullopt;
-       }},
-      {.key = "port",
-       .value = "PORT",
-       .help = "its port (1984)",
-       .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         auto port = number(value.c_str());
-         if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
-           return "a port is 1..65535";
-         d.port = static_cast<uint16_t>(*port);
-         return std::nullopt;
-       }},
-      {.key = "cameras",
-       .value = "N;N...",
-       .help = "its cameras, instead of `--camera`'s",
-       .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         d.cameras.clear();
-         std::unique_ptr<gchar*, decltype(&g_strfreev)> items(
-             g_strsplit_set(value.c_str(), ";,", -1), g_strfreev);
-         for (gchar** item = items.get(); *item; ++item) {
-           if (!**item) continue;  // "0;1;"
-           auto camera = cameraNumber(*item);
-           if (!camera) return camera.error();
-           d.cameras.push_back(*camera);
-         }
-         if (d.cameras.empty()) return "a list like 0;1";
-         return std::nullopt;
-       }},
-      {.key = "follow",
-       .value = "true|false",
-       .help = "whether it follows, instead of `--follow`",
-       .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         auto on = trueOrFalse(value.c_str());
-         if (!on) return "true or false";
-         d.follow = *on;
-         return std::nullopt;
-       }},
-      {.key = "control",
-       .value = "URI",
-       .help = "steer `rcoip://H:P`, `btemp://H:P` or `wirc://H:P` instead of this device, as "
-               "`--device`'s `control=`",
-       .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         auto control = parseControlTarget(value);
-         if (!control) return control.error();
-         d.control = *control;
-         return std::nullopt;
-       }},
-      {.key = "marvelmind",
-       .value = "HOST[:PORT]",
-       .help = "its Marvelmind dashboard, instead of `--marvelmind`",
-       .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         d.marvelmind = value;
-         return std::nullopt;
-       }},
-      {.key = "beacon",
-       .value = "ADDR[,ADDR]",
-       .help = "its beacon(s), instead of `--beacon`",
-       .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         d.beacons = value;
-         return std::nullopt;
-       }},
   };
 }
 
 }  // namespace
 
 const std::vector<OptionSpec>& optionTable() {
-  static const std::vector<OptionSpec> table = makeTable();
+  static const std::vector<OptionSpec> table = [] {
+    auto rows = recordingRows();
+    auto servers = serverOptionRows();
+    rows.insert(rows.end(), servers.begin(), servers.end());
+    return rows;
+  }();
   return table;
 }
 
@@ -754,7 +330,7 @@ const OptionSpec* findOption(const std::string& name) {
 }
 
 const std::vector<DeviceKeySpec>& deviceKeyTable() {
-  static const std::vector<DeviceKeySpec> table = makeDeviceKeys();
+  static const std::vector<DeviceKeySpec> table = deviceKeyRows();
   return table;
 }
 
