@@ -90,6 +90,10 @@ struct WircSrcState {
   int height = 0;
   Clock::time_point nextStats;
   GstClockTime lastPts = GST_CLOCK_TIME_NONE;  // the newest frame's, on the streaming thread
+  // Whether the pipeline's clock reads CLOCK_MONOTONIC, asked once per clock
+  // (a property read per frame cost more than the rest of the timestamp).
+  const GstClock* typedClock = nullptr;
+  bool monotonicClock = false;
 
   Mutex refusalMutex;                                   // refusal is written on the event loop
   std::string refusal WIRCAM_GUARDED_BY(refusalMutex);  // the device refused this camera's STST
@@ -239,6 +243,7 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   }
   state->width = state->height = 0;
   state->lastPts = GST_CLOCK_TIME_NONE;
+  state->typedClock = nullptr;  // a new clock may come at a freed one's address
   state->loginDeadline = Clock::now() + std::chrono::milliseconds(settings.loginTimeoutMs + 500);
   state->nextStats = Clock::now() + std::chrono::milliseconds(settings.statsIntervalMs);
   publishStats(self);
@@ -365,12 +370,11 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
 // otherwise) that is the arrival time itself: steady_clock reads the same
 // CLOCK_MONOTONIC, so the time is exact however loaded the machine. With any
 // other clock: its now less the frame's age, the two read back to back.
-static GstClockTime arrival_clock_time(GstClock* clock, Clock::time_point firstPacket) {
+static GstClockTime arrival_clock_time(GstClock* clock, bool monotonic,
+                                       Clock::time_point firstPacket) {
   auto sinceBoot =
       std::chrono::duration_cast<std::chrono::nanoseconds>(firstPacket.time_since_epoch());
-  GstClockType type = GST_CLOCK_TYPE_REALTIME;
-  if (GST_IS_SYSTEM_CLOCK(clock)) g_object_get(clock, "clock-type", &type, nullptr);
-  if (type == GST_CLOCK_TYPE_MONOTONIC) {
+  if (monotonic) {
     GstClockTime internal, external, rateNum, rateDenom;
     gst_clock_get_calibration(clock, &internal, &external, &rateNum, &rateDenom);
     return gst_clock_adjust_with_calibration(clock, static_cast<GstClockTime>(sinceBoot.count()),
@@ -387,10 +391,17 @@ static GstClockTime arrival_clock_time(GstClock* clock, Clock::time_point firstP
 static GstClockTime frame_timestamp(GstWircSrc* self, Clock::time_point firstPacket) {
   GstClock* clock = gst_element_get_clock(GST_ELEMENT(self));
   if (!clock) return GST_CLOCK_TIME_NONE;
-  GstClockTime arrival = arrival_clock_time(clock, firstPacket);
+  auto* state = self->state;
+  if (clock != state->typedClock) {
+    GstClockType type = GST_CLOCK_TYPE_REALTIME;
+    if (GST_IS_SYSTEM_CLOCK(clock)) g_object_get(clock, "clock-type", &type, nullptr);
+    state->typedClock = clock;
+    state->monotonicClock = type == GST_CLOCK_TYPE_MONOTONIC;
+  }
+  GstClockTime arrival = arrival_clock_time(clock, state->monotonicClock, firstPacket);
   gst_object_unref(clock);
   GstClockTime base = gst_element_get_base_time(GST_ELEMENT(self));
-  auto& last = self->state->lastPts;
+  auto& last = state->lastPts;
   std::optional<uint64_t> previous;
   if (GST_CLOCK_TIME_IS_VALID(last)) previous = last;
   last = wirc::nextFrameTime(arrival > base ? arrival - base : 0, previous);

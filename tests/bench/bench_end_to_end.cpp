@@ -18,6 +18,7 @@
 
 #include "child_process.h"
 #include "synthetic_jpeg.h"
+#include "thread_times.h"
 
 namespace {
 
@@ -40,9 +41,17 @@ using wircam::bench::spawn;
 
 void stop(pid_t pid) { wircam::bench::stopGroup(pid, SIGTERM); }
 
+// One receiver's CPU per frame: the whole process, and its source's
+// streaming thread (named "NAME:src") apart from the rest (for wircsrc the
+// vehicle link's event loop: keepalives and status reports).
 struct Result {
   double cpuPerFrameUs = 0;
+  double streamingUsPerFrame = 0;
+  double streamingWakeUpsPerFrame = 0;
+  double otherWakeUpsPerFrame = 0;
   uint64_t frames = 0;
+
+  double otherUsPerFrame() const { return cpuPerFrameUs - streamingUsPerFrame; }
 };
 
 // Runs the receiver pipeline for `seconds` and counts frames at its sink.
@@ -59,25 +68,52 @@ Result receive(const std::string& description, double seconds) {
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // warm up, log in
   uint64_t startFrames = frames;
   double startCpu = cpuSeconds();
+  auto startThreads = wircam::bench::threadTimes();
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
   double cpu = cpuSeconds() - startCpu;
+  auto threads = wircam::bench::threadTimes() - startThreads;
   uint64_t counted = frames - startFrames;
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(sink);
   gst_object_unref(pipeline);
-  return {counted ? cpu / static_cast<double>(counted) * 1e6 : 0, counted};
+  if (!counted) return {};
+  double perFrame = 1.0 / static_cast<double>(counted);
+  Result result{.cpuPerFrameUs = cpu * perFrame * 1e6, .frames = counted};
+  for (const auto& [name, time] : threads) {
+    bool streaming = name.size() > 4 && name.compare(name.size() - 4, 4, ":src") == 0;
+    if (streaming) {
+      result.streamingUsPerFrame += static_cast<double>(time.cpuNs) / 1e3 * perFrame;
+      result.streamingWakeUpsPerFrame += static_cast<double>(time.wakeUps) * perFrame;
+    } else {
+      result.otherWakeUpsPerFrame += static_cast<double>(time.wakeUps) * perFrame;
+    }
+  }
+  return result;
 }
+
+void printRow(const char* label, const char* receiver, const Result& r) {
+  std::printf("%-12s %-22s %7.1f %10.1f (%4.2f) %10.1f (%4.2f) %7llu\n", label, receiver,
+              r.cpuPerFrameUs, r.streamingUsPerFrame, r.streamingWakeUpsPerFrame,
+              r.otherUsPerFrame(), r.otherWakeUpsPerFrame,
+              static_cast<unsigned long long>(r.frames));
+}
+
+double ratio(double ours, double stock) { return stock > 0 ? ours / stock : 0; }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, FALSE);  // the build's wircsrc
   gst_init(&argc, &argv);
   double seconds = argc > 1 ? std::atof(argv[1]) : 5;
   fs::path self = fs::canonical("/proc/self/exe").parent_path();
   std::string sim = (self / "wirc-sim").string();
 
-  std::printf("%-16s %-28s %-28s %s\n", "stream", "wircsim→wircsrc µs CPU/frame",
-              "rtpjpegpay→rtpjpegdepay", "ratio");
+  std::printf(
+      "CPU per frame in µs (wake-ups per frame): the whole receiving process, its\n"
+      "streaming thread, and its other threads (wircsrc's: the vehicle link)\n");
+  std::printf("%-12s %-22s %7s %17s %17s %7s\n", "stream", "receiver", "whole", "streaming",
+              "other", "frames");
   for (Case c : {Case{352, 288, 15}, Case{1280, 720, 30}}) {
     fs::path dir = fs::temp_directory_path() / ("wircam-e2e-" + std::to_string(c.width));
     fs::create_directories(dir);
@@ -118,10 +154,11 @@ int main(int argc, char** argv) {
 
     char label[32];
     std::snprintf(label, sizeof label, "%dx%d@%d", c.width, c.height, c.fps);
-    std::printf("%-16s %8.1f (%5llu frames)          %8.1f (%5llu frames)          %.2f×\n", label,
-                wircam.cpuPerFrameUs, static_cast<unsigned long long>(wircam.frames),
-                rtp.cpuPerFrameUs, static_cast<unsigned long long>(rtp.frames),
-                wircam.cpuPerFrameUs > 0 ? rtp.cpuPerFrameUs / wircam.cpuPerFrameUs : 0.0);
+    printRow(label, "wircsrc", wircam);
+    printRow(label, "udpsrc ! rtpjpegdepay", rtp);
+    std::printf("%-12s wircsrc ÷ stock: whole %.2f×, streaming thread %.2f×\n", label,
+                ratio(wircam.cpuPerFrameUs, rtp.cpuPerFrameUs),
+                ratio(wircam.streamingUsPerFrame, rtp.streamingUsPerFrame));
   }
   return 0;
 }

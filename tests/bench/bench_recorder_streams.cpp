@@ -14,7 +14,11 @@
 // counted in the files. The senders stop first and the receiver 0.3 s later,
 // so "lost" counts the frames sent that did not reach a file, not those
 // sent while the receiver was told to stop.
-// Usage: bench_recorder_streams [SECONDS] [N...]   (default 10 s; 1 2 4 8)
+// Each recorder run also says when all its cameras were live (its log's
+// "NAME: live" lines) and how long it took to stop after SIGINT.
+// Usage: bench_recorder_streams [--together] [SECONDS] [N...]   (default 10 s; 1 2 4 8)
+//   --together: each recorder run at the same time as a stock run, on the
+//   same processors, rather than one after the other.
 #include <gst/gst.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -25,6 +29,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -47,12 +53,13 @@ int framesIn(const fs::path& file) {
       "filesrc location=\"" + file.string() + "\" ! matroskademux ! fakesink name=sink";
   GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
   GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
-  static int count;
-  count = 0;
+  int count = 0;  // not static: with --together two runs count at once
   g_object_set(sink, "signal-handoffs", TRUE, nullptr);
   g_signal_connect(sink, "handoff",
-                   G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, gpointer) { ++count; }),
-                   nullptr);
+                   G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, gpointer counter) {
+                     ++*static_cast<int*>(counter);
+                   }),
+                   &count);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   GstBus* bus = gst_element_get_bus(pipeline);
   if (GstMessage* m = gst_bus_timed_pop_filtered(
@@ -162,6 +169,22 @@ int framesSent(const fs::path& summary) {
   return 0;
 }
 
+bool fileSays(const fs::path& file, const std::string& text) {
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);)
+    if (line.find(text) != std::string::npos) return true;
+  return false;
+}
+
+// Cameras the recorder's log has said went live ("NAME: live").
+int camerasLive(const fs::path& log) {
+  std::ifstream in(log);
+  std::set<std::string> live;
+  for (std::string line; std::getline(in, line);)
+    if (line.ends_with(": live")) live.insert(line.substr(0, line.size() - 6));
+  return static_cast<int>(live.size());
+}
+
 // One receiver's run: frames sent and recorded, its resources.
 struct Run {
   int sent = 0, recorded = 0, threads = 0;
@@ -169,46 +192,75 @@ struct Run {
   Usage usage;
   double seconds = 0;
   double recordingCpu = 0;  // % per stream while recording
+  double liveSeconds = -1;  // from its start until every camera said "live" (wirc-recorder)
+  double stopSeconds = 0;   // from SIGINT until it exited
   std::string row(int streams) const {
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  "lost %4d of %5d, %5.3f / %5.3f %%, %5.2f MB (%5.2f private), %4d thr",
-                  sent - recorded, sent, 100 * usage.cpuSeconds / seconds / streams, recordingCpu,
-                  usage.maxRssKb / 1024.0 / streams, privateKb / 1024.0 / streams, threads);
+    char text[200];
+    int length = std::snprintf(
+        text, sizeof text, "lost %4d of %5d, %5.3f / %5.3f %%, %5.2f MB (%5.2f private), %4d thr",
+        sent - recorded, sent, 100 * usage.cpuSeconds / seconds / streams, recordingCpu,
+        usage.maxRssKb / 1024.0 / streams, privateKb / 1024.0 / streams, threads);
+    if (liveSeconds >= 0)
+      std::snprintf(text + length, sizeof text - static_cast<size_t>(length),
+                    ", live %5.2f s, stop %5.2f s", liveSeconds, stopSeconds);
+    else if (stopSeconds > 0)
+      std::snprintf(text + length, sizeof text - static_cast<size_t>(length),
+                    ", not all live, stop %5.2f s", stopSeconds);
     // Killed after a minute of not stopping: its files may be unfinished.
     return text + std::string(usage.exitCode == 128 + SIGKILL ? " (did not stop: killed)" : "");
   }
 };
 
 // N × wirc-sim --frames → one wirc-recorder (with `extra` options).
-Run recordWithWircam(const fs::path& work, const fs::path& bin, int basePort, int n, double seconds,
-                     const std::string& extra) {
+Run recordWithWircam(const fs::path& work, const fs::path& frames, const fs::path& bin,
+                     int basePort, int n, double seconds, const std::string& extra) {
   fs::remove_all(work / "rec");
   std::vector<pid_t> sims;
   std::string devices;
   for (int i = 0; i < n; ++i) {
     int port = basePort + 2 * i;
     sims.push_back(spawn((bin / "wirc-sim").string() + " --port " + std::to_string(port) +
-                             " --frames " + (work / "frames").string(),
+                             " --frames " + frames.string(),
                          (work / ("sim" + std::to_string(i) + ".txt")).string()));
     devices += " --device 127.0.0.1:" + std::to_string(port);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  // "live" is timed from the recorder's start: every device listens first.
+  auto listening = Clock::now() + std::chrono::seconds(20);
+  for (int i = 0; i < n && Clock::now() < listening;)
+    if (fileSays(work / ("sim" + std::to_string(i) + ".txt"), "listening on"))
+      ++i;
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
   Run run;
   auto start = Clock::now();
+  // Each configuration's log stays (WIRCAM_BENCH_KEEP=1 keeps the folder).
+  fs::path log = work / ("recorder" + std::regex_replace(extra, std::regex("[ -]+"), "-") + ".log");
+  fs::remove(log);
   pid_t recorder = spawn((bin / "wirc-recorder").string() + devices + " --out " +
-                         (work / "rec").string() + " --segment 600" + extra);
-  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 4));
+                             (work / "rec").string() + " --segment 600" + extra,
+                         log.string(), "&1");
+  // Waits a quarter of the run, watching for the moment all cameras are live.
+  auto quarter = [&] {
+    auto until = Clock::now() + std::chrono::duration<double>(seconds / 4);
+    while (Clock::now() < until) {
+      if (run.liveSeconds < 0 && camerasLive(log) >= n) run.liveSeconds = secondsSince(start);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  };
+  quarter();
   CpuWindow recording(recorder);
-  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 4));
+  quarter();
   run.threads = threadsOf(recorder);
   run.privateKb = privateKbOf(recorder);
-  std::this_thread::sleep_for(std::chrono::duration<double>(seconds / 2));
+  quarter();
+  quarter();
   run.recordingCpu = recording.end(n);
   stopGroups(sims, SIGINT);
   std::this_thread::sleep_for(kDrain);
   kill(recorder, SIGINT);
+  auto stopping = Clock::now();
   run.usage = waitForUsage(recorder);
+  run.stopSeconds = secondsSince(stopping);
   run.seconds = secondsSince(start);
   for (int i = 0; i < n; ++i) run.sent += framesSent(work / ("sim" + std::to_string(i) + ".txt"));
   run.recorded = framesInFolder(work / "rec");
@@ -217,7 +269,8 @@ Run recordWithWircam(const fs::path& work, const fs::path& bin, int basePort, in
 
 // N × (multifilesrc ! rtpjpegpay ! udpsink) → one gst-launch of
 // N × (udpsrc ! rtpjpegdepay ! matroskamux ! filesink).
-Run recordWithStock(const fs::path& work, int basePort, int n, double seconds) {
+Run recordWithStock(const fs::path& work, const fs::path& frames, int basePort, int n,
+                    double seconds) {
   fs::remove_all(work / "rtp");
   fs::create_directories(work / "rtp");
   std::string receivers;
@@ -233,12 +286,12 @@ Run recordWithStock(const fs::path& work, int basePort, int n, double seconds) {
   auto start = Clock::now();
   pid_t receiver = spawn("gst-launch-1.0 -e" + receivers);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  int frames = static_cast<int>(seconds * 15);
+  int framesEach = static_cast<int>(seconds * 15);
   std::vector<pid_t> senders;
   for (int i = 0; i < n; ++i)
     senders.push_back(
-        spawn("gst-launch-1.0 multifilesrc location=" + (work / "frames" / "%05d.jpg").string() +
-              " loop=true num-buffers=" + std::to_string(frames) +
+        spawn("gst-launch-1.0 multifilesrc location=" + (frames / "%05d.jpg").string() +
+              " loop=true num-buffers=" + std::to_string(framesEach) +
               " caps=image/jpeg,width=352,height=288,framerate=15/1 ! identity sleep-time=66666"
               " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" +
               std::to_string(basePort + 2 * i + 1)));
@@ -253,16 +306,50 @@ Run recordWithStock(const fs::path& work, int basePort, int n, double seconds) {
   kill(receiver, SIGINT);
   run.usage = waitForUsage(receiver);
   run.seconds = secondsSince(start);
-  run.sent = frames * n;
+  run.sent = framesEach * n;
   run.recorded = framesInFolder(work / "rtp");
   return run;
 }
 
 }  // namespace
 
+// The recorder's three configurations, each beside stock: one after the
+// other, or (together) each at the same time as a stock run of its own, so
+// that both see the same load.
+void compare(const fs::path& work, const fs::path& bin, int basePort, int n, double seconds,
+             bool together) {
+  const std::vector<std::string> configurations = {
+      "", " --telemetry-track off",
+      // One thread a camera, as a stock pipeline: the source's.
+      " --telemetry-track off --record-queue 0"};
+  std::vector<Run> runs;
+  Run stock;
+  for (const auto& extra : configurations) {
+    if (!together) {
+      runs.push_back(
+          recordWithWircam(work / "wircam", work / "frames", bin, basePort, n, seconds, extra));
+      continue;
+    }
+    std::thread beside(
+        [&] { stock = recordWithStock(work / "stock", work / "frames", basePort, n, seconds); });
+    runs.push_back(
+        recordWithWircam(work / "wircam", work / "frames", bin, basePort, n, seconds, extra));
+    beside.join();
+    std::printf("%-8d | %s | %s\n", n, runs.back().row(n).c_str(), stock.row(n).c_str());
+    std::fflush(stdout);
+  }
+  if (together) return;
+  stock = recordWithStock(work / "stock", work / "frames", basePort, n, seconds);
+  std::printf("%-8d | %s | %s | %s | %s\n", n, runs[0].row(n).c_str(), runs[1].row(n).c_str(),
+              runs[2].row(n).c_str(), stock.row(n).c_str());
+  std::fflush(stdout);
+}
+
 int main(int argc, char** argv) {
   g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, FALSE);
   gst_init(&argc, &argv);
+  bool together = argc > 1 && std::string(argv[1]) == "--together";
+  if (together) --argc, ++argv;
   double seconds = argc > 1 ? std::atof(argv[1]) : 10;
   std::vector<int> counts;
   for (int i = 2; i < argc; ++i) counts.push_back(std::atoi(argv[i]));
@@ -270,6 +357,8 @@ int main(int argc, char** argv) {
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-rec-" + std::to_string(getpid()));
   fs::create_directories(work / "frames");
+  fs::create_directories(work / "wircam");
+  fs::create_directories(work / "stock");
   for (int i = 0; i < 30; ++i) {
     auto jpeg = wircam::bench::syntheticJpeg(352, 288, i);
     char name[16];
@@ -280,21 +369,21 @@ int main(int argc, char** argv) {
   }
   int basePort = 21000 + getpid() % 20000;
 
-  std::printf("%-8s | %-68s | %-68s | %-68s | %-68s\n", "streams",
-              "wirc-recorder: lost, CPU life / recording, memory (private), threads",
-              "--telemetry-track off: same", "... and --record-queue 0: same",
-              "udpsrc ! rtpjpegdepay ! matroskamux: same");
-  for (int n : counts) {
-    Run track = recordWithWircam(work, bin, basePort, n, seconds, "");
-    Run sidecarOnly = recordWithWircam(work, bin, basePort, n, seconds, " --telemetry-track off");
-    // One thread a camera, as a stock pipeline: the source's.
-    Run lean = recordWithWircam(work, bin, basePort, n, seconds,
-                                " --telemetry-track off --record-queue 0");
-    Run stock = recordWithStock(work, basePort, n, seconds);
-    std::printf("%-8d | %s | %s | %s | %s\n", n, track.row(n).c_str(), sidecarOnly.row(n).c_str(),
-                lean.row(n).c_str(), stock.row(n).c_str());
-    std::fflush(stdout);
-  }
-  fs::remove_all(work);
+  const char* row = "lost, CPU life / recording, memory (private), threads";
+  if (together)
+    std::printf(
+        "%-8s | wirc-recorder (default; --telemetry-track off; ... --record-queue 0): %s "
+        "| at the same time, udpsrc ! rtpjpegdepay ! matroskamux: same\n",
+        "streams", row);
+  else
+    std::printf(
+        "%-8s | wirc-recorder: %s | --telemetry-track off: same | ... and "
+        "--record-queue 0: same | udpsrc ! rtpjpegdepay ! matroskamux: same\n",
+        "streams", row);
+  for (int n : counts) compare(work, bin, basePort, n, seconds, together);
+  if (g_getenv("WIRCAM_BENCH_KEEP"))
+    std::printf("recordings and logs kept in %s\n", work.c_str());
+  else
+    fs::remove_all(work);
   return 0;
 }

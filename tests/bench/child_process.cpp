@@ -7,11 +7,11 @@
 
 namespace wircam::bench {
 
-pid_t spawn(const std::string& command, const std::string& output) {
+pid_t spawn(const std::string& command, const std::string& output, const std::string& errors) {
   pid_t pid = fork();
   if (pid == 0) {
     setpgid(0, 0);
-    execl("/bin/sh", "sh", "-c", ("exec " + command + " >" + output + " 2>/dev/null").c_str(),
+    execl("/bin/sh", "sh", "-c", ("exec " + command + " >" + output + " 2>" + errors).c_str(),
           nullptr);
     _exit(127);
   }

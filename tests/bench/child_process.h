@@ -10,8 +10,9 @@
 namespace wircam::bench {
 
 // Runs `command` through sh in a process group of its own, its stdout to
-// `output`, its stderr discarded.
-pid_t spawn(const std::string& command, const std::string& output = "/dev/null");
+// `output`, its stderr to `errors` ("&1": where stdout goes).
+pid_t spawn(const std::string& command, const std::string& output = "/dev/null",
+            const std::string& errors = "/dev/null");
 
 // Signals the whole group and waits for its leader.
 void stopGroup(pid_t pid, int signal);

@@ -231,6 +231,35 @@ TEST(Device, PcdDrivesTheOutputsAndItsAbsenceMeansFailsafeAndDisconnect) {
   EXPECT_EQ(device->stats().pcdReceived, 5u);
 }
 
+// A scene that holds the device's thread once, as a machine busy with other
+// work keeps a simulator from its processor.
+class StallingScene : public DeviceScene {
+ public:
+  void advance(DeviceClock::time_point, const ChannelOutputs&) override {
+    if (stallOnce.exchange(false)) std::this_thread::sleep_for(milliseconds(1200));
+  }
+  std::vector<uint8_t> renderJpeg(int) override { return {}; }
+  std::atomic<bool> stallOnce{false};
+};
+
+TEST(Device, PcdThatArrivedWhileTheDeviceWasBusyCountAtTheirArrival) {
+  auto scene = std::make_shared<StallingScene>();
+  auto device = startDevice({}, scene);
+  RawTransmitter tx(device->port());
+  ASSERT_TRUE(tx.login("driver", 1).has_value());
+  {
+    PcdPump pump(*device);  // every 50 ms, from another thread
+    std::this_thread::sleep_for(milliseconds(200));
+    // The device's thread is away for 1.2 s, longer than the 800 ms PCD
+    // timeout; the PCD keep arriving in its socket meanwhile.
+    scene->stallOnce = true;
+    std::this_thread::sleep_for(milliseconds(1800));
+  }
+  EXPECT_EQ(device->stats().failsafeEntries, 0u);
+  EXPECT_LT(device->stats().maxPcdGap, milliseconds(400));
+  EXPECT_FALSE(tx.closedByDevice());
+}
+
 TEST(Device, IgnoresPcdOutOfRangeOrFromNoController) {
   auto device = startDevice();
   auto udp = bindUdp(SocketAddress::loopback(0));

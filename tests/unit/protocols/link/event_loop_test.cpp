@@ -2,8 +2,11 @@
 #include "link/event_loop.h"
 
 #include <gtest/gtest.h>
+#include <pthread.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -81,6 +84,25 @@ TEST(EventLoop, InvokeRunsOnTheLoopThreadAndInlineFromIt) {
   });
   EXPECT_TRUE(onLoop);
   EXPECT_TRUE(nested);
+}
+
+TEST(EventLoop, RunsOnANamedThreadAheadOfTheVideoWhenAllowed) {
+  EventLoop loop;
+  char name[16] = {};
+  int nice = 0, allowed = 0;
+  loop.invoke([&] {
+    pthread_getname_np(pthread_self(), name, sizeof name);
+    nice = getpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)));
+    // What this process may raise a thread to (CAP_SYS_NICE: anything).
+    rlimit limit{};
+    getrlimit(RLIMIT_NICE, &limit);
+    allowed = geteuid() == 0 ? -20 : 20 - static_cast<int>(limit.rlim_cur);
+  });
+  EXPECT_STREQ(name, "wircam-links");
+  if (allowed <= -10)
+    EXPECT_EQ(nice, -10);
+  else
+    EXPECT_EQ(nice, getpriority(PRIO_PROCESS, 0));
 }
 
 }  // namespace

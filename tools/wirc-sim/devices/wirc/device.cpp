@@ -7,6 +7,7 @@
 #include <array>
 #include <atomic>
 #include <cerrno>
+#include <cstring>
 #include <deque>
 #include <list>
 #include <map>
@@ -56,6 +57,11 @@ std::optional<std::string> Device::Impl::open() {
     if (!fd) return fd.error();
     *socket = std::move(*fd);
   }
+  // PCD are judged by when they arrived (the kernel's stamp), not by when
+  // this process got round to reading them: a real device has a processor
+  // of its own, the simulator shares one with the transmitter under test.
+  int on = 1;
+  setsockopt(control_.get(), SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
   // Frames of 64 KB datagrams at 30 fps: give the kernel room to queue them.
   int sendBuffer = 4 * 1024 * 1024;
   setsockopt(video_.get(), SOL_SOCKET, SO_SNDBUF, &sendBuffer, sizeof sendBuffer);
@@ -82,6 +88,9 @@ void Device::Impl::run() {
 
   std::vector<pollfd> fds;
   while (!stopping_) {
+    // PCD that arrived while this process waited for a processor count
+    // before the watchdog looks.
+    readPcds();
     now = DeviceClock::now();
     runTimers(now);
     sweepClosed();
@@ -98,7 +107,7 @@ void Device::Impl::run() {
     if (ready <= 0) continue;
     now = DeviceClock::now();
     if (fds[1].revents & POLLIN) readDiscovery();
-    if (fds[2].revents & POLLIN) readPcd(now);
+    if (fds[2].revents & POLLIN) readPcds();
     if (fds[3].revents & POLLIN) acceptConnection();
     size_t index = 4;
     for (auto& c : connections_) {
@@ -244,13 +253,48 @@ void Device::Impl::readDiscovery() {
   if (auto frame = encode(bcsa)) sendDatagram(discovery_.get(), SocketAddress(from), *frame);
 }
 
-void Device::Impl::readPcd(DeviceClock::time_point now) {
-  sockaddr_in from{};
-  socklen_t size = sizeof from;
-  ssize_t n = ::recvfrom(control_.get(), buffer_.data(), buffer_.size(), 0,
-                         reinterpret_cast<sockaddr*>(&from), &size);
-  if (n <= 0) return;
-  auto message = decode(std::span(buffer_.data(), static_cast<size_t>(n)));
+// When a datagram reached the socket, on the device's clock: the kernel's
+// receive stamp (CLOCK_REALTIME) moved onto the steady clock by their
+// present difference; `now` when there is no stamp.
+static DeviceClock::time_point arrivalTime(msghdr& header, DeviceClock::time_point now) {
+  for (cmsghdr* c = CMSG_FIRSTHDR(&header); c; c = CMSG_NXTHDR(&header, c)) {
+    if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SO_TIMESTAMPNS) continue;
+    timespec stamp{};
+    std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
+    auto received =
+        std::chrono::system_clock::time_point(duration_cast<std::chrono::system_clock::duration>(
+            std::chrono::seconds(stamp.tv_sec) + std::chrono::nanoseconds(stamp.tv_nsec)));
+    auto age = std::chrono::system_clock::now() - received;
+    if (age < std::chrono::nanoseconds(0)) return now;
+    return now - duration_cast<DeviceClock::duration>(age);
+  }
+  return now;
+}
+
+void Device::Impl::readPcds() {
+  for (;;) {
+    sockaddr_in from{};
+    iovec data{buffer_.data(), buffer_.size()};
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
+    msghdr header{};
+    header.msg_name = &from;
+    header.msg_namelen = sizeof from;
+    header.msg_iov = &data;
+    header.msg_iovlen = 1;
+    header.msg_control = control;
+    header.msg_controllen = sizeof control;
+    ssize_t n = ::recvmsg(control_.get(), &header, MSG_DONTWAIT);
+    if (n < 0) return;
+    // Stamps never run backwards from one PCD to the next.
+    auto arrival = arrivalTime(header, DeviceClock::now());
+    if (lastPcd_) arrival = std::max(arrival, *lastPcd_);
+    readPcd(std::span(buffer_.data(), static_cast<size_t>(n)), from, arrival);
+  }
+}
+
+void Device::Impl::readPcd(std::span<const uint8_t> datagram, const sockaddr_in& from,
+                           DeviceClock::time_point now) {
+  auto message = decode(datagram);
   Connection* current = controller();
   // On loopback every transmitter shares one address: the source host is
   // all a PCD (which carries no connection ID) can be checked against.

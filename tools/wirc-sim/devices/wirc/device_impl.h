@@ -4,6 +4,8 @@
 // does).
 #pragma once
 
+#include <netinet/in.h>
+
 #include <array>
 #include <atomic>
 #include <deque>
@@ -11,6 +13,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <thread>
 
 #include "devices/wirc/device.h"
@@ -92,7 +95,10 @@ class Device::Impl {
   void acceptConnection();
   void readConnection(Connection& connection);
   void readDiscovery();
-  void readPcd(DeviceClock::time_point now);
+  // Every PCD waiting in the socket, each at its arrival time.
+  void readPcds();
+  void readPcd(std::span<const uint8_t> datagram, const sockaddr_in& from,
+               DeviceClock::time_point now);
   void handleMessage(Connection& connection, const Expected<Message, ProtocolError>& result);
   void handle(Connection& c, const Tl& m);
   void handle(Connection& c, const Ccfg& m);
