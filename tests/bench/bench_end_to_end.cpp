@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
                  static_cast<std::streamsize>(jpeg.size()));
     }
     // Ports from the pid keep parallel runs apart.
-    int port = 20000 + getpid() % 20000;
+    int port = 10000 + getpid() % 20000;  // below the ephemeral ports (32768 and up)
 
     pid_t sender = spawn(sim + " --bind 127.0.0.1 --port " + std::to_string(port) + " --fps " +
                          std::to_string(c.fps) + " --frames " + dir.string());

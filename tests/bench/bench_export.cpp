@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
   }
 
   // The recording.
-  int port = 24000 + getpid() % 20000;
+  int port = 10000 + getpid() % 20000;  // below the ephemeral ports (32768 and up)
   pid_t sim = spawn((bin / "wirc-sim").string() + " --port " + std::to_string(port) + " --fps " +
                     std::to_string(fps) + " --frames " + (work / "frames").string() +
                     " --duration " + std::to_string(seconds + 3));

@@ -63,7 +63,8 @@ int main(int argc, char** argv) {
   pid_t broker = spawn("mosquitto -c " + (work / "mosquitto.conf").string());
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
 
-  int basePort = 23000 + getpid() % 20000;
+  // Below the kernel's ephemeral range (32768 and up).
+  int basePort = 10000 + getpid() % 10000;
   std::vector<pid_t> sims;
   std::string devices;
   for (int i = 0; i < streams; ++i) {

@@ -215,27 +215,30 @@ struct Run {
 Run recordWithWircam(const fs::path& work, const fs::path& frames, const fs::path& bin,
                      int basePort, int n, double seconds, const std::string& extra) {
   fs::remove_all(work / "rec");
+  // Each configuration's logs apart, kept with WIRCAM_BENCH_KEEP=1.
+  fs::path logs = work / ("logs" + std::regex_replace(extra, std::regex("[ -]+"), "-"));
+  fs::remove_all(logs);
+  fs::create_directories(logs);
+  auto simLog = [&](int i) { return logs / ("sim" + std::to_string(i) + ".txt"); };
   std::vector<pid_t> sims;
   std::string devices;
   for (int i = 0; i < n; ++i) {
     int port = basePort + 2 * i;
     sims.push_back(spawn((bin / "wirc-sim").string() + " --port " + std::to_string(port) +
                              " --frames " + frames.string(),
-                         (work / ("sim" + std::to_string(i) + ".txt")).string()));
+                         simLog(i).string()));
     devices += " --device 127.0.0.1:" + std::to_string(port);
   }
   // "live" is timed from the recorder's start: every device listens first.
   auto listening = Clock::now() + std::chrono::seconds(20);
   for (int i = 0; i < n && Clock::now() < listening;)
-    if (fileSays(work / ("sim" + std::to_string(i) + ".txt"), "listening on"))
+    if (fileSays(simLog(i), "listening on"))
       ++i;
     else
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
   Run run;
   auto start = Clock::now();
-  // Each configuration's log stays (WIRCAM_BENCH_KEEP=1 keeps the folder).
-  fs::path log = work / ("recorder" + std::regex_replace(extra, std::regex("[ -]+"), "-") + ".log");
-  fs::remove(log);
+  fs::path log = logs / "recorder.log";
   pid_t recorder = spawn((bin / "wirc-recorder").string() + devices + " --out " +
                              (work / "rec").string() + " --segment 600" + extra,
                          log.string(), "&1");
@@ -262,7 +265,7 @@ Run recordWithWircam(const fs::path& work, const fs::path& frames, const fs::pat
   run.usage = waitForUsage(recorder);
   run.stopSeconds = secondsSince(stopping);
   run.seconds = secondsSince(start);
-  for (int i = 0; i < n; ++i) run.sent += framesSent(work / ("sim" + std::to_string(i) + ".txt"));
+  for (int i = 0; i < n; ++i) run.sent += framesSent(simLog(i));
   run.recorded = framesInFolder(work / "rec");
   return run;
 }
@@ -284,8 +287,14 @@ Run recordWithStock(const fs::path& work, const fs::path& frames, int basePort, 
   }
   Run run;
   auto start = Clock::now();
-  pid_t receiver = spawn("gst-launch-1.0 -e" + receivers);
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  fs::path log = work / "receiver.log";
+  // Line-buffered: its "New clock" is in the file when it is said.
+  pid_t receiver = spawn("stdbuf -oL gst-launch-1.0 -e" + receivers, log.string());
+  // The senders start once every receiver is playing ("New clock"): a
+  // packet sent to a port not yet open would count as lost.
+  auto playing = Clock::now() + std::chrono::seconds(20);
+  while (!fileSays(log, "New clock") && Clock::now() < playing)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   int framesEach = static_cast<int>(seconds * 15);
   std::vector<pid_t> senders;
   for (int i = 0; i < n; ++i)
@@ -367,7 +376,9 @@ int main(int argc, char** argv) {
         .write(reinterpret_cast<const char*>(jpeg.data()),
                static_cast<std::streamsize>(jpeg.size()));
   }
-  int basePort = 21000 + getpid() % 20000;
+  // Fixed ports below the kernel's ephemeral range (32768 and up), where
+  // the sockets bound to port 0 by hundreds of pipelines would take them.
+  int basePort = 10000 + getpid() % 10000;
 
   const char* row = "lost, CPU life / recording, memory (private), threads";
   if (together)
