@@ -170,6 +170,7 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
     std::string name = spec.name;
     if (name == "help") return unexpected("help");
     if (name == "config") {
+      o.configFile = optarg;
       if (auto problem = loadConfig(optarg, o)) return unexpected(*problem);
       continue;
     }

@@ -112,6 +112,7 @@ struct RecorderOptions {
   // Marvelmind positions of every device that names none of its own.
   std::optional<std::string> marvelmind;  // HOST[:PORT]
   std::optional<std::string> beacons;
+  std::string configFile;  // --config's: what a reload reads again (empty: none)
   // Each option's values as given (command line and config file), by name:
   // what a reload compares to find the changes it cannot take.
   std::map<std::string, std::vector<std::string>> given;

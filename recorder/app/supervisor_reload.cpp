@@ -19,6 +19,9 @@ Expected<nlohmann::json, std::string> Supervisor::reload() {
     return unexpected(why);
   };
   if (stopping_) return refuse("the recorder is stopping");
+  if (options_.configFile.empty())
+    return refuse(
+        "there is no config file to read again (the recorder was started without --config)");
   auto reread = reread_();
   if (!reread) return refuse(reread.error());
   if (auto problem = reloadRefusal(options_, *reread)) return refuse(*problem);

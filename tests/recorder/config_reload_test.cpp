@@ -206,4 +206,19 @@ TEST(ConfigReload, CamerasComeGoAndRestartAloneWhileTheOthersRecordEveryFrame) {
   fs::remove_all(folder);
 }
 
+TEST(ConfigReload, WithoutAConfigFileThereIsNothingToReadAgainAndItSaysSo) {
+  auto device = startSequenceDevice();
+  ASSERT_TRUE(device);
+  RecorderProcess recorder(device->port(), {"--http", "127.0.0.1:0", "--http-token", kToken});
+  auto url = recorder.waitForLog("http://", 5000ms);
+  ASSERT_TRUE(url) << recorder.log();
+  auto answer = fetch(*url + "api/config/reload", "POST", kAuthorized);
+  EXPECT_EQ(answer.status, 400u) << answer.body;
+  EXPECT_NE(answer.body.find("started without --config"), std::string::npos) << answer.body;
+  recorder.signal(SIGHUP);
+  EXPECT_TRUE(recorder.waitForText("reload refused: there is no config file", 5s))
+      << recorder.log();
+  EXPECT_TRUE(recorder.waitForText("live", 5s)) << recorder.log();  // and it records on
+}
+
 }  // namespace

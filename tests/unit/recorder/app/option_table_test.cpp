@@ -64,6 +64,8 @@ TEST(OptionTable, EveryOptionMeansTheSameOnTheCommandLineAndInTheConfigFile) {
     ConfigFile file(config);
     auto fromConfig = parse({"--config", file.path()});
     ASSERT_TRUE(fromConfig) << fromConfig.error();
+    EXPECT_EQ(fromConfig->configFile, file.path());  // what a reload reads again
+    fromConfig->configFile.clear();
     // Both differ from the defaults where the example does, and alike.
     auto defaults = parse({"--out", "x"});
     ASSERT_TRUE(defaults);
