@@ -7,7 +7,7 @@
 //
 //   node check.mjs OPENAPI.yaml BUILD_BIN_DIR
 import { spawn } from "node:child_process";
-import { mkdtempSync, rmSync } from "node:fs";
+import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import http from "node:http";
 import os from "node:os";
 import path from "node:path";
@@ -183,8 +183,11 @@ try {
     () => sim.output.match(/listening on 127\.0\.0\.1:(\d+)/)?.[1]);
 
   // A: with a token, following, WebRTC on. B: no token, WebRTC off.
+  // A's segment length comes from a config file, which a reload reads again.
+  const configA = path.join(scratch, "a.ini");
+  writeFileSync(configA, "[recorder]\nsegment=1\n");
   const a = start("wirc-recorder", ["--device", `127.0.0.1:${simPort}`, "--out", "a",
-    "--segment", "1", "--detect", "tag36h11", "--follow", "--http", "127.0.0.1:0",
+    "--config", configA, "--detect", "tag36h11", "--follow", "--http", "127.0.0.1:0",
     "--http-token", token, "--duration", "110"]);
   const b = start("wirc-recorder", ["--device", `127.0.0.1:${simPort}`, "--out", "b",
     "--segment", "1", "--http", ":0", "--webrtc", "off", "--duration", "110"]);
@@ -261,8 +264,11 @@ try {
   await check("target, unknown", "POST", `${urlA}api/cameras/nope-cam0/target?id=1`,
     { headers: bearer, expect: 404 });
   await check("follow without token", "POST", command("follow?on=true"), { expect: 401 });
-  // Started without --config: the command line read again changes nothing.
+  // The same config again: nothing changes. One that does not validate: refused.
   await check("reload", "POST", urlA + "api/config/reload", { headers: bearer, expect: 200 });
+  writeFileSync(configA, "[recorder]\nsegment=banana\n");
+  await check("reload, invalid", "POST", urlA + "api/config/reload", { headers: bearer, expect: 400 });
+  writeFileSync(configA, "[recorder]\nsegment=1\n");
   await check("reload without token", "POST", urlA + "api/config/reload", { expect: 401 });
 
   // Drive: the WebSocket and its refusals

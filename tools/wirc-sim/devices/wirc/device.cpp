@@ -272,7 +272,8 @@ static DeviceClock::time_point arrivalTime(msghdr& header, DeviceClock::time_poi
 }
 
 void Device::Impl::readPcds() {
-  for (;;) {
+  // Bounded, so that a flood of datagrams cannot hold the device's thread.
+  for (int read = 0; read < 256; ++read) {
     sockaddr_in from{};
     iovec data{buffer_.data(), buffer_.size()};
     alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];

@@ -95,7 +95,7 @@ class Device::Impl {
   void acceptConnection();
   void readConnection(Connection& connection);
   void readDiscovery();
-  // Every PCD waiting in the socket, each at its arrival time.
+  // The PCD waiting in the socket (up to 256), each at its arrival time.
   void readPcds();
   void readPcd(std::span<const uint8_t> datagram, const sockaddr_in& from,
                DeviceClock::time_point now);
