@@ -18,7 +18,13 @@ namespace wircam::recorder {
 void useMallocForSlices(char** argv) {
   if (glib_check_version(2, 76, 0) == nullptr || std::getenv("G_SLICE") != nullptr) return;
   setenv("G_SLICE", "always-malloc", 1);
-  execv("/proc/self/exe", argv);
+  // The executable's own path, not /proc/self/exe: the process is named
+  // after the file it runs (its comm, what top, pgrep and killall show).
+  char self[4096];
+  ssize_t length = readlink("/proc/self/exe", self, sizeof self - 1);
+  if (length <= 0) return;
+  self[length] = '\0';
+  execv(self, argv);
   // Not restarted (no /proc?): the magazines stay, and nothing else changes.
 }
 

@@ -106,6 +106,10 @@ int main(int argc, char** argv) {
   g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, FALSE);  // the build's wircsrc
   gst_init(&argc, &argv);
   double seconds = argc > 1 ? std::atof(argv[1]) : 5;
+  if (argc > 2 || seconds <= 0) {
+    std::fprintf(stderr, "usage: bench_end_to_end [SECONDS]   (measured per case; default 5)\n");
+    return 2;
+  }
   fs::path self = fs::canonical("/proc/self/exe").parent_path();
   std::string sim = (self / "wirc-sim").string();
 

@@ -320,8 +320,6 @@ Run recordWithStock(const fs::path& work, const fs::path& frames, int basePort, 
   return run;
 }
 
-}  // namespace
-
 // The recorder's three configurations, each beside stock: one after the
 // other, or (together) each at the same time as a stock run of its own, so
 // that both see the same load.
@@ -353,6 +351,8 @@ void compare(const fs::path& work, const fs::path& bin, int basePort, int n, dou
               runs[2].row(n).c_str(), stock.row(n).c_str());
   std::fflush(stdout);
 }
+
+}  // namespace
 
 int main(int argc, char** argv) {
   g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, FALSE);

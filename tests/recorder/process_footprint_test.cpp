@@ -93,6 +93,8 @@ TEST(RecorderFootprint, RunsWithGlibSlicesOnMalloc) {
   ASSERT_TRUE(recorder.waitForText(": live", 10s)) << recorder.log();
   std::string environment = procFile(recorder.pid(), "environ");
   EXPECT_NE(environment.find(std::string("G_SLICE=always-malloc\0", 22)), std::string::npos);
+  // Started again under its own name (top, pgrep and killall go by it).
+  EXPECT_EQ(procFile(recorder.pid(), "comm"), "wirc-recorder\n");
 }
 
 }  // namespace

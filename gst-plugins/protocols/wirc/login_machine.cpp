@@ -135,7 +135,8 @@ LoginActions LoginMachine::loggedIn(const Wst& wst, Clock::time_point now) {
       Emit{link::StateChanged{link::LinkState::Live,
                               "logged in to " + device_->toString() + " as connection " +
                                   std::to_string(wst.connectionId) + " (" +
-                                  std::to_string(wst.cameraCount) + " cameras)"}}};
+                                  std::to_string(wst.cameraCount) +
+                                  (wst.cameraCount == 1 ? " camera)" : " cameras)")}}};
   for (auto [camera, port] : streamPorts_) actions.push_back(Send{Stst{camera, port}});
   return actions;
 }
