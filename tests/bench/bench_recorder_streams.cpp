@@ -320,6 +320,17 @@ Run recordWithStock(const fs::path& work, const fs::path& frames, int basePort, 
   return run;
 }
 
+// A recorder run over the stock one: CPU while recording, peak memory.
+std::string ratios(const Run& recorder, const Run& stock) {
+  char text[120];
+  std::snprintf(text, sizeof text, "wirc-recorder ÷ stock: CPU %.2f×, memory %.2f×",
+                stock.recordingCpu > 0 ? recorder.recordingCpu / stock.recordingCpu : 0.0,
+                stock.usage.maxRssKb > 0
+                    ? static_cast<double>(recorder.usage.maxRssKb) / stock.usage.maxRssKb
+                    : 0.0);
+  return text;
+}
+
 // The recorder's three configurations, each beside stock: one after the
 // other, or (together) each at the same time as a stock run of its own, so
 // that both see the same load.
@@ -343,12 +354,16 @@ void compare(const fs::path& work, const fs::path& bin, int basePort, int n, dou
         recordWithWircam(work / "wircam", work / "frames", bin, basePort, n, seconds, extra));
     beside.join();
     std::printf("%-8d | %s | %s\n", n, runs.back().row(n).c_str(), stock.row(n).c_str());
+    std::printf("%-8s   %s\n", "", ratios(runs.back(), stock).c_str());
     std::fflush(stdout);
   }
   if (together) return;
   stock = recordWithStock(work / "stock", work / "frames", basePort, n, seconds);
   std::printf("%-8d | %s | %s | %s | %s\n", n, runs[0].row(n).c_str(), runs[1].row(n).c_str(),
               runs[2].row(n).c_str(), stock.row(n).c_str());
+  for (size_t i = 0; i < runs.size(); ++i)
+    std::printf("%-8s   %s%s\n", "", ratios(runs[i], stock).c_str(),
+                configurations[i].empty() ? " (default)" : configurations[i].c_str());
   std::fflush(stdout);
 }
 
