@@ -7,6 +7,7 @@
 #include "app/option_values.h"
 #include "record/retention.h"
 #include "wirc/channel_list.h"
+#include "wirc/transmitter_session.h"
 
 namespace wircam::recorder::option_rows {
 
@@ -92,7 +93,12 @@ Apply channels(std::optional<std::string> RecorderOptions::*field, bool periods)
     if (!list) return list.error();
     auto invalid = periods ? wirc::validate(wirc::Ccfg{*list}) : wirc::validate(wirc::Fcfg{*list});
     if (invalid) return invalid->message();
-    o.*field = value;
+    // The login's own values written out are no setting: the cameras'
+    // pipelines stay as they were (a reload restarts no camera for them).
+    if (*list == (periods ? wirc::SessionConfig{}.periods : wirc::SessionConfig{}.failsafe))
+      o.*field = std::nullopt;
+    else
+      o.*field = value;
     return std::nullopt;
   };
 }

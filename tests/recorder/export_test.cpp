@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -157,11 +158,15 @@ TEST_F(Export, ARangeHoldsTheFramesOfTheSegmentsInIt) {
   // From the second segment's first frame to just before the fourth's.
   std::string start = index[1]["start_utc"];
   std::string fourth = index[3]["start_utc"];
-  // 1 ms before: "....123Z" → "....122Z" (the recorder writes milliseconds).
-  int ms = std::stoi(fourth.substr(20, 3));
-  ASSERT_GT(ms, 0) << "a start on a whole second: the test would need a borrow";
-  char end[32];
-  std::snprintf(end, sizeof end, "%s%03dZ", fourth.substr(0, 20).c_str(), ms - 1);
+  // 1 ms before (the recorder writes milliseconds): "...:07.000Z" → "...:06.999Z".
+  std::tm parts{};
+  ASSERT_TRUE(strptime(fourth.c_str(), "%Y-%m-%dT%H:%M:%S", &parts)) << fourth;
+  int64_t msSinceEpoch = int64_t{timegm(&parts)} * 1000 + std::stoi(fourth.substr(20, 3)) - 1;
+  time_t seconds = static_cast<time_t>(msSinceEpoch / 1000);
+  gmtime_r(&seconds, &parts);
+  char whole[24], end[32];
+  std::strftime(whole, sizeof whole, "%Y-%m-%dT%H:%M:%S", &parts);
+  std::snprintf(end, sizeof end, "%s.%03dZ", whole, static_cast<int>(msSinceEpoch % 1000));
   fs::path out = output("range.mkv");
   auto ran = runCommand(exportCommand(
       recorder_->out(), *camera_,

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "command_line.h"
+#include "wirc/transmitter_session.h"
 
 namespace wircam::recorder {
 namespace {
@@ -16,10 +17,24 @@ TEST(RecorderOptions, ServersListenOnThisMachineUnlessAHostIsGiven) {
 }
 
 TEST(RecorderOptions, TakesLoginChannelListsTheDeviceWouldAccept) {
-  auto options = parse({"--out", "x", "--periods", "20000", "--failsafe", "1500"});
+  auto options = parse({"--out", "x", "--periods", "15000", "--failsafe", "1400"});
   ASSERT_TRUE(options.has_value()) << options.error();
-  EXPECT_EQ(*options->periods, "20000");
-  EXPECT_EQ(*options->failsafe, "1500");
+  EXPECT_EQ(*options->periods, "15000");
+  EXPECT_EQ(*options->failsafe, "1400");
+}
+
+TEST(RecorderOptions, TheLoginsOwnValuesWrittenOutAreNoSetting) {
+  // So a config that spells out the default changes no camera's pipeline
+  // (a reload would restart every camera for it).
+  auto defaults = wirc::SessionConfig{};
+  std::string periods = std::to_string(defaults.periods[0]);
+  std::string failsafe;
+  for (auto value : defaults.failsafe)
+    failsafe += (failsafe.empty() ? "" : ",") + std::to_string(value);
+  auto options = parse({"--out", "x", "--periods", periods, "--failsafe", failsafe});
+  ASSERT_TRUE(options.has_value()) << options.error();
+  EXPECT_FALSE(options->periods) << *options->periods;
+  EXPECT_FALSE(options->failsafe) << *options->failsafe;
 }
 
 TEST(RecorderOptions, RefusesChannelListsTheDeviceWouldRefuseNamingTheProblem) {
