@@ -1,6 +1,8 @@
 // What a camera's elements say on its bus, turned into its report, its
 // telemetry (sidecar and text track) and its events. (Camera's lifecycle is
 // in camera.cpp.)
+#include <tuple>
+
 #include "camera/camera.h"
 #include "camera/gst_json.h"
 #include "camera/wall_clock.h"
@@ -58,6 +60,10 @@ CameraReport Camera::report() const {
                    &control.target, nullptr);
       control.hasControl = hasControl != FALSE;
       control.following = following != FALSE;
+    } else if (carriedControl_) {
+      // Between runs: what the user set, which the next run takes up (not
+      // "not following" for every reconnect's few seconds).
+      std::tie(control.following, control.target) = *carriedControl_;
     }
     report.control = control;
   }

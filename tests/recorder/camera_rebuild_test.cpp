@@ -85,4 +85,55 @@ TEST(CameraRebuild, ACameraWhoseRebuildFailsComesBackAndRecords) {
   fs::remove_all(out);
 }
 
+TEST(CameraRebuild, BetweenRunsAFollowingCameraStillSaysItFollows) {
+  // The status (MQTT, Home Assistant's switch, /api/cameras) said "not
+  // following" for each reconnect's seconds, the pipeline being gone.
+  gst_registry_scan_path(gst_registry_get(), WIRCAM_PLUGIN_DIR);
+  auto device = startFollowDevice();
+  ASSERT_TRUE(device);
+  fs::path out = fs::temp_directory_path() / ("camera-follow-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  std::vector<std::string> words = {
+      "wirc-recorder", "--device",   "127.0.0.1:" + std::to_string(device->port()),
+      "--out",         out.string(), "--detect",
+      "tag36h11",      "--follow"};
+  std::vector<char*> argv;
+  for (auto& word : words) argv.push_back(word.data());
+  auto options = parseOptions(static_cast<int>(argv.size()), argv.data());
+  ASSERT_TRUE(options) << options.error();
+  auto plan = planPipeline(*options);
+  ASSERT_EQ(plan.streams.size(), 1u);
+  CameraFiles files{.folder = out.string(), .extension = ".mkv", .limits = {.maxDuration = 0}};
+  Observed observed;
+  auto camera = Camera::create(plan.streams[0], files, {.stallTimeout = 2s}, observed);
+  ASSERT_TRUE(camera) << camera.error();
+  ASSERT_TRUE((*camera)->start());
+  guint ticks = g_timeout_add(
+      Camera::kTickIntervalMs,
+      [](gpointer c) -> gboolean {
+        static_cast<Camera*>(c)->tick();
+        return G_SOURCE_CONTINUE;
+      },
+      camera->get());
+  auto following = [&] {
+    auto control = (*camera)->report().control;
+    return control && control->following;
+  };
+  ASSERT_TRUE(runMainLoopUntil([&] { return (*camera)->report().frames > 5 && following(); }, 10s));
+
+  device.reset();  // gone: the file ends, the pipeline is torn down until the device is back
+  ASSERT_TRUE(runMainLoopUntil(
+      [&] { return (*camera)->phase() == CameraPhase::kRestarting && !(*camera)->controller(); },
+      10s));
+  EXPECT_TRUE(following());
+  EXPECT_FALSE((*camera)->report().control->hasControl);
+
+  (*camera)->stop();
+  EXPECT_TRUE(runMainLoopUntil([&] { return observed.over; }, 5s));
+  g_source_remove(ticks);
+  camera->reset();
+  fs::remove_all(out);
+}
+
 }  // namespace
