@@ -2,24 +2,12 @@
 // target, and the options it overrides.
 #include <glib.h>
 
-#include <cmath>
 #include <memory>
 
 #include "app/option_rows.h"
 #include "app/option_values.h"
 
 namespace wircam::recorder::option_rows {
-
-namespace {
-
-Expected<int, std::string> cameraNumber(const std::string& text) {
-  auto camera = number(text.c_str());
-  if (!camera || *camera < 0 || *camera > 255 || *camera != std::floor(*camera))
-    return unexpected(std::string("cameras 0..255, as in 0;1"));
-  return static_cast<int>(*camera);
-}
-
-}  // namespace
 
 std::vector<DeviceKeySpec> deviceKeyRows() {
   return {
@@ -34,9 +22,8 @@ std::vector<DeviceKeySpec> deviceKeyRows() {
        .value = "PORT",
        .help = "its port (1984)",
        .apply = [](DeviceTarget& d, const std::string& value) -> OptionProblem {
-         auto port = number(value.c_str());
-         if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
-           return "a port is 1..65535";
+         auto port = wholeWithin(value.c_str(), 1, 65535);
+         if (!port) return "a port is 1..65535";
          d.port = static_cast<uint16_t>(*port);
          return std::nullopt;
        }},
@@ -49,9 +36,9 @@ std::vector<DeviceKeySpec> deviceKeyRows() {
              g_strsplit_set(value.c_str(), ";,", -1), g_strfreev);
          for (gchar** item = items.get(); *item; ++item) {
            if (!**item) continue;  // "0;1;"
-           auto camera = cameraNumber(*item);
-           if (!camera) return camera.error();
-           d.cameras.push_back(*camera);
+           auto camera = wholeWithin(*item, 0, 255);
+           if (!camera) return "cameras 0..255, as in 0;1";
+           d.cameras.push_back(static_cast<int>(*camera));
          }
          if (d.cameras.empty()) return "a list like 0;1";
          return std::nullopt;

@@ -2,8 +2,6 @@
 
 #include <glib.h>
 
-#include <cmath>
-
 #include "app/option_values.h"
 #include "record/retention.h"
 #include "wirc/channel_list.h"
@@ -26,8 +24,8 @@ Apply seconds(double RecorderOptions::*field, double low, double high) {
 
 Apply wholeNumber(unsigned RecorderOptions::*field, double low, double high, const char* unit) {
   return [=](RecorderOptions& o, const char* value) -> OptionProblem {
-    auto n = number(value);
-    if (!n || *n < low || *n > high || *n != std::floor(*n)) {
+    auto n = wholeWithin(value, low, high);
+    if (!n) {
       char range[64];
       g_snprintf(range, sizeof range, "%s%s%g..%g", unit, *unit ? ", " : "", low, high);
       return range;

@@ -3,8 +3,6 @@
 // server_options.cpp, the [device NAME] keys in device_keys.cpp.
 #include "app/option_table.h"
 
-#include <cmath>
-
 #include "app/option_rows.h"
 #include "app/option_values.h"
 
@@ -49,9 +47,8 @@ std::vector<OptionSpec> recordingRows() {
        .deviceKey = "cameras",
        .help = "a camera of each device to record, 0..255; repeatable",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
-         auto camera = number(value);
-         if (!camera || *camera < 0 || *camera > 255 || *camera != std::floor(*camera))
-           return "0..255";
+         auto camera = wholeWithin(value, 0, 255);
+         if (!camera) return "0..255";
          o.cameras.push_back(static_cast<int>(*camera));
          return std::nullopt;
        },

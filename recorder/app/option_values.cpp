@@ -21,6 +21,12 @@ std::optional<double> number(const char* text) {
   return value;
 }
 
+std::optional<long long> wholeWithin(const char* text, double low, double high) {
+  auto n = number(text);
+  if (!n || *n < low || *n > high || *n != std::floor(*n)) return std::nullopt;
+  return static_cast<long long>(*n);
+}
+
 std::optional<uint64_t> byteSize(const char* text) {
   char* end = nullptr;
   double value = std::strtod(text, &end);
@@ -57,9 +63,8 @@ Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri) 
   auto colon = address.rfind(':');
   target.host = address.substr(0, colon);
   if (colon != std::string::npos) {
-    auto port = number(address.substr(colon + 1).c_str());
-    if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
-      return unexpected("control '" + uri + "': a port is 1..65535");
+    auto port = wholeWithin(address.substr(colon + 1).c_str(), 1, 65535);
+    if (!port) return unexpected("control '" + uri + "': a port is 1..65535");
     target.port = static_cast<uint16_t>(*port);
   }
   if (target.host.empty() || target.host.find_first_of("/ \"'") != std::string::npos)
@@ -131,9 +136,8 @@ Expected<std::optional<PositionSource>, std::string> positionSource(
   auto colon = dashboard->rfind(':');
   source.host = dashboard->substr(0, colon);
   if (colon != std::string::npos) {
-    auto port = number(dashboard->substr(colon + 1).c_str());
-    if (!port || *port < 1 || *port > 65535 || *port != std::floor(*port))
-      return unexpected("marvelmind '" + *dashboard + "': a port is 1..65535");
+    auto port = wholeWithin(dashboard->substr(colon + 1).c_str(), 1, 65535);
+    if (!port) return unexpected("marvelmind '" + *dashboard + "': a port is 1..65535");
     source.port = static_cast<uint16_t>(*port);
   }
   if (source.host.empty() || source.host.find_first_of("/ \"'") != std::string::npos)

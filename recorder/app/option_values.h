@@ -13,6 +13,8 @@ namespace wircam::recorder {
 
 // A finite decimal number, nothing after it.
 std::optional<double> number(const char* text);
+// A whole number within low..high, or nothing.
+std::optional<long long> wholeWithin(const char* text, double low, double high);
 // "500M", "20G", "1048576": bytes.
 std::optional<uint64_t> byteSize(const char* text);
 // "HOST[:PORT][,control=URI]", as --device takes it.

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 
 #include "follow_scene.h"
@@ -49,9 +51,12 @@ class PcdPump {
         thread_([this, &device](std::stop_token stop) {
           while (!stop.stop_requested()) {
             sendPcd(device, socket_.get(), neutralChannels());
+            ++sent;
             std::this_thread::sleep_for(milliseconds(50));
           }
         }) {}
+
+  std::atomic<uint64_t> sent{0};
 
  private:
   UniqueFd socket_;
@@ -231,15 +236,38 @@ TEST(Device, PcdDrivesTheOutputsAndItsAbsenceMeansFailsafeAndDisconnect) {
   EXPECT_EQ(device->stats().pcdReceived, 5u);
 }
 
-// A scene that holds the device's thread once, as a machine busy with other
-// work keeps a simulator from its processor.
+// A scene that holds the device's thread once, until released, as a
+// machine busy with other work keeps a simulator from its processor.
 class StallingScene : public DeviceScene {
  public:
   void advance(DeviceClock::time_point, const ChannelOutputs&) override {
-    if (stallOnce.exchange(false)) std::this_thread::sleep_for(milliseconds(1200));
+    std::unique_lock lock(mutex_);
+    if (!stallOnce_) return;
+    stallOnce_ = false;
+    stalling_ = true;
+    changed_.notify_all();
+    changed_.wait(lock, [&] { return !stalling_; });
   }
   std::vector<uint8_t> renderJpeg(int) override { return {}; }
-  std::atomic<bool> stallOnce{false};
+
+  void stallOnce() {
+    std::lock_guard lock(mutex_);
+    stallOnce_ = true;
+  }
+  bool stalling() {
+    std::lock_guard lock(mutex_);
+    return stalling_;
+  }
+  void release() {
+    std::lock_guard lock(mutex_);
+    stalling_ = false;
+    changed_.notify_all();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool stallOnce_ = false, stalling_ = false;
 };
 
 TEST(Device, PcdThatArrivedWhileTheDeviceWasBusyCountAtTheirArrival) {
@@ -247,14 +275,18 @@ TEST(Device, PcdThatArrivedWhileTheDeviceWasBusyCountAtTheirArrival) {
   auto device = startDevice({}, scene);
   RawTransmitter tx(device->port());
   ASSERT_TRUE(tx.login("driver", 1).has_value());
-  {
-    PcdPump pump(*device);  // every 50 ms, from another thread
-    std::this_thread::sleep_for(milliseconds(200));
-    // The device's thread is away for 1.2 s, longer than the 800 ms PCD
-    // timeout; the PCD keep arriving in its socket meanwhile.
-    scene->stallOnce = true;
-    std::this_thread::sleep_for(milliseconds(1800));
-  }
+  PcdPump pump(*device);  // every 50 ms, from another thread
+  ASSERT_TRUE(testing::waitFor([&] { return device->stats().pcdReceived >= 3; }));
+  // The device's thread is held while 24 PCD (1.2 s) arrive in its socket:
+  // longer than the 800 ms PCD timeout.
+  scene->stallOnce();
+  ASSERT_TRUE(testing::waitFor([&] { return scene->stalling(); }));
+  uint64_t from = pump.sent;
+  bool sentThrough = testing::waitFor([&] { return pump.sent >= from + 24; });
+  scene->release();
+  ASSERT_TRUE(sentThrough);
+  // Once back, it reads them all before its watchdog looks.
+  ASSERT_TRUE(testing::waitFor([&] { return device->stats().pcdReceived >= from + 24; }));
   EXPECT_EQ(device->stats().failsafeEntries, 0u);
   EXPECT_LT(device->stats().maxPcdGap, milliseconds(400));
   EXPECT_FALSE(tx.closedByDevice());

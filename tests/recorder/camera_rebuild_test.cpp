@@ -7,7 +7,9 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <optional>
 #include <thread>
+#include <utility>
 
 #include "app/pipeline_planner.h"
 #include "camera/camera.h"
@@ -26,41 +28,77 @@ using namespace std::chrono_literals;
 using Observed = wircam::testing::CameraEvents;
 using wircam::testing::runMainLoopUntil;
 
-TEST(CameraRebuild, ACameraWhoseRebuildFailsComesBackAndRecords) {
-  gst_registry_scan_path(gst_registry_get(), WIRCAM_PLUGIN_DIR);
+// A camera in this process: its recording folder, its plan from a
+// recorder's command line, and the tick its supervisor would give it.
+class CameraRebuild : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    gst_registry_scan_path(gst_registry_get(), WIRCAM_PLUGIN_DIR);
+    fs::remove_all(out_);
+    fs::create_directories(out_);
+  }
+  void TearDown() override {
+    if (ticks_) g_source_remove(ticks_);
+    fs::remove_all(out_);
+  }
+
+  // The one stream `wirc-recorder --out FOLDER WORDS...` plans.
+  std::optional<StreamPlan> streamOf(std::vector<std::string> words) {
+    words.insert(words.begin(), {"wirc-recorder", "--out", out_.string()});
+    std::vector<char*> argv;
+    for (auto& word : words) argv.push_back(word.data());
+    auto options = parseOptions(static_cast<int>(argv.size()), argv.data());
+    if (!options) {
+      ADD_FAILURE() << options.error();
+      return std::nullopt;
+    }
+    auto plan = planPipeline(*options);
+    if (plan.streams.size() != 1) return std::nullopt;
+    return plan.streams[0];
+  }
+  CameraFiles files() const {
+    return {.folder = out_.string(), .extension = ".mkv", .limits = {.maxDuration = 0}};
+  }
+  void tick(Camera& camera) {
+    ticks_ = g_timeout_add(
+        Camera::kTickIntervalMs,
+        [](gpointer c) -> gboolean {
+          static_cast<Camera*>(c)->tick();
+          return G_SOURCE_CONTINUE;
+        },
+        &camera);
+  }
+  // Stops the camera and runs the loop until it has ended.
+  bool stop(Camera& camera, Observed& observed) {
+    camera.stop();
+    bool ended = runMainLoopUntil([&] { return observed.over; }, 5s);
+    g_source_remove(std::exchange(ticks_, 0));
+    return ended;
+  }
+
+ private:
+  fs::path out_ = fs::temp_directory_path() / ("camera-rebuild-" + std::to_string(getpid()));
+  guint ticks_ = 0;
+};
+
+TEST_F(CameraRebuild, ACameraWhoseRebuildFailsComesBackAndRecords) {
   auto device = startSequenceDevice();
   ASSERT_TRUE(device);
   uint16_t port = device->port();
-  fs::path out = fs::temp_directory_path() / ("camera-rebuild-" + std::to_string(getpid()));
-  fs::remove_all(out);
-  fs::create_directories(out);
-  std::vector<std::string> words = {"wirc-recorder", "--device",
-                                    "127.0.0.1:" + std::to_string(port), "--out", out.string()};
-  std::vector<char*> argv;
-  for (auto& word : words) argv.push_back(word.data());
-  auto options = parseOptions(static_cast<int>(argv.size()), argv.data());
-  ASSERT_TRUE(options) << options.error();
-  auto plan = planPipeline(*options);
-  ASSERT_EQ(plan.streams.size(), 1u);
-  CameraFiles files{.folder = out.string(), .extension = ".mkv", .limits = {.maxDuration = 0}};
+  auto stream = streamOf({"--device", "127.0.0.1:" + std::to_string(port)});
+  ASSERT_TRUE(stream);
   int builds = 0;
   auto failingOnce =
-      [&](const StreamPlan& stream, const CameraFiles& in, FrameTap* frames,
+      [&](const StreamPlan& plan, const CameraFiles& in, FrameTap* frames,
           FrameTap* encoded) -> Expected<std::unique_ptr<CameraPipeline>, std::string> {
     if (++builds == 2) return unexpected(std::string("injected: the build failed"));
-    return CameraPipeline::build(stream, in, frames, encoded);
+    return CameraPipeline::build(plan, in, frames, encoded);
   };
   Observed observed;
-  auto camera = Camera::create(plan.streams[0], files, {.stallTimeout = 2s}, observed, failingOnce);
+  auto camera = Camera::create(*stream, files(), {.stallTimeout = 2s}, observed, failingOnce);
   ASSERT_TRUE(camera) << camera.error();
   ASSERT_TRUE((*camera)->start());
-  guint ticks = g_timeout_add(
-      Camera::kTickIntervalMs,
-      [](gpointer c) -> gboolean {
-        static_cast<Camera*>(c)->tick();
-        return G_SOURCE_CONTINUE;
-      },
-      camera->get());
+  tick(**camera);
   auto frames = [&] { return (*camera)->report().frames; };
   ASSERT_TRUE(runMainLoopUntil([&] { return frames() > 15; }, 10s));
 
@@ -77,45 +115,23 @@ TEST(CameraRebuild, ACameraWhoseRebuildFailsComesBackAndRecords) {
   EXPECT_EQ((*camera)->phase(), CameraPhase::kRunning);
   EXPECT_GE((*camera)->report().restarts, 1u);
 
-  (*camera)->stop();
-  EXPECT_TRUE(runMainLoopUntil([&] { return observed.over; }, 5s));
-  g_source_remove(ticks);
+  EXPECT_TRUE(stop(**camera, observed));
   EXPECT_GE(observed.closed.size(), 2u);  // before the loss, and after it
-  camera->reset();
-  fs::remove_all(out);
 }
 
-TEST(CameraRebuild, BetweenRunsAFollowingCameraStillSaysItFollows) {
+TEST_F(CameraRebuild, BetweenRunsAFollowingCameraStillSaysItFollows) {
   // The status (MQTT, Home Assistant's switch, /api/cameras) said "not
   // following" for each reconnect's seconds, the pipeline being gone.
-  gst_registry_scan_path(gst_registry_get(), WIRCAM_PLUGIN_DIR);
   auto device = startFollowDevice();
   ASSERT_TRUE(device);
-  fs::path out = fs::temp_directory_path() / ("camera-follow-" + std::to_string(getpid()));
-  fs::remove_all(out);
-  fs::create_directories(out);
-  std::vector<std::string> words = {
-      "wirc-recorder", "--device",   "127.0.0.1:" + std::to_string(device->port()),
-      "--out",         out.string(), "--detect",
-      "tag36h11",      "--follow"};
-  std::vector<char*> argv;
-  for (auto& word : words) argv.push_back(word.data());
-  auto options = parseOptions(static_cast<int>(argv.size()), argv.data());
-  ASSERT_TRUE(options) << options.error();
-  auto plan = planPipeline(*options);
-  ASSERT_EQ(plan.streams.size(), 1u);
-  CameraFiles files{.folder = out.string(), .extension = ".mkv", .limits = {.maxDuration = 0}};
+  auto stream = streamOf({"--device", "127.0.0.1:" + std::to_string(device->port()), "--detect",
+                          "tag36h11", "--follow"});
+  ASSERT_TRUE(stream);
   Observed observed;
-  auto camera = Camera::create(plan.streams[0], files, {.stallTimeout = 2s}, observed);
+  auto camera = Camera::create(*stream, files(), {.stallTimeout = 2s}, observed);
   ASSERT_TRUE(camera) << camera.error();
   ASSERT_TRUE((*camera)->start());
-  guint ticks = g_timeout_add(
-      Camera::kTickIntervalMs,
-      [](gpointer c) -> gboolean {
-        static_cast<Camera*>(c)->tick();
-        return G_SOURCE_CONTINUE;
-      },
-      camera->get());
+  tick(**camera);
   auto following = [&] {
     auto control = (*camera)->report().control;
     return control && control->following;
@@ -129,11 +145,7 @@ TEST(CameraRebuild, BetweenRunsAFollowingCameraStillSaysItFollows) {
   EXPECT_TRUE(following());
   EXPECT_FALSE((*camera)->report().control->hasControl);
 
-  (*camera)->stop();
-  EXPECT_TRUE(runMainLoopUntil([&] { return observed.over; }, 5s));
-  g_source_remove(ticks);
-  camera->reset();
-  fs::remove_all(out);
+  EXPECT_TRUE(stop(**camera, observed));
 }
 
 }  // namespace
