@@ -37,8 +37,8 @@ std::set<std::string> turnAddresses(const std::string& url) {
 
 std::vector<std::string> WebRtcService::missingElements() {
   std::vector<std::string> missing;
-  for (const char* name :
-       {"webrtcbin", "nicesrc", "nicesink", "vp8enc", "rtpvp8pay", "rtph264pay", "tjpegdec"}) {
+  for (const char* name : {"webrtcbin", "dtlsdec", "nicesrc", "nicesink", "vp8enc", "rtpvp8pay",
+                           "rtph264pay", "tjpegdec"}) {
     if (GstElementFactory* factory = gst_element_factory_find(name))
       gst_object_unref(factory);
     else
@@ -51,6 +51,20 @@ WebRtcService::WebRtcService(std::vector<Camera> cameras, Settings settings)
     : cameras_(std::move(cameras)),
       settings_(std::move(settings)),
       allowedHosts_(turnAddresses(settings_.servers.turn)) {
+  // webrtcbin's DTLS elements make one certificate per process, for the
+  // first viewer, while it waits for its answer: an RSA key, 0.1-0.4 s of a
+  // core here, 1.3 s beside three busy loops, more on a small machine. Made
+  // now, on a thread of its own, it is there when the first viewer comes.
+  // Until then no viewer can be prepared: a viewer's time to come up counts
+  // from then (sweep()).
+  certificateMaker_ = std::thread([this] {
+    auto started = std::chrono::steady_clock::now();
+    if (GstElement* dtls = gst_element_factory_make("dtlsdec", nullptr)) gst_object_unref(dtls);
+    auto took = std::chrono::duration_cast<std::chrono::milliseconds>(
+        std::chrono::steady_clock::now() - started);
+    logLine("webrtc: DTLS certificate made in " + std::to_string(took.count()) + " ms");
+    certificateMade_ = true;
+  });
   sweepTimer_ = g_timeout_add(
       500,
       [](gpointer self) -> gboolean {
@@ -61,6 +75,7 @@ WebRtcService::WebRtcService(std::vector<Camera> cameras, Settings settings)
 }
 
 WebRtcService::~WebRtcService() {
+  certificateMaker_.join();
   alive_.reset();
   g_source_remove(sweepTimer_);
   viewers_.clear();  // before their encoders
@@ -131,6 +146,10 @@ void WebRtcService::offer(const std::string& camera, std::string_view sdp,
     }
     // The browser has the idle timeout to connect from its answer on.
     viewer->second.downSince = std::chrono::steady_clock::now();
+    if (viewer->second.peer->candidatesGathered() == 0)
+      logLine("webrtc: " + viewer->second.camera + ": answered session " + session +
+              " without an ICE candidate of the recorder's (none gathered in time): only a "
+              "viewer the recorder can reach will connect");
     reply(Answer{*answer, session});
   };
   events.ended = [this, session] { removeLater(session); };
@@ -166,7 +185,7 @@ void WebRtcService::sweep(std::chrono::steady_clock::time_point now) {
       if (now - viewer.peer->lastHeard() > settings_.idleTimeout) expired.push_back(session);
       continue;
     }
-    if (!viewer.downSince) viewer.downSince = now;
+    if (!viewer.downSince || !certificateMade_) viewer.downSince = now;
     if (now - *viewer.downSince > settings_.idleTimeout) expired.push_back(session);
   }
   for (const auto& session : expired) remove(session);
@@ -193,6 +212,9 @@ void WebRtcService::remove(const std::string& session) {
   if (viewer == viewers_.end()) return;
   std::string camera = viewer->second.camera, key = viewer->second.encoder;
   Done unanswered = std::move(viewer->second.unanswered);
+  if (unanswered)
+    logLine("webrtc: " + camera + ": session " + session +
+            " not answered within the idle timeout: " + viewer->second.peer->preparation());
   viewers_.erase(viewer);
   logLine("webrtc: " + camera + ": viewer gone (session " + session + "), " +
           std::to_string(viewers_.size()) + " now");

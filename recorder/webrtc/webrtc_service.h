@@ -8,6 +8,7 @@
 
 #include <glib.h>
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <map>
@@ -16,6 +17,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include "camera/frame_tap.h"
@@ -77,7 +79,9 @@ class WebRtcService {
   size_t encoders() const { return encoders_.size(); }
 
   // Releases the viewers not connected, or silent, for longer than the idle
-  // timeout at `now`; the service's own timer calls it twice a second.
+  // timeout at `now` (not connected: counted from when the DTLS certificate
+  // exists, which the first viewer waits for); the service's own timer calls
+  // it twice a second.
   void sweep(std::chrono::steady_clock::time_point now);
 
  private:
@@ -99,6 +103,8 @@ class WebRtcService {
   std::map<std::string, std::unique_ptr<CameraEncoder>> encoders_;
   std::map<std::string, Viewer> viewers_;  // by session
   guint sweepTimer_ = 0;
+  std::thread certificateMaker_;  // webrtcbin's DTLS certificate, made once at start
+  std::atomic<bool> certificateMade_{false};
   std::shared_ptr<WebRtcService*> alive_ = std::make_shared<WebRtcService*>(this);
 };
 

@@ -8,10 +8,6 @@ namespace wircam::recorder {
 
 namespace {
 
-// Host candidates are there at once; STUN and TURN answers take a round
-// trip. An answer waits this long for them at most.
-constexpr guint kGatheringSeconds = 3;
-
 // The service made sure at start that each of these is installed.
 GstElement* make(const char* factory) {
   GstElement* element = gst_element_factory_make(factory, nullptr);
@@ -176,16 +172,23 @@ void WebRtcViewer::negotiate(const std::string& offer) {
       });
   g_signal_emit_by_name(webrtc_, "create-answer", nullptr, answered);
   gst_promise_unref(answered);
-  gatherTimer_ = g_timeout_add_seconds(
-      kGatheringSeconds,
+}
+
+void WebRtcViewer::waitForCandidates(const std::string& answer) {
+  answer_ = answer;
+  gathering_.answerMade(AnswerGathering::Clock::now());
+  // At the patience's end the answer goes with the candidates it has.
+  gatherTimer_ = g_timeout_add(
+      std::chrono::duration_cast<std::chrono::milliseconds>(kGatheringPatience).count(),
       [](gpointer self) -> gboolean {
         auto* viewer = static_cast<WebRtcViewer*>(self);
         viewer->gatherTimer_ = 0;
-        viewer->gathered_ = true;
-        viewer->answerIfGathered();
+        // The time it stands for: a timer is not early by GLib's clock.
+        viewer->answerIfGathered(*viewer->gathering_.patienceEnds());
         return G_SOURCE_REMOVE;
       },
       this);
+  answerIfGathered(AnswerGathering::Clock::now());
 }
 
 void WebRtcViewer::onAnswerCreated(GstPromise* promise, gpointer data) {
@@ -214,14 +217,15 @@ void WebRtcViewer::onAnswerCreated(GstPromise* promise, gpointer data) {
   }
   handOver(&answering->handle, [answer, error](WebRtcViewer& self) {
     if (!error.empty()) return self.finish(unexpected("the offer cannot be answered: " + error));
-    self.answer_ = answer;
-    self.answerIfGathered();
+    self.waitForCandidates(answer);
   });
 }
 
 void WebRtcViewer::onIceCandidate(GstElement*, guint mline, gchar* candidate, gpointer handle) {
   handOver(handle, [mline, text = std::string(candidate)](WebRtcViewer& self) {
     self.candidates_.emplace_back(mline, text);
+    self.gathering_.candidateFound();
+    self.answerIfGathered(AnswerGathering::Clock::now());
   });
 }
 
@@ -230,13 +234,13 @@ void WebRtcViewer::onGatheringState(GstElement* webrtc, GParamSpec*, gpointer ha
   g_object_get(webrtc, "ice-gathering-state", &state, nullptr);
   if (state != GST_WEBRTC_ICE_GATHERING_STATE_COMPLETE) return;
   handOver(handle, [](WebRtcViewer& self) {
-    self.gathered_ = true;
-    self.answerIfGathered();
+    self.gathering_.gatheringComplete();
+    self.answerIfGathered(AnswerGathering::Clock::now());
   });
 }
 
-void WebRtcViewer::answerIfGathered() {
-  if (answered_ || answer_.empty() || !gathered_) return;
+void WebRtcViewer::answerIfGathered(AnswerGathering::Clock::time_point now) {
+  if (answered_ || !gathering_.ready(now)) return;
   finish(
       answerWithH264Format(answerWithCandidates(answer_, candidates_), h264Payload_, h264Format_));
 }
@@ -252,16 +256,12 @@ void WebRtcViewer::finish(Expected<std::string, std::string> answer) {
 void WebRtcViewer::onConnectionState(GstElement* webrtc, GParamSpec*, gpointer handle) {
   GstWebRTCPeerConnectionState state;
   g_object_get(webrtc, "connection-state", &state, nullptr);
-  if (state != GST_WEBRTC_PEER_CONNECTION_STATE_FAILED &&
-      state != GST_WEBRTC_PEER_CONNECTION_STATE_CLOSED)
-    return;
-  handOver(handle, [](WebRtcViewer& self) { self.events_.ended(); });
-}
-
-GstWebRTCPeerConnectionState WebRtcViewer::state() const {
-  GstWebRTCPeerConnectionState state;
-  g_object_get(webrtc_, "connection-state", &state, nullptr);
-  return state;
+  handOver(handle, [state](WebRtcViewer& self) {
+    self.connectionState_ = state;
+    if (state == GST_WEBRTC_PEER_CONNECTION_STATE_FAILED ||
+        state == GST_WEBRTC_PEER_CONNECTION_STATE_CLOSED)
+      self.events_.ended();
+  });
 }
 
 std::chrono::steady_clock::time_point WebRtcViewer::lastHeard() const {

@@ -20,6 +20,7 @@
 
 #include "common/expected.h"
 #include "live/ice_servers.h"
+#include "webrtc/answer_gathering.h"
 #include "webrtc/camera_encoder.h"
 #include "webrtc/whep_sdp.h"
 
@@ -45,10 +46,18 @@ class WebRtcViewer {
   WebRtcViewer(const WebRtcViewer&) = delete;
   WebRtcViewer& operator=(const WebRtcViewer&) = delete;
 
-  GstWebRTCPeerConnectionState state() const;
+  // As webrtcbin last told it. Not asked of webrtcbin: a property read waits
+  // for the operation it runs, which for the first viewer includes making
+  // the DTLS certificate (seconds, on a loaded machine), and the main loop
+  // would wait with it (every drive command, every request).
+  GstWebRTCPeerConnectionState state() const { return connectionState_; }
   // When the viewer's browser last sent RTCP (its receiver reports, about
   // every second): a viewer silent for long has gone, however it went.
   std::chrono::steady_clock::time_point lastHeard() const;
+  // How far its answer got (for the log of one not given in time), and
+  // how many candidates of the recorder's it carries or will.
+  std::string preparation() const { return gathering_.progress(); }
+  int candidatesGathered() const { return gathering_.candidates(); }
 
  private:
   // What webrtcbin's threads are handed: the viewer, while it lives.
@@ -66,7 +75,8 @@ class WebRtcViewer {
   static void handOver(gpointer handle, std::function<void(WebRtcViewer&)> call);
   gulong connect(gpointer instance, const char* signal, GCallback callback);
   void negotiate(const std::string& offer);
-  void answerIfGathered();
+  void waitForCandidates(const std::string& answer);
+  void answerIfGathered(AnswerGathering::Clock::time_point now);
   void finish(Expected<std::string, std::string> answer);
   void openDriveChannel(GstWebRTCDataChannel* channel);
 
@@ -84,12 +94,16 @@ class WebRtcViewer {
   // Written on webrtcbin's RTCP thread (steady_clock ticks).
   std::shared_ptr<std::atomic<int64_t>> heard_ = std::make_shared<std::atomic<int64_t>>(
       std::chrono::steady_clock::now().time_since_epoch().count());
+  // Host candidates are there at once; STUN and TURN answers take a round
+  // trip. An answer that holds a candidate waits this long for them at most.
+  static constexpr auto kGatheringPatience = std::chrono::seconds(3);
+  // The answer waits for its candidates, which come one by one.
   guint gatherTimer_ = 0;
-  // The answer waits for the gathering to end; the candidates come one by one.
+  AnswerGathering gathering_{kGatheringPatience};
   std::string answer_;
   std::vector<LocalCandidate> candidates_;
-  bool gathered_ = false;
   bool answered_ = false;
+  GstWebRTCPeerConnectionState connectionState_ = GST_WEBRTC_PEER_CONNECTION_STATE_NEW;
   GstWebRTCDataChannel* drive_ = nullptr;
   std::vector<gulong> driveHandlers_;
   // What webrtcbin's threads hand over checks it: the viewer may be gone.
