@@ -3,6 +3,7 @@
 #include <apriltag/apriltag.h>
 #include <apriltag/apriltag_pose.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -37,6 +38,13 @@ TagDetector::TagDetector(DetectorOptions options, TagFamily family)
 }
 
 std::vector<TagDetection> TagDetector::detect(const GrayView& image, Point2 origin) {
+  // The library's thresholding crashes on an image (after decimation) a
+  // few pixels high or wide (a 100x2 frame did, a stranger's trial; so
+  // could a search window clipped at the frame's edge), and no tag fits
+  // in less than 8 pixels: nothing to find.
+  constexpr int kSmallestTag = 8;
+  float decimate = std::max(1.0f, detector_->quad_decimate);
+  if (image.width / decimate < kSmallestTag || image.height / decimate < kSmallestTag) return {};
   // The library takes a mutable buffer but only reads it.
   image_u8_t view{image.width, image.height, image.stride, const_cast<uint8_t*>(image.data)};
   std::unique_ptr<zarray_t, void (*)(zarray_t*)> found(

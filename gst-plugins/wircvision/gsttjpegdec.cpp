@@ -134,6 +134,16 @@ struct JpegHeader {
   int width = 0, height = 0, subsampling = 0;
 };
 
+// A whole JPEG ends with its end-of-image marker (FF D9), padding after it
+// aside. One cut short decodes with only a warning, its missing rows grey
+// (a file's frame cut to a third came out so, a stranger's trial): a
+// picture the detector must not read.
+bool ends_whole(const ScopedBufferMap& in) {
+  gsize end = in.size();
+  while (end > 0 && in.data()[end - 1] == 0x00) --end;
+  return end >= 2 && in.data()[end - 2] == 0xFF && in.data()[end - 1] == 0xD9;
+}
+
 // The JPEG's size and subsampling, or nothing (the handle is renewed: a
 // failed call can leave it mid-frame).
 std::optional<JpegHeader> read_header(TjpegDecState* state, const ScopedBufferMap& in,
@@ -204,6 +214,8 @@ static GstFlowReturn gst_tjpeg_dec_handle_frame(GstVideoDecoder* decoder,
   std::string why;
   auto header = read_header(state, in, &why);
   if (!header) return drop_with_warning(decoder, frame, why.c_str());
+  if (!ends_whole(in))
+    return drop_with_warning(decoder, frame, "cut short: no end-of-image marker");
 
   int scale;
   {

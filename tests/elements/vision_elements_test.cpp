@@ -84,6 +84,10 @@ TEST(TjpegDec, DropsACorruptFrameAndGoesOn) {
   const auto& whole = sceneFrames()[2];
   std::vector<uint8_t> truncated(whole.begin(), whole.begin() + 600);
   EXPECT_EQ(gst_harness_push(h, at(truncated, 2 * GST_SECOND)), GST_FLOW_OK);
+  // Cut after its headers, two thirds gone: TurboJPEG decodes it with a
+  // warning only, the missing rows grey (it came out so).
+  std::vector<uint8_t> third(whole.begin(), whole.begin() + whole.size() / 3);
+  EXPECT_EQ(gst_harness_push(h, at(third, 2 * GST_SECOND + 1)), GST_FLOW_OK);
   EXPECT_EQ(gst_harness_push(h, at(whole, 3 * GST_SECOND)), GST_FLOW_OK);
   // Exactly the two whole frames come out, neither corrupt one.
   ASSERT_EQ(gst_harness_buffers_in_queue(h), 2u);
@@ -93,6 +97,25 @@ TEST(TjpegDec, DropsACorruptFrameAndGoesOn) {
     gst_buffer_unref(out);
   }
   gst_harness_teardown(h);
+}
+
+TEST(ApriltagDetect, AFrameTooSmallForATagPassesWithoutOne) {
+  // AprilTag's thresholding crashed the process on a frame 2 pixels high
+  // (100x2, 1x1; 64x16 at quad-decimate=8), a stranger's trial.
+  for (const char* size : {"width=100,height=2", "width=1,height=1", "width=64,height=16"}) {
+    GstHarness* h = gst_harness_new_parse("apriltagdetect quad-decimate=8");
+    GstCaps* caps = gst_caps_from_string(
+        (std::string("video/x-raw,format=GRAY8,framerate=15/1,") + size).c_str());
+    gst_harness_set_src_caps(h, gst_caps_ref(caps));
+    GstVideoInfo info;
+    gst_video_info_from_caps(&info, caps);
+    gst_caps_unref(caps);
+    GstBuffer* frame = gst_buffer_new_allocate(nullptr, GST_VIDEO_INFO_SIZE(&info), nullptr);
+    gst_buffer_memset(frame, 0, 0x80, GST_VIDEO_INFO_SIZE(&info));
+    EXPECT_EQ(gst_harness_push(h, frame), GST_FLOW_OK) << size;
+    gst_buffer_unref(gst_harness_pull(h));
+    gst_harness_teardown(h);
+  }
 }
 
 TEST(ApriltagDetect, AttachesTheTagAndPostsAMessage) {
