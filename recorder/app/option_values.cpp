@@ -43,12 +43,20 @@ std::optional<uint64_t> byteSize(const char* text) {
   return static_cast<uint64_t>(value * scale);
 }
 
-std::optional<ServerAddress> parseServerAddress(const std::string& text) {
+std::optional<HostAndPort> hostAndPort(const std::string& text, int lowestPort) {
   auto colon = text.rfind(':');
-  if (colon == std::string::npos) return std::nullopt;
-  auto port = number(text.substr(colon + 1).c_str());
-  if (!port || *port < 0 || *port > 65535) return std::nullopt;
-  return ServerAddress{text.substr(0, colon), static_cast<uint16_t>(*port)};
+  HostAndPort split{text.substr(0, colon), std::nullopt};
+  if (colon == std::string::npos) return split;
+  auto port = wholeWithin(text.substr(colon + 1).c_str(), lowestPort, 65535);
+  if (!port) return std::nullopt;
+  split.port = static_cast<uint16_t>(*port);
+  return split;
+}
+
+std::optional<ServerAddress> parseServerAddress(const std::string& text) {
+  auto split = hostAndPort(text, 0);  // port 0: any free one
+  if (!split || !split->port) return std::nullopt;
+  return ServerAddress{split->host, *split->port};
 }
 
 Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri) {
@@ -59,14 +67,10 @@ Expected<ControlTarget, std::string> parseControlTarget(const std::string& uri) 
       (target.protocol != "wirc" && target.protocol != "rcoip" && target.protocol != "btemp"))
     return unexpected("control '" + uri + "' is not rcoip://HOST:PORT, btemp://HOST:PORT or " +
                       "wirc://HOST:PORT");
-  std::string address = uri.substr(scheme + 3);
-  auto colon = address.rfind(':');
-  target.host = address.substr(0, colon);
-  if (colon != std::string::npos) {
-    auto port = wholeWithin(address.substr(colon + 1).c_str(), 1, 65535);
-    if (!port) return unexpected("control '" + uri + "': a port is 1..65535");
-    target.port = static_cast<uint16_t>(*port);
-  }
+  auto address = hostAndPort(uri.substr(scheme + 3));
+  if (!address) return unexpected("control '" + uri + "': a port is 1..65535");
+  target.host = address->host;
+  if (address->port) target.port = *address->port;
   if (target.host.empty() || target.host.find_first_of("/ \"'") != std::string::npos)
     return unexpected("control '" + uri + "' needs a host, as in rcoip://192.168.4.1:9048");
   return target;
@@ -83,13 +87,10 @@ Expected<DeviceTarget, std::string> deviceTarget(const std::string& argument) {
     if (!control) return unexpected("--device " + argument + ": " + control.error());
     target.control = *control;
   }
-  auto colon = text.rfind(':');
-  target.host = text.substr(0, colon);
-  if (colon != std::string::npos) {
-    auto port = number(text.substr(colon + 1).c_str());
-    if (!port || *port < 1 || *port > 65535) return unexpected("bad port in --device " + text);
-    target.port = static_cast<uint16_t>(*port);
-  }
+  auto address = hostAndPort(text);
+  if (!address) return unexpected("bad port in --device " + text + ": a port is 1..65535");
+  target.host = address->host;
+  if (address->port) target.port = *address->port;
   if (target.host.empty())
     return unexpected("--device needs a host, as in 192.168.1.1 or 127.0.0.1:1984");
   target.label = target.host + (target.port == 1984 ? "" : "-" + std::to_string(target.port));
@@ -133,13 +134,10 @@ Expected<std::optional<PositionSource>, std::string> positionSource(
   if (!beacons)
     return unexpected("marvelmind " + *dashboard + " needs the vehicle's beacon (--beacon ADDR)");
   PositionSource source;
-  auto colon = dashboard->rfind(':');
-  source.host = dashboard->substr(0, colon);
-  if (colon != std::string::npos) {
-    auto port = wholeWithin(dashboard->substr(colon + 1).c_str(), 1, 65535);
-    if (!port) return unexpected("marvelmind '" + *dashboard + "': a port is 1..65535");
-    source.port = static_cast<uint16_t>(*port);
-  }
+  auto address = hostAndPort(*dashboard);
+  if (!address) return unexpected("marvelmind '" + *dashboard + "': a port is 1..65535");
+  source.host = address->host;
+  if (address->port) source.port = *address->port;
   if (source.host.empty() || source.host.find_first_of("/ \"'") != std::string::npos)
     return unexpected("marvelmind '" + *dashboard + "' needs a host, as in 192.168.1.50:49200");
   auto parsed = marvelmind::parseBeacons(*beacons);

@@ -15,6 +15,13 @@ namespace wircam::recorder {
 std::optional<double> number(const char* text);
 // A whole number within low..high, or nothing.
 std::optional<long long> wholeWithin(const char* text, double low, double high);
+// "HOST[:PORT]": the host (maybe empty), and the port if given; nothing if
+// the port is not a whole number within lowestPort..65535.
+struct HostAndPort {
+  std::string host;
+  std::optional<uint16_t> port;
+};
+std::optional<HostAndPort> hostAndPort(const std::string& text, int lowestPort = 1);
 // "500M", "20G", "1048576": bytes.
 std::optional<uint64_t> byteSize(const char* text);
 // "HOST[:PORT][,control=URI]", as --device takes it.

@@ -2,8 +2,10 @@
 
 #include <cctype>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <set>
+#include <tuple>
 
 #include "telemetry/telemetry_track_flags.h"
 
@@ -170,6 +172,23 @@ std::optional<std::string> sameNamedStreams(const PipelinePlan& plan) {
       return "two cameras would both be named " + stream.name +
              " (device names that differ only in characters a file name cannot hold, or a "
              "camera listed twice): rename one";
+  return std::nullopt;
+}
+
+std::optional<std::string> cameraRecordedTwice(const RecorderOptions& options) {
+  std::map<std::tuple<std::string, uint16_t, int>, std::string> recordedBy;
+  for (const auto& device : options.devices) {
+    if (device.host.empty()) continue;  // found by discovery: known only then
+    for (int camera : device.cameras) {
+      auto [first, added] =
+          recordedBy.emplace(std::tuple(device.host, device.port, camera), device.label);
+      if (!added)
+        return "'" + first->second + "' and '" + device.label + "' both record camera " +
+               std::to_string(camera) + " of " + device.host + ":" + std::to_string(device.port) +
+               ": a device streams each camera to one receiver, so the two would take the "
+               "stream from each other; record it once";
+    }
+  }
   return std::nullopt;
 }
 

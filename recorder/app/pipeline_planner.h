@@ -29,4 +29,9 @@ PipelinePlan planPipeline(const RecorderOptions& options);
 // each other's files: why the plan cannot be recorded, if so.
 std::optional<std::string> sameNamedStreams(const PipelinePlan& plan);
 
+// One camera of one device (as addressed) under two device names: the
+// device streams it to one of them at a time, and each would take the
+// stream from the other. Why the options cannot be recorded, if so.
+std::optional<std::string> cameraRecordedTwice(const RecorderOptions& options);
+
 }  // namespace wircam::recorder

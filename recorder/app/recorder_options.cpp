@@ -41,6 +41,9 @@ Expected<DeviceTarget, std::string> readDevice(GKeyFile* file, const std::string
                                                const std::string& where) {
   DeviceTarget device;
   device.label = group.substr(7);
+  if (device.label.find_first_not_of(" \t") == std::string::npos)
+    return unexpected(where + " [" + group +
+                      "] needs a name: [device NAME], NAME starting the stream's (NAME-cam0)");
   Strings keys(g_key_file_get_keys(file, group.c_str(), nullptr, nullptr), g_strfreev);
   for (gchar** key = keys.get(); key && *key; ++key) {
     const auto& table = deviceKeyTable();

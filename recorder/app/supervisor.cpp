@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -22,7 +23,7 @@ namespace {
 
 // A stop's own bound, past the cameras' CameraMachine::kFinishTime: whatever a camera or
 // device does, the run ends within 3 s of it.
-constexpr guint kStopBoundMs = 2900;
+constexpr std::chrono::milliseconds kStopBound{2900};
 
 }  // namespace
 
@@ -101,6 +102,7 @@ Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
     logLine("indexed " + std::to_string(added) + " segment(s) missing from " +
             supervisor->index_.path().string());
   supervisor->index_.save();
+  if (auto problem = cameraRecordedTwice(options)) return unexpected(*problem);
   auto plan = planPipeline(options);
   if (auto problem = sameNamedStreams(plan)) return unexpected(*problem);
   for (auto& stream : plan.streams) {
@@ -139,6 +141,7 @@ std::vector<std::string> Supervisor::cameraNames() const {
 void Supervisor::segmentClosed(Camera& camera, const std::string& file,
                                const PlannedSegment& planned) {
   markTelemetryTrack(file);
+  ++segmentsThisRun_;
   std::error_code error;
   auto name = std::filesystem::path(file).filename().string();
   uint64_t bytes = std::filesystem::file_size(file, error);
@@ -229,23 +232,23 @@ void Supervisor::stop(const char* why) {
   if (stopping_) return;
   stopping_ = true;
   if (why) logLine(std::string(why) + ": finishing the files (a second signal stops at once)");
+  // This run's: a folder of earlier recordings is no excuse (cameras a
+  // reload removed are gone from cameras_; their files counted).
   bool anyRecorded =
+      segmentsThisRun_ > 0 ||
       std::any_of(cameras_.begin(), cameras_.end(), [](const auto& c) { return c->hasFrames(); });
-  if (!anyRecorded && exitCode_ == 0 && index_.entries().empty()) {
+  if (!anyRecorded && exitCode_ == 0) {
     // No device ever sent a frame. Stopped by a signal while waiting is how
     // a service ends; a --duration that recorded nothing failed.
     logLine("nothing was recorded: no device sent a frame");
     if (!stoppedBySignal_) exitCode_ = kExitError;
   }
-  timers_.push_back(g_timeout_add(kStopBoundMs, onStopDeadline, this));
+  if (schedule_) {
+    schedule_->stopping(RunSchedule::Clock::now(), kStopBound);
+    armSchedule();
+  }
   for (auto& c : cameras_) c->stop();
   quitWhenAllEnded();
-}
-
-gboolean Supervisor::onStopDeadline(gpointer data) {
-  // Cameras cut themselves off at CameraMachine::kFinishTime; this is the backstop.
-  g_main_loop_quit(static_cast<Supervisor*>(data)->loop_);
-  return G_SOURCE_REMOVE;
 }
 
 gboolean Supervisor::onSignal(gpointer data) {
@@ -262,23 +265,53 @@ gboolean Supervisor::onSignal(gpointer data) {
   return G_SOURCE_CONTINUE;
 }
 
-gboolean Supervisor::onDurationOver(gpointer data) {
-  static_cast<Supervisor*>(data)->stop("--duration is over");
+// The one timer of the run's schedule: at its next job.
+void Supervisor::armSchedule() {
+  if (scheduleTimer_) g_source_remove(scheduleTimer_);
+  auto wait =
+      std::chrono::ceil<std::chrono::milliseconds>(schedule_->next() - RunSchedule::Clock::now());
+  scheduleTimer_ = g_timeout_add(static_cast<guint>(std::clamp<int64_t>(wait.count(), 0, 3600000)),
+                                 onSchedule, this);
+}
+
+gboolean Supervisor::onSchedule(gpointer data) {
+  auto* self = static_cast<Supervisor*>(data);
+  self->scheduleTimer_ = 0;
+  for (RunJob job : self->schedule_->due(RunSchedule::Clock::now())) self->perform(job);
+  self->armSchedule();
   return G_SOURCE_REMOVE;
 }
 
-gboolean Supervisor::onCameraTick(gpointer data) {
-  auto* self = static_cast<Supervisor*>(data);
-  for (auto& c : self->cameras_) c->tick();
-  self->publishFoxglovePoses();
-  return G_SOURCE_CONTINUE;
-}
-
-gboolean Supervisor::onTick(gpointer data) {
-  auto* self = static_cast<Supervisor*>(data);
-  self->printStatus();
-  self->guardDisk();
-  return G_SOURCE_CONTINUE;
+void Supervisor::perform(RunJob job) {
+  switch (job) {
+    case RunJob::End:
+      stop("--duration is over");
+      break;
+    case RunJob::Status:
+      printStatus();
+      guardDisk();
+      break;
+    case RunJob::CameraTick:
+      for (auto& c : cameras_) c->tick();
+      publishFoxglovePoses();
+      break;
+    case RunJob::FleetStatus:
+      publishFleetStatus();
+      break;
+    case RunJob::FoxgloveStatus:
+      publishFoxgloveStatus();
+      break;
+    case RunJob::Snapshots:
+      publishSnapshots();
+      break;
+    case RunJob::Retention:
+      enforceRetention();
+      break;
+    case RunJob::StopBackstop:
+      // Cameras cut themselves off at CameraMachine::kFinishTime; this is the backstop.
+      g_main_loop_quit(loop_);
+      break;
+  }
 }
 
 void Supervisor::publishFleetStatus(bool force) {
@@ -414,53 +447,31 @@ int Supervisor::run() {
   loop_ = g_main_loop_new(nullptr, FALSE);
   g_unix_signal_add(SIGINT, onSignal, this);
   g_unix_signal_add(SIGTERM, onSignal, this);
-  if (options_.duration)
-    timers_.push_back(
-        g_timeout_add(static_cast<guint>(*options_.duration * 1000), onDurationOver, this));
-  timers_.push_back(g_timeout_add(static_cast<guint>(options_.statusSeconds * 1000), onTick, this));
-  timers_.push_back(g_timeout_add(Camera::kTickIntervalMs, onCameraTick, this));
-  // Once a second, whatever --status says: the fleet's status is published
-  // on change and at least every FleetPublisher::kStatusInterval.
-  if (fleet_)
-    timers_.push_back(g_timeout_add_seconds(
-        1,
-        [](gpointer self) -> gboolean {
-          static_cast<Supervisor*>(self)->publishFleetStatus();
-          return G_SOURCE_CONTINUE;
-        },
-        this));
-  if (foxglove_)
-    timers_.push_back(g_timeout_add_seconds(
-        1,
-        [](gpointer self) -> gboolean {
-          static_cast<Supervisor*>(self)->publishFoxgloveStatus();
-          return G_SOURCE_CONTINUE;
-        },
-        this));
-  // Home Assistant's camera entity: each camera's newest frame, retained.
-  if (fleet_ && options_.mqttDiscovery)
-    timers_.push_back(g_timeout_add(
-        static_cast<guint>(options_.mqttSnapshotSeconds * 1000),
-        [](gpointer self) -> gboolean {
-          static_cast<Supervisor*>(self)->publishSnapshots();
-          return G_SOURCE_CONTINUE;
-        },
-        this));
+  using std::chrono::milliseconds;
+  // (--status takes any positive number: past 30 years is never.)
+  auto ms = [](double seconds) {
+    return milliseconds(std::llround(std::min(seconds, 1e9) * 1000));
+  };
+  RunPeriods periods{.status = ms(options_.statusSeconds),
+                     .cameraTick = milliseconds(Camera::kTickIntervalMs)};
+  if (options_.duration) periods.duration = ms(*options_.duration);
+  // MQTT's status is published on change and at least every
+  // FleetPublisher::kStatusInterval: looked at once a second.
+  if (fleet_) periods.fleetStatus = milliseconds(1000);
+  if (foxglove_) periods.foxgloveStatus = milliseconds(1000);
+  if (fleet_ && options_.mqttDiscovery) periods.snapshots = ms(options_.mqttSnapshotSeconds);
   // Segments age whether or not any camera closes one: --max-age is looked
   // at now and every minute (a reload may set it).
   if (options_.maxAge.count() > 0) enforceRetention();
-  timers_.push_back(g_timeout_add_seconds(
-      60,
-      [](gpointer self) -> gboolean {
-        static_cast<Supervisor*>(self)->enforceRetention();
-        return G_SOURCE_CONTINUE;
-      },
-      this));
+  schedule_.emplace(periods, RunSchedule::Clock::now());
+  armSchedule();
   if (reread_) timers_.push_back(g_unix_signal_add(SIGHUP, onReloadSignal, this));
   for (auto& c : cameras_)
     if (!c->start()) return kExitError;
   g_main_loop_run(loop_);
   // The run is over: its timers must not fire while the hooks drain.
+  if (scheduleTimer_) g_source_remove(scheduleTimer_);
+  scheduleTimer_ = 0;
   for (guint id : timers_)
     if (GSource* timer = g_main_context_find_source_by_id(nullptr, id)) g_source_destroy(timer);
   printStatus();

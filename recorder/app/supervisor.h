@@ -19,6 +19,7 @@
 
 #include "app/command_dispatcher.h"
 #include "app/recorder_options.h"
+#include "app/run_schedule.h"
 #include "camera/camera.h"
 #include "common/expected.h"
 #include "fleet/fleet_publisher.h"
@@ -79,11 +80,10 @@ class Supervisor : CameraObserver {
   void ended(Camera& camera) override;
 
   void stop(const char* why);
-  static gboolean onStopDeadline(gpointer self);
   static gboolean onSignal(gpointer self);  // SIGINT, SIGTERM
-  static gboolean onDurationOver(gpointer self);
-  static gboolean onTick(gpointer self);
-  static gboolean onCameraTick(gpointer self);
+  void armSchedule();
+  static gboolean onSchedule(gpointer self);
+  void perform(RunJob job);  // one job of the schedule
   void quitWhenAllEnded();
   void publishFleetStatus(bool force = false);
   void publishFoxgloveStatus();  // each camera's /STREAM/telemetry, once a second
@@ -120,10 +120,13 @@ class Supervisor : CameraObserver {
   std::unique_ptr<FoxgloveService> foxglove_;  // with --foxglove
   std::map<std::string, int64_t> posesSent_;   // by camera: the last position's time
   std::unique_ptr<SegmentHook> hook_;          // with --on-segment-closed
-  std::vector<guint> timers_;                  // the run's timeouts, removed when it ends
+  std::optional<RunSchedule> schedule_;        // from run(): what it does on time
+  guint scheduleTimer_ = 0;                    // armed to the schedule's next job
+  std::vector<guint> timers_;                  // the run's signal sources, removed when it ends
   bool stopping_ = false;
   bool stoppedBySignal_ = false;
   int exitCode_ = 0;
+  uint64_t segmentsThisRun_ = 0;  // closed since the recorder started
   bool statusShown_ = false;
 };
 

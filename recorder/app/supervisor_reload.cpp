@@ -5,9 +5,9 @@
 // untouched. Refused with the reason, nothing changed, when the options do
 // not validate or change what only a restart of the recorder can.
 #include <algorithm>
-#include <set>
 
 #include "app/pipeline_planner.h"
+#include "app/reload_plan.h"
 #include "app/supervisor.h"
 #include "log_line.h"
 
@@ -27,43 +27,43 @@ Expected<nlohmann::json, std::string> Supervisor::reload() {
   if (auto problem = reloadRefusal(options_, *reread)) return refuse(*problem);
   if (auto problem = checkFamily(reread->detectFamily)) return refuse(*problem);
 
+  if (auto problem = cameraRecordedTwice(*reread)) return refuse(*problem);
   auto plan = planPipeline(*reread);
   if (auto problem = sameNamedStreams(plan)) return refuse(*problem);
   CameraFiles files = filesOf(*reread, plan);
   CameraHealth::Policy health = healthOf(*reread);
+  std::vector<Camera*> running;
+  std::vector<RunningCamera> seen;
+  for (auto& c : cameras_) {
+    if (c->ended() || removing_.count(c.get())) continue;
+    running.push_back(c.get());
+    seen.push_back({c->plannedNext(), c->files(), c->policy()});
+  }
+  ReloadPlan changes = planReload(seen, plan.streams, files, health);
+  auto among = [](const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
   // The new cameras are built first: one that cannot be refuses the reload
   // before any other camera is touched.
   std::vector<std::unique_ptr<Camera>> added;
-  std::set<std::string> wanted;
   for (const auto& stream : plan.streams) {
-    wanted.insert(stream.name);
-    if (cameraNamed(stream.name)) continue;
+    if (!among(changes.added, stream.name)) continue;
     auto camera = Camera::create(stream, files, health, *this);
     if (!camera) return refuse(stream.name + ": " + camera.error());
     added.push_back(std::move(*camera));
   }
-  nlohmann::json result = {{"added", nlohmann::json::array()},
-                           {"removed", nlohmann::json::array()},
-                           {"restarted", nlohmann::json::array()},
-                           {"unchanged", nlohmann::json::array()}};
-  for (auto& c : cameras_) {
-    if (c->ended() || removing_.count(c.get())) continue;
-    auto stream = std::find_if(plan.streams.begin(), plan.streams.end(),
-                               [&](const StreamPlan& s) { return s.name == c->name(); });
-    if (stream == plan.streams.end()) {
-      result["removed"].push_back(c->name());
+  for (Camera* c : running) {
+    if (among(changes.removed, c->name())) {
       removeCamera(*c);
-    } else if (*stream != c->plannedNext() || files != c->files() || health != c->policy()) {
-      result["restarted"].push_back(c->name());
+    } else if (among(changes.restarted, c->name())) {
+      auto stream = std::find_if(plan.streams.begin(), plan.streams.end(),
+                                 [&](const StreamPlan& s) { return s.name == c->name(); });
       c->replan(*stream, files, health);
-    } else {
-      result["unchanged"].push_back(c->name());
     }
   }
   options_ = std::move(*reread);
   retention_.setLimits(retentionOf(options_));
   for (auto& camera : added) {
-    result["added"].push_back(camera->name());
     Camera& fresh = *camera;
     cameras_.push_back(std::move(camera));
     addToServers(fresh);
@@ -78,11 +78,11 @@ Expected<nlohmann::json, std::string> Supervisor::reload() {
       logLine(fresh.name() + ": its pipeline did not start");
   }
   enforceRetention();
-  logLine("reloaded: " + std::to_string(result["added"].size()) + " camera(s) added, " +
-          std::to_string(result["removed"].size()) + " removed, " +
-          std::to_string(result["restarted"].size()) + " restarted with new settings, " +
-          std::to_string(result["unchanged"].size()) + " recording on");
-  return result;
+  logLine("reloaded: " + std::to_string(changes.added.size()) + " camera(s) added, " +
+          std::to_string(changes.removed.size()) + " removed, " +
+          std::to_string(changes.restarted.size()) + " restarted with new settings, " +
+          std::to_string(changes.unchanged.size()) + " recording on");
+  return changes.summary();
 }
 
 void Supervisor::removeCamera(Camera& camera) {

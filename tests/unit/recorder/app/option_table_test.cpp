@@ -111,6 +111,12 @@ TEST(OptionTable, DeviceGroupsTakeTheirKeysAndOverrideTheRecorderWideOptions) {
   EXPECT_NE(refused.error().find("[device rover] speed: unknown key (host, port, cameras"),
             std::string::npos)
       << refused.error();
+  // A group without a name made files named "-cam0-...mkv" (a stranger's
+  // trial): the name is the stream's.
+  ConfigFile unnamed("[recorder]\nout=x\n[device ]\nhost=h\n");
+  auto nameless = parse({"--config", unnamed.path()});
+  ASSERT_FALSE(nameless);
+  EXPECT_NE(nameless.error().find("[device ] needs a name"), std::string::npos) << nameless.error();
 }
 
 TEST(OptionTable, HelpNamesEveryOptionWithItsValueAndDefault) {

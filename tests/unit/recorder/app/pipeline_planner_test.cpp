@@ -132,3 +132,25 @@ TEST(PipelinePlan, EachCameraIsAPipelineOfItsOwn) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(PipelinePlan, OneCameraOfOneDeviceUnderTwoNamesIsRefused) {
+  // [device a] and [device b] at one address: the device streams camera 0
+  // to one receiver at a time, and the two took it from each other (each
+  // recorded a third of the time, a stranger's trial).
+  RecorderOptions options;
+  options.devices = {{.host = "127.0.0.1", .port = 27103, .label = "a", .cameras = {0, 1}},
+                     {.host = "127.0.0.1", .port = 27103, .label = "b", .cameras = {0}}};
+  auto problem = cameraRecordedTwice(options);
+  ASSERT_TRUE(problem);
+  EXPECT_EQ(problem->rfind("'a' and 'b' both record camera 0 of 127.0.0.1:27103", 0), 0u)
+      << *problem;
+  // Other cameras of it, or the same camera of another device, are fine.
+  options.devices[1].cameras = {2};
+  EXPECT_EQ(cameraRecordedTwice(options), std::nullopt);
+  options.devices[1] = {.host = "127.0.0.1", .port = 27104, .label = "b", .cameras = {0}};
+  EXPECT_EQ(cameraRecordedTwice(options), std::nullopt);
+}
+
+}  // namespace

@@ -113,6 +113,16 @@ TEST(RecorderOptions, RefusesNumbersNoFieldCanHold) {
   EXPECT_FALSE(parse({"--out", "x", "--segment", "nan"}).has_value());
 }
 
+TEST(RecorderOptions, APortIsAWholeNumberWhereverItIsGiven) {
+  // 1984.5 read as 1984 once: a typo went to another port without a word.
+  auto device = parse({"--out", "x", "--device", "127.0.0.1:1984.5"});
+  ASSERT_FALSE(device.has_value());
+  EXPECT_NE(device.error().find("1..65535"), std::string::npos) << device.error();
+  EXPECT_FALSE(parse({"--out", "x", "--http", ":8080.5"}).has_value());
+  EXPECT_FALSE(parse({"--out", "x", "--rtsp", "127.0.0.1:1e9"}).has_value());
+  EXPECT_EQ(parse({"--out", "x", "--http", ":0"})->http->port, 0);  // any free port
+}
+
 TEST(RecorderOptions, ADeviceMaySteerAnotherVehicleThroughControl) {
   auto options = parse({"--out", "x", "--detect", "tag36h11", "--follow", "--device",
                         "10.0.0.2:1985,control=rcoip://10.0.0.3:9050", "--device", "10.0.0.4"});
