@@ -26,6 +26,11 @@ Expected<SocketAddress, std::string> SocketAddress::resolve(const std::string& h
     return SocketAddress(address);
   }
   if (inet_pton(AF_INET, host.c_str(), &address.sin_addr) == 1) return SocketAddress(address);
+  // The protocols' devices are IPv4 (their discovery is a broadcast): an
+  // IPv6 address is said to be one, not "cannot resolve".
+  in6_addr six{};
+  if (inet_pton(AF_INET6, host.c_str(), &six) == 1)
+    return unexpected("'" + host + "' is an IPv6 address: devices are reached over IPv4");
   addrinfo hints{.ai_family = AF_INET};
   addrinfo* found = nullptr;
   int rc = getaddrinfo(host.c_str(), nullptr, &hints, &found);

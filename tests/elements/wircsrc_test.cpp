@@ -144,12 +144,48 @@ TEST(WircSrc, ReportsAnUnreachableDevice) {
   EXPECT_NE(error.find("Could not log in"), std::string::npos) << error;
 }
 
+TEST(WircSrc, WaitingForADeviceWithoutReconnectingIsRefusedWithTheReason) {
+  // It failed at the first refused connection, as "Could not log in" only.
+  auto device = startDevice(ephemeral());
+  auto port = std::to_string(device->port());
+  device.reset();
+  auto error = firstErrorOf(
+      "wircsrc host=127.0.0.1 wait-for-device=true reconnect=false port=" + port + " ! fakesink",
+      milliseconds(5000));
+  EXPECT_NE(error.find("wait-for-device=true needs reconnect=true"), std::string::npos) << error;
+}
+
 TEST(WircSrc, ReportsACameraTheDeviceDoesNotHave) {
   auto device = startDevice(ephemeral({.cameras = 1}));
   auto error = firstErrorOf(
       "wircsrc host=127.0.0.1 camera=3 port=" + std::to_string(device->port()) + " ! fakesink",
       milliseconds(5000));
   EXPECT_NE(error.find("no camera 3"), std::string::npos) << error;
+}
+
+TEST(WircSrc, ACameraTheDeviceLacksFailsAloneAndItsSiblingStreamsOn) {
+  // As the recorder runs them: a pipeline per camera, one link per device.
+  // The device's refusal of camera 5 (an ERR names no camera) failed
+  // camera 0 too, at each of camera 5's retries (a stranger's trial).
+  auto device = startDevice(ephemeral({.cameras = 2, .fragmentSize = 8000}));
+  auto port = std::to_string(device->port());
+  GstElement* present =
+      launch("wircsrc name=src host=127.0.0.1 camera=0 port=" + port + " ! fakesink");
+  gst_element_set_state(present, GST_STATE_PLAYING);
+  GstElement* src = gst_bin_get_by_name(GST_BIN(present), "src");
+  ASSERT_TRUE(waitFor([&] { return stat(src, "frames-complete") > 2; }));
+  for (int retry = 0; retry < 3; ++retry) {
+    auto error = firstErrorOf("wircsrc host=127.0.0.1 camera=5 port=" + port + " ! fakesink",
+                              milliseconds(5000));
+    EXPECT_NE(error.find("no camera 5"), std::string::npos) << error;
+  }
+  auto before = stat(src, "frames-complete");
+  EXPECT_TRUE(waitFor([&] { return stat(src, "frames-complete") > before + 5; }));
+  EXPECT_EQ(busMessage(present, milliseconds(0)), "");
+  EXPECT_EQ(device->stats().errSent, 0u);
+  gst_element_set_state(present, GST_STATE_NULL);
+  gst_object_unref(src);
+  gst_object_unref(present);
 }
 
 TEST(WircSrc, FollowsTheDeviceThroughARestart) {

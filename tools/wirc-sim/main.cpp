@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -195,6 +196,30 @@ std::string timestamp() {
   char text[32];
   std::strftime(text, sizeof text, "%H:%M:%S", std::localtime(&seconds));
   return std::string(text) + "." + std::to_string(1000 + ms).substr(1);
+}
+
+// The signal that ends the run (SIGINT, SIGTERM, SIGUSR1), or 0 at the end
+// of `duration`. A stop and continue (Ctrl-Z, then fg) interrupts the wait
+// (EINTR) without ending it: it ended the run once.
+int waitForStop(const sigset_t& signals, std::optional<double> duration) {
+  using Clock = std::chrono::steady_clock;
+  auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                std::chrono::duration<double>(duration.value_or(0)));
+  while (true) {
+    int caught;
+    if (duration) {
+      auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(end - Clock::now());
+      if (left.count() <= 0) return 0;
+      timespec wait{static_cast<time_t>(left.count() / 1000000000),
+                    static_cast<long>(left.count() % 1000000000)};
+      caught = sigtimedwait(&signals, nullptr, &wait);
+      if (caught < 0 && errno == EAGAIN) return 0;
+    } else {
+      caught = sigwaitinfo(&signals, nullptr);
+    }
+    if (caught > 0) return caught;
+    if (errno != EINTR) return 0;
+  }
 }
 
 }  // namespace
@@ -504,12 +529,7 @@ int main(int argc, char** argv) {
   }
   std::fflush(stdout);
 
-  timespec wait{};
-  if (duration) {
-    wait.tv_sec = static_cast<time_t>(*duration);
-    wait.tv_nsec = static_cast<long>((*duration - static_cast<double>(wait.tv_sec)) * 1e9);
-  }
-  int caught = duration ? sigtimedwait(&signals, nullptr, &wait) : sigwaitinfo(&signals, nullptr);
+  int caught = waitForStop(signals, duration);
   sim->stop();
   std::string dashboardSummary = positions ? positions->summary() : "";
   positions.reset();

@@ -137,7 +137,8 @@ LoginActions LoginMachine::loggedIn(const Wst& wst, Clock::time_point now) {
                                   std::to_string(wst.connectionId) + " (" +
                                   std::to_string(wst.cameraCount) +
                                   (wst.cameraCount == 1 ? " camera)" : " cameras)")}}};
-  for (auto [camera, port] : streamPorts_) actions.push_back(Send{Stst{camera, port}});
+  for (auto [camera, port] : streamPorts_)
+    if (hasCamera(camera)) actions.push_back(Send{Stst{camera, port}});
   return actions;
 }
 
@@ -175,6 +176,10 @@ LoginActions LoginMachine::controlRight(const Agr& agr) {
       status_.hasControl = agr.connectionId == status_.connectionId;
       break;
   }
+  // The right's change first: whoever reports the answer reads the right
+  // as it now is.
+  if (had != status_.hasControl || agr.notification == AccessNotification::Notification)
+    actions.push_back(Emit{link::ControlRightChanged{status_.hasControl, agr.name}});
   if (answersRequest) {
     bool denied = agr.notification == AccessNotification::Denied;
     actions.push_back(Emit{link::ControlRequestAnswered{
@@ -183,8 +188,6 @@ LoginActions LoginMachine::controlRight(const Agr& agr) {
                               "hand it over"
                         : ""}});
   }
-  if (had != status_.hasControl || agr.notification == AccessNotification::Notification)
-    actions.push_back(Emit{link::ControlRightChanged{status_.hasControl, agr.name}});
   if (!had && status_.hasControl) actions.push_back(StartCommands{});
   return actions;
 }
@@ -295,6 +298,7 @@ LoginActions LoginMachine::close() {
   LoginActions actions;
   if (connected())
     for (const auto& [camera, port] : streamPorts_) {
+      if (!hasCamera(camera)) continue;
       auto stop = send(Est{camera});
       actions.insert(actions.end(), stop.begin(), stop.end());
     }
@@ -306,13 +310,21 @@ LoginActions LoginMachine::close() {
 LoginActions LoginMachine::startStream(uint8_t camera, uint16_t port) {
   streamPorts_[camera] = port;
   // Not live yet: the login sends it.
-  if (phase_ != Phase::LoggedIn) return {};
+  if (phase_ != Phase::LoggedIn || !hasCamera(camera)) return {};
   return {Send{Stst{camera, port}}};
 }
 
 LoginActions LoginMachine::stopStream(uint8_t camera) {
   streamPorts_.erase(camera);
+  if (phase_ == Phase::LoggedIn && !hasCamera(camera)) return {};
   return send(Est{camera});
+}
+
+bool LoginMachine::hasCamera(uint8_t camera) const {
+  // Never asked for otherwise: the device's refusal (an ERR names the
+  // command, not the camera) would reach every camera of the link. The
+  // source says "no camera N" from the same count.
+  return camera < status_.cameraCount;
 }
 
 LoginActions LoginMachine::requestControl(uint8_t connectionId) {

@@ -105,6 +105,8 @@ class LoginMachine {
   LoginActions listTransmitters();
   // Any message, while connected; the device's ERR land in errors().
   LoginActions send(const Message& message);
+  // Whether the device has `camera` (of the count its WST gave).
+  bool hasCamera(uint8_t camera) const;
 
   // --- State ---
   std::optional<Clock::time_point> nextDeadline() const;

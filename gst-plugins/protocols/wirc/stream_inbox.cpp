@@ -91,13 +91,17 @@ StreamInbox::Wake StreamInbox::wait(Clock::time_point deadline) {
   ::poll(fds.data(), fds.size(), static_cast<int>(std::max<int64_t>(left, 0)));
   if (readable(fds[1])) return Wake::Interrupted;
   if (readable(fds[3])) return Wake::EndRequested;
-  if (readable(fds[0])) receiveBatch();
-  receiver_->expire(Clock::now(),
-                    [&](AssembledFrame&& frame) { ready_.push_back(std::move(frame)); });
+  // A login tells this inbox before it sends STST, and the device streams at
+  // once: the caller follows the device before its first datagrams are read
+  // (they wait in the socket), or they would come from a device not yet
+  // followed and be dropped as foreign.
   if (readable(fds[2])) {
     drain(linkChanged_);
     return Wake::LinkChanged;
   }
+  if (readable(fds[0])) receiveBatch();
+  receiver_->expire(Clock::now(),
+                    [&](AssembledFrame&& frame) { ready_.push_back(std::move(frame)); });
   return ready_.empty() ? Wake::Deadline : Wake::Frame;
 }
 

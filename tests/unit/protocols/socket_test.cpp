@@ -56,3 +56,18 @@ TEST(Sockets, ManyEphemeralUdpBindsGetDistinctPorts) {
 
 }  // namespace
 }  // namespace wircam
+
+namespace wircam {
+namespace {
+
+TEST(Sockets, AnIpv6AddressIsSaidToBeOneNotUnresolvable) {
+  // wirc://[::1]:PORT failed as "cannot resolve '::1'" (a stranger's trial).
+  auto six = SocketAddress::resolve("::1", 1984);
+  ASSERT_FALSE(six);
+  EXPECT_NE(six.error().find("IPv6"), std::string::npos) << six.error();
+  ASSERT_TRUE(SocketAddress::resolve("127.0.0.1", 1984));
+  ASSERT_TRUE(SocketAddress::resolve("localhost", 1984));
+}
+
+}  // namespace
+}  // namespace wircam

@@ -261,6 +261,25 @@ TEST_F(LoginMachineTest, TheControlRightItsRequestsAndTheirAnswers) {
   EXPECT_FALSE(machine_.status().hasControl);
 }
 
+TEST_F(LoginMachineTest, AGrantedRequestSaysTheRightChangedBeforeItAnswers) {
+  // wirccontrol posts the answer with the right it holds then: answered
+  // first, a granted request read "has-control=false, request=granted" (a
+  // stranger's trial).
+  loginAt(milliseconds(0));
+  machine_.requestControl(3);
+  auto granted = machine_.onMessage(
+      Agr{.connectionId = 3, .name = "tester", .notification = AccessNotification::Granted}, now_);
+  int changedAt = -1, answeredAt = -1;
+  for (int i = 0; i < static_cast<int>(granted.size()); ++i)
+    if (const auto* emit = std::get_if<login::Emit>(&granted[i])) {
+      if (std::holds_alternative<link::ControlRightChanged>(emit->event)) changedAt = i;
+      if (std::holds_alternative<link::ControlRequestAnswered>(emit->event)) answeredAt = i;
+    }
+  ASSERT_GE(changedAt, 0);
+  ASSERT_GE(answeredAt, 0);
+  EXPECT_LT(changedAt, answeredAt);
+}
+
 TEST_F(LoginMachineTest, MalformedInputIsSummedUpOnceASecondAndPastTheLimitDropsTheDevice) {
   loginAt(milliseconds(0));
   StreamParserStats stats;
@@ -319,6 +338,27 @@ TEST_F(LoginMachineTest, ADiscoveryThatFindsNothingFailsAtTheEndOfItsWindow) {
   ASSERT_NE(findEvent<link::StateChanged>(failed), nullptr);
   EXPECT_EQ(find<login::Connect>(failed), nullptr);
   EXPECT_EQ(*machine.nextDeadline(), start_ + milliseconds(1200));
+}
+
+TEST_F(LoginMachineTest, ACameraTheDeviceLacksIsNeverAskedForSoItsRefusalBlamesNoOther) {
+  // An ERR says which command failed, not which camera: a refused STST for
+  // camera 5 of a two-camera device reached every camera of the link, and
+  // camera 0 restarted at each of camera 5's retries (a stranger's trial).
+  // The device said at login how many cameras it has (WST).
+  machine_.startStream(0, 6000);
+  machine_.startStream(5, 6005);
+  auto live = loginAt(milliseconds(0));
+  int asked = 0;
+  for (const auto& action : live)
+    if (const auto* send = std::get_if<login::Send>(&action))
+      if (const auto* stst = std::get_if<Stst>(&send->message)) {
+        EXPECT_EQ(stst->camera, 0);
+        ++asked;
+      }
+  EXPECT_EQ(asked, 1);
+  EXPECT_TRUE(machine_.startStream(7, 6007).empty());
+  EXPECT_TRUE(machine_.stopStream(7).empty());
+  ASSERT_NE(findSent<Stst>(machine_.startStream(1, 6001)), nullptr);
 }
 
 TEST_F(LoginMachineTest, LoggingOutStopsTheStreamsAndClosesForGood) {

@@ -66,5 +66,27 @@ TEST(StreamInbox, ASocketsFramesCarryTheKernelsArrivalTime) {
   EXPECT_LE(frame->firstPacketTime, read);
 }
 
+TEST(StreamInbox, TheLoginIsHeardBeforeTheFirstFrameItBrought) {
+  // The device streams the moment STST arrives, which the login sends right
+  // after telling the inbox the link changed. Both are waiting when the
+  // streaming thread wakes: the link first, so that the caller follows the
+  // device before its datagrams are read. (Read first, the first frame came
+  // from a device not yet followed: dropped as foreign. Replay.* saw it on
+  // a loaded machine: the recording lacked its first frame.)
+  StreamInbox inbox;
+  ASSERT_EQ(inbox.open(0, {}), std::nullopt);
+  auto device = bindUdp(SocketAddress::loopback(0));
+  ASSERT_TRUE(device);
+  inbox.linkChanged();
+  std::vector<uint8_t> jpeg = {0xFF, 0xD8, 0xFF, 0xD9};
+  ASSERT_TRUE(sendDatagram(device->get(), SocketAddress::loopback(inbox.port()),
+                           packetizeFrame(jpeg, 1, 1400).front()));
+  ASSERT_EQ(inbox.wait(Clock::now() + milliseconds(1000)), StreamInbox::Wake::LinkChanged);
+  inbox.receiver().follow(SocketAddress::loopback(1984), 1);
+  ASSERT_EQ(inbox.wait(Clock::now() + milliseconds(1000)), StreamInbox::Wake::Frame);
+  EXPECT_TRUE(inbox.takeFrame());
+  EXPECT_EQ(inbox.receiver().stats().packetsForeign, 0u);
+}
+
 }  // namespace
 }  // namespace wircam::wirc
