@@ -225,6 +225,13 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
     state->active = state->settings;
   }
   const Settings& settings = state->active;
+  // Waiting for a device is trying again: without reconnect the first
+  // refused connection ended it, said only as "Could not log in".
+  if (settings.waitForDevice && !settings.reconnect) {
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("wait-for-device=true needs reconnect=true"),
+                      ("waiting for a device is logging in again until it answers"));
+    return FALSE;
+  }
 
   auto session = wirc::TransmitterSession::acquire(sessionConfig(settings), GST_OBJECT_NAME(self));
   if (!session) {
@@ -319,12 +326,17 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
                       ("%s", status.reason.c_str()));
     return GST_FLOW_ERROR;
   }
+  // What to check: the address given, or (discovering) the device's name
+  // and the discovery address.
+  const char* check = settings.host.empty()
+                          ? "Check the device is on and on this network (device=, "
+                            "discovery-address=), or give its host="
+                          : "Check host/port, or leave host empty to discover the device";
   if (status.state == link::LinkState::Failed) {
     if (status.logins == 0)
       GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
                         ("Could not log in to the WiRC device %s", where),
-                        ("%s. Check host/port, or leave host empty to discover the device.",
-                         status.reason.c_str()));
+                        ("%s. %s.", status.reason.c_str(), check));
     else
       GST_ELEMENT_ERROR(self, RESOURCE, READ, ("Lost the WiRC device %s", where),
                         ("%s (reconnect=false)", status.reason.c_str()));
@@ -334,10 +346,8 @@ static GstFlowReturn follow_link(GstWircSrc* self) {
     if (status.logins == 0 && !settings.waitForDevice && Clock::now() >= state->loginDeadline) {
       GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ,
                         ("Could not log in to the WiRC device %s", where),
-                        ("no login within %u ms%s%s. Check host/port, or leave host empty to "
-                         "discover the device.",
-                         settings.loginTimeoutMs + 500, status.reason.empty() ? "" : ": ",
-                         status.reason.c_str()));
+                        ("no login within %u ms (login-timeout)%s%s. %s.", settings.loginTimeoutMs,
+                         status.reason.empty() ? "" : ": ", status.reason.c_str(), check));
       return GST_FLOW_ERROR;
     }
     return GST_FLOW_OK;

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "common/printable_text.h"
 #include "export/segment_reader.h"
 #include "record/recording_index.h"
 #include "record/segment_inspector.h"
@@ -27,20 +28,25 @@ std::optional<int64_t> parseIsoTime(const std::string& text) {
                   &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &consumed) != 6 ||
       consumed != 19)
     return std::nullopt;
-  if (tm.tm_mon < 1 || tm.tm_mon > 12 || tm.tm_mday < 1 || tm.tm_mday > 31 || tm.tm_hour > 23 ||
-      tm.tm_min > 59 || tm.tm_sec > 60)
+  // A day the month has (February 30 was taken as March 2).
+  static constexpr int kDays[] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  bool leap = tm.tm_year % 4 == 0 && (tm.tm_year % 100 != 0 || tm.tm_year % 400 == 0);
+  if (tm.tm_mon < 1 || tm.tm_mon > 12 || tm.tm_mday < 1 || tm.tm_mday > kDays[tm.tm_mon - 1] ||
+      (tm.tm_mon == 2 && tm.tm_mday == 29 && !leap) || tm.tm_hour > 23 || tm.tm_min > 59 ||
+      tm.tm_sec > 60)
     return std::nullopt;
   std::string rest = text.substr(19);
   int64_t fraction = 0;
   if (!rest.empty() && rest[0] == '.') {
     size_t digits = 1;
     int64_t scale = 100000000;
+    // Any number of digits (ISO 8601 sets no limit); past nanoseconds cut.
     while (digits < rest.size() && std::isdigit(static_cast<unsigned char>(rest[digits]))) {
       fraction += (rest[digits] - '0') * scale;
       scale /= 10;
       ++digits;
     }
-    if (digits == 1 || digits > 10) return std::nullopt;
+    if (digits == 1) return std::nullopt;
     rest = rest.substr(digits);
   }
   tm.tm_year -= 1900;
@@ -154,17 +160,21 @@ Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
     selection.notes.push_back(filename + " is not in " + std::string(RecordingIndex::kFileName) +
                               ": read back and exported");
   }
+  // The name as asked for, which may be anything (a query's 50 KB went
+  // whole into the answer and the log): its start, printable.
+  std::string asked =
+      printableText(std::string_view(camera).substr(0, 80)) + (camera.size() > 80 ? "…" : "");
   if (!cameras.count(camera) && !beingWritten.empty())
-    return unexpected("camera " + camera + " has no finished segment yet: " + beingWritten +
+    return unexpected("camera " + asked + " has no finished segment yet: " + beingWritten +
                       " is still being written");
   if (!cameras.count(camera)) {
     std::string known;
     for (const auto& name : cameras) known += (known.empty() ? "" : ", ") + name;
-    return unexpected("no camera " + camera + " in " + folder.string() +
+    return unexpected("no camera " + asked + " in " + folder.string() +
                       (known.empty() ? " (no finished segments)" : " (there are: " + known + ")"));
   }
   if (selection.segments.empty())
-    return unexpected("camera " + camera + " has no frame in that range");
+    return unexpected("camera " + asked + " has no frame in that range");
   std::sort(selection.segments.begin(), selection.segments.end(),
             [](const auto& a, const auto& b) { return a.startNs < b.startNs; });
   return selection;

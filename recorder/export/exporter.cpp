@@ -1,6 +1,7 @@
 #include "export/exporter.h"
 
 #include <algorithm>
+#include <cstring>
 #include <fstream>
 #include <memory>
 
@@ -224,7 +225,10 @@ Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
   else
     sink = std::make_unique<MuxedExport>(writing.string(), exportFormatName(request.format));
   std::ofstream jsonl(writingJsonl);
-  if (!jsonl) return unexpected(ExportError{Kind::kFailed, "cannot write " + jsonlPath.string()});
+  if (!jsonl)  // the first file opened: most often --out's folder is missing or read-only
+    return unexpected(ExportError{Kind::kFailed, "cannot write " + request.out.string() + " (nor " +
+                                                     jsonlPath.filename().string() +
+                                                     " beside it): " + std::strerror(errno)});
 
   Timeline timeline(*sink, jsonl, request);
   uint64_t total = 0, done = 0;

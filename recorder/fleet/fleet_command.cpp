@@ -25,8 +25,10 @@ Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
   if (command == "target/set") {
     char* end = nullptr;
     long id = std::strtol(payload.c_str(), &end, 10);
-    if (payload.empty() || *end != '\0' || id < -1 || id > 1000000)
-      return unexpected("target/set takes a tag id (or -1: the largest), not '" +
+    // wirccontrol's target-id: what it cannot take must not be answered
+    // as taken.
+    if (payload.empty() || *end != '\0' || id < -1 || id > 65535)
+      return unexpected("a target is a tag id 0..65535 (or -1: the largest), not '" +
                         printableText(payload.substr(0, 40)) + "'");
     parsed.kind = FleetCommand::Kind::kTarget;
     parsed.target = static_cast<int>(id);

@@ -176,7 +176,10 @@ void HttpServer::servePlayback(SoupServerMessage* message, const std::string& na
   };
   auto playback = PlaybackStream::start(file.string(), from, std::move(callbacks));
   if (!playback)
-    return respondJsonError(message, SOUP_STATUS_UNSUPPORTED_MEDIA_TYPE, playback.error());
+    return respondJsonError(
+        message,
+        playback.error().pastTheEnd ? SOUP_STATUS_BAD_REQUEST : SOUP_STATUS_UNSUPPORTED_MEDIA_TYPE,
+        playback.error().text);
   std::string type = std::string("multipart/x-mixed-replace; boundary=") + kBoundary;
   openStream(message, type.c_str(), playbackClients_);
   playbackClients_.back()->playback = std::move(*playback);

@@ -93,8 +93,13 @@ bool carriesToken(const char* authorization, const char* cookie, std::string_vie
   if (token.empty()) return true;
   constexpr std::string_view kBearer = "Bearer ", kBasic = "Basic ";
   std::string_view given = authorization ? authorization : "";
-  if (given.starts_with(kBearer) && sameSecret(given.substr(kBearer.size()), token)) return true;
-  if (given.starts_with(kBasic) && basicCarries(given.substr(kBasic.size()), token)) return true;
+  // A scheme's name is case-insensitive (RFC 9110 11.1).
+  auto scheme = [&](std::string_view name) {
+    return given.size() >= name.size() &&
+           g_ascii_strncasecmp(given.data(), name.data(), name.size()) == 0;
+  };
+  if (scheme(kBearer) && sameSecret(given.substr(kBearer.size()), token)) return true;
+  if (scheme(kBasic) && basicCarries(given.substr(kBasic.size()), token)) return true;
   if (!cookie) return false;
   // "a=1; wircam_token=T; b=2"
   std::string_view cookies = cookie;

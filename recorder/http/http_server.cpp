@@ -26,6 +26,9 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
     const ServerAddress& address, Content content, std::chrono::milliseconds idleTimeout) {
   std::unique_ptr<HttpServer> self(new HttpServer(std::move(content)));
   self->server_ = soup_server_new("server-header", "wirc-recorder", nullptr);
+  // Drive messages are a few dozen bytes. Deflated, a megabyte of them
+  // passed the 4 KB bound on the wire (DriveSocket) and was inflated whole.
+  soup_server_remove_websocket_extension(self->server_, SOUP_TYPE_WEBSOCKET_EXTENSION_DEFLATE);
   auto connections =
       HttpConnections::listen(self->server_, address,
                               {.maxOpen = kMaxConnections,

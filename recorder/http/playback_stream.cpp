@@ -6,7 +6,7 @@ namespace wircam::recorder {
 
 PlaybackStream::PlaybackStream(Callbacks callbacks) : callbacks_(std::move(callbacks)) {}
 
-Expected<std::unique_ptr<PlaybackStream>, std::string> PlaybackStream::start(
+Expected<std::unique_ptr<PlaybackStream>, PlaybackStream::Refusal> PlaybackStream::start(
     const std::string& path, double fromSeconds, Callbacks callbacks) {
   std::unique_ptr<PlaybackStream> self(new PlaybackStream(std::move(callbacks)));
   GError* error = nullptr;
@@ -19,7 +19,7 @@ Expected<std::unique_ptr<PlaybackStream>, std::string> PlaybackStream::start(
   if (!self->pipeline_) {
     std::string text = error ? error->message : "cannot build the replay pipeline";
     g_clear_error(&error);
-    return unexpected(text);
+    return unexpected(Refusal{false, text});
   }
   GstElement* file = gst_bin_get_by_name(GST_BIN(self->pipeline_), "file");
   g_object_set(file, "location", path.c_str(), nullptr);
@@ -35,14 +35,28 @@ Expected<std::unique_ptr<PlaybackStream>, std::string> PlaybackStream::start(
   if (gst_element_set_state(self->pipeline_, GST_STATE_PAUSED) == GST_STATE_CHANGE_FAILURE ||
       gst_element_get_state(self->pipeline_, nullptr, nullptr, 5 * GST_SECOND) !=
           GST_STATE_CHANGE_SUCCESS)
-    return unexpected("cannot read '" + path + "' as a Matroska file of JPEG frames");
+    return unexpected(
+        Refusal{false, "cannot read '" + path + "' as a Matroska file of JPEG frames"});
+  // Past the end there is no frame to start at (and a position of 1e308 s
+  // has no nanoseconds to seek to). A file still being written has no
+  // duration yet: its seek finds what there is.
+  gint64 duration = -1;
+  bool known =
+      gst_element_query_duration(self->pipeline_, GST_FORMAT_TIME, &duration) && duration > 0;
+  double end = known ? static_cast<double>(duration) / GST_SECOND : 1e7;
+  if (fromSeconds >= end) {
+    char text[96];
+    g_snprintf(text, sizeof text, "from=%.3g s is past the recording's end (%.1f s)", fromSeconds,
+               end);
+    return unexpected(Refusal{true, known ? text : "from= is past any recording's length"});
+  }
   if (fromSeconds > 0 &&
       !gst_element_seek_simple(
           self->pipeline_, GST_FORMAT_TIME,
           // Accurate: from the frame at the offset, not the index point before it.
           static_cast<GstSeekFlags>(GST_SEEK_FLAG_FLUSH | GST_SEEK_FLAG_ACCURATE),
           static_cast<gint64>(std::llround(fromSeconds * GST_SECOND))))
-    return unexpected("cannot seek to " + std::to_string(fromSeconds) + " s");
+    return unexpected(Refusal{false, "cannot seek to " + std::to_string(fromSeconds) + " s"});
   gst_element_set_state(self->pipeline_, GST_STATE_PLAYING);
   return self;
 }

@@ -23,11 +23,16 @@ class PlaybackStream {
     // The segment ended, or could not be read (`error` says why).
     std::function<void(const std::string& error)> ended;
   };
-  // Starts at the frame at `fromSeconds`. Fails when the
-  // file holds no JPEG video.
-  static Expected<std::unique_ptr<PlaybackStream>, std::string> start(const std::string& path,
-                                                                      double fromSeconds,
-                                                                      Callbacks callbacks);
+  // Why a replay cannot start: the file holds no JPEG video (or cannot be
+  // read), or `fromSeconds` is at or past its end.
+  struct Refusal {
+    bool pastTheEnd = false;
+    std::string text;
+  };
+  // Starts at the frame at `fromSeconds`.
+  static Expected<std::unique_ptr<PlaybackStream>, Refusal> start(const std::string& path,
+                                                                  double fromSeconds,
+                                                                  Callbacks callbacks);
   ~PlaybackStream();
   PlaybackStream(const PlaybackStream&) = delete;
   PlaybackStream& operator=(const PlaybackStream&) = delete;

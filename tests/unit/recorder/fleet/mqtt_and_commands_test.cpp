@@ -45,8 +45,13 @@ TEST(FleetCommand, TakesOnOffAndTagIdsAndNamesWhatItRefuses) {
   EXPECT_EQ(parseFleetCommand("s", "target/set", "42")->target, 42);
   EXPECT_EQ(parseFleetCommand("s", "follow/set", "MAYBE").error(),
             "follow/set takes ON or OFF, not 'MAYBE'");
-  for (const char* bad : {"", "-2", "7x", "1e3", "99999999999"})
+  EXPECT_EQ(parseFleetCommand("s", "target/set", "65535")->target, 65535);
+  // Past wirccontrol's target-id (65535) a command was taken, answered 200
+  // and never obeyed (a stranger's trial): refused.
+  for (const char* bad : {"", "-2", "7x", "1e3", "65536", "70000", "99999999999"})
     EXPECT_FALSE(parseFleetCommand("s", "target/set", bad)) << bad;
+  EXPECT_EQ(parseFleetCommand("s", "target/set", "70000").error(),
+            "a target is a tag id 0..65535 (or -1: the largest), not '70000'");
   EXPECT_FALSE(parseFleetCommand("s", "speed/set", "3"));
 }
 

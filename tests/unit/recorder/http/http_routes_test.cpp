@@ -48,6 +48,10 @@ TEST(HttpRoutes, TheTokenComesAsBearerOrCookie) {
   EXPECT_FALSE(carriesToken("Basic dTowMTIzNDU2Nzg5YWJjZGU=", nullptr, token));  // one short
   EXPECT_FALSE(carriesToken("Basic MDEyMzQ1Njc4OWFiY2RlZg==", nullptr, token));  // no colon
   EXPECT_FALSE(carriesToken("Basic !!!", nullptr, token));
+  // The scheme's name in any case (RFC 9110 11.1); lowercase was refused.
+  EXPECT_TRUE(carriesToken("bearer 0123456789abcdef", nullptr, token));
+  EXPECT_TRUE(carriesToken("BASIC dTowMTIzNDU2Nzg5YWJjZGVm", nullptr, token));
+  EXPECT_FALSE(carriesToken("bearer0123456789abcdef", nullptr, token));
   EXPECT_TRUE(carriesToken(nullptr, "a=1; wircam_token=0123456789abcdef; b=2", token));
   EXPECT_TRUE(carriesToken(nullptr, "wircam_token=0123456789abcdef", token));
   EXPECT_FALSE(carriesToken(nullptr, "xwircam_token=0123456789abcdef", token));
