@@ -57,6 +57,8 @@ class DevToolsPage {
  private:
   DevToolsPage() = default;
   bool attach(const std::string& webSocketUrl);
+  // Keeps the page focused whatever its window does (key events).
+  bool keepsFocus();
   // Loads a first page with its own start-up budget (DevToolsPage::launch).
   bool warmUp();
 

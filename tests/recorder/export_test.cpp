@@ -226,6 +226,21 @@ TEST_F(Export, SaysWhyWhenThereIsNothingToExport) {
   EXPECT_EQ(unknown.exitCode, 1);
   EXPECT_NE(unknown.output.find("no camera nosuch-cam0"), std::string::npos) << unknown.output;
   EXPECT_NE(unknown.output.find(*camera_), std::string::npos) << unknown.output;  // those there are
+  // A name of any length is said by its start (50 KB went whole into an
+  // answer and the recorder's log, a stranger's trial).
+  auto longName = runCommand(exportCommand(recorder_->out(), std::string(5000, 'c'),
+                                           "--format mkv --out '" + out.string() + "'"));
+  EXPECT_EQ(longName.exitCode, 1);
+  EXPECT_NE(longName.output.find("no camera " + std::string(80, 'c') + "…"), std::string::npos)
+      << longName.output.substr(0, 300);
+  EXPECT_LT(longName.output.size(), 1000u);
+  // A folder that is not there: the file asked for is named (it was the
+  // sidecar's name, the first file opened).
+  auto nowhere = runCommand(
+      exportCommand(recorder_->out(), *camera_, "--format mkv --out /nonexistent/dir/x.mkv"));
+  EXPECT_EQ(nowhere.exitCode, 1);
+  EXPECT_NE(nowhere.output.find("cannot write /nonexistent/dir/x.mkv"), std::string::npos)
+      << nowhere.output;
   auto before = runCommand(
       exportCommand(recorder_->out(), *camera_,
                     "--end 2001-01-01T00:00:00Z --format mkv --out '" + out.string() + "'"));

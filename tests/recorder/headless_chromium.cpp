@@ -2,6 +2,7 @@
 
 #include <gst/app/gstappsink.h>
 #include <gst/video/video.h>
+#include <unistd.h>
 
 #include <cstdlib>
 
@@ -10,6 +11,10 @@
 namespace wircam::testing {
 
 bool chromiumInstalled() { return std::system("command -v chromium > /dev/null") == 0; }
+
+std::filesystem::path processProfile(const std::filesystem::path& base) {
+  return base.string() + "-" + std::to_string(getpid());
+}
 
 std::vector<std::string> chromiumFlags(const std::filesystem::path& profile, int width,
                                        int height) {
@@ -28,7 +33,7 @@ std::vector<std::string> chromiumFlags(const std::filesystem::path& profile, int
 
 bool screenshot(const std::string& url, const std::filesystem::path& shot, int width, int height,
                 int budgetMs) {
-  auto profile = shot.parent_path() / (shot.stem().string() + "-chromium-profile");
+  auto profile = processProfile(shot.parent_path() / (shot.stem().string() + "-chromium-profile"));
   std::string command = "timeout 60 chromium";
   for (const auto& flag : chromiumFlags(profile, width, height)) command += " " + flag;
   command += (budgetMs > 0 ? " --virtual-time-budget=" + std::to_string(budgetMs) : "") +

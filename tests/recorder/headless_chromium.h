@@ -11,6 +11,11 @@ namespace wircam::testing {
 
 bool chromiumInstalled();
 
+// `base` made this process's own: a second Chromium on a profile in use
+// hands its URL to the first and exits, so two runs of one test at once
+// would fail each other.
+std::filesystem::path processProfile(const std::filesystem::path& base);
+
 // The flags every test run of chromium gets: headless, a fresh profile
 // in `profile`, nothing fetched from the network, the window's size.
 std::vector<std::string> chromiumFlags(const std::filesystem::path& profile, int width, int height);

@@ -4,6 +4,7 @@
 // that are idle, half-open or many from one address, which never starve it.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <libsoup/soup.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -13,10 +14,13 @@
 #include <thread>
 
 #include "common/socket.h"
+#include "main_loop_until.h"
 #include "process_memory.h"
 #include "recorder_process.h"
+#include "signed_in_page.h"
 #include "simulated_device.h"
 #include "wait_for.h"
+#include "websocket_test_client.h"
 
 namespace {
 
@@ -221,6 +225,37 @@ TEST(WircRecorderHttpLimits, ASymbolicLinkInTheRecordingsFolderIsNeitherListedNo
   ssize_t n;
   while ((n = ::recv(fd->get(), chunk, sizeof chunk, 0)) > 0) listing.append(chunk, n);
   EXPECT_EQ(listing.find("passwd"), std::string::npos) << listing;
+}
+
+TEST(WircRecorderHttpLimits, ALongDriveMessageIsRefusedWithNeutralAndAHugeOneClosesItsSocket) {
+  FollowedCar car;
+  ASSERT_TRUE(car.device);
+  RecorderProcess recorder(car.device->port(), {"--detect", "tag36h11", "--follow", "--http",
+                                                "127.0.0.1:0", "--http-token", kToken});
+  auto url = recorder.waitForLog("http://", milliseconds(10000));
+  ASSERT_TRUE(url) << recorder.log();
+  ASSERT_TRUE(recorder.waitForText(": live", milliseconds(10000))) << recorder.log();
+  // libsoup's own client, which offers permessage-deflate as browsers do.
+  WebSocketTestClient client(
+      "ws://" + url->substr(7) + "api/cameras/127.0.0.1-" + std::to_string(car.device->port()) +
+          "-cam0/drive",
+      {.headers = {{"Authorization", std::string("Bearer ") + kToken}}, .offerDeflate = true});
+  ASSERT_TRUE(runMainLoopUntil([&] { return client.connection || client.failed; }));
+  ASSERT_TRUE(client.open()) << recorder.log();
+  // Over 256 bytes: no command, the vehicle to neutral, the socket open.
+  std::string padded = R"({"steering": 0, "throttle": 0, "pad": ")" + std::string(300, ' ') + "\"}";
+  soup_websocket_connection_send_text(client.connection, padded.c_str());
+  ASSERT_TRUE(runMainLoopUntil([&] { return !client.texts.empty(); }));
+  EXPECT_EQ(client.texts[0], R"({"error":"longer than 256 bytes","neutral":true})");
+  EXPECT_TRUE(client.open());
+  // Over 4 KB closes the socket, however well it compresses: a megabyte of
+  // spaces deflated fits in a few hundred bytes, and was read whole. (Its
+  // close code may not reach the client: the server closes with most of
+  // the megabyte unread, and TCP resets the connection.)
+  std::string huge = R"({"pad": ")" + std::string(1 << 20, ' ') + "\"}";
+  soup_websocket_connection_send_text(client.connection, huge.c_str());
+  EXPECT_TRUE(runMainLoopUntil([&] { return !client.open(); }))
+      << client.texts.size() << " answers, the last " << client.texts.back();
 }
 
 }  // namespace

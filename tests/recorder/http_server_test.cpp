@@ -144,6 +144,15 @@ TEST(WircRecorderHttp, ListsAndServesTheRecordings) {
   auto at = played.find("X-Position: ");
   ASSERT_NE(at, std::string::npos) << played.substr(0, 200);
   EXPECT_GE(std::stod(played.substr(at + 12)), 0.499) << played.substr(at, 30);
+  // From past its end: no replay, and the reason (it was an empty 200, or a
+  // 415 "the file cannot be read" with a 309-digit number, a stranger's trial).
+  for (const char* from : {"99999", "1e308"}) {
+    auto past =
+        fetch(live.url + "play/" + (*finished)["name"].get<std::string>() + ".mjpg?from=" + from);
+    EXPECT_EQ(past.status, 400u) << from << " " << past.body;
+    EXPECT_NE(past.body.find("past the recording's end"), std::string::npos) << past.body;
+    EXPECT_LT(past.body.size(), 120u) << past.body;
+  }
   // Nothing outside the recordings folder, nothing but recordings: refused
   // by libsoup (400) or by the server (404).
   for (const char* path : {"recordings/..%2Fstderr.log", "recordings/%2Fetc%2Fpasswd",

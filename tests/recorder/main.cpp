@@ -2,8 +2,12 @@
 #include <gtest/gtest.h>
 
 int main(int argc, char** argv) {
-  // The recorder finds the plugins itself; these tests only read files
-  // back, with system plugins, through a registry of their own.
+  // These tests read files back with system plugins, through a registry of
+  // their own, which the recorders they start share. A recorder adds the
+  // build's plugins to the path; so does this process: with two plugin
+  // sets, each recorder added them to the registry and each test's start
+  // took them out again, a scan and a rewrite each time.
+  g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, TRUE);
   g_setenv("GST_REGISTRY", WIRCAM_TEST_REGISTRY, TRUE);
   gst_init(&argc, &argv);
   ::testing::InitGoogleTest(&argc, argv);

@@ -47,20 +47,38 @@ RecorderProcess::RecorderProcess(uint16_t port, std::vector<std::string> extra,
   }
 }
 
+namespace {
+
+// Where each thread of a running process stands, by gdb (when installed):
+// a test that failed on a recorder that stopped answering shows why.
+std::string threadsOf(pid_t pid) {
+  if (runCommand("command -v gdb").exitCode != 0) return "(gdb is not installed)\n";
+  return commandOutput("timeout 60 gdb -p " + std::to_string(pid) +
+                       " -batch -nx -ex 'thread apply all bt 12' 2>/dev/null | grep -E "
+                       "'^(Thread|#)'");
+}
+
+std::string tail(std::string text, size_t size) {
+  return text.size() > size ? "...\n" + text.substr(text.size() - size) : text;
+}
+
+}  // namespace
+
 RecorderProcess::~RecorderProcess() {
+  // The folder goes away with the test: a failing test shows why the
+  // recorder did what it did (its threads, its errors, a sanitizer's
+  // report) first.
+  bool failed = ::testing::Test::HasFailure();
   if (!exited_) {
+    if (failed)
+      std::fprintf(stderr, "--- wirc-recorder's threads ---\n%s--- end of its threads ---\n",
+                   tail(threadsOf(pid_), 64 * 1024).c_str());
     kill(pid_, SIGKILL);
     wait();
   }
-  // The folder goes away with the test: a failing test shows why the
-  // recorder did what it did (its errors, a sanitizer's report) first.
-  if (::testing::Test::HasFailure()) {
-    std::string text = log();
-    constexpr size_t kTail = 64 * 1024;
-    if (text.size() > kTail) text = "...\n" + text.substr(text.size() - kTail);
+  if (failed)
     std::fprintf(stderr, "--- wirc-recorder's log (%s) ---\n%s--- end of its log ---\n",
-                 folder_.c_str(), text.c_str());
-  }
+                 folder_.c_str(), tail(log(), 64 * 1024).c_str());
   fs::remove_all(folder_);
 }
 

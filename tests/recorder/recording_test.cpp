@@ -285,12 +285,16 @@ TEST(WircRecorder, RejectsABadConfigFileNamingTheProblem) {
 }
 
 // A device that never comes is waited for; a --duration that ends with
-// nothing recorded is a failure, said as such.
+// nothing recorded is a failure, said as such: whatever earlier runs left
+// in the folder (with a service's folder of recordings it exited 0 and
+// said nothing, a stranger's trial).
 TEST(WircRecorder, ADurationWithoutTheDeviceRecordsNothingAndExitsOne) {
   auto device = startSequenceDevice();
   uint16_t port = device->port();
+  RecorderProcess earlier(port, {"--duration", "1"});
+  ASSERT_EQ(earlier.wait(), 0) << earlier.log();
   device.reset();
-  RecorderProcess recorder(port, {"--duration", "3"});
+  RecorderProcess recorder(port, {"--duration", "2", "--out", earlier.out().string()});
   EXPECT_EQ(recorder.wait(), 1);
   EXPECT_NE(recorder.statusLines().find("waiting for device"), std::string::npos);
   EXPECT_NE(recorder.log().find("nothing was recorded"), std::string::npos) << recorder.log();

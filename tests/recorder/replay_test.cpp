@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <future>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -117,9 +118,17 @@ class Replay : public ::testing::Test {
     original_ = new RecorderProcess(car_->device->port(), {"--detect", "tag36h11", "--follow",
                                                            "--segment", "60", "--duration", "5"});
     ASSERT_EQ(original_->wait(), 0) << original_->log();
+    // The two replays at once: each has its own device and recorder.
+    auto halved = std::async(std::launch::async, [] {
+      return replay(segmentOf(*original_),
+                    {"--follow-tuning", "steering-kp=1.25,steering-ki=0.3,steering-kd=0.05"},
+                    "halved");
+    });
     same_ = new ReplayRun(replay(segmentOf(*original_), {}, "same"));
+    halved_ = new ReplayRun(halved.get());
   }
   static void TearDownTestSuite() {
+    delete halved_;
     delete same_;
     delete original_;
     delete car_;
@@ -127,10 +136,12 @@ class Replay : public ::testing::Test {
   static FollowedCar* car_;
   static RecorderProcess* original_;
   static ReplayRun* same_;
+  static ReplayRun* halved_;  // --follow-tuning with half the steering gains
 };
 FollowedCar* Replay::car_ = nullptr;
 RecorderProcess* Replay::original_ = nullptr;
 ReplayRun* Replay::same_ = nullptr;
+ReplayRun* Replay::halved_ = nullptr;
 
 TEST_F(Replay, EveryFrameArrivesByteForByteAtItsRecordedInterval) {
   ASSERT_TRUE(same_->recorder);
@@ -188,11 +199,8 @@ TEST_F(Replay, TheSameFollowerCommandsTheSameDirectionAndSaysSo) {
 }
 
 TEST_F(Replay, AHalvedSteeringGainSteersLess) {
-  auto halved =
-      replay(segmentOf(*original_),
-             {"--follow-tuning", "steering-kp=1.25,steering-ki=0.3,steering-kd=0.05"}, "halved");
-  ASSERT_TRUE(halved.recorder);
-  auto result = compare(sidecarOf(*original_), halved.commands);
+  ASSERT_TRUE(halved_->recorder);
+  auto result = compare(sidecarOf(*original_), halved_->commands);
   ASSERT_TRUE(result.is_object());
   double recorded = result["steering_from_neutral_us"]["recorded"];
   double replayed = result["steering_from_neutral_us"]["replayed"];

@@ -62,7 +62,9 @@ struct SignedInPage {
                bool withToken = true);
   // The centre of the first element `selector` names, in page pixels.
   std::pair<double, double> centreOf(const std::string& selector);
-  void clickOn(const std::string& selector);
+  // Clicks it as a user would; whether the click reached it (made again
+  // if the page moved it meanwhile).
+  bool clickOn(const std::string& selector);
 };
 
 }  // namespace wircam::testing

@@ -161,7 +161,7 @@ TEST(WebRtcView, DriveModeGoesOverTheDataChannelAndAPageThatHangsOrGoesAwayStops
                      "Object.values(views)[0].webrtc.drive.readyState === 'open'",
                      milliseconds(30000)))
       << signedIn.recorder.log();
-  signedIn.clickOn("button.drive");
+  ASSERT_TRUE(signedIn.clickOn("button.drive"));
   ASSERT_TRUE(
       page.waitUntil("document.querySelector('.drive-info').textContent.startsWith('round trip')"))
       << page.evaluate("document.querySelector('.drive-info').textContent");

@@ -3,16 +3,12 @@
 // timers) until the test's condition holds.
 #pragma once
 
-#include <glib.h>
-
-#include <chrono>
-#include <functional>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "camera/camera.h"
+#include "main_loop_until.h"
 
 namespace wircam::testing {
 
@@ -28,16 +24,5 @@ struct CameraEvents : recorder::CameraObserver {
   void diskFull(recorder::Camera&) override {}
   void ended(recorder::Camera&) override { over = true; }
 };
-
-// Runs the default main context until `done`, at most `limit`.
-inline bool runMainLoopUntil(const std::function<bool()>& done, std::chrono::milliseconds limit) {
-  auto until = std::chrono::steady_clock::now() + limit;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    if (!g_main_context_iteration(nullptr, FALSE))
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return true;
-}
 
 }  // namespace wircam::testing
