@@ -39,6 +39,20 @@ GstCaps* offeredCaps(const ViewerOffer& offer, int payload) {
   return caps;
 }
 
+// libnice asks the LAN's router for a UPnP port mapping for every agent
+// (webrtcbin leaves it on): a context manager, an HTTP server and SSDP
+// searches a viewer, which WebRTC has no use for (its candidates and STUN
+// or TURN reach the viewer). Twenty viewers at once fought over ports
+// ("gupnp-context: Unable to listen on ...") and kept memory after them.
+void withoutUpnp(GstWebRTCICE* ice) {
+  if (!ice || !g_object_class_find_property(G_OBJECT_GET_CLASS(ice), "agent")) return;
+  GObject* agent = nullptr;
+  g_object_get(ice, "agent", &agent, nullptr);
+  if (agent && g_object_class_find_property(G_OBJECT_GET_CLASS(agent), "upnp"))
+    g_object_set(agent, "upnp", FALSE, nullptr);
+  if (agent) g_object_unref(agent);
+}
+
 }  // namespace
 
 void WebRtcViewer::handOver(gpointer handle, std::function<void(WebRtcViewer&)> call) {
@@ -85,15 +99,14 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
   gst_util_set_object_arg(G_OBJECT(webrtc_), "bundle-policy", "max-bundle");
   if (!servers.stun.empty()) g_object_set(webrtc_, "stun-server", servers.stun.c_str(), nullptr);
   if (!servers.turn.empty()) g_object_set(webrtc_, "turn-server", servers.turn.c_str(), nullptr);
-  if (!servers.localAddresses.empty()) {
-    GstWebRTCICE* ice = nullptr;
-    g_object_get(webrtc_, "ice-agent", &ice, nullptr);
-    for (const auto& address : servers.localAddresses) {
-      gboolean added = FALSE;
-      g_signal_emit_by_name(ice, "add-local-ip-address", address.c_str(), &added);
-    }
-    gst_object_unref(ice);
+  GstWebRTCICE* ice = nullptr;
+  g_object_get(webrtc_, "ice-agent", &ice, nullptr);
+  for (const auto& address : servers.localAddresses) {
+    gboolean added = FALSE;
+    g_signal_emit_by_name(ice, "add-local-ip-address", address.c_str(), &added);
   }
+  withoutUpnp(ice);
+  gst_object_unref(ice);
   gst_bin_add_many(encoder_.pipeline(), queue_, payloader_, webrtc_, nullptr);
   gst_element_link(queue_, payloader_);
 

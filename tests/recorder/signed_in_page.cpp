@@ -13,7 +13,9 @@ namespace wircam::testing {
 namespace {
 
 std::vector<std::string> withArgs(std::vector<std::string> extra, bool withToken) {
-  extra.insert(extra.end(), {"--http", "127.0.0.1:0", "--duration", "120"});
+  // The duration ends a recorder its test left behind; the churn soak runs
+  // up to 15 minutes when asked to (WIRCAM_SOAK_SECONDS).
+  extra.insert(extra.end(), {"--http", "127.0.0.1:0", "--duration", "960"});
   if (withToken) extra.insert(extra.end(), {"--http-token", kToken});
   return extra;
 }
