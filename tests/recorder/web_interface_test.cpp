@@ -51,23 +51,26 @@ TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
   ASSERT_TRUE(
       page.waitUntil("parseFloat(document.getElementById('playback-time').textContent) "
                      "> 0.3"));
-  // One second of the recording takes about a second of the clock: never
+  // Two seconds of the recording take about two of the clock: never
   // more of the recording than the time since play was pressed (a loaded
   // machine may hold frames back and then show them at once: a second in
-  // 0.42 s, after such a pause), and not much longer (the page shows tenths;
-  // 2.8 s once, beside two busy loops and seven browser tests).
+  // 0.42 s, after such a pause), and under 3.6 s, which half speed would
+  // not make. Over two seconds, not one: a loaded machine's pause of a second
+  // (a second took 4 s beside a fresh root's build and eight suites) is no
+  // longer most of what is measured.
   double first = shownPosition(page);
   auto started = Clock::now();
   ASSERT_TRUE(
       page.waitUntil("parseFloat(document.getElementById('playback-time').textContent) "
                      ">= " +
-                     std::to_string(first + 1.0)));
+                         std::to_string(first + 2.0),
+                     milliseconds(15000)));
   auto took = std::chrono::duration<double>(Clock::now() - started).count();
   double shown = shownPosition(page);
   auto sincePressed = std::chrono::duration<double>(Clock::now() - pressed).count();
   EXPECT_LE(shown, sincePressed + 0.1) << "ahead of the clock: " << shown << " s of the recording "
                                        << sincePressed << " s after play was pressed";
-  EXPECT_LT(took, 3.0) << "a second played in " << took << " s";
+  EXPECT_LT(took, 3.6) << "two seconds played in " << took << " s";
   EXPECT_TRUE(page.waitUntil("document.getElementById('playback-image').naturalWidth === 352"));
 
   // The timeline is drawn from the sidecar: detections (green) and the
