@@ -54,10 +54,11 @@ TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
   // Two seconds of the recording take about two of the clock: never
   // more of the recording than the time since play was pressed (a loaded
   // machine may hold frames back and then show them at once: a second in
-  // 0.42 s, after such a pause), and under 3.6 s, which half speed would
-  // not make. Over two seconds, not one: a loaded machine's pause of a second
-  // (a second took 4 s beside a fresh root's build and eight suites) is no
-  // longer most of what is measured.
+  // 0.42 s, after such a pause), and less than half speed would take. The
+  // player keeps time by the pipeline clock (late frames come at once, so
+  // a pause is caught up), yet a pause at the end of the window counts:
+  // over one second it made a second take 4 s beside a fresh root's build
+  // and eight suites, over two seconds 3.7 s beside ten.
   double first = shownPosition(page);
   auto started = Clock::now();
   ASSERT_TRUE(
@@ -70,7 +71,7 @@ TEST(WebInterface, ARecordingPlaysItsTimeAdvancesAndATimelineClickSeeks) {
   auto sincePressed = std::chrono::duration<double>(Clock::now() - pressed).count();
   EXPECT_LE(shown, sincePressed + 0.1) << "ahead of the clock: " << shown << " s of the recording "
                                        << sincePressed << " s after play was pressed";
-  EXPECT_LT(took, 3.6) << "two seconds played in " << took << " s";
+  EXPECT_LT(took, 4.0) << "two seconds played in " << took << " s (half speed or slower)";
   EXPECT_TRUE(page.waitUntil("document.getElementById('playback-image').naturalWidth === 352"));
 
   // The timeline is drawn from the sidecar: detections (green) and the
