@@ -18,9 +18,6 @@ bool HttpServer::refusedWithoutToken(SoupServerMessage* message, const char* wha
 }
 
 void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query) {
-  if (std::string(soup_server_message_get_method(message)) != "POST")
-    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                            "POST /api/cameras/NAME/" + route.action);
   if (refusedWithoutToken(message, "controlling the vehicle")) return;
   auto lookup = [&](const char* key) -> std::string {
     const char* value = queryValue(query, key);
@@ -53,11 +50,6 @@ void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GH
 }
 
 void HttpServer::serveReload(SoupServerMessage* message) {
-  if (std::string(soup_server_message_get_method(message)) != "POST") {
-    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Allow",
-                                 "POST");
-    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED, "POST /api/config/reload");
-  }
   if (refusedWithoutToken(message, "reloading the config")) return;
   auto changed = content_.reload ? content_.reload()
                                  : unexpected(std::string("this recorder has no config to reload"));

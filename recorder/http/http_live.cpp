@@ -104,6 +104,10 @@ void HttpServer::serveLive(SoupServerMessage* message, const std::string& camera
   std::string type = std::string("multipart/x-mixed-replace; boundary=") + kBoundary;
   openStream(message, type.c_str(), (*feed)->clients);
   (*feed)->clientCount = static_cast<int>((*feed)->clients.size());
+  // The status and headers now, whether or not the camera has a frame yet:
+  // a client waiting on a silent socket cannot tell a slow camera from a
+  // dead server. libsoup pauses again when it runs out of parts.
+  soup_server_message_unpause(message);
 }
 
 void HttpServer::sendFrame(const std::string& camera, GstBuffer* jpeg) {

@@ -1,5 +1,6 @@
 // HttpServer's recordings: snapshots of the live cameras, the index, the
 // files themselves (downloads, ranges) and their deletion.
+#include <algorithm>
 #include <filesystem>
 #include <set>
 
@@ -13,6 +14,22 @@
 namespace wircam::recorder {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// Whether the request's Range (valid, "bytes=...") starts wholly past a file
+// of `size` bytes. libsoup answers such a range 416 by itself, but without
+// the Content-Range that says the size (RFC 9110 15.5.17).
+bool rangePastTheEnd(SoupMessageHeaders* request, goffset size) {
+  SoupRange* ranges = nullptr;
+  int count = 0;
+  if (size <= 0 || !soup_message_headers_get_ranges(request, size, &ranges, &count)) return false;
+  bool past = std::all_of(ranges, ranges + count, [&](const SoupRange& r) { return r.start >= size; });
+  soup_message_headers_free_ranges(request, ranges);
+  return past;
+}
+
+}  // namespace
 
 void HttpServer::serveSnapshot(SoupServerMessage* message, const std::string& camera) {
   auto feed =
@@ -94,6 +111,15 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
         message, SOUP_STATUS_NOT_FOUND,
         "no recording named '" + printableText(name) + "'; GET /api/recordings lists them");
     return;
+  }
+  auto size = static_cast<goffset>(fs::file_size(file, error));
+  if (!error && std::string(soup_server_message_get_method(message)) == "GET" &&
+      rangePastTheEnd(soup_server_message_get_request_headers(message), size)) {
+    soup_message_headers_replace(soup_server_message_get_response_headers(message),
+                                 "Content-Range", ("bytes */" + std::to_string(size)).c_str());
+    return respondJsonError(message, SOUP_STATUS_REQUESTED_RANGE_NOT_SATISFIABLE,
+                            "the range starts past the end of the file (" +
+                                std::to_string(size) + " bytes)");
   }
   GError* mapError = nullptr;
   GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &mapError);

@@ -64,6 +64,56 @@ Route routeOf(std::string_view path) {
   return {Kind::NotFound, ""};
 }
 
+const char* allowedMethods(Route::Kind kind) {
+  using Kind = Route::Kind;
+  switch (kind) {
+    case Kind::Recording:
+      return "GET, HEAD, DELETE";
+    case Kind::RecordingEntry:
+    case Kind::WhepSession:
+      return "DELETE";
+    case Kind::CameraCommand:
+    case Kind::Whep:
+    case Kind::ConfigReload:
+      return "POST";
+    // HEAD where a client asks for headers alone: a monitor checking the
+    // server is up, a download manager or <video> learning a file's size.
+    case Kind::Page:
+    case Kind::Login:
+    case Kind::Status:
+    case Kind::Metrics:
+    case Kind::RecordingList:
+      return "GET, HEAD";
+    // Streams, snapshots and exports: a HEAD would do the work for nothing.
+    case Kind::Events:
+    case Kind::Live:
+    case Kind::Cameras:
+    case Kind::Snapshot:
+    case Kind::RecordingIndex:
+    case Kind::Drive:
+    case Kind::Playback:
+    case Kind::Export:
+      return "GET";
+    case Kind::ApiNotFound:
+    case Kind::NotFound:
+      return nullptr;
+  }
+  return nullptr;
+}
+
+bool methodAllowed(const char* allowed, std::string_view method) {
+  if (!allowed || method.empty()) return false;
+  std::string_view list = allowed;
+  while (!list.empty()) {
+    auto comma = list.find(',');
+    if (list.substr(0, comma) == method) return true;
+    if (comma == std::string_view::npos) break;
+    list.remove_prefix(comma + 1);
+    while (!list.empty() && list.front() == ' ') list.remove_prefix(1);
+  }
+  return false;
+}
+
 namespace {
 
 bool sameSecret(std::string_view given, std::string_view token) {

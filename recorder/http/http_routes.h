@@ -39,6 +39,13 @@ struct Route {
 // `path` as libsoup hands it over (percent-decoded).
 Route routeOf(std::string_view path);
 
+// The methods a resource of this kind serves, as a 405's Allow header says
+// them; nullptr for a path that names nothing (a 404 whatever the method).
+const char* allowedMethods(Route::Kind kind);
+
+// Whether `allowed` (as allowedMethods gives it) holds `method`.
+bool methodAllowed(const char* allowed, std::string_view method);
+
 // Whether a request carries the access token, as "Authorization: Bearer T",
 // as the password of "Authorization: Basic" (any user name), or the
 // "wircam_token" cookie (either header may be null). Compared in constant

@@ -20,6 +20,50 @@ namespace wircam::recorder {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// What a 405 adds to its Allow, where the path has more to say.
+std::string methodHint(Route::Kind kind) {
+  switch (kind) {
+    case Route::Kind::RecordingEntry:
+      return " (GET /recordings/FILE downloads it)";
+    case Route::Kind::Whep:
+      return ", with an SDP offer (Content-Type: application/sdp)";
+    case Route::Kind::WhepSession:
+      return " to end the session (trickle ICE, PATCH, is not taken)";
+    default:
+      return "";
+  }
+}
+
+// libsoup refuses some requests before any handler of ours sees them: a path
+// that climbs out with an encoded "..", a scheme that is not the
+// connection's. It answers a bare 400 with no body; the reason goes with it
+// here, in JSON under /api/ as every error of the API.
+void explainRefusal(SoupServerMessage* message, gpointer) {
+  if (soup_server_message_get_status(message) != SOUP_STATUS_BAD_REQUEST ||
+      soup_server_message_get_response_body(message)->length > 0)
+    return;
+  GUri* uri = soup_server_message_get_uri(message);
+  std::string path = uri ? g_uri_get_path(uri) : "";  // as sent: still encoded
+  char* decoded = g_uri_unescape_string(path.c_str(), nullptr);
+  std::string reason =
+      !decoded ? "the path does not decode (an encoded NUL or a bad %-escape)"
+      : std::string_view(decoded).find("/..") != std::string_view::npos
+          ? "the path climbs out with an encoded '..': not served"
+          : "the request is malformed (an https:// URL over plain HTTP, or the other way round)";
+  g_free(decoded);
+  if (path.starts_with("/api/")) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, reason);
+  respondError(message, SOUP_STATUS_BAD_REQUEST, reason);
+}
+
+// Every request: after libsoup has read (and perhaps refused) its headers.
+void watchForRefusal(SoupServer*, SoupServerMessage* message, gpointer) {
+  g_signal_connect_after(message, "got-headers", G_CALLBACK(explainRefusal), nullptr);
+}
+
+}  // namespace
+
 HttpServer::HttpServer(Content content) : content_(std::move(content)) {}
 
 Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
@@ -50,6 +94,7 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
   // Upgrades only the requests onRequest leaves unanswered (the drive mode's).
   soup_server_add_websocket_handler(self->server_, nullptr, nullptr, nullptr, onWebSocket,
                                     self.get(), nullptr);
+  g_signal_connect(self->server_, "request-started", G_CALLBACK(watchForRefusal), nullptr);
   g_signal_connect(self->server_, "request-finished", G_CALLBACK(onRequestEnded), self.get());
   g_signal_connect(self->server_, "request-aborted", G_CALLBACK(onRequestEnded), self.get());
   auto missing = WebRtcService::missingElements();
@@ -228,7 +273,11 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* 
     // client stops; libsoup then finds the connection closed for writing.
     g_socket_shutdown(socket, FALSE, TRUE, nullptr);
   }
-  soup_server_message_set_status(message, SOUP_STATUS_BAD_REQUEST, nullptr);
+  // (Never a bare 400: that is libsoup's own refusal, which explainRefusal
+  // gives its reason.)
+  soup_server_message_set_status(
+      message, known ? SOUP_STATUS_REQUEST_ENTITY_TOO_LARGE : SOUP_STATUS_METHOD_NOT_ALLOWED,
+      nullptr);
 }
 
 void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* path,
@@ -250,31 +299,18 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                             "/login");
   }
   std::string method = soup_server_message_get_method(message);
+  // (A HEAD allowed is served as its GET: libsoup leaves the body out.)
+  if (const char* allowed = allowedMethods(route.kind); allowed && !methodAllowed(allowed, method))
+    return respondMethodNotAllowed(message, allowed,
+                                   method + " is not served here; this path takes " + allowed +
+                                       methodHint(route.kind));
   if (route.kind == Route::Kind::Whep || route.kind == Route::Kind::WhepSession)
     return self->serveWhep(message, route);
-  if (method == "DELETE") {
-    if (route.kind != Route::Kind::Recording && route.kind != Route::Kind::RecordingEntry)
-      return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                              "only recordings can be deleted: DELETE /api/recordings/FILE");
+  if (method == "DELETE" && allowedMethods(route.kind))
     return self->deleteRecording(message, route.name);
-  }
   if (route.kind == Route::Kind::CameraCommand) return self->serveCommand(message, route, query);
   if (route.kind == Route::Kind::ConfigReload) return self->serveReload(message);
-  if (method == "POST") {
-    // What this path does take (RFC 9110: a 405 says so in Allow).
-    bool deletable =
-        route.kind == Route::Kind::Recording || route.kind == Route::Kind::RecordingEntry;
-    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Allow",
-                                 deletable ? "GET, HEAD, DELETE" : "GET, HEAD");
-    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                            "POST is for /api/cameras/NAME/follow, /target, /request-control, "
-                            "/whep and /api/config/reload");
-  }
   switch (route.kind) {
-    case Route::Kind::RecordingEntry:
-      return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                              "GET /recordings/FILE downloads it; DELETE /api/recordings/FILE "
-                              "deletes it");
     case Route::Kind::Login:
       return respond(message, SOUP_STATUS_OK, "text/html; charset=utf-8", pageFile("login.html"));
     case Route::Kind::Page:
@@ -308,6 +344,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
     case Route::Kind::Drive:
       // Left unanswered when allowed: libsoup then upgrades it (onWebSocket).
       return self->refuseDriveUnlessAllowed(message, route.name);
+    case Route::Kind::RecordingEntry:
     case Route::Kind::CameraCommand:
     case Route::Kind::ConfigReload:
     case Route::Kind::Whep:

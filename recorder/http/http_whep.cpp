@@ -23,21 +23,14 @@ std::string peerAddress(SoupServerMessage* message) {
 }  // namespace
 
 void HttpServer::serveWhep(SoupServerMessage* message, const Route& route) {
-  std::string method = soup_server_message_get_method(message);
   if (!webrtc_)
     return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
                             webrtcOff_ + "; the live view is /live/CAMERA.mjpg");
   if (route.kind == Route::Kind::WhepSession) {
-    if (method != "DELETE")
-      return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                              "DELETE ends a WHEP session; trickle ICE (PATCH) is not taken");
     if (!webrtc_->end(route.name, route.action))
       return respondJsonError(message, SOUP_STATUS_NOT_FOUND, "no such WHEP session");
     return respond(message, SOUP_STATUS_OK, "application/json", "{}");
   }
-  if (method != "POST")
-    return respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED,
-                            "POST /api/cameras/NAME/whep with an SDP offer (application/sdp)");
   const char* type = soup_message_headers_get_content_type(
       soup_server_message_get_request_headers(message), nullptr);
   if (g_strcmp0(type, "application/sdp") != 0)

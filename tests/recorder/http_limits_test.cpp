@@ -16,6 +16,7 @@
 #include "common/socket.h"
 #include "main_loop_until.h"
 #include "process_memory.h"
+#include "raw_http.h"
 #include "recorder_process.h"
 #include "signed_in_page.h"
 #include "simulated_device.h"
@@ -35,33 +36,6 @@ constexpr long kMemoryLimitKb = 20 * 1024;
 namespace fs = std::filesystem;
 using namespace wircam::testing;
 using std::chrono::milliseconds;
-
-uint16_t portOf(const std::string& url) {
-  return static_cast<uint16_t>(std::stoi(url.substr(url.rfind(':') + 1)));
-}
-
-// Sends `request` on a fresh connection; the first line of the answer.
-// The answer to `request`, up to the server's close (`whole`) or its status
-// line's end.
-std::string answerTo(uint16_t port, const std::string& request, bool whole = true) {
-  auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(port));
-  if (!fd) return "";
-  ::send(fd->get(), request.data(), request.size(), MSG_NOSIGNAL);
-  std::string answer;
-  char chunk[512];
-  pollfd p{fd->get(), POLLIN, 0};
-  while ((whole || answer.find("\r\n") == std::string::npos) && ::poll(&p, 1, 5000) > 0) {
-    ssize_t n = ::recv(fd->get(), chunk, sizeof chunk, 0);
-    if (n <= 0) break;
-    answer.append(chunk, static_cast<size_t>(n));
-  }
-  return answer;
-}
-
-std::string statusLine(uint16_t port, const std::string& request) {
-  auto answer = answerTo(port, request, false);
-  return answer.substr(0, answer.find("\r\n"));
-}
 
 struct ServedRecorder {
   std::unique_ptr<wircam::wirc::Device> device = startSequenceDevice();

@@ -61,9 +61,11 @@ function templateOf(urlPath) {
 const mediaType = (value) => (value || "").split(";")[0].trim().toLowerCase();
 
 // Checks one answer against the document; returns the parsed JSON body, if any.
-function conform(label, method, url, answer, { expect } = {}) {
+// `template` names the path of the document where the URL's own cannot
+// (an encoded "/" that, decoded, matches no path).
+function conform(label, method, url, answer, { expect, template: given } = {}) {
   const urlPath = decodeURIComponent(new URL(url).pathname);
-  const template = templateOf(urlPath);
+  const template = given || templateOf(urlPath);
   const where = `${label}: ${method} ${urlPath} → ${answer.status}`;
   if (expect !== undefined && answer.status !== expect)
     problem(`${where}: expected ${expect} (${answer.body.toString().slice(0, 200)})`);
@@ -377,6 +379,38 @@ try {
   if (unknown.status !== 404 || mediaType(unknown.headers["content-type"]) !== "application/json")
     problem(`GET /api/nothing → ${unknown.status} ${unknown.headers["content-type"]}`);
 
+  // HEAD where the document names it: the GET's headers, no body.
+  for (const [label, url] of [["page", urlA], ["index.html", urlA + "index.html"],
+    ["status", urlA + "api/status"], ["metrics", urlA + "metrics"], ["files", urlA + "recordings"],
+    ["download", urlA + "recordings/" + enc(toKeep.file)]]) {
+    const head = await check(`${label}, HEAD`, "HEAD", url, { headers: bearer, expect: 200 });
+    if (head.body.length) problem(`${label}, HEAD: a body of ${head.body.length} bytes`);
+  }
+  await check("login, HEAD", "HEAD", urlA + "login", { expect: 200 });
+  await check("download, HEAD, unknown", "HEAD", urlA + "recordings/nope.mkv", { headers: bearer, expect: 404 });
+  await check("status, HEAD without token", "HEAD", urlA + "api/status", { expect: 401 });
+
+  // A method a path does not serve: 405, Allow naming those it does, JSON.
+  for (const [method, url, allow] of [
+    ["GET", command("follow"), "POST"], ["DELETE", urlA + "api/cameras", "GET"],
+    ["POST", urlA + "api/status", "GET, HEAD"], ["HEAD", urlA + "api/cameras", "GET"],
+    ["GET", urlA + "api/config/reload", "POST"]]) {
+    const answer = await request(method, url, { headers: bearer });
+    const where = `${method} ${new URL(url).pathname} → ${answer.status}`;
+    if (answer.status !== 405) problem(`${where}: expected 405`);
+    if (answer.headers.allow !== allow) problem(`${where}: Allow is ${answer.headers.allow}, not ${allow}`);
+    if (method !== "HEAD" && !validatorOf(api.components.schemas.Error)(JSON.parse(answer.body.toString() || "null")))
+      problem(`${where}: not the Error schema: ${answer.body.toString().slice(0, 200)}`);
+  }
+
+  // Paths that climb out with an encoded "..", and a range past the end.
+  await check("delete, climbing path", "DELETE", urlA + "api/recordings/..%2Fx",
+    { headers: bearer, expect: 400, template: "/api/recordings/{file}" });
+  await check("download, climbing path", "GET", urlA + "recordings/..%2F..%2Fetc%2Fpasswd",
+    { headers: bearer, expect: 400, template: "/recordings/{file}" });
+  await check("download, past the end", "GET", urlA + "recordings/" + enc(toKeep.file),
+    { headers: { ...bearer, Range: "bytes=999999999-" }, expect: 416 });
+
   // B: no token set, WebRTC off
   await waitFor("recorder B's camera", async () => {
     const answer = await request("GET", urlB + "api/cameras");
@@ -395,7 +429,7 @@ try {
   // Every operation of the document was exercised at least once.
   for (const [template, item] of Object.entries(api.paths))
     for (const method of Object.keys(item))
-      if (["get", "post", "delete", "put", "patch"].includes(method) &&
+      if (["get", "head", "post", "delete", "put", "patch"].includes(method) &&
           ![...checked].some((c) => c.startsWith(`${method.toUpperCase()} ${template} `)))
         problem(`${method.toUpperCase()} ${template} was never checked`);
 } catch (error) {

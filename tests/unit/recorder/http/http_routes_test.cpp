@@ -102,5 +102,30 @@ TEST(HttpRoutes, ServesOnlyPlainNamesOfRecordings) {
   EXPECT_FALSE(isRecordingName(std::string_view("a\0b.mkv", 7)));
 }
 
+TEST(HttpRoutes, EachResourceSaysTheMethodsItServes) {
+  auto allowed = [](const char* path) { return std::string(allowedMethods(routeOf(path).kind)); };
+  EXPECT_EQ(allowed("/api/cameras"), "GET");
+  EXPECT_EQ(allowed("/api/cameras/rover-cam0/follow"), "POST");
+  EXPECT_EQ(allowed("/api/cameras/rover-cam0/whep/5d2f"), "DELETE");
+  EXPECT_EQ(allowed("/api/recordings/a.mkv"), "DELETE");
+  EXPECT_EQ(allowed("/recordings/a.mkv"), "GET, HEAD, DELETE");
+  EXPECT_EQ(allowed("/api/status"), "GET, HEAD");
+  EXPECT_EQ(allowed("/live/rover-cam0.mjpg"), "GET");
+  // A path that names nothing is a 404 whatever the method.
+  EXPECT_EQ(allowedMethods(routeOf("/api/nothing").kind), nullptr);
+  EXPECT_EQ(allowedMethods(routeOf("/nothing").kind), nullptr);
+}
+
+TEST(HttpRoutes, AMethodIsAllowedOnlyAsAWholeWordOfTheList) {
+  EXPECT_TRUE(methodAllowed("GET, HEAD, DELETE", "GET"));
+  EXPECT_TRUE(methodAllowed("GET, HEAD, DELETE", "HEAD"));
+  EXPECT_TRUE(methodAllowed("GET, HEAD, DELETE", "DELETE"));
+  EXPECT_FALSE(methodAllowed("GET, HEAD, DELETE", "POST"));
+  EXPECT_FALSE(methodAllowed("GET, HEAD", "GE"));
+  EXPECT_FALSE(methodAllowed("GET, HEAD", "EAD"));
+  EXPECT_FALSE(methodAllowed("GET", ""));
+  EXPECT_FALSE(methodAllowed(nullptr, "GET"));
+}
+
 }  // namespace
 }  // namespace wircam::recorder
