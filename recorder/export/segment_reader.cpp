@@ -6,6 +6,8 @@
 #include <optional>
 #include <utility>
 
+#include "gst_h264_start.h"
+
 namespace wircam::recorder {
 
 SegmentFrame::SegmentFrame(SegmentFrame&& other) noexcept
@@ -108,7 +110,10 @@ Expected<std::optional<SegmentFrame>, std::string> SegmentReader::next() {
   GstClockTime time =
       segment ? gst_segment_to_stream_time(segment, GST_FORMAT_TIME, pts) : GST_CLOCK_TIME_NONE;
   frame.ptsNs = GST_CLOCK_TIME_IS_VALID(time) ? static_cast<int64_t>(time) : 0;
-  frame.key = !GST_BUFFER_FLAG_IS_SET(frame.buffer, GST_BUFFER_FLAG_DELTA_UNIT);
+  // Whether a decoder can start here, from the bitstream: matroskademux
+  // flags no H.264 frame as a delta (gst_h264_start.h). Every JPEG is one.
+  bool h264 = gst_structure_has_name(gst_caps_get_structure(caps_, 0), "video/x-h264");
+  frame.key = !h264 || gst::h264StartsDecoding(frame.buffer, caps_);
   gst_sample_unref(sample);
   // A recorded JPEG is whole (the source never emits another): one without
   // its end marker was damaged in the file (zeros where a power loss left

@@ -17,7 +17,7 @@ namespace wircam::recorder {
 struct SegmentFrame {
   GstBuffer* buffer = nullptr;  // owned: the frame's bytes and flags
   int64_t ptsNs = 0;            // on the segment's timeline
-  bool key = true;
+  bool key = true;              // a decoder can start here (an IDR; every JPEG)
   SegmentFrame() = default;
   SegmentFrame(SegmentFrame&& other) noexcept;
   SegmentFrame& operator=(SegmentFrame&& other) noexcept;

@@ -9,6 +9,7 @@
 
 #include "foxglove/annex_b.h"
 #include "foxglove/foxglove_messages.h"
+#include "gst_h264_start.h"
 #include "gst_scoped.h"
 #include "http/foxglove_clients.h"
 #include "http/foxglove_server.h"
@@ -69,7 +70,9 @@ void FoxgloveServer::sendFrame(Feed& feed, GstSample* sample, int64_t utcNs) {
   GstBuffer* buffer = gst_sample_get_buffer(sample);
   gst::ScopedBufferMap map(buffer, GST_MAP_READ);
   if (!map) return;
-  bool key = !GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_DELTA_UNIT);
+  // A subscriber's first H.264 frame is an IDR, decided from the bitstream
+  // (h264parse calls a scene cut's non-IDR I-frame a key frame too).
+  bool key = !feed.h264 || gst::h264StartsDecoding(buffer, gst_sample_get_caps(sample));
   utcNs = stampOf(feed, GST_BUFFER_PTS(buffer), utcNs);
   std::string converted;
   std::string_view data = map.view();

@@ -24,7 +24,8 @@ bool rangePastTheEnd(SoupMessageHeaders* request, goffset size) {
   SoupRange* ranges = nullptr;
   int count = 0;
   if (size <= 0 || !soup_message_headers_get_ranges(request, size, &ranges, &count)) return false;
-  bool past = std::all_of(ranges, ranges + count, [&](const SoupRange& r) { return r.start >= size; });
+  bool past =
+      std::all_of(ranges, ranges + count, [&](const SoupRange& r) { return r.start >= size; });
   soup_message_headers_free_ranges(request, ranges);
   return past;
 }
@@ -115,11 +116,11 @@ void HttpServer::serveRecordings(SoupServerMessage* message, const std::string& 
   auto size = static_cast<goffset>(fs::file_size(file, error));
   if (!error && std::string(soup_server_message_get_method(message)) == "GET" &&
       rangePastTheEnd(soup_server_message_get_request_headers(message), size)) {
-    soup_message_headers_replace(soup_server_message_get_response_headers(message),
-                                 "Content-Range", ("bytes */" + std::to_string(size)).c_str());
-    return respondJsonError(message, SOUP_STATUS_REQUESTED_RANGE_NOT_SATISFIABLE,
-                            "the range starts past the end of the file (" +
-                                std::to_string(size) + " bytes)");
+    soup_message_headers_replace(soup_server_message_get_response_headers(message), "Content-Range",
+                                 ("bytes */" + std::to_string(size)).c_str());
+    return respondJsonError(
+        message, SOUP_STATUS_REQUESTED_RANGE_NOT_SATISFIABLE,
+        "the range starts past the end of the file (" + std::to_string(size) + " bytes)");
   }
   GError* mapError = nullptr;
   GMappedFile* mapped = g_mapped_file_new(file.c_str(), FALSE, &mapError);

@@ -37,8 +37,7 @@ inline void respondJsonError(SoupServerMessage* message, guint status, const std
 // 405 with what the resource does serve (RFC 9110 15.5.6: Allow is required).
 inline void respondMethodNotAllowed(SoupServerMessage* message, const char* allowed,
                                     const std::string& text) {
-  soup_message_headers_replace(soup_server_message_get_response_headers(message), "Allow",
-                               allowed);
+  soup_message_headers_replace(soup_server_message_get_response_headers(message), "Allow", allowed);
   respondJsonError(message, SOUP_STATUS_METHOD_NOT_ALLOWED, text);
 }
 

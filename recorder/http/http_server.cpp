@@ -301,9 +301,9 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
   std::string method = soup_server_message_get_method(message);
   // (A HEAD allowed is served as its GET: libsoup leaves the body out.)
   if (const char* allowed = allowedMethods(route.kind); allowed && !methodAllowed(allowed, method))
-    return respondMethodNotAllowed(message, allowed,
-                                   method + " is not served here; this path takes " + allowed +
-                                       methodHint(route.kind));
+    return respondMethodNotAllowed(
+        message, allowed,
+        method + " is not served here; this path takes " + allowed + methodHint(route.kind));
   if (route.kind == Route::Kind::Whep || route.kind == Route::Kind::WhepSession)
     return self->serveWhep(message, route);
   if (method == "DELETE" && allowedMethods(route.kind))

@@ -45,6 +45,20 @@ std::vector<double> packetTimes(const fs::path& file) {
   return times;
 }
 
+// "2026-11-24T14:59:35.467Z" moved by `deltaMs` (the recorder writes
+// milliseconds), in the same form.
+std::string shiftedIso(const std::string& iso, int64_t deltaMs) {
+  std::tm parts{};
+  if (!strptime(iso.c_str(), "%Y-%m-%dT%H:%M:%S", &parts)) return iso;
+  int64_t ms = int64_t{timegm(&parts)} * 1000 + std::stoi(iso.substr(20, 3)) + deltaMs;
+  time_t seconds = static_cast<time_t>(ms / 1000);
+  gmtime_r(&seconds, &parts);
+  char whole[24], shifted[32];
+  std::strftime(whole, sizeof whole, "%Y-%m-%dT%H:%M:%S", &parts);
+  std::snprintf(shifted, sizeof shifted, "%s.%03dZ", whole, static_cast<int>(ms % 1000));
+  return shifted;
+}
+
 std::string exportCommand(const fs::path& recordings, const std::string& camera,
                           const std::string& rest) {
   return std::string(WIRC_EXPORT) + " --recordings '" + recordings.string() + "' --camera " +
@@ -157,16 +171,7 @@ TEST_F(Export, ARangeHoldsTheFramesOfTheSegmentsInIt) {
   ASSERT_GE(index.size(), 4u);
   // From the second segment's first frame to just before the fourth's.
   std::string start = index[1]["start_utc"];
-  std::string fourth = index[3]["start_utc"];
-  // 1 ms before (the recorder writes milliseconds): "...:07.000Z" → "...:06.999Z".
-  std::tm parts{};
-  ASSERT_TRUE(strptime(fourth.c_str(), "%Y-%m-%dT%H:%M:%S", &parts)) << fourth;
-  int64_t msSinceEpoch = int64_t{timegm(&parts)} * 1000 + std::stoi(fourth.substr(20, 3)) - 1;
-  time_t seconds = static_cast<time_t>(msSinceEpoch / 1000);
-  gmtime_r(&seconds, &parts);
-  char whole[24], end[32];
-  std::strftime(whole, sizeof whole, "%Y-%m-%dT%H:%M:%S", &parts);
-  std::snprintf(end, sizeof end, "%s.%03dZ", whole, static_cast<int>(msSinceEpoch % 1000));
+  std::string end = shiftedIso(index[3]["start_utc"], -1);  // just before the fourth
   fs::path out = output("range.mkv");
   auto ran = runCommand(exportCommand(
       recorder_->out(), *camera_,
@@ -518,4 +523,36 @@ TEST(ExportH264, EveryFormatCarriesTheRecordedH264Untouched) {
   EXPECT_EQ(result["images"].size(), recorded.size());
   EXPECT_EQ(ffmpegDecodeErrors(stream), "");
   EXPECT_EQ(decodedFrameCount(stream), std::to_string(recorded.size()) + "\n");
+}
+
+// A range that starts between key frames starts on the next IDR, decided
+// from the bitstream: matroskademux flags no H.264 frame as a delta, and
+// the export began on frames no decoder could use (5 of 32 undecodable).
+TEST(ExportH264, ARangeStartingBetweenKeyFramesStartsOnAnIdrAndEveryFrameDecodes) {
+  auto device = startSequenceDevice();
+  RecorderProcess recorder(device->port(),
+                           {"--segment", "2", "--duration", "5", "--codec", "h264"});
+  ASSERT_EQ(recorder.wait(), 0) << recorder.log();
+  auto index = nlohmann::json::parse(std::ifstream(recorder.out() / "index.json"))["segments"];
+  ASSERT_GE(index.size(), 2u);
+  // 200 ms into the second segment: past its first key frame, before the
+  // next (one each 0.5 s).
+  std::string start = shiftedIso(index[1]["start_utc"], 200);
+  fs::path out = recorder.out().parent_path() / "mid-gop.mkv";
+  auto ran =
+      runCommand(exportCommand(recorder.out(), cameraName(device->port()),
+                               "--start " + start + " --format mkv --out '" + out.string() + "'"));
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
+  auto first = runCommand(
+      "ffprobe -v error -select_streams v:0 -read_intervals %+#1 "
+      "-show_entries frame=key_frame,pict_type -of csv=p=0 '" +
+      out.string() + "'");
+  EXPECT_EQ(first.output, "1,I\n") << ran.output;
+  // "wirc-export: FILE: 36 frames from 2 segments, ...": each one decodes.
+  auto said = ran.output.find(" frames from ");
+  ASSERT_NE(said, std::string::npos) << ran.output;
+  auto count = ran.output.substr(ran.output.rfind(' ', said - 1) + 1,
+                                 said - ran.output.rfind(' ', said - 1) - 1);
+  EXPECT_EQ(decodedFrameCount(out), count + "\n") << ran.output;
+  EXPECT_EQ(ffmpegDecodeErrors(out), "");
 }

@@ -31,7 +31,8 @@ struct SilentCameraRecorder {
   }
   std::string camera() const { return "127.0.0.1-" + std::to_string(device->port()) + "-cam0"; }
   std::string ask(const std::string& method, const std::string& path) const {
-    return answerTo(port, method + " " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+    return answerTo(port,
+                    method + " " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
   }
 };
 
@@ -46,14 +47,13 @@ TEST(WircRecorderHttpStatuses, AMethodAPathDoesNotServeIs405WithWhatItDoesServe)
   struct Case {
     std::string method, path, allow;
   };
-  for (const Case& c : {Case{"GET", "/api/cameras/" + served.camera() + "/follow", "POST"},
-                        Case{"DELETE", "/api/cameras", "GET"},
-                        Case{"POST", "/api/status", "GET, HEAD"},
-                        Case{"GET", "/api/recordings/a.mkv", "DELETE"},
-                        Case{"POST", "/recordings/a.mkv", "GET, HEAD, DELETE"},
-                        Case{"HEAD", "/api/cameras", "GET"},
-                        Case{"GET", "/api/config/reload", "POST"},
-                        Case{"GET", "/api/cameras/" + served.camera() + "/whep/s1", "DELETE"}}) {
+  for (const Case& c :
+       {Case{"GET", "/api/cameras/" + served.camera() + "/follow", "POST"},
+        Case{"DELETE", "/api/cameras", "GET"}, Case{"POST", "/api/status", "GET, HEAD"},
+        Case{"GET", "/api/recordings/a.mkv", "DELETE"},
+        Case{"POST", "/recordings/a.mkv", "GET, HEAD, DELETE"}, Case{"HEAD", "/api/cameras", "GET"},
+        Case{"GET", "/api/config/reload", "POST"},
+        Case{"GET", "/api/cameras/" + served.camera() + "/whep/s1", "DELETE"}}) {
     auto answer = served.ask(c.method, c.path);
     SCOPED_TRACE(c.method + " " + c.path + ":\n" + answer);
     EXPECT_EQ(answer.rfind("HTTP/1.1 405 ", 0), 0u);
@@ -88,8 +88,9 @@ TEST(WircRecorderHttpStatuses, AnEncodedDotDotIs400WithItsReasonAndARangePastThe
 
   std::ofstream(served.recorder->out() / "notes.jsonl") << std::string(100, 'n');
   auto range = [&](const std::string& bytes) {
-    return answerTo(served.port, "GET /recordings/notes.jsonl HTTP/1.1\r\nHost: x\r\nRange: bytes=" +
-                                     bytes + "\r\nConnection: close\r\n\r\n");
+    return answerTo(served.port,
+                    "GET /recordings/notes.jsonl HTTP/1.1\r\nHost: x\r\nRange: bytes=" + bytes +
+                        "\r\nConnection: close\r\n\r\n");
   };
   auto past = range("100-");
   EXPECT_EQ(past.rfind("HTTP/1.1 416 ", 0), 0u) << past;
@@ -109,9 +110,9 @@ TEST(WircRecorderHttpStatuses, ALiveStreamAnswersAtOnceBeforeItsCamerasFirstFram
       milliseconds(10000)))
       << served.recorder->log();
   // Headers within a second, though no part will follow.
-  auto answer = answerTo(served.port,
-                         "GET /live/" + served.camera() + ".mjpg HTTP/1.1\r\nHost: x\r\n\r\n",
-                         true, 1000);
+  auto answer =
+      answerTo(served.port, "GET /live/" + served.camera() + ".mjpg HTTP/1.1\r\nHost: x\r\n\r\n",
+               true, 1000);
   EXPECT_EQ(answer.rfind("HTTP/1.1 200 ", 0), 0u) << answer << served.recorder->log();
   EXPECT_EQ(headerOf(answer, "Content-Type"), "multipart/x-mixed-replace; boundary=wircframe")
       << answer;

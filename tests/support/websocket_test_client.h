@@ -55,6 +55,7 @@ class WebSocketTestClient {
   SoupWebsocketConnection* connection = nullptr;  // once connected
   bool failed = false;                            // the connection was refused
   std::vector<std::string> texts;                 // the text messages, in order
+  std::vector<std::string> binaries;              // the binary ones, in order
 
  private:
   static void onConnected(GObject* source, GAsyncResult* result, gpointer self) {
@@ -66,10 +67,11 @@ class WebSocketTestClient {
     g_signal_connect(
         client->connection, "message",
         G_CALLBACK(+[](SoupWebsocketConnection*, gint type, GBytes* bytes, gpointer data) {
-          if (type != SOUP_WEBSOCKET_DATA_TEXT) return;
           gsize size = 0;
-          auto* text = static_cast<const char*>(g_bytes_get_data(bytes, &size));
-          static_cast<WebSocketTestClient*>(data)->texts.emplace_back(text, size);
+          auto* message = static_cast<const char*>(g_bytes_get_data(bytes, &size));
+          auto* receiver = static_cast<WebSocketTestClient*>(data);
+          (type == SOUP_WEBSOCKET_DATA_TEXT ? receiver->texts : receiver->binaries)
+              .emplace_back(message, size);
         }),
         self);
   }

@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/h264_access_unit.h"
 #include "main_loop_until.h"
 #include "websocket_test_client.h"
 
@@ -73,6 +74,50 @@ TEST(FoxgloveServer, CamerasAddedAndRemovedAreAdvertisedAndUnadvertisedToEveryCl
   for (const auto& channel : client.said("advertise")[2]["channels"])
     EXPECT_GT(channel["id"].get<uint32_t>(), ids.back());
   EXPECT_EQ((*server)->stats().clients, 1u);
+}
+
+// An encoder that makes non-IDR I-frames (x264 at scene cuts: here every
+// frame of noise is one) between IDRs a second apart, its H.264 handed to
+// the server as the recorder's is: a client that subscribes mid-stream gets
+// an IDR with its SPS and PPS first, never an I-frame it cannot decode.
+TEST(FoxgloveServer, AnH264SubscriberStartsOnAnIdrThoughIFramesComeBefore) {
+  gst_init(nullptr, nullptr);
+  GstElement* pipeline = gst_parse_launch(
+      "videotestsrc pattern=snow is-live=true ! video/x-raw,width=160,height=120,framerate=30/1 "
+      "! x264enc tune=zerolatency speed-preset=veryfast key-int-max=30 "
+      "option-string=keyint=30:min-keyint=30:scenecut=100 ! h264parse "
+      "! video/x-h264,stream-format=avc,alignment=au ! fakesink name=out",
+      nullptr);
+  ASSERT_TRUE(pipeline);
+  FrameTap jpeg, encoded;
+  GstElement* out = gst_bin_get_by_name(GST_BIN(pipeline), "out");
+  GstPad* pad = gst_element_get_static_pad(out, "sink");
+  encoded.attachPad(pad);
+  gst_object_unref(pad);
+  gst_object_unref(out);
+  FoxgloveContent content;
+  content.cameras = {{"rover-cam0", &jpeg, &encoded}};
+  content.drive = [](const std::string&, double, double) { return std::optional<bool>(); };
+  content.drivable = [](const std::string&) { return false; };
+  auto server = FoxgloveServer::start({"", 0}, content, 10s);
+  ASSERT_TRUE(server) << server.error();
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  for (int round = 0; round < 3; ++round) {
+    Client client((*server)->url());
+    ASSERT_TRUE(runMainLoopUntil([&] { return !client.said("advertise").empty(); }));
+    uint32_t image = client.said("advertise")[0]["channels"][0]["id"];
+    // Mid-way between two IDRs, a different way each round.
+    std::this_thread::sleep_for(std::chrono::milliseconds(150 + 270 * round));
+    json subscribe = {{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", image}}}}};
+    soup_websocket_connection_send_text(client.connection, subscribe.dump().c_str());
+    ASSERT_TRUE(runMainLoopUntil([&] { return !client.binaries.empty(); }, 3s));
+    const std::string& first = client.binaries[0];
+    EXPECT_TRUE(startsDecoding(first, H264Framing::byteStream())) << "round " << round;
+    EXPECT_NE(first.find(std::string("\0\0\1\x67", 4)), std::string::npos) << "no SPS";
+  }
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  encoded.detach();
+  gst_object_unref(pipeline);
 }
 
 }  // namespace
