@@ -66,11 +66,27 @@ TEST(WhepH264, ChromiumsOwnOfferGetsTheMainStreamFromTheFirstViewerOn) {
   }
 }
 
-// A webrtcbin that receives H.264, offering Constrained Baseline (108)
-// before Main (116), and counts the frames avdec_h264 decodes.
+// Constrained Baseline (108) before Main (116).
+constexpr const char* kBaselineThenMain =
+    "application/x-rtp,media=video,encoding-name=H264,payload=108,clock-rate=90000,"
+    "packetization-mode=(string)1,profile-level-id=(string)42e01f,"
+    "level-asymmetry-allowed=(string)1;"
+    "application/x-rtp,media=video,encoding-name=H264,payload=116,clock-rate=90000,"
+    "packetization-mode=(string)1,profile-level-id=(string)4d001f,"
+    "level-asymmetry-allowed=(string)1";
+
+// VP8 (96) before Main (102), as a stranger's webrtcbin client offered.
+constexpr const char* kVp8ThenMain =
+    "application/x-rtp,media=video,encoding-name=VP8,payload=96,clock-rate=90000;"
+    "application/x-rtp,media=video,encoding-name=H264,payload=102,clock-rate=90000,"
+    "packetization-mode=(string)1,profile-level-id=(string)4d001f,"
+    "level-asymmetry-allowed=(string)1";
+
+// A webrtcbin that receives video offering `codecs` in their order, and
+// counts the frames avdec_h264 decodes.
 class WebRtcBinViewer {
  public:
-  WebRtcBinViewer() {
+  explicit WebRtcBinViewer(const char* codecs = kBaselineThenMain) {
     pipeline_ = gst_pipeline_new(nullptr);
     webrtc_ = gst_element_factory_make("webrtcbin", nullptr);
     gst_util_set_object_arg(G_OBJECT(webrtc_), "bundle-policy", "max-bundle");
@@ -81,17 +97,11 @@ class WebRtcBinViewer {
     gboolean added = FALSE;
     g_signal_emit_by_name(ice, "add-local-ip-address", "127.0.0.1", &added);
     gst_object_unref(ice);
-    GstCaps* codecs = gst_caps_from_string(
-        "application/x-rtp,media=video,encoding-name=H264,payload=108,clock-rate=90000,"
-        "packetization-mode=(string)1,profile-level-id=(string)42e01f,"
-        "level-asymmetry-allowed=(string)1;"
-        "application/x-rtp,media=video,encoding-name=H264,payload=116,clock-rate=90000,"
-        "packetization-mode=(string)1,profile-level-id=(string)4d001f,"
-        "level-asymmetry-allowed=(string)1");
+    GstCaps* offered = gst_caps_from_string(codecs);
     GstWebRTCRTPTransceiver* transceiver = nullptr;
     g_signal_emit_by_name(webrtc_, "add-transceiver", GST_WEBRTC_RTP_TRANSCEIVER_DIRECTION_RECVONLY,
-                          codecs, &transceiver);
-    gst_caps_unref(codecs);
+                          offered, &transceiver);
+    gst_caps_unref(offered);
     if (transceiver) gst_object_unref(transceiver);
     g_signal_connect(webrtc_, "pad-added", G_CALLBACK(onPad), this);
     gst_element_set_state(pipeline_, GST_STATE_PLAYING);
@@ -175,6 +185,26 @@ TEST(WhepH264, AWebrtcbinViewerOfferingBaselineFirstDecodesTheRecordingsMainStre
   if (answered.status == 503) answered = h264.offer(viewer.offer());
   ASSERT_EQ(answered.status, 201u) << answered.body;
   EXPECT_EQ(videoLineOf(answered.body), "m=video 9 UDP/TLS/RTP/SAVPF 116") << answered.body;
+  viewer.answer(answered.body);
+  EXPECT_TRUE(waitFor([&] { return viewer.decoded() > 15; }, milliseconds(15000)))
+      << viewer.decoded() << " frames decoded\n"
+      << h264.recorder.log();
+}
+
+// The first viewer of the camera, offering VP8 before H.264 Main: the
+// recording's H.264, sendonly, frames decoded (it was answered an inactive
+// VP8 line and got no frame; the second viewer got H.264).
+TEST(WhepH264, AWebrtcbinViewerOfferingVp8FirstGetsTheRecordingsH264AsTheFirstViewer) {
+  if (!gst_element_factory_find("avdec_h264"))
+    GTEST_SKIP() << "avdec_h264 (gstreamer1.0-libav) is not installed";
+  H264Recorder h264;
+  ASSERT_FALSE(h264.url.empty()) << h264.recorder.log();
+  WebRtcBinViewer viewer(kVp8ThenMain);
+  auto answered = h264.offer(viewer.offer());
+  if (answered.status == 503) answered = h264.offer(viewer.offer());  // as above
+  ASSERT_EQ(answered.status, 201u) << answered.body;
+  EXPECT_EQ(videoLineOf(answered.body), "m=video 9 UDP/TLS/RTP/SAVPF 102") << answered.body;
+  EXPECT_NE(answered.body.find("a=sendonly"), std::string::npos) << answered.body;
   viewer.answer(answered.body);
   EXPECT_TRUE(waitFor([&] { return viewer.decoded() > 15; }, milliseconds(15000)))
       << viewer.decoded() << " frames decoded\n"
