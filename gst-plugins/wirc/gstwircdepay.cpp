@@ -4,7 +4,8 @@
  * Reassembles the WiRC MJPEG-over-UDP packets, one UDP payload per input
  * buffer, into whole JPEG frames: for captures, or when another application
  * holds the device's control connection. Same assembler and counters as
- * wircsrc; it never pushes a corrupt or partial frame. The device sends
+ * wircsrc, posted as a `wirc-stats` element message every `stats-interval`
+ * of the datagrams' time; it never pushes a corrupt or partial frame. The device sends
  * datagrams of up to 64 KB, so give udpsrc a large enough buffer and mtu.
  *
  * ## Example launch line
@@ -16,6 +17,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "common/mutex.h"
 #include "frame_buffers.h"
@@ -31,11 +33,14 @@ using namespace wircam;
 using Clock = std::chrono::steady_clock;
 
 #define DEFAULT_FRAME_TIMEOUT 200
+#define DEFAULT_STATS_INTERVAL 1000  // as wircsrc's
 
-enum { PROP_0, PROP_FRAME_TIMEOUT, PROP_STATS };
+enum { PROP_0, PROP_FRAME_TIMEOUT, PROP_STATS_INTERVAL, PROP_STATS };
 
 struct WircDepayState {
   guint frameTimeoutMs = DEFAULT_FRAME_TIMEOUT;     // guarded by the object lock
+  guint statsIntervalMs = DEFAULT_STATS_INTERVAL;   // guarded by the object lock
+  std::optional<Clock::time_point> nextStats;       // streaming thread only
   std::unique_ptr<wirc::FrameAssembler> assembler;  // streaming thread only
   int width = 0;
   int height = 0;
@@ -121,6 +126,28 @@ static GstFlowReturn push_frames(GstWircDepay* self, std::vector<wirc::Assembled
   return result;
 }
 
+// The counters as a "wirc-stats" element message every stats-interval of
+// the datagrams' time (the clock's when they carry none), as wircsrc posts
+// them; the first one interval after the first datagram.
+static void post_stats_when_due(GstWircDepay* self, Clock::time_point now) {
+  guint intervalMs;
+  {
+    gst::GLibLocker lock(self);
+    intervalMs = self->state->statsIntervalMs;
+  }
+  auto& next = self->state->nextStats;
+  if (intervalMs == 0) return next.reset();
+  if (!next) next = now + std::chrono::milliseconds(intervalMs);
+  if (now < *next) return;
+  next = now + std::chrono::milliseconds(intervalMs);
+  GstStructure* stats;
+  {
+    MutexLock lock(self->state->statsMutex);
+    stats = gst::statsStructure(self->state->stats, 0);
+  }
+  gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), stats));
+}
+
 static GstFlowReturn gst_wirc_depay_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
   auto* self = GST_WIRC_DEPAY(parent);
   auto& assembler = assembler_of(self);
@@ -134,6 +161,7 @@ static GstFlowReturn gst_wirc_depay_chain(GstPad*, GstObject* parent, GstBuffer*
     MutexLock lock(self->state->statsMutex);
     self->state->stats = assembler.stats();
   }
+  post_stats_when_due(self, now);
   bool stamped = GST_BUFFER_PTS_IS_VALID(buffer);
   gst_buffer_unref(buffer);
   return push_frames(self, frames, stamped);
@@ -169,6 +197,7 @@ static GstStateChangeReturn gst_wirc_depay_change_state(GstElement* element,
   if (transition == GST_STATE_CHANGE_PAUSED_TO_READY) {
     gst_event_replace(&self->state->pendingSegment, nullptr);
     self->state->assembler.reset();
+    self->state->nextStats.reset();
     self->state->width = self->state->height = 0;
   }
   return result;
@@ -180,6 +209,8 @@ static void gst_wirc_depay_set_property(GObject* object, guint id, const GValue*
   gst::GLibLocker lock(self);
   if (id == PROP_FRAME_TIMEOUT)
     self->state->frameTimeoutMs = g_value_get_uint(value);
+  else if (id == PROP_STATS_INTERVAL)
+    self->state->statsIntervalMs = g_value_get_uint(value);
   else
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
 }
@@ -193,6 +224,9 @@ static void gst_wirc_depay_get_property(GObject* object, guint id, GValue* value
   } else if (id == PROP_FRAME_TIMEOUT) {
     gst::GLibLocker lock(self);
     g_value_set_uint(value, self->state->frameTimeoutMs);
+  } else if (id == PROP_STATS_INTERVAL) {
+    gst::GLibLocker lock(self);
+    g_value_set_uint(value, self->state->statsIntervalMs);
   } else {
     G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
   }
@@ -230,6 +264,14 @@ static void gst_wirc_depay_class_init(GstWircDepayClass* klass) {
                         10, 10000, DEFAULT_FRAME_TIMEOUT,
                         static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                  GST_PARAM_MUTABLE_READY)));
+  g_object_class_install_property(
+      gobject, PROP_STATS_INTERVAL,
+      g_param_spec_uint("stats-interval", "Stats interval",
+                        "Milliseconds of the datagrams' time between wirc-stats element messages "
+                        "(0 = none)",
+                        0, 3600000, DEFAULT_STATS_INTERVAL,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_PLAYING)));
   g_object_class_install_property(
       gobject, PROP_STATS,
       g_param_spec_boxed("stats", "Statistics",

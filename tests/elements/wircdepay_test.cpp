@@ -7,6 +7,7 @@
 #include "buffer_bytes.h"
 #include "scene_frames.h"
 #include "wirc/mjpeg_packet.h"
+#include "wirc_bus_messages.h"
 
 namespace {
 
@@ -128,6 +129,30 @@ TEST_F(WircDepayTest, TheFrameTimeoutRunsOnTheDatagramsTimestamps) {
   push({1, 2, 3});
   EXPECT_EQ(stat("frames-timed-out"), 1u);
   EXPECT_TRUE(pullBytes().empty());
+}
+
+// The counters come as wirc-stats element messages, as wircsrc's do: one
+// each stats-interval of the datagrams' time, none before the first.
+TEST_F(WircDepayTest, PostsItsCountersAsWircStatsEachStatsInterval) {
+  GstBus* bus = gst_bus_new();
+  gst_element_set_bus(harness_->element, bus);
+  g_object_set(harness_->element, "stats-interval", 500u, nullptr);
+  auto frame = wircam::wirc::packetizeFrame(sceneFrames()[2], 1, 64512);
+  for (const auto& p : frame) push(p);
+  EXPECT_EQ(gst_bus_pop(bus), nullptr);  // the first interval has not passed
+  wait(600 * GST_MSECOND);
+  push({1, 2, 3});
+  GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ELEMENT);
+  ASSERT_NE(message, nullptr);
+  const GstStructure* stats = gst_message_get_structure(message);
+  EXPECT_TRUE(gst_structure_has_name(stats, "wirc-stats"));
+  auto read = wircam::bus::Stats::read(stats);
+  EXPECT_EQ(read.framesComplete, 1u);
+  gst_message_unref(message);
+  push({1, 2, 3});  // within the next interval: nothing more
+  EXPECT_EQ(gst_bus_pop(bus), nullptr);
+  gst_element_set_bus(harness_->element, nullptr);
+  gst_object_unref(bus);
 }
 
 }  // namespace
