@@ -5,10 +5,10 @@
 #include <fstream>
 #include <memory>
 
-#include "export/cut_segment.h"
 #include "export/mcap_export.h"
 #include "export/muxed_export.h"
-#include "export/segment_reader.h"
+#include "recording/cut_segment.h"
+#include "recording/segment_reader.h"
 
 namespace wircam::recorder {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/expected.h"
-#include "export/export_range.h"
+#include "recording/segment_selection.h"
 
 namespace wircam::recorder {
 

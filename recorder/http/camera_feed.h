@@ -13,7 +13,7 @@
 
 #include "camera/frame_tap.h"
 #include "http/http_server.h"
-#include "http/playback_stream.h"
+#include "recording/playback_stream.h"
 
 namespace wircam::recorder {
 

@@ -10,10 +10,10 @@
 #include <utility>
 
 #include "common/printable_text.h"
-#include "export/export_range.h"
 #include "export/exporter.h"
 #include "http/http_responses.h"
 #include "log_line.h"
+#include "recording/segment_selection.h"
 
 namespace wircam::recorder {
 

@@ -9,7 +9,7 @@
 #include "http/camera_feed.h"
 #include "http/http_responses.h"
 #include "http/http_server.h"
-#include "http/playback_stream.h"
+#include "recording/playback_stream.h"
 
 namespace wircam::recorder {
 

@@ -12,9 +12,9 @@
 #include "http/http_responses.h"
 #include "http/http_routes.h"
 #include "http/page_resources.h"
-#include "http/playback_stream.h"
 #include "log_line.h"
 #include "record/telemetry_log.h"
+#include "recording/playback_stream.h"
 
 namespace wircam::recorder {
 

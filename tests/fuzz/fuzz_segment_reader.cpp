@@ -11,8 +11,8 @@
 #include <cstring>
 #include <string>
 
-#include "export/cut_segment.h"
-#include "export/segment_reader.h"
+#include "recording/cut_segment.h"
+#include "recording/segment_reader.h"
 
 using namespace wircam::recorder;
 

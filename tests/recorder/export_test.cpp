@@ -16,8 +16,8 @@
 #include <sstream>
 
 #include "camera_checks.h"
-#include "export/export_range.h"
 #include "recorder_process.h"
+#include "recording/segment_selection.h"
 #include "shell_command.h"
 #include "simulated_device.h"
 #include "wait_for.h"

@@ -99,8 +99,10 @@ TEST(RecorderUdpPorts, ManyCamerasHoldDistinctPortsThatNoOtherSocketCanBind) {
     EXPECT_FALSE(canBind(port, false)) << port;
     EXPECT_FALSE(canBind(port, true)) << port << " with SO_REUSEADDR";
   }
+  // It stops (how fast 128 cameras stop is bench_recorder_streams' to
+  // measure: 3.0 s was once just too short beside a build).
   recorder.signal(SIGINT);
-  EXPECT_TRUE(recorder.waitExit(patience(3000ms)).has_value()) << recorder.log();
+  EXPECT_TRUE(recorder.waitExit(patience(15000ms)).has_value()) << recorder.log();
 }
 
 }  // namespace

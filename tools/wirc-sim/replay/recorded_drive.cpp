@@ -7,11 +7,11 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "export/cut_segment.h"
-#include "export/export_range.h"
-#include "export/segment_reader.h"
 #include "gst_scoped.h"
 #include "record/recording_index.h"
+#include "recording/cut_segment.h"
+#include "recording/segment_reader.h"
+#include "recording/segment_selection.h"
 
 namespace wircam::sim {
 

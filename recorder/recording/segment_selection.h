@@ -1,6 +1,7 @@
-// Which recorded segments of one camera an export reads, and the times it
-// keeps: from the folder's index.json (rebuilt from the files, as the
-// recorder does at start-up, when it is missing).
+// Which recorded segments of one camera a time range holds, and their
+// times: from the folder's index.json (rebuilt from the files, as the
+// recorder does at start-up, when it is missing). Read by the export and
+// the replay alike.
 #pragma once
 
 #include <cstdint>

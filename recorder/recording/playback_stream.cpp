@@ -1,6 +1,8 @@
-#include "http/playback_stream.h"
+#include "recording/playback_stream.h"
 
 #include <cmath>
+
+#include "recording/segment_reader.h"
 
 namespace wircam::recorder {
 
@@ -80,7 +82,10 @@ GstFlowReturn PlaybackStream::onSample(GstElement* sink, gpointer data) {
   // them: the ones before the position are left out here, not sent at once.
   GstBuffer* buffer = gst_sample_get_buffer(sample);
   const GstSegment* segment = gst_sample_get_segment(sample);
-  if (segment && GST_BUFFER_PTS_IS_VALID(buffer) && GST_BUFFER_PTS(buffer) < segment->start) {
+  // A frame damaged in the file is left out, as every reader of recordings
+  // leaves it out (segment_reader.h).
+  if ((segment && GST_BUFFER_PTS_IS_VALID(buffer) && GST_BUFFER_PTS(buffer) < segment->start) ||
+      !isWholeJpeg(buffer)) {
     gst_sample_unref(sample);
     return GST_FLOW_OK;
   }

@@ -1,4 +1,4 @@
-#include "export/segment_reader.h"
+#include "recording/segment_reader.h"
 
 #include <gst/app/gstappsink.h>
 
@@ -77,14 +77,14 @@ std::optional<std::string> demuxerError(GstElement* pipeline) {
   return text;
 }
 
-bool endsWithJpegEnd(GstBuffer* buffer) {
-  gsize size = gst_buffer_get_size(buffer);
+}  // namespace
+
+bool isWholeJpeg(GstBuffer* jpeg) {
+  gsize size = gst_buffer_get_size(jpeg);
   guint8 end[2] = {0, 0};
-  return size >= 4 && gst_buffer_extract(buffer, size - 2, end, 2) == 2 && end[0] == 0xFF &&
+  return size >= 4 && gst_buffer_extract(jpeg, size - 2, end, 2) == 2 && end[0] == 0xFF &&
          end[1] == 0xD9;
 }
-
-}  // namespace
 
 Expected<std::optional<SegmentFrame>, std::string> SegmentReader::next() {
   // A demuxer that errors (zeros, random bytes, text named .mkv) or finds
@@ -115,11 +115,8 @@ Expected<std::optional<SegmentFrame>, std::string> SegmentReader::next() {
   bool h264 = gst_structure_has_name(gst_caps_get_structure(caps_, 0), "video/x-h264");
   frame.key = !h264 || gst::h264StartsDecoding(frame.buffer, caps_);
   gst_sample_unref(sample);
-  // A recorded JPEG is whole (the source never emits another): one without
-  // its end marker was damaged in the file (zeros where a power loss left
-  // its last blocks), and is not passed on as a frame.
   if (gst_structure_has_name(gst_caps_get_structure(caps_, 0), "image/jpeg") &&
-      !endsWithJpegEnd(frame.buffer))
+      !isWholeJpeg(frame.buffer))
     return unexpected(std::string("a JPEG frame without its end marker (the file is damaged)"));
   return std::optional<SegmentFrame>(std::move(frame));
 }

@@ -1,4 +1,4 @@
-#include "export/export_range.h"
+#include "recording/segment_selection.h"
 
 #include <algorithm>
 #include <chrono>
@@ -9,9 +9,9 @@
 #include <set>
 
 #include "common/printable_text.h"
-#include "export/segment_reader.h"
 #include "record/recording_index.h"
 #include "record/segment_inspector.h"
+#include "recording/segment_reader.h"
 
 namespace wircam::recorder {
 

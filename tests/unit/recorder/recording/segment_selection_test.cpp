@@ -1,6 +1,6 @@
 // The times an export takes (--start, --end, /api/export): ISO 8601 as
 // people write it, and nothing a calendar does not have.
-#include "export/export_range.h"
+#include "recording/segment_selection.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "export/cut_segment.h"
+#include "recording/cut_segment.h"
 
 #include <array>
 #include <cstdint>

@@ -45,6 +45,12 @@ class SegmentReader {
   GstCaps* caps_ = nullptr;
 };
 
+// Whether a recorded JPEG frame is whole: its end marker is there. The
+// source never emits another, so one without it was damaged in the file
+// (zeros where a power loss left its last blocks). Every reader of
+// recordings refuses such a frame.
+bool isWholeJpeg(GstBuffer* jpeg);
+
 // The sidecar's lines (JSON text), in file order; none if it is missing.
 std::vector<std::string> sidecarLines(const std::filesystem::path& video);
 
