@@ -2,6 +2,8 @@
 
 #include <gst/app/gstappsink.h>
 
+#include "camera/wall_clock.h"
+
 namespace wircam::recorder {
 
 void FrameTap::attach(GstElement* appsink) {
@@ -19,7 +21,12 @@ void FrameTap::attachPad(GstPad* pad) {
       [](GstPad* tapped, GstPadProbeInfo* info, gpointer self) {
         auto* tap = static_cast<FrameTap*>(self);
         GstCaps* caps = gst_pad_get_current_caps(tapped);
-        GstSample* sample = gst_sample_new(GST_PAD_PROBE_INFO_BUFFER(info), caps, nullptr, nullptr);
+        // The segment too, so that the frame's running time can be known.
+        GstEvent* event = gst_pad_get_sticky_event(tapped, GST_EVENT_SEGMENT, 0);
+        const GstSegment* segment = nullptr;
+        if (event) gst_event_parse_segment(event, &segment);
+        GstSample* sample = gst_sample_new(GST_PAD_PROBE_INFO_BUFFER(info), caps, segment, nullptr);
+        if (event) gst_event_unref(event);
         if (caps) gst_caps_unref(caps);
         tap->hand(sample);
         gst_sample_unref(sample);
@@ -69,6 +76,17 @@ GstFlowReturn FrameTap::onNewSample(GstElement* appsink, gpointer data) {
   self->hand(sample);
   gst_sample_unref(sample);
   return GST_FLOW_OK;
+}
+
+int64_t FrameTap::wallTimeNs(GstSample* sample) const {
+  GstElement* element = appsink_ ? appsink_ : pad_ ? GST_PAD_PARENT(pad_) : nullptr;
+  GstBuffer* buffer = gst_sample_get_buffer(sample);
+  const GstSegment* segment = gst_sample_get_segment(sample);
+  GstClockTime running = GST_CLOCK_TIME_NONE;
+  if (buffer && segment && segment->format == GST_FORMAT_TIME)
+    running = gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+  if (!element) return g_get_real_time() * 1000;
+  return unixNsOf(element, running);
 }
 
 void FrameTap::hand(GstSample* sample) {

@@ -38,6 +38,11 @@ class FrameTap {
   void forget(int id);
   // The newest frame (a reference to unref), or null before the first.
   GstBuffer* latest();
+  // When a frame handed to a listener arrived, as Unix nanoseconds: its
+  // running time (wircsrc stamps a frame with the kernel's receive time of
+  // its first datagram) on the pipeline's clock, as the recording's times
+  // are; now when it carries none. Only from within a listener's call.
+  int64_t wallTimeNs(GstSample* sample) const;
 
  private:
   static GstFlowReturn onNewSample(GstElement* appsink, gpointer self);

@@ -299,7 +299,8 @@ void FoxgloveServer::addCamera(const FoxgloveCamera& camera) {
   feed->listener = feed->camera.frames->listen([this, raw](GstSample* sample) {
     if (raw->imageSubscribers.load() == 0) return;
     std::shared_ptr<GstSample> held(gst_sample_ref(sample), gst_sample_unref);
-    int64_t arrivedNs = g_get_real_time() * 1000;
+    // The frame's own time, as the recording keeps it: not its arrival here.
+    int64_t arrivedNs = raw->camera.frames->wallTimeNs(sample);
     callOnMainLoop(alive_,
                    [this, raw, held, arrivedNs] { sendFrame(*raw, held.get(), arrivedNs); });
   });

@@ -1,0 +1,64 @@
+// A frame handed on by FrameTap carries its own time: the running time it
+// was stamped with (wircsrc's kernel receive time), on the wall clock, as
+// the recording keeps it; not the moment a listener got it.
+#include "camera/frame_tap.h"
+
+#include <gst/app/gstappsrc.h>
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+namespace wircam::recorder {
+namespace {
+
+// appsrc ! SINK: a frame stamped 300 ms before it is pushed; the time the
+// tap says, against the wall clock when it was pushed.
+int64_t lagOfTappedFrame(const char* sink, bool byPad) {
+  std::string description = std::string("appsrc name=in is-live=true format=time ! ") + sink;
+  GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
+  GstElement* in = gst_bin_get_by_name(GST_BIN(pipeline), "in");
+  GstElement* out = gst_bin_get_by_name(GST_BIN(pipeline), "out");
+  gst_app_src_set_caps(GST_APP_SRC(in), gst_caps_from_string("image/jpeg"));
+  FrameTap tap;
+  GstPad* pad = gst_element_get_static_pad(out, "sink");
+  if (byPad)
+    tap.attachPad(pad);
+  else
+    tap.attach(out);
+  gst_object_unref(pad);
+  std::atomic<int64_t> said = 0;
+  tap.listen([&](GstSample* sample) { said = tap.wallTimeNs(sample); });
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  gst_element_get_state(pipeline, nullptr, nullptr, GST_CLOCK_TIME_NONE);
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  GstBuffer* frame = gst_buffer_new_allocate(nullptr, 16, nullptr);
+  GST_BUFFER_PTS(frame) = gst_element_get_current_running_time(pipeline) - 300 * GST_MSECOND;
+  int64_t pushedNs = g_get_real_time() * 1000;
+  gst_app_src_push_buffer(GST_APP_SRC(in), frame);
+  for (int i = 0; i < 200 && said == 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  tap.detach();
+  gst_object_unref(in);
+  gst_object_unref(out);
+  gst_object_unref(pipeline);
+  return said == 0 ? INT64_MIN : pushedNs - said;
+}
+
+TEST(FrameTap, AFramesTimeIsItsRunningTimeOnTheWallClockNotItsArrival) {
+  gst_init(nullptr, nullptr);
+  constexpr int64_t kMs = 1000000;
+  // An appsink (the live JPEG branch), and a pad (the recording's H.264).
+  int64_t appsink = lagOfTappedFrame("appsink name=out sync=false async=false", false);
+  EXPECT_GT(appsink, 280 * kMs);
+  EXPECT_LT(appsink, 330 * kMs);
+  int64_t pad = lagOfTappedFrame("fakesink name=out sync=false async=false", true);
+  EXPECT_GT(pad, 280 * kMs);
+  EXPECT_LT(pad, 330 * kMs);
+}
+
+}  // namespace
+}  // namespace wircam::recorder
