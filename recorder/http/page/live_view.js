@@ -54,9 +54,17 @@ function setState(view, state, sinceUtc) {
   }
 }
 
+// A frame the detector missed the tag in (about one in eight) does not
+// blank the outline at once: it flickered off at 15 fps. Outlines stay up
+// to this long after the last frame that had them.
+const outlineHoldMs = 300;
+
 function showDetections(event) {
   const view = views[event.stream];
   if (!view || view.state !== "live") return;
+  const now = performance.now();
+  if (!event.detections.length && now - (view.outlinedAt || -Infinity) < outlineHoldMs) return;
+  if (event.detections.length) view.outlinedAt = now;
   const shown = view.webrtc ? { width: view.video.videoWidth, height: view.video.videoHeight }
                             : { width: view.img.naturalWidth, height: view.img.naturalHeight };
   const width = shown.width || view.width, height = shown.height || view.height;
