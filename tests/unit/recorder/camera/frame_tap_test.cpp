@@ -4,18 +4,20 @@
 #include "camera/frame_tap.h"
 
 #include <gst/app/gstappsrc.h>
+#include <gst/check/gsttestclock.h>
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <chrono>
-#include <thread>
+
+#include "wait_for.h"
 
 namespace wircam::recorder {
 namespace {
 
-// appsrc ! SINK: a frame stamped 300 ms before it is pushed; the time the
-// tap says, against the wall clock when it was pushed.
+// appsrc ! SINK on a test clock: a frame stamped 300 ms of running time
+// before it is pushed; the time the tap says, against the wall clock when
+// it was pushed.
 int64_t lagOfTappedFrame(const char* sink, bool byPad) {
   std::string description = std::string("appsrc name=in is-live=true format=time ! ") + sink;
   GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
@@ -31,20 +33,24 @@ int64_t lagOfTappedFrame(const char* sink, bool byPad) {
   gst_object_unref(pad);
   std::atomic<int64_t> said = 0;
   tap.listen([&](GstSample* sample) { said = tap.wallTimeNs(sample); });
+  // The pipeline's time moves only when the test moves it: 400 ms of it
+  // run at once, and the frame was stamped at 100 ms.
+  GstClock* clock = gst_test_clock_new_with_start_time(GST_SECOND);
+  gst_pipeline_use_clock(GST_PIPELINE(pipeline), clock);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   gst_element_get_state(pipeline, nullptr, nullptr, GST_CLOCK_TIME_NONE);
-  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  gst_test_clock_advance_time(GST_TEST_CLOCK(clock), 400 * GST_MSECOND);
   GstBuffer* frame = gst_buffer_new_allocate(nullptr, 16, nullptr);
   GST_BUFFER_PTS(frame) = gst_element_get_current_running_time(pipeline) - 300 * GST_MSECOND;
   int64_t pushedNs = g_get_real_time() * 1000;
   gst_app_src_push_buffer(GST_APP_SRC(in), frame);
-  for (int i = 0; i < 200 && said == 0; ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  testing::waitFor([&] { return said != 0; });
   gst_element_set_state(pipeline, GST_STATE_NULL);
   tap.detach();
   gst_object_unref(in);
   gst_object_unref(out);
   gst_object_unref(pipeline);
+  gst_object_unref(clock);
   return said == 0 ? INT64_MIN : pushedNs - said;
 }
 

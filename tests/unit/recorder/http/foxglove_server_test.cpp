@@ -6,12 +6,13 @@
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <nlohmann/json.hpp>
-#include <thread>
 #include <vector>
 
 #include "common/h264_access_unit.h"
+#include "gst_h264_start.h"
 #include "main_loop_until.h"
 #include "websocket_test_client.h"
 
@@ -101,13 +102,21 @@ TEST(FoxgloveServer, AnH264SubscriberStartsOnAnIdrThoughIFramesComeBefore) {
   content.drivable = [](const std::string&) { return false; };
   auto server = FoxgloveServer::start({"", 0}, content, 10s);
   ASSERT_TRUE(server) << server.error();
+  // Frames since the encoder's last IDR, counted as they pass.
+  std::atomic<int> sinceIdr = -1;
+  int counting = encoded.listen([&](GstSample* sample) {
+    bool idr = gst::h264StartsDecoding(gst_sample_get_buffer(sample), gst_sample_get_caps(sample));
+    sinceIdr = idr ? 0 : sinceIdr < 0 ? -1 : sinceIdr + 1;
+  });
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   for (int round = 0; round < 3; ++round) {
     Client client((*server)->url());
     ASSERT_TRUE(runMainLoopUntil([&] { return !client.said("advertise").empty(); }));
     uint32_t image = client.said("advertise")[0]["channels"][0]["id"];
-    // Mid-way between two IDRs, a different way each round.
-    std::this_thread::sleep_for(std::chrono::milliseconds(150 + 270 * round));
+    // Between two IDRs, a different way each round.
+    int after = 3 + 4 * round;
+    ASSERT_TRUE(runMainLoopUntil([&] { return sinceIdr >= after && sinceIdr < after + 4; }, 3s))
+        << sinceIdr << " frames since the last IDR, round " << round;
     json subscribe = {{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", image}}}}};
     soup_websocket_connection_send_text(client.connection, subscribe.dump().c_str());
     ASSERT_TRUE(runMainLoopUntil([&] { return !client.binaries.empty(); }, 3s));
@@ -116,6 +125,7 @@ TEST(FoxgloveServer, AnH264SubscriberStartsOnAnIdrThoughIFramesComeBefore) {
     EXPECT_NE(first.find(std::string("\0\0\1\x67", 4)), std::string::npos) << "no SPS";
   }
   gst_element_set_state(pipeline, GST_STATE_NULL);
+  encoded.forget(counting);
   encoded.detach();
   gst_object_unref(pipeline);
 }
