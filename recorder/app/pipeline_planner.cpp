@@ -100,6 +100,8 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       StreamPlan stream;
       std::string& d = stream.description;
       stream.device = fileSafe(device.label);
+      stream.host = device.host;
+      stream.port = device.port;
       stream.camera = camera;
       stream.name = stream.device + "-cam" + std::to_string(camera);
       stream.source = "src";

@@ -107,6 +107,9 @@ std::optional<std::string> checkTogether(RecorderOptions& o) {
   if (o.follow && o.detectFamily.empty()) return std::string("--follow needs --detect FAMILY");
   if (o.mqttDiscovery && !o.mqtt)
     return std::string("--mqtt-discovery publishes to the MQTT broker: it needs --mqtt URL");
+  if ((o.fleet || !o.fleetUrl.empty()) && (!o.mqtt || !o.http))
+    return std::string(o.fleet ? "--fleet" : "--fleet-url") +
+           " works over the broker and the web server: it needs --mqtt URL and --http [HOST]:PORT";
   if (!o.mqttCaFile.empty() && (!o.mqtt || !parseMqttUrl(*o.mqtt)->tls))
     return std::string("--mqtt-cafile is for a TLS broker: --mqtt mqtts://HOST[:PORT]");
   if (o.httpCert.empty() != o.httpKey.empty())

@@ -105,6 +105,8 @@ struct RecorderOptions {
   std::optional<std::string> mqttDiscovery;
   double mqttSnapshotSeconds = 10;  // the camera entity's pictures
   std::string mqttPrefix = "wircam";
+  bool fleet = false;    // --fleet: the fleet directory (needs --mqtt and --http)
+  std::string fleetUrl;  // --fleet-url: the HTTP address announced, if not the listening one
   double mqttDetectionsRate = 0;             // per second and stream at most; 0 = every frame
   std::vector<std::string> onSegmentClosed;  // the command and its arguments
   double hookTimeoutSeconds = 600;

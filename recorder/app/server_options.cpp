@@ -200,6 +200,37 @@ std::vector<OptionSpec> serverOptionRows() {
          return std::nullopt;
        },
        .example = "2"},
+      {.name = "fleet",
+       .value = nullptr,
+       .fallback = "off",
+       .section = kFleet,
+       .help = "the page and `GET /api/fleet` show every recorder announced on the broker, with "
+               "its cameras and their vehicles; `GET /api/fleet/recordings` asks them all "
+               "([fleet.md](fleet.md))",
+       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
+         auto on = trueOrFalse(value);
+         if (!on) return "true or false";
+         o.fleet = *on;
+         return std::nullopt;
+       },
+       .example = "true",
+       .needs = {"mqtt", "mqtt://192.168.1.3", "http", ":8080"}},
+      {.name = "fleet-url",
+       .value = "URL",
+       .fallback = "the listening address",
+       .section = kFleet,
+       .help = "the HTTP address other recorders and browsers reach this one at, where the "
+               "listening one is not (NAT, a proxy): announced to the fleet; its host stands for "
+               "RTSP's and Foxglove's too",
+       .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
+         std::string url = value;
+         if (!(url.starts_with("http://") || url.starts_with("https://")) || url.size() < 9)
+           return "an http:// or https:// URL, as in http://rover-lab.example:8080/";
+         o.fleetUrl = url;
+         return std::nullopt;
+       },
+       .example = "http://recorder-a.lab:8080/",
+       .needs = {"mqtt", "mqtt://192.168.1.3", "http", ":8080"}},
       {.name = "on-segment-closed",
        .value = "CMD",
        .fallback = "none",

@@ -76,7 +76,11 @@ Supervisor::Supervisor(RecorderOptions options, Reread reread)
                 [this](Camera& camera, const nlohmann::json& applied) {
                   event(camera, applied);
                   publishFleetStatus(true);
-                }) {}
+                }),
+      vehicles_([this](const std::string&) {
+        announce();
+        publishFleetStatus(true);
+      }) {}
 
 Expected<std::unique_ptr<Supervisor>, std::string> Supervisor::create(
     const RecorderOptions& options, Reread reread) {
@@ -151,7 +155,8 @@ void Supervisor::segmentClosed(Camera& camera, const std::string& file,
               .startUtc = SegmentPlanner::isoUtc(planned.startUnixMs),
               .durationSeconds = planned.durationSeconds(),
               .frames = planned.frames,
-              .bytes = bytes});
+              .bytes = bytes,
+              .vehicle = toJson(vehicles_.of(camera.plan().device))});
   auto& totals = recorded_[camera.name()];
   ++totals.segmentsClosed;
   totals.frames += planned.frames;
@@ -184,6 +189,7 @@ void Supervisor::enforceRetention() {
 }
 
 void Supervisor::event(Camera& camera, const nlohmann::json& event) {
+  if (event.value("type", "") == "state" && event.value("state", "") == "live") identify(camera);
   if (foxglove_) foxglove_->log(camera.name(), eventText(event), g_get_real_time() / 1000);
   if (!fleet_) return;
   nlohmann::json line = event;
@@ -316,7 +322,9 @@ void Supervisor::perform(RunJob job) {
 
 void Supervisor::publishFleetStatus(bool force) {
   if (!fleet_) return;
-  for (const auto& c : cameras_) fleet_->status(c->name(), fleetStatusJson(c->report()), force);
+  for (const auto& c : cameras_)
+    fleet_->status(c->name(), withVehicle(fleetStatusJson(c->report()), *c), force);
+  if (g_get_monotonic_time() / 1000 - announcedAt_ >= kAnnounceIntervalMs) announce();
 }
 
 std::optional<std::pair<guint, std::string>> Supervisor::deleteSegment(const std::string& file) {
@@ -375,7 +383,8 @@ std::string Supervisor::rtspOf(const Camera& camera) const {
 
 nlohmann::json Supervisor::status() const {
   nlohmann::json streams = nlohmann::json::array();
-  for (const auto& c : cameras_) streams.push_back(statusJson(c->report(), rtspOf(*c)));
+  for (const auto& c : cameras_)
+    streams.push_back(withVehicle(statusJson(c->report(), rtspOf(*c)), *c));
   nlohmann::json result = {{"out", options_.outDir},
                            {"free_bytes", disk_.free()},
                            {"stopping", stopping_},

@@ -23,6 +23,7 @@
 #include "camera/camera.h"
 #include "common/expected.h"
 #include "fleet/fleet_publisher.h"
+#include "fleet/vehicle_identity.h"
 #include "live/live_servers.h"
 #include "record/disk_guard.h"
 #include "record/recording_index.h"
@@ -86,6 +87,14 @@ class Supervisor : CameraObserver {
   void perform(RunJob job);  // one job of the schedule
   void quitWhenAllEnded();
   void publishFleetStatus(bool force = false);
+  // The fleet (supervisor_fleet.cpp): a live device is asked who its
+  // vehicle is; the announcement says this recorder, its addresses and its
+  // cameras' vehicles, on change and every kAnnounceIntervalMs (when it was
+  // last seen, for a fleet that finds it offline).
+  static constexpr int64_t kAnnounceIntervalMs = 30000;
+  void identify(Camera& camera);
+  void announce();
+  nlohmann::json withVehicle(nlohmann::json entry, const Camera& camera) const;
   void publishFoxgloveStatus();  // each camera's /STREAM/telemetry, once a second
   void publishFoxglovePoses();   // each new position on /STREAM/pose
   // DELETE /api/recordings/FILE: the HTTP status and reason when it cannot.
@@ -117,6 +126,9 @@ class Supervisor : CameraObserver {
   std::unique_ptr<WebServer> http_;            // with --http
   std::unique_ptr<RtspService> rtsp_;          // with --rtsp
   std::unique_ptr<FleetPublisher> fleet_;      // with --mqtt
+  VehicleIdentities vehicles_;                 // by device label
+  std::string recorderId_;                     // with --mqtt (fleet/recorder_id.h)
+  int64_t announcedAt_ = 0;                    // monotonic ms
   std::unique_ptr<FoxgloveService> foxglove_;  // with --foxglove
   std::map<std::string, int64_t> posesSent_;   // by camera: the last position's time
   std::unique_ptr<SegmentHook> hook_;          // with --on-segment-closed

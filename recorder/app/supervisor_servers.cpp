@@ -3,6 +3,7 @@
 // and commands.
 #include "app/live_servers_module.h"
 #include "app/supervisor.h"
+#include "fleet/recorder_id.h"
 #include "log_line.h"
 #include "record/segment_planner.h"
 #include "status/camera_report.h"
@@ -43,6 +44,7 @@ void Supervisor::addToServers(Camera& camera) {
     logLine("RTSP at " + rtsp_->url() + mount.path);
   }
   if (fleet_) fleet_->setStreams(cameraNames());
+  announce();
 }
 
 void Supervisor::removeFromServers(Camera& camera) {
@@ -50,6 +52,7 @@ void Supervisor::removeFromServers(Camera& camera) {
   if (foxglove_) foxglove_->removeCamera(camera.name());
   if (rtsp_) rtsp_->removeCamera(rtspCameraOf(camera).path);
   if (fleet_) fleet_->setStreams(cameraNames());
+  announce();
 }
 
 std::optional<std::string> Supervisor::startServers() {
@@ -70,7 +73,7 @@ std::optional<std::string> Supervisor::startServers() {
     content.trails = [this] { return trails(); };
     content.cameraStates = [this] {
       nlohmann::json cameras = nlohmann::json::array();
-      for (const auto& c : cameras_) cameras.push_back(cameraJson(c->report()));
+      for (const auto& c : cameras_) cameras.push_back(withVehicle(cameraJson(c->report()), *c));
       return cameras;
     };
     content.deleteRecording = [this](const std::string& file) { return deleteSegment(file); };
@@ -82,6 +85,10 @@ std::optional<std::string> Supervisor::startServers() {
     content.openSegments = [this] { return openSegments(); };
     content.command = [this](const FleetCommand& c) { return commands_.apply(c, "web"); };
     content.reload = [this] { return reload(); };
+    if (options_.fleet)
+      content.fleet = [this] {
+        return fleet_ && fleet_->directory() ? fleet_->directory()->view() : nlohmann::json();
+      };
     content.drive = [this](const std::string& camera, double steering, double throttle) {
       return commands_.drive(camera, steering, throttle);
     };
@@ -103,6 +110,10 @@ std::optional<std::string> Supervisor::startServers() {
                                           .topicPrefix = options_.mqttPrefix,
                                           .version = WIRCAM_VERSION};
     for (auto& c : cameras_) settings.streams.push_back(c->name());
+    settings.fleet = options_.fleet;
+    auto id = recorderId(options_.outDir);
+    if (!id) return id.error();
+    recorderId_ = *id;
     auto fleet = FleetPublisher::start(
         settings, [this](const FleetCommand& c) { commands_.apply(c, "MQTT"); });
     if (!fleet) return fleet.error();
@@ -163,6 +174,7 @@ std::optional<std::string> Supervisor::startServers() {
     rtsp_ = std::move(*server);
     for (auto& camera : cameras) logLine("RTSP at " + rtsp_->url() + camera.path);
   }
+  announce();  // with every server's address known
   return std::nullopt;
 }
 

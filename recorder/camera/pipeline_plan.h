@@ -26,6 +26,8 @@ struct MuxerSpec {
 struct StreamPlan {
   std::string description;  // gst-launch syntax
   std::string device;       // the device's label, made safe for file names
+  std::string host;         // the device's control address (empty: found by discovery)
+  uint16_t port = 0;
   int camera = 0;
   std::string name;    // "<device>-cam<N>", also in file names and the live view
   std::string source;  // wircsrc

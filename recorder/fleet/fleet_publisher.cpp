@@ -76,6 +76,11 @@ void FleetPublisher::republish(MqttClient& client) {
     std::lock_guard lock(retainedMutex_);
     for (const auto& [stream, status] : retained_)
       client.publish(topic(stream, "status"), status, true);
+    if (!announcement_.empty()) client.publish(announcementTopic_, announcement_, true, 1);
+  }
+  if (settings_.fleet) {
+    client.subscribe(std::string(kFleetTopicRoot) + "+");
+    for (const auto& prefix : directory_.prefixes()) follow(client, prefix);
   }
   client.subscribe(settings_.prefix + "/+/follow/set");
   client.subscribe(settings_.prefix + "/+/target/set");
@@ -101,9 +106,25 @@ bool FleetPublisher::clearedStaleConfig(const std::string& topicName, const std:
   return true;
 }
 
+void FleetPublisher::follow(MqttClient& client, const std::string& prefix) {
+  client.subscribe(prefix + "/available");
+  client.subscribe(prefix + "/+/status");
+}
+
+bool FleetPublisher::fleetMessage(const std::string& topicName, const std::string& payload) {
+  if (!settings_.fleet) return false;
+  int64_t now = g_get_real_time() / 1000;
+  if (topicName.starts_with(kFleetTopicRoot)) {
+    if (auto prefix = directory_.announced(topicName, payload, now))
+      follow(*sessionClient_, *prefix);
+    return true;
+  }
+  return directory_.heard(topicName, payload, now);
+}
+
 void FleetPublisher::onMessage(const std::string& topicName, const std::string& payload,
                                bool retained) {
-  if (clearedStaleConfig(topicName, payload)) return;
+  if (clearedStaleConfig(topicName, payload) || fleetMessage(topicName, payload)) return;
   // PREFIX/STREAM/follow/set: the stream is the level after the prefix.
   std::string rest = topicName.substr(std::min(topicName.size(), settings_.prefix.size() + 1));
   auto slash = rest.find('/');
@@ -136,6 +157,17 @@ void FleetPublisher::onMessage(const std::string& topicName, const std::string& 
       },
       handed,
       [](gpointer data) { delete static_cast<std::pair<FleetPublisher*, FleetCommand>*>(data); });
+}
+
+void FleetPublisher::announce(const Announcement& announcement) {
+  std::string topicName = announcementTopic(announcement.id);
+  std::string text = toJson(announcement).dump();
+  {
+    std::lock_guard lock(retainedMutex_);
+    announcementTopic_ = topicName;
+    announcement_ = text;
+  }
+  client_->publish(topicName, text, true, 1);
 }
 
 void FleetPublisher::status(const std::string& stream, const nlohmann::json& status, bool force) {

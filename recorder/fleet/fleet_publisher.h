@@ -2,7 +2,8 @@
 // last will, each stream's retained status (on change, at least every 5 s),
 // its detections (rate-limited) and events, and the follow/target commands
 // it takes; with discovery, Home Assistant's configs and the snapshots its
-// camera entity shows. Everything here runs on the GLib main loop; commands arrive on
+// camera entity shows; the recorder's announcement to the fleet and, with
+// --fleet, the fleet's directory (fleet_directory.h). Everything here runs on the GLib main loop; commands arrive on
 // the MQTT client's thread and are handed over to it.
 #pragma once
 
@@ -19,7 +20,9 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "fleet/fleet_announcement.h"
 #include "fleet/fleet_command.h"
+#include "fleet/fleet_directory.h"
 #include "fleet/home_assistant.h"
 #include "fleet/mqtt_client.h"
 
@@ -36,6 +39,8 @@ class FleetPublisher {
     std::vector<std::string> streams;
     // Home Assistant's discovery (--mqtt-discovery), or none.
     std::optional<DiscoveryNames> discovery;
+    // --fleet: follow every recorder's announcement and statuses.
+    bool fleet = false;
   };
   // `apply` runs on the main loop for each valid live command.
   static Expected<std::unique_ptr<FleetPublisher>, std::string> start(
@@ -51,6 +56,10 @@ class FleetPublisher {
   void snapshot(const std::string& stream, const std::string& jpeg);
   // The cameras a reload left (Home Assistant's configs follow).
   void setStreams(const std::vector<std::string>& streams);
+  // Retained at wircam-fleet/recorders/ID, now and at each connection.
+  void announce(const Announcement& announcement);
+  // With --fleet: the fleet as the broker tells it; else null.
+  const FleetDirectory* directory() const { return settings_.fleet ? &directory_ : nullptr; }
   MqttClient::Stats stats() const { return client_->stats(); }
   bool connected() const { return client_->connected(); }
 
@@ -65,6 +74,11 @@ class FleetPublisher {
   std::string topic(const std::string& stream, const char* leaf) const;
   void onMessage(const std::string& topic, const std::string& payload, bool retained);
   void republish(MqttClient& client);
+  // Its availability and statuses: the fleet directory's view of it.
+  void follow(MqttClient& client, const std::string& prefix);
+  // A message of the fleet (announcements, others' availability and
+  // statuses), taken in; false when it is not one.
+  bool fleetMessage(const std::string& topic, const std::string& payload);
   // Whether the message was a discovery config (cleared if stale).
   bool clearedStaleConfig(const std::string& topic, const std::string& payload);
 
@@ -82,6 +96,8 @@ class FleetPublisher {
   // The retained statuses, for a new connection (guarded: the MQTT thread reads it).
   std::mutex retainedMutex_;
   std::map<std::string, std::string> retained_;
+  std::string announcementTopic_, announcement_;  // guarded likewise
+  FleetDirectory directory_;
 };
 
 }  // namespace wircam::recorder

@@ -9,6 +9,7 @@
 #include "http/camera_feed.h"
 #include "http/http_responses.h"
 #include "http/http_server.h"
+#include "record/recording_query.h"
 #include "record/telemetry_log.h"
 
 namespace wircam::recorder {
@@ -66,8 +67,13 @@ void HttpServer::deleteRecording(SoupServerMessage* message, const std::string& 
   respondJsonError(message, refused->first, refused->second);
 }
 
-void HttpServer::serveRecordingIndex(SoupServerMessage* message) {
-  nlohmann::json list = content_.recordings();
+void HttpServer::serveRecordingIndex(SoupServerMessage* message, GHashTable* query) {
+  auto asked = recordingQueryOf(queryValue(query, "camera"), queryValue(query, "vehicle"),
+                                queryValue(query, "day"));
+  if (!asked) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, asked.error());
+  nlohmann::json list = nlohmann::json::array();
+  for (auto& entry : content_.recordings())
+    if (matches(*asked, entry)) list.push_back(std::move(entry));
   for (auto& entry : list) {
     gchar* escaped = g_uri_escape_string(entry["file"].get<std::string>().c_str(), nullptr, FALSE);
     entry["url"] = std::string("/recordings/") + escaped;

@@ -27,6 +27,8 @@ Route routeOf(std::string_view path) {
   if (path == "/api/export") return {Kind::Export, ""};
   if (path == "/api/config/reload") return {Kind::ConfigReload, ""};
   if (path == "/metrics") return {Kind::Metrics, ""};
+  if (path == "/api/fleet") return {Kind::Fleet, ""};
+  if (path == "/api/fleet/recordings") return {Kind::FleetRecordings, ""};
   constexpr std::string_view kRecordingEntry = "/api/recordings/";
   if (path.starts_with(kRecordingEntry) && path.size() > kRecordingEntry.size())
     return {Kind::RecordingEntry, std::string(path.substr(kRecordingEntry.size()))};
@@ -93,6 +95,8 @@ const char* allowedMethods(Route::Kind kind) {
     case Kind::Drive:
     case Kind::Playback:
     case Kind::Export:
+    case Kind::Fleet:
+    case Kind::FleetRecordings:
       return "GET";
     case Kind::ApiNotFound:
     case Kind::NotFound:

@@ -28,6 +28,8 @@ struct Route {
     Export,          // GET /api/export?camera=&start=&end=&format=: a range as one file
     ConfigReload,    // POST /api/config/reload: the config file read again
     Metrics,         // GET /metrics: Prometheus's text format
+    Fleet,           // GET /api/fleet: every recorder of the fleet (--fleet)
+    FleetRecordings,  // GET /api/fleet/recordings?vehicle=&camera=&day=: theirs, merged
     ApiNotFound,     // any other /api/ path: 404 with JSON
     NotFound
   };

@@ -8,6 +8,7 @@
 #include "common/printable_text.h"
 #include "gst_scoped.h"
 #include "http/camera_feed.h"
+#include "http/cors.h"
 #include "http/http_connections.h"
 #include "http/http_responses.h"
 #include "http/http_routes.h"
@@ -86,6 +87,8 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
       [connections = self->connections_.get()](SoupServerMessage* message) {
         return connections->socketOf(message);
       });
+  self->fleetRecordings_ =
+      std::make_unique<FleetRecordings>(self->content_.fleet, self->content_.token);
   self->url_ = std::string(self->connections_->tls() ? "https://" : "http://") +
                address.listenHost() + ":" + std::to_string(self->connections_->port()) + "/";
 
@@ -217,6 +220,7 @@ HttpServer::~HttpServer() {
   release(eventClients_);
   release(playbackClients_);
   exports_.reset();       // before libsoup frees the messages it answers
+  fleetRecordings_.reset();
   webrtc_.reset();        // each viewer with a drive channel sends neutral
   driveSockets_.clear();  // each sends neutral and closes
   if (server_) {
@@ -240,7 +244,8 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* 
   auto* headers = soup_server_message_get_request_headers(message);
   bool hasBody = soup_message_headers_get_content_length(headers) > 0 ||
                  soup_message_headers_get_encoding(headers) == SOUP_ENCODING_CHUNKED;
-  bool known = method == "GET" || method == "HEAD" || method == "DELETE" || method == "POST";
+  bool known = method == "GET" || method == "HEAD" || method == "DELETE" || method == "POST" ||
+               method == "OPTIONS";
   if (known && !hasBody) return;
   // The one body taken: a WebRTC offer, its length given and bounded (read
   // by libsoup into memory, so never more than kMaxOfferBytes).
@@ -284,6 +289,12 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                            GHashTable* query, gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
   auto route = routeOf(path);
+  std::string method = soup_server_message_get_method(message);
+  if (sharedAcrossOrigins(route.kind)) {
+    // Another recorder's page (cors.h): its preflight carries no token.
+    if (method == "OPTIONS") return answerPreflight(message);
+    allowAnyOrigin(message);
+  }
   if (route.kind != Route::Kind::Login && !self->authorised(message)) {
     // Pages get the sign-in form; the API, streams and files a 401 in JSON.
     if (route.kind == Route::Kind::Page)
@@ -298,7 +309,6 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
                             "needs the access token: Authorization: Bearer T, or sign in at "
                             "/login");
   }
-  std::string method = soup_server_message_get_method(message);
   // (A HEAD allowed is served as its GET: libsoup leaves the body out.)
   if (const char* allowed = allowedMethods(route.kind); allowed && !methodAllowed(allowed, method))
     return respondMethodNotAllowed(
@@ -331,11 +341,18 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
     case Route::Kind::Snapshot:
       return self->serveSnapshot(message, route.name);
     case Route::Kind::RecordingIndex:
-      return self->serveRecordingIndex(message);
+      return self->serveRecordingIndex(message, query);
     case Route::Kind::Playback:
       return self->servePlayback(message, route.name, query);
     case Route::Kind::Export:
       return self->exports_->serve(message, query);
+    case Route::Kind::Fleet:
+      if (!self->content_.fleet)
+        return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
+                                "this recorder was not started with --fleet (and --mqtt)");
+      return respond(message, SOUP_STATUS_OK, "application/json", self->content_.fleet().dump());
+    case Route::Kind::FleetRecordings:
+      return self->fleetRecordings_->serve(message, query);
     case Route::Kind::Metrics:
       if (!self->content_.metrics)
         return respondError(message, SOUP_STATUS_NOT_FOUND, "no metrics");

@@ -22,6 +22,7 @@
 #include "fleet/fleet_command.h"
 #include "http/drive_socket.h"
 #include "http/export_downloads.h"
+#include "http/fleet_recordings.h"
 #include "http/http_connections.h"
 #include "http/http_routes.h"
 #include "live/live_servers.h"
@@ -74,7 +75,7 @@ class HttpServer : public WebServer {
   void serveLive(SoupServerMessage* message, const std::string& camera);
   void serveEvents(SoupServerMessage* message);
   void serveSnapshot(SoupServerMessage* message, const std::string& camera);
-  void serveRecordingIndex(SoupServerMessage* message);
+  void serveRecordingIndex(SoupServerMessage* message, GHashTable* query);
   void deleteRecording(SoupServerMessage* message, const std::string& name);
   void serveRecordings(SoupServerMessage* message, const std::string& name);
   void servePlayback(SoupServerMessage* message, const std::string& name, GHashTable* query);
@@ -109,6 +110,7 @@ class HttpServer : public WebServer {
   std::vector<std::unique_ptr<DriveSocket>> driveSockets_;
   std::unique_ptr<HttpConnections> connections_;
   std::unique_ptr<ExportDownloads> exports_;
+  std::unique_ptr<FleetRecordings> fleetRecordings_;
   std::unique_ptr<WebRtcService> webrtc_;                   // with --webrtc on
   std::string webrtcOff_ = "WebRTC is off (--webrtc off)";  // why, when it is
   // Frames queued for the main loop check it: the server may be gone.

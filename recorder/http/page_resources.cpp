@@ -36,6 +36,7 @@ std::string liveViewPage(const std::string& initialState) {
   put("DAY_TIMELINE_SCRIPT", pageFile("day_timeline.js"));
   put("CONTROL_SCRIPT", pageFile("control.js"));
   put("WEBRTC_SCRIPT", pageFile("webrtc_view.js"));
+  put("FLEET_SCRIPT", pageFile("fleet_view.js"));
   put("PAGE_SCRIPT", pageFile("live_view.js"));
   put("INITIAL_STATE", initialState);
   return html;

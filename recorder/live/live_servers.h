@@ -68,6 +68,9 @@ struct WebContent {
   // POST /api/config/reload: what changed ({added, removed, restarted,
   // unchanged}), or why nothing did.
   std::function<Expected<nlohmann::json, std::string>()> reload;
+  // With --fleet: GET /api/fleet's {"recorders": [...]} (fleet/fleet_directory.h),
+  // which GET /api/fleet/recordings asks; null without.
+  std::function<nlohmann::json()> fleet;
   // The WebRTC live view (WHEP at /api/cameras/NAME/whep), with these ICE
   // servers and each camera's VP8 rate.
   bool webrtc = false;

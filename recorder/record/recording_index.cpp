@@ -11,7 +11,8 @@ namespace fs = std::filesystem;
 nlohmann::json toJson(const IndexEntry& e) {
   return {{"camera", e.camera},      {"file", e.file},
           {"start_utc", e.startUtc}, {"duration_s", e.durationSeconds},
-          {"frames", e.frames},      {"bytes", e.bytes}};
+          {"frames", e.frames},      {"bytes", e.bytes},
+          {"vehicle", e.vehicle}};
 }
 
 namespace {
@@ -25,6 +26,8 @@ std::optional<IndexEntry> entryOf(const nlohmann::json& j) {
   e.durationSeconds = j.value("duration_s", 0.0);
   e.frames = j.value("frames", uint64_t{0});
   e.bytes = j.value("bytes", uint64_t{0});
+  if (auto vehicle = j.find("vehicle"); vehicle != j.end() && vehicle->is_object())
+    e.vehicle = *vehicle;
   return e;
 }
 

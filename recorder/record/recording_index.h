@@ -23,6 +23,8 @@ struct IndexEntry {
   double durationSeconds = 0;
   uint64_t frames = 0;
   uint64_t bytes = 0;
+  // The vehicle as the device named itself ({"name", "serial"}), or null.
+  nlohmann::json vehicle;
 };
 
 nlohmann::json toJson(const IndexEntry& entry);

@@ -250,5 +250,6 @@ function start() {
   // Twice a second: the trails follow the vehicles.
   setInterval(refreshStatus, 500);
   setInterval(refresh, 2000);
+  startFleet();
 }
 start();

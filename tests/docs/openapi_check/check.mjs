@@ -9,6 +9,7 @@
 import { spawn } from "node:child_process";
 import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import http from "node:http";
+import net from "node:net";
 import os from "node:os";
 import path from "node:path";
 import crypto from "node:crypto";
@@ -156,7 +157,9 @@ async function waitFor(what, condition, timeout = 30000) {
 const scratch = mkdtempSync(path.join(os.tmpdir(), "wircam-openapi-"));
 const children = [];
 function start(name, args) {
-  const child = spawn(path.join(binDir, name), args, {
+  // Ours from the build; others (the MQTT broker) from PATH.
+  const program = name.startsWith("wirc-") ? path.join(binDir, name) : name;
+  const child = spawn(program, args, {
     cwd: scratch,
     env: { ...process.env, GST_REGISTRY: path.join(scratch, "registry.bin") },
     stdio: ["ignore", "pipe", "pipe"],
@@ -184,13 +187,17 @@ try {
   const simPort = await waitFor("wirc-sim's port",
     () => sim.output.match(/listening on 127\.0\.0\.1:(\d+)/)?.[1]);
 
-  // A: with a token, following, WebRTC on. B: no token, WebRTC off.
+  // A: with a token, following, WebRTC on, in a fleet on a real mosquitto.
+  // B: no token, WebRTC off, no fleet.
+  const brokerPort = await freePort();
+  const broker = start("mosquitto", ["-p", String(brokerPort)]);
   // A's segment length comes from a config file, which a reload reads again.
   const configA = path.join(scratch, "a.ini");
   writeFileSync(configA, "[recorder]\nsegment=1\n");
   const a = start("wirc-recorder", ["--device", `127.0.0.1:${simPort}`, "--out", "a",
     "--config", configA, "--detect", "tag36h11", "--follow", "--http", "127.0.0.1:0",
-    "--http-token", token, "--duration", "110"]);
+    "--http-token", token, "--duration", "110", "--mqtt", `mqtt://127.0.0.1:${brokerPort}`,
+    "--mqtt-prefix", "openapi/a", "--fleet"]);
   const b = start("wirc-recorder", ["--device", `127.0.0.1:${simPort}`, "--out", "b",
     "--segment", "1", "--http", ":0", "--webrtc", "off", "--duration", "110"]);
   const urlA = await waitFor("recorder A's URL", () => a.output.match(/live view at (http:\/\/\S+\/)/)?.[1]);
@@ -374,6 +381,39 @@ try {
   await check("export, empty range", "GET",
     exportUrl(`camera=${enc(camera)}&format=mkv&start=2099-01-01T00:00:00Z`), { headers: bearer, expect: 404 });
 
+  // The index narrowed, and the fleet (A's, of itself alone).
+  await check("index of a vehicle", "GET", urlA + "api/recordings?vehicle=SIM0001&day=" +
+    toKeep.start_utc.slice(0, 10), { headers: bearer, expect: 200 });
+  await check("index, bad day", "GET", urlA + "api/recordings?day=2026-02-30", { headers: bearer, expect: 400 });
+  await waitFor("A in its fleet, with its vehicle", async () => {
+    const fleet = (await check("fleet", "GET", urlA + "api/fleet", { headers: bearer, expect: 200 })).json;
+    return fleet?.recorders?.[0]?.online && fleet.recorders[0].cameras[0]?.vehicle;
+  });
+  const history = (await check("fleet recordings", "GET", urlA + "api/fleet/recordings?vehicle=SIM0001",
+    { headers: bearer, expect: 200 })).json;
+  if (!history?.recordings?.length || !history.recordings[0].url.startsWith(urlA))
+    problem(`fleet recordings: none, or not at A: ${JSON.stringify(history).slice(0, 300)}`);
+  await check("fleet recordings, bad day", "GET", urlA + "api/fleet/recordings?day=tuesday",
+    { headers: bearer, expect: 400 });
+  await check("fleet, no token", "GET", urlA + "api/fleet", { expect: 401 });
+  // Another recorder's page reads these across origins (CORS).
+  const origin = { Origin: "http://other-recorder.example:8080" };
+  for (const url of [urlA + "api/fleet", urlA + "api/cameras", urlA + "api/status",
+    `${urlA}api/cameras/${enc(camera)}/snapshot.jpg`]) {
+    await check("preflight", "OPTIONS", url, {
+      headers: { ...origin, "Access-Control-Request-Method": "GET",
+                 "Access-Control-Request-Headers": "authorization" }, expect: 204 });
+    const read = await request("GET", url, { headers: { ...origin, ...bearer } });
+    if (read.headers["access-control-allow-origin"] !== "*")
+      problem(`GET ${new URL(url).pathname} from another origin: no Access-Control-Allow-Origin`);
+  }
+  const closed = await request("OPTIONS", urlA + "api/recordings", { headers: origin });
+  if (closed.headers["access-control-allow-origin"])
+    problem("OPTIONS /api/recordings: allowed across origins, which the page does not need");
+  await check("fleet recordings, no token", "GET", urlA + "api/fleet/recordings", { expect: 401 });
+  await check("B fleet, not one", "GET", urlB + "api/fleet", { expect: 404 });
+  await check("B fleet recordings, not one", "GET", urlB + "api/fleet/recordings", { expect: 404 });
+
   // Unknown API path: JSON 404 (not a path of the document)
   const unknown = await request("GET", urlA + "api/nothing", { headers: bearer });
   if (unknown.status !== 404 || mediaType(unknown.headers["content-type"]) !== "application/json")
@@ -429,7 +469,7 @@ try {
   // Every operation of the document was exercised at least once.
   for (const [template, item] of Object.entries(api.paths))
     for (const method of Object.keys(item))
-      if (["get", "head", "post", "delete", "put", "patch"].includes(method) &&
+      if (["get", "head", "post", "delete", "put", "patch", "options"].includes(method) &&
           ![...checked].some((c) => c.startsWith(`${method.toUpperCase()} ${template} `)))
         problem(`${method.toUpperCase()} ${template} was never checked`);
 } catch (error) {
@@ -448,6 +488,16 @@ await sleep(200);
 process.exit(exitCode);
 
 // --- helpers ----------------------------------------------------------------
+
+// A loopback port free now, for the broker.
+function freePort() {
+  return new Promise((resolve) => {
+    const server = net.createServer().listen(0, "127.0.0.1", () => {
+      const { port } = server.address();
+      server.close(() => resolve(port));
+    });
+  });
+}
 
 function sdpOffer() {
   const fingerprint = Array.from(crypto.randomBytes(32), (b) => b.toString(16).padStart(2, "0"))

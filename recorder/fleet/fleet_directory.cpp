@@ -1,0 +1,111 @@
+#include "fleet/fleet_directory.h"
+
+#include <algorithm>
+
+#include "record/segment_planner.h"
+
+namespace wircam::recorder {
+
+std::optional<std::string> FleetDirectory::announced(const std::string& topic,
+                                                      const std::string& payload,
+                                                      int64_t nowUnixMs) {
+  if (!topic.starts_with(kFleetTopicRoot)) return std::nullopt;
+  std::string id = topic.substr(std::string(kFleetTopicRoot).size());
+  std::lock_guard lock(mutex_);
+  if (payload.empty()) {
+    recorders_.erase(id);
+    return std::nullopt;
+  }
+  auto announcement = announcementOf(payload);
+  if (!announcement || announcement->id != id) return std::nullopt;
+  bool knownPrefix = std::any_of(recorders_.begin(), recorders_.end(), [&](const auto& r) {
+    return r.second.announcement.mqttPrefix == announcement->mqttPrefix;
+  });
+  auto& recorder = recorders_[id];
+  recorder.announcement = std::move(*announcement);
+  // A retained announcement is as old as it says; a fresh one is now.
+  recorder.lastSeenUnixMs = std::max(recorder.lastSeenUnixMs, recorder.announcement.seenUnixMs);
+  if (recorder.online) recorder.lastSeenUnixMs = nowUnixMs;
+  if (knownPrefix) return std::nullopt;
+  return recorder.announcement.mqttPrefix;
+}
+
+FleetDirectory::Recorder* FleetDirectory::ownerOf(const std::string& topic, std::string& rest) {
+  Recorder* owner = nullptr;
+  size_t longest = 0;
+  for (auto& [id, recorder] : recorders_) {
+    const auto& prefix = recorder.announcement.mqttPrefix;
+    if (prefix.size() > longest && topic.size() > prefix.size() && topic.starts_with(prefix) &&
+        topic[prefix.size()] == '/') {
+      owner = &recorder;
+      longest = prefix.size();
+    }
+  }
+  if (owner) rest = topic.substr(longest + 1);
+  return owner;
+}
+
+bool FleetDirectory::heard(const std::string& topic, const std::string& payload,
+                           int64_t nowUnixMs) {
+  std::lock_guard lock(mutex_);
+  std::string rest;
+  Recorder* recorder = ownerOf(topic, rest);
+  if (!recorder) return false;
+  if (rest == "available") {
+    bool online = payload == "online";
+    if (online || recorder->online) recorder->lastSeenUnixMs = nowUnixMs;
+    recorder->online = online;
+    return true;
+  }
+  auto slash = rest.find('/');
+  if (slash == std::string::npos || rest.substr(slash + 1) != "status") return false;
+  auto status = nlohmann::json::parse(payload, nullptr, false);
+  if (!status.is_object()) return false;
+  recorder->statuses[rest.substr(0, slash)] = std::move(status);
+  if (recorder->online) recorder->lastSeenUnixMs = nowUnixMs;
+  return true;
+}
+
+std::vector<std::string> FleetDirectory::prefixes() const {
+  std::lock_guard lock(mutex_);
+  std::vector<std::string> all;
+  for (const auto& [id, recorder] : recorders_)
+    if (std::find(all.begin(), all.end(), recorder.announcement.mqttPrefix) == all.end())
+      all.push_back(recorder.announcement.mqttPrefix);
+  return all;
+}
+
+nlohmann::json FleetDirectory::view() const {
+  std::lock_guard lock(mutex_);
+  std::vector<const Recorder*> ordered;
+  for (const auto& [id, recorder] : recorders_) ordered.push_back(&recorder);
+  std::stable_sort(ordered.begin(), ordered.end(), [](auto* a, auto* b) {
+    return a->announcement.host < b->announcement.host;
+  });
+  nlohmann::json recorders = nlohmann::json::array();
+  for (const Recorder* r : ordered) {
+    const auto& a = r->announcement;
+    nlohmann::json cameras = nlohmann::json::array();
+    for (const auto& c : a.cameras) {
+      nlohmann::json camera = {
+          {"name", c.name}, {"vehicle", toJson(c.vehicle)}, {"rtsp_path", c.rtspPath}};
+      auto status = r->statuses.find(c.name);
+      // What its recorder last said; a recorder offline says nothing now.
+      camera["state"] = r->online && status != r->statuses.end()
+                            ? status->second.value("state", "unknown")
+                            : "unknown";
+      camera["status"] = status != r->statuses.end() ? status->second : nlohmann::json();
+      cameras.push_back(std::move(camera));
+    }
+    nlohmann::json entry = toJson(a);
+    entry.erase("seen_utc");
+    entry.erase("seen_unix_ms");
+    entry["online"] = r->online;
+    entry["last_seen_utc"] = SegmentPlanner::isoUtc(r->lastSeenUnixMs);
+    entry["cameras"] = std::move(cameras);
+    recorders.push_back(std::move(entry));
+  }
+  return {{"recorders", recorders}};
+}
+
+}  // namespace wircam::recorder

@@ -1,0 +1,48 @@
+// The fleet as one recorder sees it (--fleet): every recorder announced on
+// the broker, online or when it was last seen, and its cameras' states from
+// their retained statuses. Fed from the MQTT client's thread, read from the
+// main loop's: thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/fleet_announcement.h"
+
+namespace wircam::recorder {
+
+class FleetDirectory {
+ public:
+  // A message on wircam-fleet/recorders/ID; the recorder's MQTT prefix when
+  // it is one not heard of before (its topics are then to be subscribed to).
+  // An empty payload forgets the recorder (a retired one, cleared by hand).
+  std::optional<std::string> announced(const std::string& topic, const std::string& payload,
+                                       int64_t nowUnixMs);
+  // A message under an announced recorder's prefix: PREFIX/available or
+  // PREFIX/STREAM/status. False when it is neither.
+  bool heard(const std::string& topic, const std::string& payload, int64_t nowUnixMs);
+
+  // The prefixes to subscribe to again after a new connection.
+  std::vector<std::string> prefixes() const;
+  // GET /api/fleet: {"recorders": [...]}, by host, then id.
+  nlohmann::json view() const;
+
+ private:
+  struct Recorder {
+    Announcement announcement;
+    bool online = false;
+    int64_t lastSeenUnixMs = 0;
+    std::map<std::string, nlohmann::json> statuses;  // by camera
+  };
+  Recorder* ownerOf(const std::string& topic, std::string& rest);
+
+  mutable std::mutex mutex_;
+  std::map<std::string, Recorder> recorders_;  // by id
+};
+
+}  // namespace wircam::recorder

@@ -1,0 +1,261 @@
+// A fleet as users set one up: three wirc-recorder processes on loopback,
+// one real mosquitto, four simulated vehicles each with its own name and
+// serial. One vehicle moves from the first recorder to the second by
+// reloads mid-drive. The third recorder (--fleet) sees every recorder and
+// camera with its vehicle, its one history across the two that recorded
+// it, and a recorder killed with SIGKILL as offline, named in the history
+// as not answering while the others answer on. Its page, in Chromium, shows
+// every camera of the fleet with a live picture fetched from the recorder
+// that holds it, and the killed recorder as offline.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "devices/wirc/device.h"
+#include "devtools_page.h"
+#include "headless_chromium.h"
+#include "http_fetch.h"
+#include "jpeg_sequence_scene.h"
+#include "mqtt_broker.h"
+#include "recorder_process.h"
+#include "scene_frames.h"
+#include "signed_in_page.h"
+#include "wait_for.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam;
+using namespace wircam::testing;
+using namespace std::chrono_literals;
+using Json = nlohmann::json;
+
+const Headers kAuthorized = {{"Authorization", std::string("Bearer ") + kToken}};
+
+std::unique_ptr<wirc::Device> startVehicle(const std::string& name, const std::string& serial) {
+  auto device = wirc::Device::start(
+      {.port = 0, .name = name, .serial = serial, .fps = 15, .fragmentSize = 8000},
+      std::make_shared<sim::JpegSequenceScene>(sceneFrames()));
+  return device ? std::move(*device) : nullptr;
+}
+
+Json getJson(const std::string& url) {
+  auto response = fetch(url, "GET", kAuthorized);
+  return response.status == 200 ? Json::parse(response.body, nullptr, false) : Json();
+}
+
+// A recorder of the fleet: its devices in a config file ([device NAME]
+// groups, rewritten for a reload), its servers on the command line.
+class Member {
+ public:
+  Member(const fs::path& folder, const std::string& name, const MosquittoBroker& broker,
+         const std::map<std::string, uint16_t>& devices, bool fleet = false)
+      : config_(folder / (name + ".ini")), out_(folder / name) {
+    write(devices);
+    std::vector<std::string> args = {"--config",      config_.string(),  "--http",
+                                     "127.0.0.1:0",   "--http-token",    kToken,
+                                     "--mqtt",        broker.url(),      "--mqtt-prefix",
+                                     "fleet/" + name, "--webrtc",        "off"};
+    if (fleet) args.push_back("--fleet");
+    process_ = std::make_unique<RecorderProcess>(0, args);
+    if (auto url = process_->waitForLog("http://", 10s)) url_ = *url;
+  }
+  void write(const std::map<std::string, uint16_t>& devices) {
+    std::ofstream file(config_);
+    file << "[recorder]\nout=" << out_.string() << "\nsegment=2\n";
+    for (const auto& [name, port] : devices)
+      file << "[device " << name << "]\nhost=127.0.0.1\nport=" << port << "\n";
+  }
+  // Rewrites the config and reloads (SIGHUP), as an operator would.
+  void reload(const std::map<std::string, uint16_t>& devices) {
+    write(devices);
+    process_->signal(SIGHUP);
+  }
+  const std::string& url() const { return url_; }
+  RecorderProcess& process() { return *process_; }
+  std::string id() const {
+    std::ifstream in(out_ / ".wircam-recorder-id");
+    std::string id;
+    std::getline(in, id);
+    return id;
+  }
+
+ private:
+  fs::path config_, out_;
+  std::unique_ptr<RecorderProcess> process_;
+  std::string url_;
+};
+
+// The recorders of GET /api/fleet by id.
+std::map<std::string, Json> recordersOf(const Json& fleet) {
+  std::map<std::string, Json> byId;
+  if (fleet.is_object())
+    for (const auto& r : fleet.value("recorders", Json::array())) byId[r.value("id", "")] = r;
+  return byId;
+}
+
+// Every camera of the fleet live, with the vehicle its device named.
+bool allLiveWithVehicles(const Json& fleet, size_t recorders, size_t cameras) {
+  auto byId = recordersOf(fleet);
+  size_t live = 0;
+  for (const auto& [id, r] : byId) {
+    if (!r["online"].get<bool>()) return false;
+    for (const auto& c : r["cameras"])
+      live += c["state"] == "live" && c["vehicle"].is_object() ? 1 : 0;
+  }
+  return byId.size() == recorders && live == cameras;
+}
+
+// The spans the merged history leaves without a recording, in seconds,
+// between its first start and its last end.
+double longestHole(const Json& recordings) {
+  std::vector<std::pair<double, double>> spans;
+  for (const auto& r : recordings) {
+    GDateTime* start = g_date_time_new_from_iso8601(r["start_utc"].get<std::string>().c_str(),
+                                                    nullptr);
+    double from = g_date_time_to_unix(start) + g_date_time_get_microsecond(start) / 1e6;
+    g_date_time_unref(start);
+    spans.emplace_back(from, from + r["duration_s"].get<double>());
+  }
+  std::sort(spans.begin(), spans.end());
+  double hole = 0, reached = spans.empty() ? 0 : spans[0].second;
+  for (const auto& [from, to] : spans) {
+    hole = std::max(hole, from - reached);
+    reached = std::max(reached, to);
+  }
+  return hole;
+}
+
+TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledOneShowsOffline) {
+  MosquittoBroker broker;
+  ASSERT_TRUE(broker.running());
+  std::map<std::string, std::unique_ptr<wirc::Device>> cars;
+  for (int n = 1; n <= 4; ++n) {
+    cars["car" + std::to_string(n)] = startVehicle("car-" + std::to_string(n), "S" + std::to_string(n));
+    ASSERT_TRUE(cars["car" + std::to_string(n)]);
+  }
+  auto port = [&](const char* car) { return cars[car]->port(); };
+  fs::path folder = fs::temp_directory_path() / ("wircam-fleet-" + std::to_string(getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+
+  Member first(folder, "first", broker, {{"car1", port("car1")}, {"car2", port("car2")}});
+  Member second(folder, "second", broker, {{"car3", port("car3")}});
+  Member third(folder, "third", broker, {{"car4", port("car4")}}, true);
+  for (Member* m : {&first, &second, &third})
+    ASSERT_FALSE(m->url().empty()) << m->process().log();
+
+  // The fleet as the third recorder sees it: three recorders, four live
+  // cameras, each with its vehicle.
+  Json fleet;
+  ASSERT_TRUE(waitFor([&] {
+    fleet = getJson(third.url() + "api/fleet");
+    return allLiveWithVehicles(fleet, 3, 4);
+  }, 20s)) << fleet.dump(1) << "\n" << third.process().log();
+  auto byId = recordersOf(fleet);
+  ASSERT_TRUE(byId.contains(first.id()) && byId.contains(second.id()) && byId.contains(third.id()));
+  EXPECT_EQ(byId[first.id()]["urls"]["http"], first.url());
+  EXPECT_EQ(byId[first.id()]["mqtt_prefix"], "fleet/first");
+  std::set<std::string> serials;
+  for (const auto& [id, r] : byId)
+    for (const auto& c : r["cameras"]) serials.insert(c["vehicle"]["serial"].get<std::string>());
+  EXPECT_EQ(serials, (std::set<std::string>{"S1", "S2", "S3", "S4"}));
+  // The fleet on the third recorder's page: every camera with a picture
+  // from its own recorder.
+  std::unique_ptr<DevToolsPage> page;
+  if (chromiumInstalled()) {
+    page = DevToolsPage::launch(shotPath("fleet-page"), 1000, 1400);
+    ASSERT_TRUE(page);
+    ASSERT_TRUE(page->setCookie("wircam_token", kToken, third.url()));
+    ASSERT_TRUE(page->navigate(third.url()));
+    const std::string pictures =
+        "[...document.querySelectorAll('.fleet-camera[data-state=live] img')]"
+        ".filter(i => i.naturalWidth > 0).length";
+    EXPECT_TRUE(page->waitUntil(pictures + " === 4", 20s)) << page->evaluate(pictures);
+    EXPECT_EQ(page->evaluate("document.querySelectorAll('.fleet-recorder[data-online=true]').length"),
+              3);
+    page->evaluate("document.getElementById('fleet').scrollIntoView()");
+    page->screenshot(shotPath("fleet-page.png"));
+  }
+  // A recorder without --fleet says so.
+  EXPECT_EQ(fetch(first.url() + "api/fleet", "GET", kAuthorized).status, 404u);
+
+  // car2 drives from the first recorder to the second: the second takes it
+  // on (a reload), then the first lets it go (another).
+  auto recordedOf = [&](Member& m, const char* vehicle) {
+    return getJson(m.url() + "api/recordings?vehicle=" + vehicle);
+  };
+  ASSERT_TRUE(waitFor([&] { return recordedOf(first, "S2").size() >= 2; }, 20s));
+  second.reload({{"car3", port("car3")}, {"car2", port("car2")}});
+  ASSERT_TRUE(waitFor([&] { return recordedOf(second, "car-2").size() >= 1; }, 20s))
+      << second.process().log();
+  first.reload({{"car1", port("car1")}});
+  ASSERT_TRUE(first.process().waitForText("1 removed", 20s)) << first.process().log();
+  ASSERT_TRUE(waitFor([&] { return recordedOf(second, "S2").size() >= 3; }, 20s));
+
+  // Its one history, merged by time from both recorders, without a hole.
+  Json history;
+  ASSERT_TRUE(waitFor([&] {
+    history = getJson(third.url() + "api/fleet/recordings?vehicle=S2");
+    std::set<std::string> from;
+    for (const auto& r : history.value("recordings", Json::array()))
+      from.insert(r["recorder"].get<std::string>());
+    return from == std::set<std::string>{first.id(), second.id()};
+  }, 20s)) << history.dump(1);
+  const auto& recordings = history["recordings"];
+  for (size_t i = 1; i < recordings.size(); ++i)
+    EXPECT_LE(recordings[i - 1]["start_utc"], recordings[i]["start_utc"]);
+  EXPECT_LT(longestHole(recordings), 1.0) << history.dump(1);
+  for (const auto& r : recordings) {
+    EXPECT_EQ(r["vehicle"]["serial"], "S2");
+    // Each entry's URL is its own recorder's, and serves the file.
+    std::string url = r["url"];
+    std::string owner = r["recorder"] == first.id() ? first.url() : second.url();
+    EXPECT_TRUE(url.starts_with(owner)) << url;
+  }
+  auto file = fetch(recordings[0]["url"].get<std::string>(), "GET",
+                    {{"Authorization", std::string("Bearer ") + kToken}, {"Range", "bytes=0-3"}});
+  EXPECT_EQ(file.status, 206u);
+  EXPECT_EQ(file.body, std::string("\x1a\x45\xdf\xa3", 4));  // Matroska's EBML magic
+
+  // The second recorder killed: offline within MQTT's keepalive (the broker
+  // sees the socket go at once; a cut network would take 1.5 keepalives),
+  // named in the history as not answering; the first answers on.
+  second.process().signal(SIGKILL);
+  ASSERT_TRUE(waitFor([&] {
+    fleet = getJson(third.url() + "api/fleet");
+    auto now = recordersOf(fleet);
+    return now.contains(second.id()) && now[second.id()]["online"] == false;
+  }, 20s)) << fleet.dump(1);
+  EXPECT_EQ(recordersOf(fleet)[first.id()]["online"], true);
+  if (page) {
+    EXPECT_TRUE(page->waitUntil("document.querySelector('.fleet-recorder[data-id=\"" + second.id() +
+                                "\"]').dataset.online === 'false'"));
+    page->screenshot(shotPath("fleet-page-offline.png"));
+  }
+  history = getJson(third.url() + "api/fleet/recordings?vehicle=S2");
+  bool secondNamed = false;
+  for (const auto& r : history["recorders"]) {
+    if (r["id"] == second.id()) {
+      secondNamed = true;
+      EXPECT_EQ(r["answered"], false);
+      EXPECT_TRUE(r["error"].get<std::string>().starts_with("offline since")) << r.dump();
+    }
+    if (r["id"] == first.id()) {
+      EXPECT_EQ(r["answered"], true);
+    }
+  }
+  EXPECT_TRUE(secondNamed) << history.dump(1);
+  for (const auto& r : history["recordings"]) EXPECT_EQ(r["recorder"], first.id());
+  EXPECT_FALSE(history["recordings"].empty());
+  // A day that is not one is refused, as on one recorder.
+  EXPECT_EQ(fetch(third.url() + "api/fleet/recordings?day=2026-02-30", "GET", kAuthorized).status,
+            400u);
+  fs::remove_all(folder);
+}
+
+}  // namespace

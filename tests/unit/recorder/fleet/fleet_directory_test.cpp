@@ -1,0 +1,142 @@
+// The fleet as a recorder sees it from the broker's messages (announcements,
+// availability, statuses), and the announcement's own form and addresses.
+#include "fleet/fleet_directory.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "fleet/recorder_id.h"
+
+namespace {
+
+using namespace wircam::recorder;
+using Json = nlohmann::json;
+
+Announcement recorderOf(const std::string& id, const std::string& prefix,
+                        const std::string& camera, int64_t seen) {
+  return {.id = id,
+          .host = "node-" + id,
+          .version = "1.0",
+          .mqttPrefix = prefix,
+          .http = "http://10.0.0.1:8080/",
+          .cameras = {{camera, VehicleIdentity{"car-7", "S7"}, "/rover/cam0"}},
+          .seenUnixMs = seen};
+}
+
+TEST(FleetAnnouncement, SaysWhatItParsesBack) {
+  auto sent = recorderOf("a1", "lab/a", "rover-cam0", 1'700'000'000'000);
+  auto back = announcementOf(toJson(sent).dump());
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->id, "a1");
+  EXPECT_EQ(back->mqttPrefix, "lab/a");
+  EXPECT_EQ(back->http, "http://10.0.0.1:8080/");
+  ASSERT_EQ(back->cameras.size(), 1u);
+  EXPECT_EQ(back->cameras[0].vehicle, (VehicleIdentity{"car-7", "S7"}));
+  EXPECT_EQ(back->seenUnixMs, 1'700'000'000'000);
+  EXPECT_EQ(announcementTopic("a1"), "wircam-fleet/recorders/a1");
+}
+
+TEST(FleetAnnouncement, RefusesWhatIsNotOne) {
+  EXPECT_FALSE(announcementOf("not json"));
+  EXPECT_FALSE(announcementOf("[1,2]"));
+  EXPECT_FALSE(announcementOf(R"({"id":"a1"})"));  // no prefix: its topics unknown
+  auto odd = announcementOf(R"({"id":"a1","mqtt_prefix":"p","cameras":[7,{"name":3},{"name":"c"}],
+                                "urls":"no","seen_unix_ms":"soon"})");
+  ASSERT_TRUE(odd);
+  ASSERT_EQ(odd->cameras.size(), 1u);  // the one camera that is one
+  EXPECT_FALSE(odd->cameras[0].vehicle);
+  EXPECT_EQ(odd->seenUnixMs, 0);
+}
+
+TEST(FleetAnnouncement, AddressesOthersCanReach) {
+  // A wildcard listening address is this machine's name; --fleet-url wins,
+  // and its host stands for the other servers'.
+  EXPECT_EQ(fleetHttpUrl("http://0.0.0.0:8080/", "", "node-a"), "http://node-a:8080/");
+  EXPECT_EQ(fleetHttpUrl("http://127.0.0.1:8080/", "", "node-a"), "http://127.0.0.1:8080/");
+  EXPECT_EQ(fleetHttpUrl("http://0.0.0.0:8080/", "https://cars.example/rec-a", "node-a"),
+            "https://cars.example/rec-a/");
+  EXPECT_EQ(fleetServiceUrl("rtsp://0.0.0.0:8554", "https://cars.example:9443/", "node-a"),
+            "rtsp://cars.example:8554");
+  EXPECT_EQ(fleetServiceUrl("ws://[::]:8765/", "", "node-a"), "ws://node-a:8765/");
+  EXPECT_EQ(fleetServiceUrl("", "", "node-a"), "");
+}
+
+TEST(FleetDirectory, ARecorderIsOnlineFromItsAvailabilityWithItsCamerasStates) {
+  FleetDirectory fleet;
+  auto said = toJson(recorderOf("a1", "lab/a", "rover-cam0", 1000)).dump();
+  // New: its prefix is to be followed, once.
+  EXPECT_EQ(fleet.announced("wircam-fleet/recorders/a1", said, 5000), "lab/a");
+  EXPECT_EQ(fleet.announced("wircam-fleet/recorders/a1", said, 6000), std::nullopt);
+  auto view = fleet.view()["recorders"];
+  ASSERT_EQ(view.size(), 1u);
+  EXPECT_EQ(view[0]["online"], false);  // until it says online
+  EXPECT_EQ(view[0]["cameras"][0]["state"], "unknown");
+
+  EXPECT_TRUE(fleet.heard("lab/a/available", "online", 7000));
+  EXPECT_TRUE(fleet.heard("lab/a/rover-cam0/status", R"({"state":"live","fps":15})", 8000));
+  EXPECT_FALSE(fleet.heard("lab/a/rover-cam0/follow/set", "ON", 8000));  // a command: not ours
+  EXPECT_FALSE(fleet.heard("lab/b/available", "online", 8000));          // nobody announced
+  view = fleet.view()["recorders"];
+  EXPECT_EQ(view[0]["online"], true);
+  EXPECT_EQ(view[0]["cameras"][0]["state"], "live");
+  EXPECT_EQ(view[0]["cameras"][0]["vehicle"]["serial"], "S7");
+  EXPECT_EQ(view[0]["last_seen_utc"], "1970-01-01T00:00:08.000Z");
+
+  // Its last will: offline, last seen when it went; what it said stays.
+  EXPECT_TRUE(fleet.heard("lab/a/available", "offline", 9000));
+  EXPECT_TRUE(fleet.heard("lab/a/rover-cam0/status", R"({"state":"live"})", 20000));
+  view = fleet.view()["recorders"];
+  EXPECT_EQ(view[0]["online"], false);
+  EXPECT_EQ(view[0]["last_seen_utc"], "1970-01-01T00:00:09.000Z");
+  EXPECT_EQ(view[0]["cameras"][0]["state"], "unknown");
+  EXPECT_EQ(view[0]["cameras"][0]["status"]["state"], "live");
+}
+
+TEST(FleetDirectory, ARetainedAnnouncementOfADeadRecorderSaysWhenItWasSeen) {
+  FleetDirectory fleet;
+  fleet.announced("wircam-fleet/recorders/a1",
+                  toJson(recorderOf("a1", "lab/a", "rover-cam0", 42'000)).dump(), 99'000);
+  fleet.heard("lab/a/available", "offline", 99'500);
+  auto recorder = fleet.view()["recorders"][0];
+  EXPECT_EQ(recorder["online"], false);
+  EXPECT_EQ(recorder["last_seen_utc"], "1970-01-01T00:00:42.000Z");
+}
+
+TEST(FleetDirectory, TopicsGoToTheRecorderWithTheLongestPrefixAndAnEmptyAnnouncementForgets) {
+  FleetDirectory fleet;
+  fleet.announced("wircam-fleet/recorders/a", toJson(recorderOf("a", "lab", "x-cam0", 1)).dump(),
+                  1);
+  fleet.announced("wircam-fleet/recorders/b",
+                  toJson(recorderOf("b", "lab/b", "y-cam0", 1)).dump(), 1);
+  fleet.heard("lab/b/available", "online", 2);
+  fleet.heard("lab/available", "offline", 2);
+  auto view = fleet.view()["recorders"];
+  ASSERT_EQ(view.size(), 2u);
+  for (const auto& r : view) EXPECT_EQ(r["online"], r["id"] == "b") << r.dump();
+  EXPECT_EQ(fleet.prefixes().size(), 2u);
+  // One announced under another's id, or not an announcement, is ignored.
+  fleet.announced("wircam-fleet/recorders/c", toJson(recorderOf("a", "x", "z", 1)).dump(), 3);
+  fleet.announced("wircam-fleet/recorders/d", "garbage", 3);
+  EXPECT_EQ(fleet.view()["recorders"].size(), 2u);
+  fleet.announced("wircam-fleet/recorders/a", "", 4);  // cleared by hand: retired
+  EXPECT_EQ(fleet.view()["recorders"].size(), 1u);
+}
+
+TEST(RecorderId, IsMadeOnceAndKeptBesideTheRecordings) {
+  auto folder = std::filesystem::temp_directory_path() / ("recorder-id-" + std::to_string(getpid()));
+  std::filesystem::create_directories(folder);
+  auto first = recorderId(folder);
+  ASSERT_TRUE(first) << first.error();
+  EXPECT_EQ(first->size(), 36u);  // a UUID
+  EXPECT_EQ(*recorderId(folder), *first);
+  std::ofstream(folder / kRecorderIdFile) << "a/b#\n";  // a topic level it cannot be
+  auto refused = recorderId(folder);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().find(kRecorderIdFile), std::string::npos);
+  std::filesystem::remove_all(folder);
+}
+
+}  // namespace
