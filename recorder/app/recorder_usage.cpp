@@ -69,6 +69,10 @@ MQTT topics (PREFIX/STREAM, STREAM as in the file names):
   PREFIX/STREAM/snapshot    with --mqtt-discovery: the newest JPEG, retained
   PREFIX/STREAM/follow/set  ON or OFF (takes effect at once; OFF = neutral)
   PREFIX/STREAM/target/set  a tag id (-1: the largest)
+  wircam-fleet/recorders/ID this recorder's announcement, retained (fleet.md)
+  wircam-fleet/vehicles/SERIAL/follow/set, .../target/set
+                            the same commands for a vehicle by its serial,
+                            obeyed by the recorder that holds it
 
 Exit status: 0 finished cleanly (or stopped by a signal before any frame),
 1 error (or --duration ended with nothing recorded), 2 bad arguments, 3 the

@@ -16,6 +16,11 @@
 namespace wircam::recorder {
 
 inline constexpr const char* kFleetTopicRoot = "wircam-fleet/recorders/";
+// Commands for a vehicle, by its serial, whichever recorder holds it:
+// wircam-fleet/vehicles/SERIAL/follow/set and .../target/set (mqtt.md's
+// payloads). The recorder whose camera sees the vehicle obeys; the others
+// are silent.
+inline constexpr const char* kVehicleTopicRoot = "wircam-fleet/vehicles/";
 
 struct AnnouncedCamera {
   std::string name;  // the stream, "<device>-cam<N>": unique within its recorder only

@@ -84,6 +84,8 @@ void FleetPublisher::republish(MqttClient& client) {
   }
   client.subscribe(settings_.prefix + "/+/follow/set");
   client.subscribe(settings_.prefix + "/+/target/set");
+  client.subscribe(std::string(kVehicleTopicRoot) + "+/follow/set");
+  client.subscribe(std::string(kVehicleTopicRoot) + "+/target/set");
   if (settings_.discovery) {
     for (const auto& stream : streamNames())
       for (const auto& [configTopic, config] : discoveryConfigs(*settings_.discovery, stream))
@@ -125,11 +127,20 @@ bool FleetPublisher::fleetMessage(const std::string& topicName, const std::strin
 void FleetPublisher::onMessage(const std::string& topicName, const std::string& payload,
                                bool retained) {
   if (clearedStaleConfig(topicName, payload) || fleetMessage(topicName, payload)) return;
-  // PREFIX/STREAM/follow/set: the stream is the level after the prefix.
-  std::string rest = topicName.substr(std::min(topicName.size(), settings_.prefix.size() + 1));
+  // PREFIX/STREAM/follow/set: the stream is the level after the prefix;
+  // wircam-fleet/vehicles/SERIAL/follow/set: the vehicle's steering camera.
+  bool forVehicle = topicName.starts_with(kVehicleTopicRoot);
+  size_t root = forVehicle ? std::string(kVehicleTopicRoot).size() : settings_.prefix.size() + 1;
+  std::string rest = topicName.substr(std::min(topicName.size(), root));
   auto slash = rest.find('/');
   std::string stream = rest.substr(0, slash);
   std::string command = slash == std::string::npos ? "" : rest.substr(slash + 1);
+  if (forVehicle) {
+    std::lock_guard lock(retainedMutex_);
+    auto held = vehicleStreams_.find(stream);
+    if (held == vehicleStreams_.end()) return;  // another recorder's vehicle, or none
+    stream = held->second;
+  }
   if (retained) {
     // A command is an act, not a state: one left retained would replay at
     // every restart.
@@ -166,6 +177,11 @@ void FleetPublisher::announce(const Announcement& announcement) {
     std::lock_guard lock(retainedMutex_);
     announcementTopic_ = topicName;
     announcement_ = text;
+    // Each vehicle's first camera here: the one whose wirccontrol steers it.
+    vehicleStreams_.clear();
+    for (const auto& camera : announcement.cameras)
+      if (camera.vehicle && !camera.vehicle->serial.empty())
+        vehicleStreams_.emplace(camera.vehicle->serial, camera.name);
   }
   client_->publish(topicName, text, true, 1);
 }

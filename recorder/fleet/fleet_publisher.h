@@ -2,7 +2,8 @@
 // last will, each stream's retained status (on change, at least every 5 s),
 // its detections (rate-limited) and events, and the follow/target commands
 // it takes; with discovery, Home Assistant's configs and the snapshots its
-// camera entity shows; the recorder's announcement to the fleet and, with
+// camera entity shows; the fleet's vehicle commands for the vehicles it
+// holds; the recorder's announcement to the fleet and, with
 // --fleet, the fleet's directory (fleet_directory.h). Everything here runs on the GLib main loop; commands arrive on
 // the MQTT client's thread and are handed over to it.
 #pragma once
@@ -97,6 +98,7 @@ class FleetPublisher {
   std::mutex retainedMutex_;
   std::map<std::string, std::string> retained_;
   std::string announcementTopic_, announcement_;  // guarded likewise
+  std::map<std::string, std::string> vehicleStreams_;  // serial → its steering camera; likewise
   FleetDirectory directory_;
 };
 

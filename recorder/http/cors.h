@@ -4,7 +4,9 @@
 // carry Access-Control-Allow-Origin: * on every answer (401s included, so
 // the page can tell a refused token from an unreachable recorder). `*` lets
 // no cookie through (there is no Allow-Credentials): a page of another
-// origin reads them only with the token itself.
+// origin reads them only with the token itself. So only a recorder with a
+// token shares them: one without (on 127.0.0.1 alone) would otherwise show
+// its cameras to any web site its user's browser opens.
 #pragma once
 
 #include <libsoup/soup.h>

@@ -290,7 +290,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
   auto* self = static_cast<HttpServer*>(data);
   auto route = routeOf(path);
   std::string method = soup_server_message_get_method(message);
-  if (sharedAcrossOrigins(route.kind)) {
+  if (sharedAcrossOrigins(route.kind) && !self->content_.token.empty()) {
     // Another recorder's page (cors.h): its preflight carries no token.
     if (method == "OPTIONS") return answerPreflight(message);
     allowAnyOrigin(message);

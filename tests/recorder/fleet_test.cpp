@@ -6,7 +6,8 @@
 // it, and a recorder killed with SIGKILL as offline, named in the history
 // as not answering while the others answer on. Its page, in Chromium, shows
 // every camera of the fleet with a live picture fetched from the recorder
-// that holds it, and the killed recorder as offline.
+// that holds it, and the killed recorder as offline. A command for the
+// moved vehicle, by its serial, reaches the recorder that holds it now.
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -53,8 +54,9 @@ Json getJson(const std::string& url) {
 class Member {
  public:
   Member(const fs::path& folder, const std::string& name, const MosquittoBroker& broker,
-         const std::map<std::string, uint16_t>& devices, bool fleet = false)
-      : config_(folder / (name + ".ini")), out_(folder / name) {
+         const std::map<std::string, uint16_t>& devices, bool fleet = false,
+         std::string settings = "")
+      : config_(folder / (name + ".ini")), out_(folder / name), settings_(std::move(settings)) {
     write(devices);
     std::vector<std::string> args = {"--config",      config_.string(),  "--http",
                                      "127.0.0.1:0",   "--http-token",    kToken,
@@ -66,7 +68,7 @@ class Member {
   }
   void write(const std::map<std::string, uint16_t>& devices) {
     std::ofstream file(config_);
-    file << "[recorder]\nout=" << out_.string() << "\nsegment=2\n";
+    file << "[recorder]\nout=" << out_.string() << "\nsegment=2\n" << settings_;
     for (const auto& [name, port] : devices)
       file << "[device " << name << "]\nhost=127.0.0.1\nport=" << port << "\n";
   }
@@ -86,6 +88,7 @@ class Member {
 
  private:
   fs::path config_, out_;
+  std::string settings_;  // more of [recorder]
   std::unique_ptr<RecorderProcess> process_;
   std::string url_;
 };
@@ -144,7 +147,9 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
   fs::create_directories(folder);
 
   Member first(folder, "first", broker, {{"car1", port("car1")}, {"car2", port("car2")}});
-  Member second(folder, "second", broker, {{"car3", port("car3")}});
+  // The second steers its vehicles after their tags.
+  Member second(folder, "second", broker, {{"car3", port("car3")}}, false,
+                "detect=tag36h11\nfollow=true\n");
   Member third(folder, "third", broker, {{"car4", port("car4")}}, true);
   for (Member* m : {&first, &second, &third})
     ASSERT_FALSE(m->url().empty()) << m->process().log();
@@ -196,6 +201,22 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
   first.reload({{"car1", port("car1")}});
   ASSERT_TRUE(first.process().waitForText("1 removed", 20s)) << first.process().log();
   ASSERT_TRUE(waitFor([&] { return recordedOf(second, "S2").size() >= 3; }, 20s));
+
+  // A command for the vehicle reaches it where it is now: the second
+  // recorder's camera, the other vehicle there untouched.
+  auto followingOf = [&](Member& m, const std::string& camera) {
+    for (const auto& c : getJson(m.url() + "api/cameras"))
+      if (c["name"] == camera) return c.value("following", Json());
+    return Json();
+  };
+  ASSERT_TRUE(waitFor([&] { return followingOf(second, "car2-cam0") == true; }, 10s));
+  MqttProbe commander(broker.port(), "wircam-fleet/vehicles/#");
+  commander.publish("wircam-fleet/vehicles/S2/follow/set", "OFF");
+  EXPECT_TRUE(waitFor([&] { return followingOf(second, "car2-cam0") == false; }, 10s))
+      << second.process().log();
+  EXPECT_EQ(followingOf(second, "car3-cam0"), true);
+  commander.publish("wircam-fleet/vehicles/S2/follow/set", "ON");
+  EXPECT_TRUE(waitFor([&] { return followingOf(second, "car2-cam0") == true; }, 10s));
 
   // Its one history, merged by time from both recorders, without a hole.
   Json history;

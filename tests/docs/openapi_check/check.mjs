@@ -458,6 +458,11 @@ try {
   });
   const cameraB = JSON.parse((await request("GET", urlB + "api/cameras")).body.toString())[0].name;
   await check("B status, open", "GET", urlB + "api/status", { expect: 200 });
+  // Without a token, nothing is shared across origins: any site could read it.
+  const acrossB = await request("GET", urlB + "api/cameras",
+    { headers: { Origin: "http://any-site.example" } });
+  if (acrossB.headers["access-control-allow-origin"])
+    problem("B, with no token, lets any origin read /api/cameras");
   await check("B follow, no token set", "POST", `${urlB}api/cameras/${enc(cameraB)}/follow?on=true`,
     { expect: 403 });
   await check("B drive, no token set", "GET", `${urlB}api/cameras/${enc(cameraB)}/drive`, { expect: 403 });
