@@ -37,14 +37,12 @@ void Supervisor::announce() {
                             .seenUnixMs = g_get_real_time() / 1000};
   if (http_) announcement.http = fleetHttpUrl(http_->url(), options_.fleetUrl, host);
   if (rtsp_) announcement.rtsp = fleetServiceUrl(rtsp_->url(), options_.fleetUrl, host);
-  if (foxglove_)
-    announcement.foxglove = fleetServiceUrl(foxglove_->url(), options_.fleetUrl, host);
+  if (foxglove_) announcement.foxglove = fleetServiceUrl(foxglove_->url(), options_.fleetUrl, host);
   for (const auto& c : cameras_) {
     if (removing_.count(c.get())) continue;
     const auto& plan = c->plan();
-    announcement.cameras.push_back(
-        {c->name(), vehicles_.of(plan.device),
-         "/" + plan.device + "/cam" + std::to_string(plan.camera)});
+    announcement.cameras.push_back({c->name(), vehicles_.of(plan.device),
+                                    "/" + plan.device + "/cam" + std::to_string(plan.camera)});
   }
   fleet_->announce(announcement);
 }

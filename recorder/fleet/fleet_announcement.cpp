@@ -34,12 +34,15 @@ std::string text(const nlohmann::json& j, const char* key) {
 
 }  // namespace
 
-std::string announcementTopic(const std::string& recorderId) { return kFleetTopicRoot + recorderId; }
+std::string announcementTopic(const std::string& recorderId) {
+  return kFleetTopicRoot + recorderId;
+}
 
 nlohmann::json toJson(const Announcement& a) {
   nlohmann::json cameras = nlohmann::json::array();
   for (const auto& c : a.cameras)
-    cameras.push_back({{"name", c.name}, {"vehicle", toJson(c.vehicle)}, {"rtsp_path", c.rtspPath}});
+    cameras.push_back(
+        {{"name", c.name}, {"vehicle", toJson(c.vehicle)}, {"rtsp_path", c.rtspPath}});
   return {{"id", a.id},
           {"host", a.host},
           {"version", a.version},

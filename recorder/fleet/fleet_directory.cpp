@@ -7,8 +7,8 @@
 namespace wircam::recorder {
 
 std::optional<std::string> FleetDirectory::announced(const std::string& topic,
-                                                      const std::string& payload,
-                                                      int64_t nowUnixMs) {
+                                                     const std::string& payload,
+                                                     int64_t nowUnixMs) {
   if (!topic.starts_with(kFleetTopicRoot)) return std::nullopt;
   std::string id = topic.substr(std::string(kFleetTopicRoot).size());
   std::lock_guard lock(mutex_);
@@ -79,9 +79,8 @@ nlohmann::json FleetDirectory::view() const {
   std::lock_guard lock(mutex_);
   std::vector<const Recorder*> ordered;
   for (const auto& [id, recorder] : recorders_) ordered.push_back(&recorder);
-  std::stable_sort(ordered.begin(), ordered.end(), [](auto* a, auto* b) {
-    return a->announcement.host < b->announcement.host;
-  });
+  std::stable_sort(ordered.begin(), ordered.end(),
+                   [](auto* a, auto* b) { return a->announcement.host < b->announcement.host; });
   nlohmann::json recorders = nlohmann::json::array();
   for (const Recorder* r : ordered) {
     const auto& a = r->announcement;

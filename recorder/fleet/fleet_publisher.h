@@ -97,7 +97,7 @@ class FleetPublisher {
   // The retained statuses, for a new connection (guarded: the MQTT thread reads it).
   std::mutex retainedMutex_;
   std::map<std::string, std::string> retained_;
-  std::string announcementTopic_, announcement_;  // guarded likewise
+  std::string announcementTopic_, announcement_;       // guarded likewise
   std::map<std::string, std::string> vehicleStreams_;  // serial → its steering camera; likewise
   FleetDirectory directory_;
 };

@@ -18,8 +18,8 @@ constexpr std::chrono::seconds kGatherTime{10};
 // server gone).
 struct FleetRecordings::Gathering {
   FleetRecordings* owner;
-  SoupServerMessage* message;  // null once the client left
-  std::string query;           // "?vehicle=..."
+  SoupServerMessage* message;                      // null once the client left
+  std::string query;                               // "?vehicle=..."
   nlohmann::json toAsk = nlohmann::json::array();  // recorders, in order
   size_t next = 0, asking = 0;
   nlohmann::json recordings = nlohmann::json::array();
@@ -39,8 +39,8 @@ struct FleetRecordings::Question {
 FleetRecordings::FleetRecordings(std::function<nlohmann::json()> fleet, std::string token)
     : fleet_(std::move(fleet)), token_(std::move(token)) {
   session_ = soup_session_new_with_options(
-      "timeout", static_cast<guint>(kAnswerTime.count()), "idle-timeout", 30u,
-      "max-conns", static_cast<int>(kMaxAsking * 2), "user-agent", "wirc-recorder-fleet", nullptr);
+      "timeout", static_cast<guint>(kAnswerTime.count()), "idle-timeout", 30u, "max-conns",
+      static_cast<int>(kMaxAsking * 2), "user-agent", "wirc-recorder-fleet", nullptr);
 }
 
 FleetRecordings::~FleetRecordings() {
@@ -81,13 +81,13 @@ void FleetRecordings::serve(SoupServerMessage* message, GHashTable* query) {
     else
       gathering->toAsk.push_back(recorder);
   }
-  gathering->clientLeft = g_signal_connect(
-      message, "finished", G_CALLBACK(+[](SoupServerMessage*, gpointer data) {
-        auto* g = static_cast<Gathering*>(data);
-        g->message = nullptr;
-        g_cancellable_cancel(g->cancellable);
-      }),
-      gathering.get());
+  gathering->clientLeft =
+      g_signal_connect(message, "finished", G_CALLBACK(+[](SoupServerMessage*, gpointer data) {
+                         auto* g = static_cast<Gathering*>(data);
+                         g->message = nullptr;
+                         g_cancellable_cancel(g->cancellable);
+                       }),
+                       gathering.get());
   gathering->deadline = g_timeout_add_seconds(
       kGatherTime.count(),
       [](gpointer data) {
@@ -128,10 +128,9 @@ void FleetRecordings::askNext(const std::shared_ptr<Gathering>& gathering) {
         [](GObject* session, GAsyncResult* result, gpointer data) {
           auto* pending = static_cast<Question*>(data);
           GError* error = nullptr;
-          GBytes* body =
-              soup_session_send_and_read_finish(SOUP_SESSION(session), result, &error);
-          SoupMessage* message = soup_session_get_async_result_message(SOUP_SESSION(session),
-                                                                       result);
+          GBytes* body = soup_session_send_and_read_finish(SOUP_SESSION(session), result, &error);
+          SoupMessage* message =
+              soup_session_get_async_result_message(SOUP_SESSION(session), result);
           auto* owner = pending->gathering->owner;
           if (owner) owner->answered(pending, message, body, error);
           if (body) g_bytes_unref(body);
@@ -151,9 +150,8 @@ void FleetRecordings::answered(Question* question, SoupMessage* asked, GBytes* b
   if (gathering->done) return;
   const auto& recorder = question->recorder;
   std::string base = recorder["urls"].value("http", "");
-  nlohmann::json said = {{"id", recorder.value("id", "")},
-                         {"host", recorder.value("host", "")},
-                         {"answered", false}};
+  nlohmann::json said = {
+      {"id", recorder.value("id", "")}, {"host", recorder.value("host", "")}, {"answered", false}};
   guint status = asked ? soup_message_get_status(asked) : 0;
   nlohmann::json list;
   if (body) {
@@ -164,9 +162,9 @@ void FleetRecordings::answered(Question* question, SoupMessage* asked, GBytes* b
   if (error)
     said["error"] = std::string("no answer: ") + error->message;
   else if (status != SOUP_STATUS_OK)
-    said["error"] = "answered " + std::to_string(status) +
-                    (status == SOUP_STATUS_UNAUTHORIZED ? " (its --http-token is not this one's)"
-                                                        : "");
+    said["error"] =
+        "answered " + std::to_string(status) +
+        (status == SOUP_STATUS_UNAUTHORIZED ? " (its --http-token is not this one's)" : "");
   else if (!list.is_array())
     said["error"] = "answered no list of recordings";
   if (said.contains("error")) {

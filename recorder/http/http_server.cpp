@@ -219,7 +219,7 @@ HttpServer::~HttpServer() {
   for (auto& feed : feeds_) release(feed->clients);
   release(eventClients_);
   release(playbackClients_);
-  exports_.reset();       // before libsoup frees the messages it answers
+  exports_.reset();  // before libsoup frees the messages it answers
   fleetRecordings_.reset();
   webrtc_.reset();        // each viewer with a drive channel sends neutral
   driveSockets_.clear();  // each sends neutral and closes

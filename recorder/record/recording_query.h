@@ -15,8 +15,8 @@
 namespace wircam::recorder {
 
 struct RecordingQuery {
-  std::string camera;   // empty: any
-  std::string vehicle;  // empty: any
+  std::string camera;                     // empty: any
+  std::string vehicle;                    // empty: any
   std::optional<int64_t> dayStartUnixMs;  // the UTC day's midnight, or any day
   bool any() const { return camera.empty() && vehicle.empty() && !dayStartUnixMs; }
 };

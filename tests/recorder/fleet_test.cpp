@@ -58,10 +58,9 @@ class Member {
          std::string settings = "")
       : config_(folder / (name + ".ini")), out_(folder / name), settings_(std::move(settings)) {
     write(devices);
-    std::vector<std::string> args = {"--config",      config_.string(),  "--http",
-                                     "127.0.0.1:0",   "--http-token",    kToken,
-                                     "--mqtt",        broker.url(),      "--mqtt-prefix",
-                                     "fleet/" + name, "--webrtc",        "off"};
+    std::vector<std::string> args = {"--config",      config_.string(), "--http",   "127.0.0.1:0",
+                                     "--http-token",  kToken,           "--mqtt",   broker.url(),
+                                     "--mqtt-prefix", "fleet/" + name,  "--webrtc", "off"};
     if (fleet) args.push_back("--fleet");
     process_ = std::make_unique<RecorderProcess>(0, args);
     if (auto url = process_->waitForLog("http://", 10s)) url_ = *url;
@@ -118,8 +117,8 @@ bool allLiveWithVehicles(const Json& fleet, size_t recorders, size_t cameras) {
 double longestHole(const Json& recordings) {
   std::vector<std::pair<double, double>> spans;
   for (const auto& r : recordings) {
-    GDateTime* start = g_date_time_new_from_iso8601(r["start_utc"].get<std::string>().c_str(),
-                                                    nullptr);
+    GDateTime* start =
+        g_date_time_new_from_iso8601(r["start_utc"].get<std::string>().c_str(), nullptr);
     double from = g_date_time_to_unix(start) + g_date_time_get_microsecond(start) / 1e6;
     g_date_time_unref(start);
     spans.emplace_back(from, from + r["duration_s"].get<double>());
@@ -138,7 +137,8 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
   ASSERT_TRUE(broker.running());
   std::map<std::string, std::unique_ptr<wirc::Device>> cars;
   for (int n = 1; n <= 4; ++n) {
-    cars["car" + std::to_string(n)] = startVehicle("car-" + std::to_string(n), "S" + std::to_string(n));
+    cars["car" + std::to_string(n)] =
+        startVehicle("car-" + std::to_string(n), "S" + std::to_string(n));
     ASSERT_TRUE(cars["car" + std::to_string(n)]);
   }
   auto port = [&](const char* car) { return cars[car]->port(); };
@@ -151,16 +151,19 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
   Member second(folder, "second", broker, {{"car3", port("car3")}}, false,
                 "detect=tag36h11\nfollow=true\n");
   Member third(folder, "third", broker, {{"car4", port("car4")}}, true);
-  for (Member* m : {&first, &second, &third})
-    ASSERT_FALSE(m->url().empty()) << m->process().log();
+  for (Member* m : {&first, &second, &third}) ASSERT_FALSE(m->url().empty()) << m->process().log();
 
   // The fleet as the third recorder sees it: three recorders, four live
   // cameras, each with its vehicle.
   Json fleet;
-  ASSERT_TRUE(waitFor([&] {
-    fleet = getJson(third.url() + "api/fleet");
-    return allLiveWithVehicles(fleet, 3, 4);
-  }, 20s)) << fleet.dump(1) << "\n" << third.process().log();
+  ASSERT_TRUE(waitFor(
+      [&] {
+        fleet = getJson(third.url() + "api/fleet");
+        return allLiveWithVehicles(fleet, 3, 4);
+      },
+      20s))
+      << fleet.dump(1) << "\n"
+      << third.process().log();
   auto byId = recordersOf(fleet);
   ASSERT_TRUE(byId.contains(first.id()) && byId.contains(second.id()) && byId.contains(third.id()));
   EXPECT_EQ(byId[first.id()]["urls"]["http"], first.url());
@@ -181,8 +184,8 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
         "[...document.querySelectorAll('.fleet-camera[data-state=live] img')]"
         ".filter(i => i.naturalWidth > 0).length";
     EXPECT_TRUE(page->waitUntil(pictures + " === 4", 20s)) << page->evaluate(pictures);
-    EXPECT_EQ(page->evaluate("document.querySelectorAll('.fleet-recorder[data-online=true]').length"),
-              3);
+    EXPECT_EQ(
+        page->evaluate("document.querySelectorAll('.fleet-recorder[data-online=true]').length"), 3);
     page->evaluate("document.getElementById('fleet').scrollIntoView()");
     page->screenshot(shotPath("fleet-page.png"));
   }
@@ -220,13 +223,16 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
 
   // Its one history, merged by time from both recorders, without a hole.
   Json history;
-  ASSERT_TRUE(waitFor([&] {
-    history = getJson(third.url() + "api/fleet/recordings?vehicle=S2");
-    std::set<std::string> from;
-    for (const auto& r : history.value("recordings", Json::array()))
-      from.insert(r["recorder"].get<std::string>());
-    return from == std::set<std::string>{first.id(), second.id()};
-  }, 20s)) << history.dump(1);
+  ASSERT_TRUE(waitFor(
+      [&] {
+        history = getJson(third.url() + "api/fleet/recordings?vehicle=S2");
+        std::set<std::string> from;
+        for (const auto& r : history.value("recordings", Json::array()))
+          from.insert(r["recorder"].get<std::string>());
+        return from == std::set<std::string>{first.id(), second.id()};
+      },
+      20s))
+      << history.dump(1);
   const auto& recordings = history["recordings"];
   for (size_t i = 1; i < recordings.size(); ++i)
     EXPECT_LE(recordings[i - 1]["start_utc"], recordings[i]["start_utc"]);
@@ -247,11 +253,14 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
   // sees the socket go at once; a cut network would take 1.5 keepalives),
   // named in the history as not answering; the first answers on.
   second.process().signal(SIGKILL);
-  ASSERT_TRUE(waitFor([&] {
-    fleet = getJson(third.url() + "api/fleet");
-    auto now = recordersOf(fleet);
-    return now.contains(second.id()) && now[second.id()]["online"] == false;
-  }, 20s)) << fleet.dump(1);
+  ASSERT_TRUE(waitFor(
+      [&] {
+        fleet = getJson(third.url() + "api/fleet");
+        auto now = recordersOf(fleet);
+        return now.contains(second.id()) && now[second.id()]["online"] == false;
+      },
+      20s))
+      << fleet.dump(1);
   EXPECT_EQ(recordersOf(fleet)[first.id()]["online"], true);
   if (page) {
     EXPECT_TRUE(page->waitUntil("document.querySelector('.fleet-recorder[data-id=\"" + second.id() +

@@ -3,10 +3,10 @@
 #include "fleet/fleet_directory.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 #include "fleet/recorder_id.h"
 
@@ -15,8 +15,8 @@ namespace {
 using namespace wircam::recorder;
 using Json = nlohmann::json;
 
-Announcement recorderOf(const std::string& id, const std::string& prefix,
-                        const std::string& camera, int64_t seen) {
+Announcement recorderOf(const std::string& id, const std::string& prefix, const std::string& camera,
+                        int64_t seen) {
   return {.id = id,
           .host = "node-" + id,
           .version = "1.0",
@@ -109,8 +109,8 @@ TEST(FleetDirectory, TopicsGoToTheRecorderWithTheLongestPrefixAndAnEmptyAnnounce
   FleetDirectory fleet;
   fleet.announced("wircam-fleet/recorders/a", toJson(recorderOf("a", "lab", "x-cam0", 1)).dump(),
                   1);
-  fleet.announced("wircam-fleet/recorders/b",
-                  toJson(recorderOf("b", "lab/b", "y-cam0", 1)).dump(), 1);
+  fleet.announced("wircam-fleet/recorders/b", toJson(recorderOf("b", "lab/b", "y-cam0", 1)).dump(),
+                  1);
   fleet.heard("lab/b/available", "online", 2);
   fleet.heard("lab/available", "offline", 2);
   auto view = fleet.view()["recorders"];
@@ -126,7 +126,8 @@ TEST(FleetDirectory, TopicsGoToTheRecorderWithTheLongestPrefixAndAnEmptyAnnounce
 }
 
 TEST(RecorderId, IsMadeOnceAndKeptBesideTheRecordings) {
-  auto folder = std::filesystem::temp_directory_path() / ("recorder-id-" + std::to_string(getpid()));
+  auto folder =
+      std::filesystem::temp_directory_path() / ("recorder-id-" + std::to_string(getpid()));
   std::filesystem::create_directories(folder);
   auto first = recorderId(folder);
   ASSERT_TRUE(first) << first.error();
