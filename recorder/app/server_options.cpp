@@ -221,7 +221,7 @@ std::vector<OptionSpec> serverOptionRows() {
        .section = kFleet,
        .help = "the HTTP address other recorders and browsers reach this one at, where the "
                "listening one is not (NAT, a proxy): announced to the fleet; its host stands for "
-               "RTSP's and Foxglove's too",
+               "RTSP's and Foxglove's too (with `--mqtt` and `--http`)",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          std::string url = value;
          if (!(url.starts_with("http://") || url.starts_with("https://")) || url.size() < 9)

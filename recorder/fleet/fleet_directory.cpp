@@ -25,7 +25,7 @@ std::optional<std::string> FleetDirectory::announced(const std::string& topic,
   recorder.announcement = std::move(*announcement);
   // A retained announcement is as old as it says; a fresh one is now.
   recorder.lastSeenUnixMs = std::max(recorder.lastSeenUnixMs, recorder.announcement.seenUnixMs);
-  if (recorder.online) recorder.lastSeenUnixMs = nowUnixMs;
+  if (online(recorder)) recorder.lastSeenUnixMs = nowUnixMs;
   if (knownPrefix) return std::nullopt;
   return recorder.announcement.mqttPrefix;
 }
@@ -35,14 +35,29 @@ FleetDirectory::Recorder* FleetDirectory::ownerOf(const std::string& topic, std:
   size_t longest = 0;
   for (auto& [id, recorder] : recorders_) {
     const auto& prefix = recorder.announcement.mqttPrefix;
-    if (prefix.size() > longest && topic.size() > prefix.size() && topic.starts_with(prefix) &&
-        topic[prefix.size()] == '/') {
+    if (topic.size() > prefix.size() && topic.starts_with(prefix) && topic[prefix.size()] == '/' &&
+        prefix.size() >= longest && !superseded(recorder)) {
       owner = &recorder;
       longest = prefix.size();
     }
   }
   if (owner) rest = topic.substr(longest + 1);
   return owner;
+}
+
+bool FleetDirectory::superseded(const Recorder& recorder) const {
+  const auto& mine = recorder.announcement;
+  return std::any_of(recorders_.begin(), recorders_.end(), [&](const auto& other) {
+    const auto& theirs = other.second.announcement;
+    return theirs.mqttPrefix == mine.mqttPrefix &&
+           (theirs.seenUnixMs > mine.seenUnixMs ||
+            (theirs.seenUnixMs == mine.seenUnixMs && theirs.id > mine.id));
+  });
+}
+
+bool FleetDirectory::online(const Recorder& recorder) const {
+  auto available = available_.find(recorder.announcement.mqttPrefix);
+  return available != available_.end() && available->second && !superseded(recorder);
 }
 
 bool FleetDirectory::heard(const std::string& topic, const std::string& payload,
@@ -52,9 +67,9 @@ bool FleetDirectory::heard(const std::string& topic, const std::string& payload,
   Recorder* recorder = ownerOf(topic, rest);
   if (!recorder) return false;
   if (rest == "available") {
-    bool online = payload == "online";
-    if (online || recorder->online) recorder->lastSeenUnixMs = nowUnixMs;
-    recorder->online = online;
+    bool nowOnline = payload == "online";
+    if (nowOnline || online(*recorder)) recorder->lastSeenUnixMs = nowUnixMs;
+    available_[recorder->announcement.mqttPrefix] = nowOnline;
     return true;
   }
   auto slash = rest.find('/');
@@ -62,7 +77,7 @@ bool FleetDirectory::heard(const std::string& topic, const std::string& payload,
   auto status = nlohmann::json::parse(payload, nullptr, false);
   if (!status.is_object()) return false;
   recorder->statuses[rest.substr(0, slash)] = std::move(status);
-  if (recorder->online) recorder->lastSeenUnixMs = nowUnixMs;
+  if (online(*recorder)) recorder->lastSeenUnixMs = nowUnixMs;
   return true;
 }
 
@@ -90,7 +105,7 @@ nlohmann::json FleetDirectory::view() const {
           {"name", c.name}, {"vehicle", toJson(c.vehicle)}, {"rtsp_path", c.rtspPath}};
       auto status = r->statuses.find(c.name);
       // What its recorder last said; a recorder offline says nothing now.
-      camera["state"] = r->online && status != r->statuses.end()
+      camera["state"] = online(*r) && status != r->statuses.end()
                             ? status->second.value("state", "unknown")
                             : "unknown";
       camera["status"] = status != r->statuses.end() ? status->second : nlohmann::json();
@@ -99,7 +114,7 @@ nlohmann::json FleetDirectory::view() const {
     nlohmann::json entry = toJson(a);
     entry.erase("seen_utc");
     entry.erase("seen_unix_ms");
-    entry["online"] = r->online;
+    entry["online"] = online(*r);
     entry["last_seen_utc"] = SegmentPlanner::isoUtc(r->lastSeenUnixMs);
     entry["cameras"] = std::move(cameras);
     recorders.push_back(std::move(entry));

@@ -35,14 +35,21 @@ class FleetDirectory {
  private:
   struct Recorder {
     Announcement announcement;
-    bool online = false;
     int64_t lastSeenUnixMs = 0;
     std::map<std::string, nlohmann::json> statuses;  // by camera
   };
+  // The recorder a topic is about: the longest prefix it is under and, of
+  // recorders announced on one prefix (one came back with a new id, its
+  // folder replaced), the newest; the others are superseded.
   Recorder* ownerOf(const std::string& topic, std::string& rest);
+  bool superseded(const Recorder& recorder) const;
+  bool online(const Recorder& recorder) const;
 
   mutable std::mutex mutex_;
   std::map<std::string, Recorder> recorders_;  // by id
+  // PREFIX/available, by prefix: a prefix's will is one topic, whoever
+  // announced on it.
+  std::map<std::string, bool> available_;
 };
 
 }  // namespace wircam::recorder

@@ -26,6 +26,16 @@ void FleetPublisher::setStreams(const std::vector<std::string>& streams) {
     names_ = streams;
   }
   for (const auto& stream : streams) streams_[stream];
+  // A camera gone (moved to another recorder by a reload) leaves no
+  // retained status saying it is live here.
+  for (const auto& stream : before)
+    if (std::find(streams.begin(), streams.end(), stream) == streams.end() && client_) {
+      {
+        std::lock_guard lock(retainedMutex_);
+        retained_.erase(stream);
+      }
+      client_->publish(topic(stream, "status"), "", true, 1);
+    }
   if (!settings_.discovery || !client_) return;
   // Home Assistant learns of a camera added, and forgets one removed.
   for (const auto& stream : streams)
@@ -141,6 +151,7 @@ void FleetPublisher::onMessage(const std::string& topicName, const std::string& 
     if (held == vehicleStreams_.end()) return;  // another recorder's vehicle, or none
     stream = held->second;
   }
+  if (payload.empty()) return;  // clearing a retained command: nothing to do
   if (retained) {
     // A command is an act, not a state: one left retained would replay at
     // every restart.

@@ -1,6 +1,7 @@
 #include "http/fleet_recordings.h"
 
 #include <algorithm>
+#include <tuple>
 
 #include "http/http_responses.h"
 #include "record/recording_query.h"
@@ -204,6 +205,14 @@ void FleetRecordings::finish(Gathering* gathering) {
            {"answered", false},
            {"error", "no answer within " + std::to_string(kGatherTime.count()) + " s"}});
   }
+  // As /api/fleet lists them, whatever order they answered in.
+  auto& said = gathering->recorders;
+  std::stable_sort(said.begin(), said.end(), [](const auto& a, const auto& b) {
+    return std::tie(a["host"].template get_ref<const std::string&>(),
+                    a["id"].template get_ref<const std::string&>()) <
+           std::tie(b["host"].template get_ref<const std::string&>(),
+                    b["id"].template get_ref<const std::string&>());
+  });
   auto& recordings = gathering->recordings;
   std::stable_sort(recordings.begin(), recordings.end(), [](const auto& a, const auto& b) {
     return unixMsOfUtc(a.value("start_utc", "")).value_or(0) <

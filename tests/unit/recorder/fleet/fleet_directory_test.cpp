@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "fleet/recorder_id.h"
 
@@ -123,6 +124,28 @@ TEST(FleetDirectory, TopicsGoToTheRecorderWithTheLongestPrefixAndAnEmptyAnnounce
   EXPECT_EQ(fleet.view()["recorders"].size(), 2u);
   fleet.announced("wircam-fleet/recorders/a", "", 4);  // cleared by hand: retired
   EXPECT_EQ(fleet.view()["recorders"].size(), 1u);
+}
+
+TEST(FleetDirectory, ARecorderBackWithANewIdOnItsPrefixSupersedesItsOldSelf) {
+  // Its folder replaced (a new id), its prefix kept: the old announcement
+  // stays retained, the prefix's availability and statuses are the new one's.
+  FleetDirectory fleet;
+  fleet.announced("wircam-fleet/recorders/old",
+                  toJson(recorderOf("old", "lab/yard", "nine-cam0", 1000)).dump(), 1000);
+  fleet.heard("lab/yard/available", "online", 1500);
+  EXPECT_EQ(fleet.announced("wircam-fleet/recorders/new",
+                            toJson(recorderOf("new", "lab/yard", "nine-cam0", 9000)).dump(), 9000),
+            std::nullopt);  // its prefix is followed already
+  fleet.heard("lab/yard/available", "online", 9001);
+  fleet.heard("lab/yard/nine-cam0/status", R"({"state":"live"})", 9002);
+  std::map<std::string, Json> byId;
+  auto view = fleet.view();
+  for (const auto& r : view["recorders"]) byId[r["id"].get<std::string>()] = r;
+  EXPECT_EQ(byId["new"]["online"], true);
+  EXPECT_EQ(byId["new"]["cameras"][0]["state"], "live");
+  EXPECT_EQ(byId["old"]["online"], false);
+  EXPECT_EQ(byId["old"]["cameras"][0]["state"], "unknown");
+  EXPECT_EQ(byId["old"]["last_seen_utc"], "1970-01-01T00:00:01.500Z");
 }
 
 TEST(RecorderId, IsMadeOnceAndKeptBesideTheRecordings) {
