@@ -323,7 +323,8 @@ void Supervisor::perform(RunJob job) {
 void Supervisor::publishFleetStatus(bool force) {
   if (!fleet_) return;
   for (const auto& c : cameras_)
-    fleet_->status(c->name(), withVehicle(fleetStatusJson(c->report()), *c), force);
+    if (!removing_.count(c.get()))  // its retained status was cleared as it went
+      fleet_->status(c->name(), withVehicle(fleetStatusJson(c->report()), *c), force);
   if (g_get_monotonic_time() / 1000 - announcedAt_ >= kAnnounceIntervalMs) announce();
 }
 

@@ -203,6 +203,17 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
       << second.process().log();
   first.reload({{"car1", port("car1")}});
   ASSERT_TRUE(first.process().waitForText("1 removed", 20s)) << first.process().log();
+  // The camera that left the first recorder leaves no retained status there
+  // (a late subscriber gets car1's, not car2's).
+  EXPECT_TRUE(waitFor(
+      [&] {
+        MqttProbe late(broker.port(), "fleet/first/+/status");
+        if (!late.waitFor(
+                "fleet/first/car1-cam0/status", [](auto&) { return true; }, 5s))
+          return false;
+        return late.messages("fleet/first/car2-cam0/status").empty();
+      },
+      10s));
   ASSERT_TRUE(waitFor([&] { return recordedOf(second, "S2").size() >= 3; }, 20s));
 
   // A command for the vehicle reaches it where it is now: the second
