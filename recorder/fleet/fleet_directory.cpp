@@ -1,6 +1,7 @@
 #include "fleet/fleet_directory.h"
 
 #include <algorithm>
+#include <tuple>
 
 #include "record/segment_planner.h"
 
@@ -31,12 +32,18 @@ std::optional<std::string> FleetDirectory::announced(const std::string& topic,
 }
 
 FleetDirectory::Recorder* FleetDirectory::ownerOf(const std::string& topic, std::string& rest) {
+  // One pass: this runs for every status of every camera of the fleet.
   Recorder* owner = nullptr;
   size_t longest = 0;
   for (auto& [id, recorder] : recorders_) {
-    const auto& prefix = recorder.announcement.mqttPrefix;
-    if (topic.size() > prefix.size() && topic.starts_with(prefix) && topic[prefix.size()] == '/' &&
-        prefix.size() >= longest && !superseded(recorder)) {
+    const auto& a = recorder.announcement;
+    const auto& prefix = a.mqttPrefix;
+    if (topic.size() <= prefix.size() || !topic.starts_with(prefix) ||
+        topic[prefix.size()] != '/' || prefix.size() < longest)
+      continue;
+    if (!owner || prefix.size() > longest ||
+        std::tie(a.seenUnixMs, a.id) >
+            std::tie(owner->announcement.seenUnixMs, owner->announcement.id)) {
       owner = &recorder;
       longest = prefix.size();
     }
@@ -68,7 +75,9 @@ bool FleetDirectory::heard(const std::string& topic, const std::string& payload,
   if (!recorder) return false;
   if (rest == "available") {
     bool nowOnline = payload == "online";
-    if (nowOnline || online(*recorder)) recorder->lastSeenUnixMs = nowUnixMs;
+    // (The owner is the newest on its prefix: online is the prefix's word.)
+    if (nowOnline || available_[recorder->announcement.mqttPrefix])
+      recorder->lastSeenUnixMs = nowUnixMs;
     available_[recorder->announcement.mqttPrefix] = nowOnline;
     return true;
   }
@@ -77,7 +86,7 @@ bool FleetDirectory::heard(const std::string& topic, const std::string& payload,
   auto status = nlohmann::json::parse(payload, nullptr, false);
   if (!status.is_object()) return false;
   recorder->statuses[rest.substr(0, slash)] = std::move(status);
-  if (online(*recorder)) recorder->lastSeenUnixMs = nowUnixMs;
+  if (available_[recorder->announcement.mqttPrefix]) recorder->lastSeenUnixMs = nowUnixMs;
   return true;
 }
 
