@@ -2,11 +2,16 @@
 
 #include <gmodule.h>
 
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 namespace wircam::recorder {
 
 namespace {
+
+std::atomic<const LiveServers*> loaded{nullptr};
 
 Expected<const LiveServers*, std::string> open() {
   gchar* executable = g_file_read_link("/proc/self/exe", nullptr);
@@ -23,7 +28,8 @@ Expected<const LiveServers*, std::string> open() {
   if (!g_module_symbol(module, kLiveServersEntry, &entry) || !entry)
     return unexpected(path + " is not wirc-recorder's servers module: " + g_module_error());
   g_module_make_resident(module);
-  return reinterpret_cast<const LiveServers* (*)()>(entry)();
+  loaded = reinterpret_cast<const LiveServers* (*)()>(entry)();
+  return loaded.load();
 }
 
 }  // namespace
@@ -31,6 +37,14 @@ Expected<const LiveServers*, std::string> open() {
 Expected<const LiveServers*, std::string> liveServers() {
   static const Expected<const LiveServers*, std::string> opened = open();
   return opened;
+}
+
+void endProcess(int code) {
+  if (const LiveServers* servers = loaded; servers && servers->busyAtExit()) {
+    std::fflush(nullptr);
+    std::_Exit(code);
+  }
+  std::exit(code);
 }
 
 }  // namespace wircam::recorder

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "app/live_servers_module.h"
 #include "app/recorder_options.h"
 #include "app/slice_allocator.h"
 #include "app/supervisor.h"
@@ -45,5 +46,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "wirc-recorder: %s\n", supervisor.error().c_str());
     return 1;
   }
-  return (*supervisor)->run();
+  int code = (*supervisor)->run();
+  supervisor->reset();
+  endProcess(code);
 }

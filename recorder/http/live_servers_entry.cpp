@@ -5,6 +5,7 @@
 #include "http/foxglove_server.h"
 #include "http/http_server.h"
 #include "http/rtsp_server.h"
+#include "webrtc/dtls_certificate.h"
 
 namespace wircam::recorder {
 namespace {
@@ -37,6 +38,7 @@ Expected<std::unique_ptr<FoxgloveService>, std::string> startFoxglove(
 
 extern "C" G_MODULE_EXPORT const wircam::recorder::LiveServers* wircam_live_servers() {
   static const wircam::recorder::LiveServers servers{
-      &wircam::recorder::startWeb, &wircam::recorder::startRtsp, &wircam::recorder::startFoxglove};
+      &wircam::recorder::startWeb, &wircam::recorder::startRtsp, &wircam::recorder::startFoxglove,
+      &wircam::recorder::dtls_certificate::beingMade};
   return &servers;
 }

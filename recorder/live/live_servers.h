@@ -168,6 +168,9 @@ struct LiveServers {
                                                                    const std::string& token);
   Expected<std::unique_ptr<FoxgloveService>, std::string> (*startFoxglove)(
       const ServerAddress& address, FoxgloveContent content, std::chrono::milliseconds idleTimeout);
+  // Whether a thread of the module is still at work that exit's handlers
+  // would break (WebRTC's DTLS certificate, its RSA key still being made).
+  bool (*busyAtExit)();
 };
 
 inline constexpr const char* kLiveServersEntry = "wircam_live_servers";

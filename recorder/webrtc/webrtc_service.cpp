@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "log_line.h"
+#include "webrtc/dtls_certificate.h"
 #include "webrtc/whep_sdp.h"
 
 namespace wircam::recorder {
@@ -51,20 +52,9 @@ WebRtcService::WebRtcService(std::vector<Camera> cameras, Settings settings)
     : cameras_(std::move(cameras)),
       settings_(std::move(settings)),
       allowedHosts_(turnAddresses(settings_.servers.turn)) {
-  // webrtcbin's DTLS elements make one certificate per process, for the
-  // first viewer, while it waits for its answer: an RSA key, 0.1-0.4 s of a
-  // core here, 1.3 s beside three busy loops, more on a small machine. Made
-  // now, on a thread of its own, it is there when the first viewer comes.
-  // Until then no viewer can be prepared: a viewer's time to come up counts
-  // from then (sweep()).
-  certificateMaker_ = std::thread([this] {
-    auto started = std::chrono::steady_clock::now();
-    if (GstElement* dtls = gst_element_factory_make("dtlsdec", nullptr)) gst_object_unref(dtls);
-    auto took = std::chrono::duration_cast<std::chrono::milliseconds>(
-        std::chrono::steady_clock::now() - started);
-    logLine("webrtc: DTLS certificate made in " + std::to_string(took.count()) + " ms");
-    certificateMade_ = true;
-  });
+  // Until the DTLS certificate is made no viewer can be prepared: a
+  // viewer's time to come up counts from then (sweep()).
+  dtls_certificate::makeAhead();
   sweepTimer_ = g_timeout_add(
       500,
       [](gpointer self) -> gboolean {
@@ -75,7 +65,6 @@ WebRtcService::WebRtcService(std::vector<Camera> cameras, Settings settings)
 }
 
 WebRtcService::~WebRtcService() {
-  certificateMaker_.join();
   alive_.reset();
   g_source_remove(sweepTimer_);
   viewers_.clear();  // before their encoders
@@ -185,7 +174,7 @@ void WebRtcService::sweep(std::chrono::steady_clock::time_point now) {
       if (now - viewer.peer->lastHeard() > settings_.idleTimeout) expired.push_back(session);
       continue;
     }
-    if (!viewer.downSince || !certificateMade_) viewer.downSince = now;
+    if (!viewer.downSince || !dtls_certificate::made()) viewer.downSince = now;
     if (now - *viewer.downSince > settings_.idleTimeout) expired.push_back(session);
   }
   for (const auto& session : expired) remove(session);

@@ -8,7 +8,6 @@
 
 #include <glib.h>
 
-#include <atomic>
 #include <chrono>
 #include <functional>
 #include <map>
@@ -17,7 +16,6 @@
 #include <set>
 #include <string>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 #include "camera/frame_tap.h"
@@ -103,8 +101,6 @@ class WebRtcService {
   std::map<std::string, std::unique_ptr<CameraEncoder>> encoders_;
   std::map<std::string, Viewer> viewers_;  // by session
   guint sweepTimer_ = 0;
-  std::thread certificateMaker_;  // webrtcbin's DTLS certificate, made once at start
-  std::atomic<bool> certificateMade_{false};
   std::shared_ptr<WebRtcService*> alive_ = std::make_shared<WebRtcService*>(this);
 };
 
