@@ -41,8 +41,10 @@ void Supervisor::announce() {
   for (const auto& c : cameras_) {
     if (removing_.count(c.get())) continue;
     const auto& plan = c->plan();
-    announcement.cameras.push_back({c->name(), vehicles_.of(plan.device),
-                                    "/" + plan.device + "/cam" + std::to_string(plan.camera)});
+    // Its path on the RTSP server, when there is one to play it from.
+    std::string rtspPath =
+        rtsp_ ? "/" + plan.device + "/cam" + std::to_string(plan.camera) : std::string();
+    announcement.cameras.push_back({c->name(), vehicles_.of(plan.device), rtspPath});
   }
   fleet_->announce(announcement);
 }

@@ -25,7 +25,7 @@ inline constexpr const char* kVehicleTopicRoot = "wircam-fleet/vehicles/";
 struct AnnouncedCamera {
   std::string name;  // the stream, "<device>-cam<N>": unique within its recorder only
   std::optional<VehicleIdentity> vehicle;
-  std::string rtspPath;  // "/<device>/cam<N>"
+  std::string rtspPath;  // "/<device>/cam<N>"; empty without an RTSP server
 };
 
 struct Announcement {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "http/request_head_gate.h"
+
 namespace wircam::recorder {
 
 namespace {
@@ -118,23 +120,21 @@ gboolean HttpConnections::onIncoming(GSocketService*, GSocketConnection* connect
   self->accepted_[endpoint] = {connection, socket, *slot};
   g_object_weak_ref(G_OBJECT(connection), onConnectionGone,
                     new GoneWatch{self, endpoint, connection, self->alive_});
-  GSocketAddress* local = g_socket_connection_get_local_address(connection, nullptr);
-  GError* error = nullptr;
-  // HTTPS: libsoup gets the TLS stream over the connection (which it keeps
-  // alive: the slot is still the connection's). The handshake happens on
-  // the first read.
-  GIOStream* stream = G_IO_STREAM(g_object_ref(connection));
-  if (self->certificate_) {
-    GIOStream* tls = g_tls_server_connection_new(stream, self->certificate_, &error);
-    g_object_unref(stream);
-    stream = tls;
-  }
-  if (!stream || !soup_server_accept_iostream(self->server_, stream, local, remote, &error))
-    g_io_stream_close(G_IO_STREAM(connection), nullptr, nullptr);
-  g_clear_error(&error);
-  g_clear_object(&stream);
-  g_clear_object(&local);
   g_clear_object(&remote);
+  // HTTPS: libsoup gets the TLS stream over the connection at once (its
+  // head is encrypted). Plain HTTP: once its first head is seen to be
+  // within libsoup's bound, or answered 414/431 if not.
+  if (self->certificate_) {
+    self->handOn(connection);
+  } else {
+    std::weak_ptr<bool> alive = self->alive_;
+    gateRequestHead(connection, [self, alive](GSocketConnection* gated) {
+      if (alive.lock())
+        self->handOn(gated);
+      else
+        g_io_stream_close(G_IO_STREAM(gated), nullptr, nullptr);
+    });
+  }
   return TRUE;
 }
 
@@ -166,6 +166,28 @@ gboolean HttpConnections::onSweep(gpointer data) {
       // libsoup, reading, sees the end and lets the connection go.
       g_socket_shutdown(accepted.socket, TRUE, TRUE, nullptr);
   return G_SOURCE_CONTINUE;
+}
+
+void HttpConnections::handOn(GSocketConnection* connection) {
+  GSocketAddress* local = g_socket_connection_get_local_address(connection, nullptr);
+  GSocketAddress* remote = g_socket_connection_get_remote_address(connection, nullptr);
+  GError* error = nullptr;
+  // HTTPS: libsoup gets the TLS stream over the connection (which it keeps
+  // alive: the slot is still the connection's). The handshake happens on
+  // the first read.
+  GIOStream* stream = G_IO_STREAM(g_object_ref(connection));
+  if (certificate_) {
+    GIOStream* tls = g_tls_server_connection_new(stream, certificate_, &error);
+    g_object_unref(stream);
+    stream = tls;
+  }
+  if (!stream || !local || !remote ||
+      !soup_server_accept_iostream(server_, stream, local, remote, &error))
+    g_io_stream_close(G_IO_STREAM(connection), nullptr, nullptr);
+  g_clear_error(&error);
+  g_clear_object(&stream);
+  g_clear_object(&local);
+  g_clear_object(&remote);
 }
 
 const HttpConnections::Accepted* HttpConnections::find(SoupServerMessage* message) const {

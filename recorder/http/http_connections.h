@@ -61,6 +61,8 @@ class HttpConnections {
   static gboolean onIncoming(GSocketService*, GSocketConnection* connection, GObject*,
                              gpointer self);
   static void onConnectionGone(gpointer data, GObject* connection);
+  // The connection to libsoup (over TLS with a certificate).
+  void handOn(GSocketConnection* connection);
   static gboolean onSweep(gpointer self);
   struct Accepted {
     GSocketConnection* connection;  // weak: libsoup owns it

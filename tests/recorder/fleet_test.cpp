@@ -170,7 +170,12 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
   EXPECT_EQ(byId[first.id()]["mqtt_prefix"], "fleet/first");
   std::set<std::string> serials;
   for (const auto& [id, r] : byId)
-    for (const auto& c : r["cameras"]) serials.insert(c["vehicle"]["serial"].get<std::string>());
+    for (const auto& c : r["cameras"]) {
+      serials.insert(c["vehicle"]["serial"].get<std::string>());
+      // No recorder here serves RTSP: no path to play a camera from.
+      EXPECT_EQ(r["urls"]["rtsp"], "");
+      EXPECT_EQ(c["rtsp_path"], "") << c.dump();
+    }
   EXPECT_EQ(serials, (std::set<std::string>{"S1", "S2", "S3", "S4"}));
   // The fleet on the third recorder's page: every camera with a picture
   // from its own recorder.

@@ -3,9 +3,12 @@
 // reason (JSON under /api/) and the headers RFC 9110 asks of it, and a live
 // stream that answers before its camera has a frame.
 #include <gtest/gtest.h>
+#include <poll.h>
 
+#include <chrono>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "raw_http.h"
 #include "recorder_process.h"
@@ -100,6 +103,38 @@ TEST(WircRecorderHttpStatuses, AnEncodedDotDotIs400WithItsReasonAndARangePastThe
   EXPECT_EQ(last.rfind("HTTP/1.1 206 ", 0), 0u) << last;
   EXPECT_EQ(headerOf(last, "Content-Range"), "bytes 99-99/100") << last;
   EXPECT_EQ(bodyOf(last), "n") << last;
+}
+
+// libsoup drops a head over 64 KiB without a word (a reset); RFC 9110 has
+// 414 and 431, with a reason, and the client reads them before the close.
+TEST(WircRecorderHttpStatuses, AnOverlongRequestLineIs414AndOverlongHeadersAre431) {
+  SilentCameraRecorder served;
+  ASSERT_NE(served.port, 0) << served.recorder->log();
+  auto query = answerTo(served.port, "GET /api/recordings?camera=" + std::string(200 * 1024, 'q') +
+                                         " HTTP/1.1\r\nHost: x\r\n\r\n");
+  EXPECT_EQ(query.rfind("HTTP/1.1 414 ", 0), 0u) << query.substr(0, 200);
+  EXPECT_EQ(headerOf(query, "Content-Type"), "application/json") << query;
+  EXPECT_NE(errorOf(query).find("request line is over 64 KiB"), std::string::npos) << query;
+  auto header = answerTo(served.port, "GET /api/status HTTP/1.1\r\nHost: x\r\nX-Big: " +
+                                          std::string(100 * 1024, 'h') + "\r\n\r\n");
+  EXPECT_EQ(header.rfind("HTTP/1.1 431 ", 0), 0u) << header.substr(0, 200);
+  EXPECT_NE(errorOf(header).find("header fields are over 64 KiB"), std::string::npos) << header;
+  // A head near the bound, in pieces, is still served.
+  auto fd = wircam::connectTcp(wircam::SocketAddress::loopback(served.port));
+  ASSERT_TRUE(fd.has_value());
+  std::string near = "GET /api/status HTTP/1.1\r\nHost: x\r\nConnection: close\r\nX-Big: " +
+                     std::string(60 * 1024, 'n');
+  for (size_t at = 0; at < near.size(); at += 20 * 1024) {
+    std::string piece = near.substr(at, 20 * 1024);
+    ::send(fd->get(), piece.data(), piece.size(), MSG_NOSIGNAL);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ::send(fd->get(), "\r\n\r\n", 4, MSG_NOSIGNAL);
+  char status[16] = {};
+  pollfd readable{fd->get(), POLLIN, 0};
+  ASSERT_GT(::poll(&readable, 1, 5000), 0);
+  ASSERT_GT(::recv(fd->get(), status, sizeof status - 1, 0), 0);
+  EXPECT_EQ(std::string(status).rfind("HTTP/1.1 200 ", 0), 0u) << status;
 }
 
 TEST(WircRecorderHttpStatuses, ALiveStreamAnswersAtOnceBeforeItsCamerasFirstFrame) {
