@@ -26,6 +26,13 @@ struct Gate {
   guint timer = 0;
 };
 
+// One buffer for every peek and drain: the gate runs on the main loop only,
+// and a connection's first look is not worth a 64 KiB allocation (zeroed).
+std::vector<char>& scratch() {
+  static std::vector<char> buffer(kHeadLimit + 1);
+  return buffer;
+}
+
 int fdOf(const Gate* gate) {
   return g_socket_get_fd(g_socket_connection_get_socket(gate->connection));
 }
@@ -51,7 +58,7 @@ void closeAndForget(Gate* gate) {
 // does not reset the connection before it has read the answer.
 gboolean drain(GSocket*, GIOCondition, gpointer data) {
   auto* gate = static_cast<Gate*>(data);
-  std::vector<char> sink(64 * 1024);
+  auto& sink = scratch();
   ssize_t n;
   while ((n = recv(fdOf(gate), sink.data(), sink.size(), MSG_DONTWAIT)) > 0) {
     gate->drained += static_cast<size_t>(n);
@@ -97,7 +104,7 @@ enum class Look { Done, NothingYet, LongAndUnfinished };
 
 // Looks at what has come: handed on or answered (Done), or waited for.
 Look look(Gate* gate) {
-  std::vector<char> head(kHeadLimit + 1);
+  auto& head = scratch();
   ssize_t n = recv(fdOf(gate), head.data(), head.size(), MSG_PEEK | MSG_DONTWAIT);
   // (Woken with nothing to read: the socket's own timeout.)
   if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return Look::NothingYet;
