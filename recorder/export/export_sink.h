@@ -12,6 +12,14 @@
 
 namespace wircam::recorder {
 
+// Where an export's file goes: to `path`, or, with a `stream` descriptor,
+// out as its bytes are made (which no muxer can go back over: Matroska
+// without its index, MP4 fragmented; `path` then names it in messages).
+struct ExportTarget {
+  std::string path;
+  int stream = -1;
+};
+
 class ExportSink {
  public:
   virtual ~ExportSink() = default;
@@ -24,6 +32,8 @@ class ExportSink {
                                           int64_t utcNs) = 0;
   // Everything written and the file closed.
   virtual std::optional<std::string> finish() = 0;
+  // The file's bytes so far (for progress).
+  virtual uint64_t bytesWritten() = 0;
 };
 
 }  // namespace wircam::recorder

@@ -81,8 +81,11 @@ bool sameFrames(GstCaps* a, GstCaps* b) {
 // frame, each frame after the one before.
 class Timeline {
  public:
-  Timeline(ExportSink& sink, std::ofstream& jsonl, const ExportRequest& request)
-      : sink_(sink), jsonl_(jsonl), request_(request) {}
+  // `jsonl`: where the lines go as well (none when streamed); `onFirst`:
+  // told the first frame's time, before the sink has it.
+  Timeline(ExportSink& sink, std::ofstream* jsonl, const ExportRequest& request,
+           std::function<void(int64_t)> onFirst)
+      : sink_(sink), jsonl_(jsonl), request_(request), onFirst_(std::move(onFirst)) {}
 
   bool inRange(int64_t utcNs) const {
     return (!request_.start || utcNs >= *request_.start) &&
@@ -91,6 +94,7 @@ class Timeline {
 
   std::optional<ExportError> frame(GstBuffer* buffer, int64_t utcNs, bool key, GstCaps* caps) {
     if (!origin_) {
+      onFirst_(utcNs);
       // The format cannot hold these frames (JPEG in MP4), or its muxer is missing.
       if (auto problem = sink_.start(caps))
         return ExportError{ExportError::Kind::kUnsupported, *problem};
@@ -116,7 +120,7 @@ class Timeline {
     if (!origin_) return std::nullopt;  // lines before the first frame wait for it
     int64_t pts = std::max<int64_t>(line.utcNs - *origin_, 0);
     line.json["pts"] = pts;
-    jsonl_ << line.json.dump() << '\n';
+    if (jsonl_) *jsonl_ << line.json.dump() << '\n';
     ++report.lines;
     return failed(sink_.line(line.json, pts, line.utcNs));
   }
@@ -131,8 +135,9 @@ class Timeline {
   }
 
   ExportSink& sink_;
-  std::ofstream& jsonl_;
+  std::ofstream* jsonl_;
   const ExportRequest& request_;
+  std::function<void(int64_t)> onFirst_;
   std::optional<int64_t> origin_;
   static constexpr int64_t kLongestFrameInterval = 1000000000;  // 1 fps
   int64_t lastFrame_ = -1;
@@ -204,33 +209,50 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
   return std::nullopt;
 }
 
-// What an export's files are called until they are whole.
-constexpr const char* kPartial = ".partial";
+// The sink for the request's format, to its file or its stream.
+std::unique_ptr<ExportSink> sinkFor(const ExportRequest& request, const fs::path& writing) {
+  ExportTarget target{request.stream >= 0 ? request.out.string() : writing.string(),
+                      request.stream};
+  if (request.format == ExportFormat::kMcap)
+    return std::make_unique<McapExport>(target, request.camera);
+  return std::make_unique<MuxedExport>(target, exportFormatName(request.format));
+}
+
+// Where the range ends as planned: its end, or the last segment's.
+int64_t plannedEnd(const ExportRequest& request, const ExportSelection& selection) {
+  int64_t last = 0;
+  for (const auto& segment : selection.segments)
+    last = std::max(last, segment.startNs + segment.durationNs);
+  return request.end ? std::min(*request.end, last) : last;
+}
 
 }  // namespace
 
 Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
-                                                const ExportProgress& progress) {
+                                                const ExportProgress& progress,
+                                                const ExportStarted& started) {
   using Kind = ExportError::Kind;
   auto selection = selectSegments(request.recordings, request.camera, request.start, request.end);
   if (!selection) return unexpected(ExportError{Kind::kNothing, selection.error()});
+  bool streamed = request.stream >= 0;
   // Written beside under other names, and renamed only once whole: an
   // export that fails or is stopped leaves the files of an earlier one as
   // they were.
   fs::path jsonlPath = fs::path(request.out).replace_extension(".jsonl");
-  fs::path writing = request.out.string() + kPartial, writingJsonl = jsonlPath.string() + kPartial;
-  std::unique_ptr<ExportSink> sink;
-  if (request.format == ExportFormat::kMcap)
-    sink = std::make_unique<McapExport>(writing.string(), request.camera);
-  else
-    sink = std::make_unique<MuxedExport>(writing.string(), exportFormatName(request.format));
-  std::ofstream jsonl(writingJsonl);
-  if (!jsonl)  // the first file opened: most often --out's folder is missing or read-only
-    return unexpected(ExportError{Kind::kFailed, "cannot write " + request.out.string() + " (nor " +
-                                                     jsonlPath.filename().string() +
-                                                     " beside it): " + std::strerror(errno)});
+  fs::path writing = partialPathOf(request.out), writingJsonl = partialPathOf(jsonlPath);
+  auto sink = sinkFor(request, writing);
+  std::ofstream jsonl;
+  if (!streamed) {
+    jsonl.open(writingJsonl);
+    if (!jsonl)  // the first file opened: most often --out's folder is missing or read-only
+      return unexpected(ExportError{Kind::kFailed, "cannot write " + request.out.string() +
+                                                       " (nor " + jsonlPath.filename().string() +
+                                                       " beside it): " + std::strerror(errno)});
+  }
 
-  Timeline timeline(*sink, jsonl, request);
+  Timeline timeline(*sink, streamed ? nullptr : &jsonl, request, [&](int64_t firstUtcNs) {
+    if (started) started({firstUtcNs, plannedEnd(request, *selection), selection->notes});
+  });
   uint64_t total = 0, done = 0;
   for (const auto& segment : selection->segments) total += segment.frames;
   GstCaps* caps = nullptr;
@@ -239,7 +261,8 @@ Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
     bool stopped = false;
     uint64_t framesBefore = timeline.report.frames;
     problem = exportSegment(segment, timeline, caps, selection->notes, [&] {
-      if (progress && ++done % 50 == 0 && !progress(done, total)) stopped = true;
+      if (progress && ++done % 50 == 0 && !progress(done, total, sink->bytesWritten()))
+        stopped = true;
       return !stopped;
     });
     if (stopped) problem = ExportError{Kind::kCancelled, "the export was stopped"};
@@ -252,24 +275,29 @@ Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
         ExportError{Kind::kNothing, "camera " + request.camera + " has no frame in that range"};
   if (!problem && timeline.started())
     if (auto failed = sink->finish()) problem = ExportError{Kind::kFailed, *failed};
+  uint64_t bytes = sink->bytesWritten();
   sink.reset();
-  jsonl.close();
   std::error_code error;
-  if (!problem) {
-    fs::rename(writing, request.out, error);
-    if (!error) fs::rename(writingJsonl, jsonlPath, error);
-    if (error)
-      problem = ExportError{Kind::kFailed,
-                            "cannot write " + request.out.string() + ": " + error.message()};
+  if (!streamed) {
+    jsonl.close();
+    if (!problem) {
+      fs::rename(writing, request.out, error);
+      if (!error) fs::rename(writingJsonl, jsonlPath, error);
+      if (error)
+        problem = ExportError{Kind::kFailed,
+                              "cannot write " + request.out.string() + ": " + error.message()};
+    }
+    if (problem) {
+      fs::remove(writing, error);
+      fs::remove(writingJsonl, error);
+    }
   }
-  if (problem) {
-    fs::remove(writing, error);
-    fs::remove(writingJsonl, error);
-    return unexpected(*problem);
-  }
-  if (progress) progress(total, total);
+  if (problem) return unexpected(*problem);
+  if (progress) progress(total, total, bytes);
   timeline.report.notes = std::move(selection->notes);
   return timeline.report;
 }
+
+fs::path partialPathOf(const fs::path& out) { return out.string() + ".partial"; }
 
 }  // namespace wircam::recorder

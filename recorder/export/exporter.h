@@ -25,6 +25,9 @@ struct ExportRequest {
   std::optional<int64_t> start, end;  // UTC ns; open-ended without
   ExportFormat format = ExportFormat::kMkv;
   std::filesystem::path out;
+  // With a descriptor: the file streamed to it as it is made (see
+  // ExportTarget), `out` only naming it, and no .jsonl.
+  int stream = -1;
 };
 
 struct ExportReport {
@@ -33,8 +36,18 @@ struct ExportReport {
   std::vector<std::string> notes;  // segments skipped or left out, and why
 };
 
-// Frames done of about how many; false stops the export (a client gone).
-using ExportProgress = std::function<bool(uint64_t done, uint64_t total)>;
+// Frames done of about how many, and the file's bytes so far; false stops
+// the export (a client gone).
+using ExportProgress = std::function<bool(uint64_t done, uint64_t total, uint64_t bytes)>;
+
+// What is known as the first frame goes in, before any byte of the file:
+// what a streamed response says in its headers.
+struct ExportStart {
+  int64_t firstUtcNs = 0;
+  int64_t lastUtcNs = 0;           // as planned: the range's end or the last segment's
+  std::vector<std::string> notes;  // left out so far
+};
+using ExportStarted = std::function<void(const ExportStart&)>;
 
 struct ExportError {
   enum class Kind {
@@ -47,8 +60,13 @@ struct ExportError {
   std::string message;
 };
 
-// On an error nothing is left at `out`.
+// What an export's file is called until it is whole (and its .jsonl's,
+// likewise): `out` with ".partial" added.
+std::filesystem::path partialPathOf(const std::filesystem::path& out);
+
+// On an error nothing is left at `out` (what was streamed is the reader's).
 Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
-                                                const ExportProgress& progress = {});
+                                                const ExportProgress& progress = {},
+                                                const ExportStarted& started = {});
 
 }  // namespace wircam::recorder

@@ -1,10 +1,12 @@
 // wirc-export: one camera's recordings over a time range as one file.
 //   wirc-export --recordings DIR --camera NAME [--start ISO8601] [--end ISO8601]
-//               --format mkv|mp4|mcap --out FILE
+//               --format mkv|mp4|mcap --out FILE|-
 #include <getopt.h>
 #include <gst/gst.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <string>
@@ -16,7 +18,7 @@ namespace {
 using namespace wircam::recorder;
 
 const char* kUsage =
-    R"(Usage: wirc-export --recordings DIR --camera NAME [--start ISO8601] [--end ISO8601] --format mkv|mp4|mcap --out FILE
+    R"(Usage: wirc-export --recordings DIR --camera NAME [--start ISO8601] [--end ISO8601] --format mkv|mp4|mcap --out FILE|-
 
 Writes one camera's recorded segments between two times as one file, the
 frames untouched (JPEG stays JPEG, H.264 stays H.264), on one timeline from
@@ -31,7 +33,11 @@ re-based in FILE's .jsonl beside it.
                      (+01:00); without a zone, local time. Default: all
   --format           mkv | mp4 (H.264 recordings) | mcap (Foxglove, Lichtblick:
                      /NAME/image, /NAME/tags, /NAME/telemetry, /NAME/log)
-  --out FILE         the file to write (replaced)
+  --out FILE         the file to write (replaced); - streams it to stdout as
+                     it is made (mkv without its index, mp4 fragmented; no
+                     .jsonl), e.g. into ffplay, ssh or curl -T
+
+On a terminal, progress is shown as it goes: frames, MB/s, time left.
 
 Segments still being written are left out, and a broken one is skipped:
 both are said; so is a segment that cannot be read (zeros, a cut or empty
@@ -41,6 +47,23 @@ no output is left behind), 2 for a wrong command line.
 )";
 
 volatile std::sig_atomic_t stopRequested = 0;
+
+// "1200 of 9000 frames (13%), 41.5 MB/s, 0:52 left".
+std::string progressLine(uint64_t done, uint64_t total, uint64_t bytes,
+                         std::chrono::steady_clock::time_point begun) {
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begun).count();
+  char line[160];
+  int length =
+      std::snprintf(line, sizeof line, "%llu of %llu frames (%d%%)",
+                    static_cast<unsigned long long>(done), static_cast<unsigned long long>(total),
+                    static_cast<int>(100 * std::min(done, total) / total));
+  if (seconds > 0.5 && done > 0 && done < total) {
+    auto left = static_cast<long>(seconds * static_cast<double>(total - done) / done);
+    std::snprintf(line + length, sizeof line - length, ", %.1f MB/s, %ld:%02ld left",
+                  static_cast<double>(bytes) / 1e6 / seconds, left / 60, left % 60);
+  }
+  return line;
+}
 
 int usageError(const std::string& problem) {
   std::fprintf(stderr, "wirc-export: %s\n(wirc-export --help for the options)\n", problem.c_str());
@@ -110,13 +133,18 @@ int main(int argc, char** argv) {
   stop.sa_handler = [](int) { stopRequested = 1; };
   sigaction(SIGINT, &stop, nullptr);
   sigaction(SIGTERM, &stop, nullptr);
+  bool toStdout = request.out == "-";
+  if (toStdout) {
+    if (isatty(STDOUT_FILENO)) return usageError("--out - would write the file to the terminal");
+    request.stream = STDOUT_FILENO;
+  }
   bool terminal = isatty(STDERR_FILENO);
-  auto report = exportRange(request, [terminal](uint64_t done, uint64_t total) {
+  auto begun = std::chrono::steady_clock::now();
+  auto report = exportRange(request, [&](uint64_t done, uint64_t total, uint64_t bytes) {
     if (stopRequested) return false;
     if (!terminal || total == 0) return true;
-    std::fprintf(stderr, "\rwirc-export: %llu of %llu frames (%d%%)",
-                 static_cast<unsigned long long>(done), static_cast<unsigned long long>(total),
-                 static_cast<int>(100 * done / total));
+    std::fprintf(stderr, "\rwirc-export: %s\x1b[K",
+                 progressLine(done, total, bytes, begun).c_str());
     return true;
   });
   if (terminal) std::fputc('\n', stderr);
@@ -125,10 +153,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   for (const auto& note : report->notes) std::fprintf(stderr, "wirc-export: %s\n", note.c_str());
-  std::printf("wirc-export: %s: %llu frames from %llu segments, %llu telemetry lines, %s to %s\n",
-              request.out.c_str(), static_cast<unsigned long long>(report->frames),
-              static_cast<unsigned long long>(report->segments),
-              static_cast<unsigned long long>(report->lines), isoTimeOf(report->firstUtcNs).c_str(),
-              isoTimeOf(report->lastUtcNs).c_str());
+  // On stdout the file goes: the summary goes with the other messages.
+  std::fprintf(toStdout ? stderr : stdout,
+               "wirc-export: %s: %llu frames from %llu segments, %llu telemetry lines, %s to %s\n",
+               request.out.c_str(), static_cast<unsigned long long>(report->frames),
+               static_cast<unsigned long long>(report->segments),
+               static_cast<unsigned long long>(report->lines),
+               isoTimeOf(report->firstUtcNs).c_str(), isoTimeOf(report->lastUtcNs).c_str());
   return 0;
 }

@@ -10,8 +10,10 @@
 
 namespace wircam::recorder {
 
-McapExport::McapExport(std::string path, std::string stream)
-    : path_(std::move(path)), stream_(std::move(stream)) {}
+McapExport::McapExport(ExportTarget target, std::string stream)
+    : target_(std::move(target)), stream_(std::move(stream)) {
+  if (target_.stream >= 0) output_ = std::make_unique<ByteStream>(target_.stream);
+}
 
 std::optional<std::string> McapExport::start(GstCaps* caps) {
   std::string media = gst_structure_get_name(gst_caps_get_structure(caps, 0));
@@ -25,9 +27,15 @@ std::optional<std::string> McapExport::start(GstCaps* caps) {
       if (!annexB_) return "the H.264 stream's codec_data is not an avcC record";
     }
   }
-  auto writer = McapWriter::create(path_);
-  if (!writer) return writer.error();
-  writer_ = std::move(*writer);
+  if (output_) {
+    FILE* file = output_->openFile();
+    if (!file) return "cannot stream " + target_.path + ": " + std::strerror(errno);
+    writer_ = McapWriter::create(file);
+  } else {
+    auto writer = McapWriter::create(target_.path);
+    if (!writer) return writer.error();
+    writer_ = std::move(*writer);
+  }
   for (const auto& channel : foxgloveChannels({.video = format_ == "h264"})) {
     uint16_t schema =
         writer_->addSchema(channel.schemaName, channel.schemaEncoding, channel.schema);
@@ -54,6 +62,7 @@ std::optional<std::string> McapExport::start(GstCaps* caps) {
 }
 
 std::optional<std::string> McapExport::frame(GstBuffer* buffer, int64_t, int64_t utcNs, bool) {
+  if (output_ && !output_->error().empty()) return output_->error();  // the reader is gone
   gst::ScopedBufferMap map(buffer, GST_MAP_READ);
   if (!map) return "an unreadable frame";
   auto time = static_cast<uint64_t>(std::max<int64_t>(utcNs, 0));
@@ -85,7 +94,9 @@ std::optional<std::string> McapExport::line(const nlohmann::json& line, int64_t,
 }
 
 std::optional<std::string> McapExport::finish() {
-  if (!writer_->finish()) return "cannot write " + path_ + ": " + std::strerror(errno);
+  bool written = writer_->finish();
+  if (output_ && !output_->error().empty()) return output_->error();
+  if (!written) return "cannot write " + target_.path + ": " + std::strerror(errno);
   return std::nullopt;
 }
 

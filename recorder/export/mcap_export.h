@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "export/byte_stream.h"
 #include "export/export_sink.h"
 #include "export/mcap_writer.h"
 #include "foxglove/annex_b.h"
@@ -19,7 +20,8 @@ namespace wircam::recorder {
 
 class McapExport : public ExportSink {
  public:
-  McapExport(std::string path, std::string stream);
+  // `stream`: the camera's name, the topics' prefix.
+  McapExport(ExportTarget target, std::string stream);
 
   std::optional<std::string> start(GstCaps* caps) override;
   std::optional<std::string> frame(GstBuffer* buffer, int64_t ptsNs, int64_t utcNs,
@@ -27,11 +29,14 @@ class McapExport : public ExportSink {
   std::optional<std::string> line(const nlohmann::json& line, int64_t ptsNs,
                                   int64_t utcNs) override;
   std::optional<std::string> finish() override;
+  uint64_t bytesWritten() override { return writer_ ? writer_->bytesWritten() : 0; }
 
  private:
   void write(uint16_t channel, int64_t utcNs, const nlohmann::json& message);
 
-  std::string path_, stream_, format_;
+  ExportTarget target_;
+  std::unique_ptr<ByteStream> output_;  // streamed: where the writer's FILE* goes
+  std::string stream_, format_;
   std::unique_ptr<McapWriter> writer_;
   std::optional<AnnexB> annexB_;  // for H.264: Foxglove decodes Annex B
   uint16_t image_ = 0, tags_ = 0, telemetry_ = 0, log_ = 0;

@@ -64,9 +64,14 @@ uint32_t crcOf(const std::string& bytes, uint32_t crc = 0) {
 
 Expected<std::unique_ptr<McapWriter>, std::string> McapWriter::create(const std::string& path,
                                                                       const std::string& profile) {
+  FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) return unexpected("cannot create " + path + ": " + std::strerror(errno));
+  return create(file, profile);
+}
+
+std::unique_ptr<McapWriter> McapWriter::create(FILE* file, const std::string& profile) {
   std::unique_ptr<McapWriter> writer(new McapWriter);
-  writer->file_ = std::fopen(path.c_str(), "wb");
-  if (!writer->file_) return unexpected("cannot create " + path + ": " + std::strerror(errno));
+  writer->file_ = file;
   writer->put(std::string(kMagic, kMagicSize));
   writer->emit(kHeader, Bytes().str(profile).str("wircam wirc-export").out);
   return writer;

@@ -33,6 +33,9 @@ class McapWriter {
   // Creates `path` (replacing it) and writes the magic and the header.
   static Expected<std::unique_ptr<McapWriter>, std::string> create(const std::string& path,
                                                                    const std::string& profile = "");
+  // The same into `file` (written straight through: a reader of a stream
+  // finds the summary at its end as ever), which it closes.
+  static std::unique_ptr<McapWriter> create(FILE* file, const std::string& profile = "");
   McapWriter(const McapWriter&) = delete;
   McapWriter& operator=(const McapWriter&) = delete;
   ~McapWriter();

@@ -1,7 +1,10 @@
 #include "export/muxed_export.h"
 
+#include <gst/app/gstappsink.h>
 #include <gst/app/gstappsrc.h>
 
+#include <chrono>
+#include <thread>
 #include <utility>
 
 #include "telemetry/telemetry_track.h"
@@ -9,8 +12,18 @@
 
 namespace wircam::recorder {
 
-MuxedExport::MuxedExport(std::string path, std::string container)
-    : path_(std::move(path)), container_(std::move(container)) {}
+namespace {
+
+// How far the muxer may fall behind the export (a slow reader of a stream):
+// the bound of the export's memory.
+constexpr guint64 kQueuedBytes = 8000000;
+
+}  // namespace
+
+MuxedExport::MuxedExport(ExportTarget target, std::string container)
+    : target_(std::move(target)), container_(std::move(container)) {
+  if (target_.stream >= 0) stream_ = std::make_unique<ByteStream>(target_.stream);
+}
 
 MuxedExport::~MuxedExport() {
   if (pending_) gst_buffer_unref(pending_);
@@ -18,6 +31,7 @@ MuxedExport::~MuxedExport() {
   gst_element_set_state(pipeline_, GST_STATE_NULL);
   gst_object_unref(video_);
   gst_object_unref(text_);
+  gst_object_unref(out_);
   gst_object_unref(pipeline_);
 }
 
@@ -28,15 +42,21 @@ std::optional<std::string> MuxedExport::start(GstCaps* caps) {
            "JPEG frames as they are (use mkv or mcap to keep them untouched)";
   // The text track is named as in the recordings (in Matroska a
   // placeholder, rewritten when the file is done: telemetry_track_flags.h).
-  gchar* location = g_strescape(path_.c_str(), nullptr);
+  // Streamed, nothing goes back over what left: Matroska without its index
+  // (which players do without), MP4 in fragments of a second.
+  std::string muxer = mkv ? (stream_ ? "matroskamux streamable=true" : "matroskamux")
+                          : (stream_ ? "mp4mux fragment-duration=1000 streamable=true" : "mp4mux");
+  std::string sink = "appsink name=out sync=false emit-signals=true";
+  if (!stream_) {
+    gchar* location = g_strescape(target_.path.c_str(), nullptr);
+    sink = std::string("filesink name=out location=\"") + location + "\"";
+    g_free(location);
+  }
   std::string description =
-      std::string("appsrc name=video format=time block=true max-bytes=8000000 ! mux.video_%u ") +
-      (mkv ? "matroskamux" : "mp4mux") + " name=mux ! filesink location=\"" + location +
-      "\" appsrc name=text format=time caps=\"text/x-raw,format=(string)utf8\" ! taginject "
-      "name=title "
-      "tags=\"title=" +
+      "appsrc name=video format=time ! mux.video_%u " + muxer + " name=mux ! " + sink +
+      " appsrc name=text format=time caps=\"text/x-raw,format=(string)utf8\" ! taginject "
+      "name=title tags=\"title=" +
       std::string(mkv ? kTelemetryTrackPlaceholder : kTelemetryTrackName) + "\" ! mux.subtitle_%u";
-  g_free(location);
   GError* error = nullptr;
   pipeline_ = gst_parse_launch(description.c_str(), &error);
   if (error) {
@@ -47,6 +67,8 @@ std::optional<std::string> MuxedExport::start(GstCaps* caps) {
   }
   video_ = gst_bin_get_by_name(GST_BIN(pipeline_), "video");
   text_ = gst_bin_get_by_name(GST_BIN(pipeline_), "text");
+  out_ = gst_bin_get_by_name(GST_BIN(pipeline_), "out");
+  if (stream_) g_signal_connect(out_, "new-sample", G_CALLBACK(onBytes), this);
   gst_app_src_set_caps(GST_APP_SRC(video_), caps);
   // Gaps become what the muxer wants after taginject, which sends the
   // track's title with the first buffer it sees: a GAP event would pass it
@@ -57,8 +79,57 @@ std::optional<std::string> MuxedExport::start(GstCaps* caps) {
   gst_pad_add_probe(textOut, GST_PAD_PROBE_TYPE_BUFFER, onText, this, nullptr);
   gst_object_unref(textOut);
   if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE)
-    return failure().value_or("cannot write " + path_);
+    return failure().value_or("cannot write " + target_.path);
   return std::nullopt;
+}
+
+GstFlowReturn MuxedExport::onBytes(GstElement* appsink, gpointer data) {
+  auto* self = static_cast<MuxedExport*>(data);
+  GstSample* sample = gst_app_sink_pull_sample(GST_APP_SINK(appsink));
+  if (!sample) return GST_FLOW_FLUSHING;
+  GstMapInfo map;
+  bool sent = false;
+  if (gst_buffer_map(gst_sample_get_buffer(sample), &map, GST_MAP_READ)) {
+    std::lock_guard lock(self->streamLock_);
+    sent = self->send(map.data, map.size);
+    gst_buffer_unmap(gst_sample_get_buffer(sample), &map);
+  }
+  gst_sample_unref(sample);
+  return sent ? GST_FLOW_OK : GST_FLOW_ERROR;
+}
+
+bool MuxedExport::send(const uint8_t* data, size_t size) {
+  if (headerSent_) return stream_->write(data, size);
+  header_.insert(header_.end(), data, data + size);
+  return header_.size() < kTelemetryTrackHeaderBytes || sendHeader();
+}
+
+bool MuxedExport::sendHeader() {
+  headerSent_ = true;
+  markTelemetryTrackInHeader(
+      header_, container_ == "mkv" ? TrackContainer::kMatroska : TrackContainer::kMp4);
+  bool sent = stream_->write(header_.data(), header_.size());
+  header_ = {};
+  return sent;
+}
+
+std::optional<std::string> MuxedExport::waitForRoom() {
+  while (gst_app_src_get_current_level_bytes(GST_APP_SRC(video_)) >= kQueuedBytes) {
+    if (auto problem = failure()) return problem;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return std::nullopt;
+}
+
+uint64_t MuxedExport::bytesWritten() {
+  if (stream_) {
+    std::lock_guard lock(streamLock_);
+    return stream_->written();
+  }
+  gint64 position = 0;
+  if (out_ && gst_element_query_position(out_, GST_FORMAT_BYTES, &position))
+    return static_cast<uint64_t>(position);
+  return 0;
 }
 
 GstPadProbeReturn MuxedExport::onText(GstPad* pad, GstPadProbeInfo* info, gpointer self) {
@@ -90,6 +161,10 @@ std::optional<std::string> MuxedExport::pushPending(int64_t durationNs) {
   lastDuration_ = durationNs;
   GST_BUFFER_DURATION(pending_) = static_cast<GstClockTime>(durationNs);
   GstBuffer* out = std::exchange(pending_, nullptr);
+  if (auto problem = waitForRoom()) {
+    gst_buffer_unref(out);
+    return problem;
+  }
   if (gst_app_src_push_buffer(GST_APP_SRC(video_), out) != GST_FLOW_OK)
     return failure().value_or("the muxer stopped taking frames");
   return std::nullopt;
@@ -110,31 +185,56 @@ std::optional<std::string> MuxedExport::finish() {
     if (auto problem = pushPending(lastDuration_)) return problem;
   gst_app_src_end_of_stream(GST_APP_SRC(video_));
   gst_app_src_end_of_stream(GST_APP_SRC(text_));
+  // Until the file is written, or the stream's reader is gone (the muxer
+  // may then stop without a word).
   GstBus* bus = gst_element_get_bus(pipeline_);
-  GstMessage* message = gst_bus_timed_pop_filtered(
-      bus, GST_CLOCK_TIME_NONE, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
-  gst_object_unref(bus);
   std::optional<std::string> problem;
-  if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR) {
-    GError* error = nullptr;
-    gst_message_parse_error(message, &error, nullptr);
-    problem = "cannot write " + path_ + ": " + error->message;
-    g_error_free(error);
+  while (true) {
+    GstMessage* message = gst_bus_timed_pop_filtered(
+        bus, 100 * GST_MSECOND, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
+    if (!message) {
+      std::lock_guard lock(streamLock_);
+      if (stream_ && !stream_->error().empty()) problem = stream_->error();
+      if (problem) break;
+      continue;
+    }
+    if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR) {
+      GError* error = nullptr;
+      gst_message_parse_error(message, &error, nullptr);
+      std::lock_guard lock(streamLock_);
+      problem = stream_ && !stream_->error().empty()
+                    ? stream_->error()
+                    : "cannot write " + target_.path + ": " + error->message;
+      g_error_free(error);
+    }
+    gst_message_unref(message);
+    break;
   }
-  gst_message_unref(message);
+  gst_object_unref(bus);
   gst_element_set_state(pipeline_, GST_STATE_NULL);
-  if (!problem) markTelemetryTrack(path_);
-  return problem;
+  if (problem) return problem;
+  if (!stream_) {
+    markTelemetryTrack(target_.path);
+    return std::nullopt;
+  }
+  // A stream shorter than a header's room.
+  std::lock_guard lock(streamLock_);
+  if (!headerSent_ && !sendHeader()) return stream_->error();
+  return std::nullopt;
 }
 
 std::optional<std::string> MuxedExport::failure() {
+  if (stream_) {
+    std::lock_guard lock(streamLock_);
+    if (!stream_->error().empty()) return stream_->error();
+  }
   GstBus* bus = gst_element_get_bus(pipeline_);
   GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
   gst_object_unref(bus);
   if (!message) return std::nullopt;
   GError* error = nullptr;
   gst_message_parse_error(message, &error, nullptr);
-  std::string text = "cannot write " + path_ + ": " + error->message;
+  std::string text = "cannot write " + target_.path + ": " + error->message;
   g_error_free(error);
   gst_message_unref(message);
   return text;

@@ -1,10 +1,14 @@
 #include "http/export_downloads.h"
 
+#include <glib-unix.h>
 #include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <fstream>
+#include <cerrno>
+#include <cstring>
+#include <mutex>
 #include <optional>
 #include <thread>
 #include <utility>
@@ -47,12 +51,12 @@ std::string compactTime(int64_t unixNs) {
   return compact;
 }
 
-// The name a browser saves the file as: the camera and the range.
-std::string downloadName(const std::string& camera, const ExportReport& report,
-                         ExportFormat format) {
+// The name a browser saves the file as: the camera and the range (its
+// first frame to its planned end).
+std::string downloadName(const std::string& camera, const ExportStart& start, ExportFormat format) {
   std::string name;
   for (char c : camera) name += g_ascii_isalnum(c) || c == '-' || c == '.' ? c : '_';
-  return name + "_" + compactTime(report.firstUtcNs) + "-" + compactTime(report.lastUtcNs) + "." +
+  return name + "_" + compactTime(start.firstUtcNs) + "-" + compactTime(start.lastUtcNs) + "." +
          exportFormatName(format);
 }
 
@@ -68,81 +72,155 @@ std::optional<int64_t> queryTime(const char* text) {
 
 struct ExportDownloads::Download {
   ExportDownloads* owner = nullptr;
-  SoupServerMessage* message = nullptr;
+  SoupServerMessage* message = nullptr;  // null once libsoup is done with it
   gulong finishedHandler = 0, wroteHandler = 0;
-  ExportRequest request;
+  ExportRequest request;  // its `stream` is the worker's end, closed by the worker
+  int readEnd = -1;       // ours, non-blocking
+  guint readable = 0;     // the watch on readEnd, while a block is wanted
   std::atomic<bool> stop{false};
-  std::optional<Expected<ExportReport, ExportError>> result;  // the worker's, read after it posts
   std::thread worker;
-  GSocket* socket = nullptr;  // the client's, borrowed: looked at while exporting
+  GSocket* socket = nullptr;  // the client's, borrowed: looked at until the first bytes
   guint clientCheck = 0;
-  std::ifstream file;
-  bool sentAll = false;
+  std::mutex startLock;
+  std::optional<ExportStart> start;  // the worker's, set before its first byte
+  std::optional<Expected<ExportReport, ExportError>> result;  // the worker's
+  bool exported = false;  // the worker joined: `result` is ours to read
+  bool atEnd = false;     // the worker's end closed and everything read
+  bool responding = false, sentAll = false;
   // The result on its way to the main loop checks it: the download may be gone.
   std::shared_ptr<bool> alive = std::make_shared<bool>(true);
 
-  // The file's next block, or the body's end after its last.
-  void sendNextBlock() {
+  void watch() {
+    readable = g_unix_fd_add(readEnd, static_cast<GIOCondition>(G_IO_IN | G_IO_HUP | G_IO_ERR),
+                             onReadable, this);
+  }
+
+  // A block of the file, then nothing until libsoup has written it.
+  static gboolean onReadable(int fd, GIOCondition, gpointer data) {
+    auto* self = static_cast<Download*>(data);
     // Read into memory the body then owns: no copy, freed once written.
     auto* block = static_cast<char*>(g_malloc(kBlockBytes));
-    file.read(block, static_cast<std::streamsize>(kBlockBytes));
-    auto* body = soup_server_message_get_response_body(message);
-    if (file.gcount() > 0) {
-      soup_message_body_append(body, SOUP_MEMORY_TAKE, block, static_cast<gsize>(file.gcount()));
-    } else {
+    ssize_t got = read(fd, block, kBlockBytes);
+    if (got < 0 && (errno == EAGAIN || errno == EINTR)) {
       g_free(block);
-      soup_message_body_complete(body);
+      return G_SOURCE_CONTINUE;
+    }
+    self->readable = 0;
+    if (got <= 0) {
+      g_free(block);
+      self->atEnd = true;
+      self->finish();
+      return G_SOURCE_REMOVE;
+    }
+    if (!self->responding) self->beginResponse();
+    soup_message_body_append(soup_server_message_get_response_body(self->message), SOUP_MEMORY_TAKE,
+                             block, static_cast<gsize>(got));
+    soup_server_message_unpause(self->message);
+    return G_SOURCE_REMOVE;
+  }
+
+  // The headers, with the first bytes: what is known as the first frame went in.
+  void beginResponse() {
+    responding = true;
+    // From here libsoup, writing, sees a client that left.
+    if (clientCheck) g_source_remove(std::exchange(clientCheck, 0));
+    ExportStart started;
+    {
+      std::lock_guard lock(startLock);
+      if (start) started = *start;
+    }
+    soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
+    SoupMessageHeaders* headers = soup_server_message_get_response_headers(message);
+    soup_message_headers_set_encoding(headers, SOUP_ENCODING_CHUNKED);
+    soup_message_headers_set_content_type(headers, contentTypeOf(request.format), nullptr);
+    std::string name = downloadName(request.camera, started, request.format);
+    soup_message_headers_replace(headers, "Content-Disposition",
+                                 ("attachment; filename=\"" + name + "\"").c_str());
+    // What was left out before the first frame and why (a segment still
+    // being written, a broken one), as ASCII JSON: a header carries no
+    // other bytes safely. What the export meets later goes to the log.
+    soup_message_headers_replace(headers, "X-Export-Notes",
+                                 nlohmann::json(started.notes)
+                                     .dump(-1, ' ', true, nlohmann::json::error_handler_t::replace)
+                                     .c_str());
+    soup_message_headers_replace(headers, "Cache-Control", "no-store");
+    // Blocks sent are freed, not kept for the whole response.
+    soup_message_body_set_accumulate(soup_server_message_get_response_body(message), FALSE);
+    wroteHandler =
+        g_signal_connect(message, "wrote-chunk", G_CALLBACK(+[](SoupServerMessage*, gpointer d) {
+                           auto* self = static_cast<Download*>(d);
+                           if (!self->atEnd && !self->readable) self->watch();
+                         }),
+                         this);
+  }
+
+  // Once the worker is joined and its stream read to the end: the response
+  // ends as the export did.
+  void finish() {
+    if (!exported || !atEnd || !message) return;
+    if (!responding) {  // not a byte made: said in JSON
+      guint status = SOUP_STATUS_INTERNAL_SERVER_ERROR;
+      std::string reason = "the export made nothing";
+      if (!*result) {
+        auto kind = result->error().kind;
+        if (kind == ExportError::Kind::kNothing) status = SOUP_STATUS_NOT_FOUND;
+        if (kind == ExportError::Kind::kUnsupported) status = SOUP_STATUS_UNSUPPORTED_MEDIA_TYPE;
+        reason = result->error().message;
+      }
+      respondJsonError(message, status, reason);
+    } else if (*result) {
+      soup_message_body_complete(soup_server_message_get_response_body(message));
       sentAll = true;
+    } else {
+      // Broken off: the response must not end as if whole (its last chunk
+      // would say so), so its connection goes.
+      GSocket* connection = socket ? socket : soup_server_message_get_socket(message);
+      if (connection) shutdown(g_socket_get_fd(connection), SHUT_RDWR);
     }
     soup_server_message_unpause(message);
   }
 
-  // The export's files, written or half written: never kept.
-  void removeFiles() {
-    file.close();
-    std::error_code ignored;
-    fs::remove(request.out, ignored);
-    fs::remove(fs::path(request.out).replace_extension(".jsonl"), ignored);
+  void closeReadEnd() {
+    if (readable) g_source_remove(std::exchange(readable, 0));
+    if (readEnd >= 0) close(std::exchange(readEnd, -1));
   }
 
-  // The response is over: the export stopped (if it still ran), its files
-  // gone, and then the recorder's log says how it ended (a reader of the log
-  // finds nothing left behind).
+  // The response is over: the export stopped (if it still ran; our end
+  // closed, its writes fail), and then the recorder's log says how it ended.
   void end() {
     stop = true;
+    closeReadEnd();
     if (worker.joinable()) worker.join();  // the result is written then
-    removeFiles();
     std::string what =
         "export of " + request.camera + " (" + exportFormatName(request.format) + ")";
     if (!result) return;
-    if (!*result) {
-      bool stopped = result->error().kind == ExportError::Kind::kCancelled;
-      logLine(what + (stopped ? ": stopped, the client left" : ": " + result->error().message));
-    } else {
-      logLine(what + (sentAll ? ": " + std::to_string((*result)->frames) + " frames sent"
-                              : ": the client left before the end"));
+    if (sentAll) {
+      logLine(what + ": " + std::to_string((*result)->frames) + " frames sent");
+    } else if (responding || (!*result && result->error().kind == ExportError::Kind::kCancelled)) {
+      logLine(what + ": stopped, the client left");
+    } else if (!*result) {
+      logLine(what + ": " + result->error().message);
     }
   }
 
   ~Download() {
     if (clientCheck) g_source_remove(clientCheck);
     stop = true;
+    closeReadEnd();
     if (worker.joinable()) worker.join();
     if (message) {
       // The server is going away with the response unfinished.
       g_signal_handler_disconnect(message, finishedHandler);
       if (wroteHandler) g_signal_handler_disconnect(message, wroteHandler);
     }
-    removeFiles();
   }
 };
 
 ExportDownloads::ExportDownloads(fs::path recordings, SocketOf socketOf)
-    : recordings_(std::move(recordings)),
-      scratch_(recordings_ / ".exports"),
-      socketOf_(std::move(socketOf)) {
+    : recordings_(std::move(recordings)), socketOf_(std::move(socketOf)) {
+  // Where exports were written before they were streamed.
   std::error_code ignored;
-  fs::remove_all(scratch_, ignored);
+  if (!recordings_.empty()) fs::remove_all(recordings_ / ".exports", ignored);
 }
 
 ExportDownloads::~ExportDownloads() { downloads_.clear(); }
@@ -183,9 +261,14 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
     return respondJsonError(
         message, SOUP_STATUS_SERVICE_UNAVAILABLE,
         "already exporting " + std::to_string(kMaxAtOnce) + " ranges; try again when one is done");
-  std::error_code error;
-  fs::create_directories(scratch_, error);
-  range.out = scratch_ / (std::to_string(++serial_) + "." + exportFormatName(*format));
+  int ends[2];
+  if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, ends) != 0)
+    return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE,
+                            std::string("cannot start an export: ") + std::strerror(errno));
+  download->readEnd = ends[0];
+  g_unix_set_fd_nonblocking(ends[0], TRUE, nullptr);
+  range.stream = ends[1];
+  range.out = range.camera + "." + exportFormatName(*format);  // for messages only
 
   download->message = message;
   download->owner = this;
@@ -198,16 +281,23 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
                        }),
                        download);
   // A status now, or the WebSocket handler (which upgrades only unanswered
-  // requests) would answer it; the real one is set when the export is done.
+  // requests) would answer it; the real one is set with the first bytes.
   soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
   soup_server_message_pause(message);
   download->socket = socketOf_ ? socketOf_(message) : nullptr;
   if (download->socket) download->clientCheck = g_timeout_add(500, checkClient, download);
-  download->worker = std::thread([this, download, alive = std::weak_ptr<bool>(download->alive)] {
-    download->result = exportRange(
-        download->request, [download](uint64_t, uint64_t) { return !download->stop.load(); });
+  download->watch();
+  download->worker = std::thread([download, alive = std::weak_ptr<bool>(download->alive)] {
+    auto result = exportRange(
+        download->request,
+        [download](uint64_t, uint64_t, uint64_t) { return !download->stop.load(); },
+        [download](const ExportStart& start) {
+          std::lock_guard lock(download->startLock);
+          download->start = start;
+        });
+    download->result = std::move(result);
+    close(download->request.stream);  // the end of the file, for the reader
     struct Done {
-      ExportDownloads* self;
       Download* download;
       std::weak_ptr<bool> alive;
     };
@@ -215,10 +305,14 @@ void ExportDownloads::serve(SoupServerMessage* message, GHashTable* query) {
         nullptr, G_PRIORITY_DEFAULT,
         [](gpointer data) -> gboolean {
           auto* done = static_cast<Done*>(data);
-          if (!done->alive.expired()) done->self->exported(done->download);
+          if (done->alive.expired()) return G_SOURCE_REMOVE;
+          Download* finished = done->download;
+          finished->worker.join();
+          finished->exported = true;
+          finished->finish();
           return G_SOURCE_REMOVE;
         },
-        new Done{this, download, alive}, [](gpointer data) { delete static_cast<Done*>(data); });
+        new Done{download, alive}, [](gpointer data) { delete static_cast<Done*>(data); });
   });
   downloads_.push_back(std::move(owned));
 }
@@ -237,54 +331,6 @@ gboolean ExportDownloads::checkClient(gpointer data) {
   download->stop = true;
   download->clientCheck = 0;
   return G_SOURCE_REMOVE;
-}
-
-void ExportDownloads::exported(Download* download) {
-  if (download->clientCheck) g_source_remove(std::exchange(download->clientCheck, 0));
-  download->worker.join();
-  SoupServerMessage* message = download->message;
-  auto& result = *download->result;
-  if (!result) {
-    guint status = SOUP_STATUS_INTERNAL_SERVER_ERROR;
-    if (result.error().kind == ExportError::Kind::kNothing) status = SOUP_STATUS_NOT_FOUND;
-    if (result.error().kind == ExportError::Kind::kUnsupported)
-      status = SOUP_STATUS_UNSUPPORTED_MEDIA_TYPE;
-    respondJsonError(message, status, result.error().message);
-    soup_server_message_unpause(message);
-    return;
-  }
-  std::error_code error;
-  auto bytes = fs::file_size(download->request.out, error);
-  download->file.open(download->request.out, std::ios::binary);
-  if (error || !download->file) {
-    respondJsonError(message, SOUP_STATUS_INTERNAL_SERVER_ERROR,
-                     "the export was written but cannot be read back");
-    soup_server_message_unpause(message);
-    return;
-  }
-  soup_server_message_set_status(message, SOUP_STATUS_OK, nullptr);
-  SoupMessageHeaders* headers = soup_server_message_get_response_headers(message);
-  soup_message_headers_set_content_type(headers, contentTypeOf(download->request.format), nullptr);
-  soup_message_headers_set_content_length(headers, static_cast<goffset>(bytes));
-  std::string name = downloadName(download->request.camera, *result, download->request.format);
-  soup_message_headers_replace(headers, "Content-Disposition",
-                               ("attachment; filename=\"" + name + "\"").c_str());
-  soup_message_headers_replace(headers, "X-Export-Frames", std::to_string(result->frames).c_str());
-  // What was left out and why (a segment still being written, a broken one),
-  // as ASCII JSON: a header carries no other bytes safely.
-  soup_message_headers_replace(headers, "X-Export-Notes",
-                               nlohmann::json(result->notes)
-                                   .dump(-1, ' ', true, nlohmann::json::error_handler_t::replace)
-                                   .c_str());
-  soup_message_headers_replace(headers, "Cache-Control", "no-store");
-  // Blocks sent are freed, not kept for the whole response.
-  soup_message_body_set_accumulate(soup_server_message_get_response_body(message), FALSE);
-  download->wroteHandler =
-      g_signal_connect(message, "wrote-chunk", G_CALLBACK(+[](SoupServerMessage*, gpointer d) {
-                         static_cast<Download*>(d)->sendNextBlock();
-                       }),
-                       download);
-  download->sendNextBlock();
 }
 
 void ExportDownloads::forget(Download* download) {

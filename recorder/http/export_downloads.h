@@ -1,12 +1,13 @@
 // GET /api/export?camera=NAME&start=ISO8601&end=ISO8601&format=mkv|mp4|mcap:
 // a time range of one camera exported as wirc-export does, on a thread of
-// its own, into the recordings folder's .exports/ (out of retention's
-// reach: it only looks at the folder's own files), then sent to the client
-// a block at a time (never the whole file in memory) and deleted once the
-// response ends, however it ends. A client that leaves while its file is
-// being written stops the export (its socket is looked at twice a second:
-// libsoup does not read a request's connection while it waits for the
-// answer). Main loop only.
+// its own, and streamed to the client as it is made (chunked; Matroska
+// without its index, MP4 fragmented): the first bytes leave with the first
+// frames, nothing is kept on disk, and the export goes no faster than the
+// client takes it (a socket pair between them, read a block at a time when
+// the last one is written), so the recorder's memory stays flat whatever
+// the range. A client that leaves stops the export (its socket is looked at
+// twice a second until the first bytes: libsoup does not read a request's
+// connection while it waits for the answer). Main loop only.
 #pragma once
 
 #include <libsoup/soup.h>
@@ -25,9 +26,9 @@ class ExportDownloads {
   // A request's connection, for seeing whether its client is still there
   // (null when it is not known).
   using SocketOf = std::function<GSocket*(SoupServerMessage*)>;
-  // Removes what a previous run left in `recordings`/.exports.
+  // Removes what an earlier version left in `recordings`/.exports.
   ExportDownloads(std::filesystem::path recordings, SocketOf socketOf);
-  ~ExportDownloads();  // stops the exports, removes their files
+  ~ExportDownloads();  // stops the exports
   ExportDownloads(const ExportDownloads&) = delete;
   ExportDownloads& operator=(const ExportDownloads&) = delete;
 
@@ -36,13 +37,11 @@ class ExportDownloads {
 
  private:
   struct Download;
-  void exported(Download* download);
   static gboolean checkClient(gpointer download);
   void forget(Download* download);
 
-  std::filesystem::path recordings_, scratch_;
+  std::filesystem::path recordings_;
   SocketOf socketOf_;
-  uint64_t serial_ = 0;
   std::vector<std::unique_ptr<Download>> downloads_;
 };
 

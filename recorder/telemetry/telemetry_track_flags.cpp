@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,8 +17,6 @@ constexpr uint32_t kTracks = 0x1654AE6B;
 constexpr uint32_t kTrackEntry = 0xAE;
 constexpr uint32_t kTrackName = 0x536E;
 constexpr uint32_t kCluster = 0x1F43B675;
-// The header, tracks included, is written before the first cluster.
-constexpr size_t kHeaderBytes = 64 * 1024;
 
 struct Element {
   uint32_t id;
@@ -105,22 +104,39 @@ std::optional<std::vector<uint8_t>> replacement(std::string_view name, size_t si
 
 // The track's title tag, which matroskamux also writes, in a Tags element
 // at the end of the file: TagString (0x4487) holding the placeholder.
-bool renameTitleTag(FILE* f) {
+static std::vector<uint8_t> titleTagPattern() {
   std::string placeholder(kTelemetryTrackPlaceholder);
-  auto pattern =
-      stringElement(0x44, 0x87, std::string_view(placeholder.c_str(), placeholder.size() + 1));
+  return stringElement(0x44, 0x87, std::string_view(placeholder.c_str(), placeholder.size() + 1));
+}
+
+// TagString "telemetry", then a Void to the placeholder's size.
+static std::vector<uint8_t> titleTagReplacement() {
+  auto bytes = stringElement(0x44, 0x87, kTelemetryTrackName);
+  appendVoid(bytes, titleTagPattern().size() - bytes.size());
+  return bytes;
+}
+
+// Where in `data` the title tag still holds the placeholder, if it does.
+static std::optional<size_t> findTitleTag(const uint8_t* data, size_t size) {
+  static const auto pattern = titleTagPattern();
+  const uint8_t* end = data + size;
+  const uint8_t* at =
+      std::search(data, end, std::boyer_moore_horspool_searcher(pattern.begin(), pattern.end()));
+  if (at == end) return std::nullopt;
+  return static_cast<size_t>(at - data);
+}
+
+static bool renameTitleTag(FILE* f) {
   if (std::fseek(f, 0, SEEK_END) != 0) return false;
   long size = std::ftell(f);
-  long from = std::max(0L, size - static_cast<long>(kHeaderBytes));
+  long from = std::max(0L, size - static_cast<long>(kTelemetryTrackHeaderBytes));
   std::vector<uint8_t> tail(static_cast<size_t>(size - from));
   if (std::fseek(f, from, SEEK_SET) != 0) return false;
   tail.resize(std::fread(tail.data(), 1, tail.size(), f));
-  auto at = std::search(tail.begin(), tail.end(), pattern.begin(), pattern.end());
-  if (at == tail.end()) return false;
-  // TagString "telemetry", then a Void to the same size.
-  auto bytes = stringElement(0x44, 0x87, kTelemetryTrackName);
-  appendVoid(bytes, pattern.size() - bytes.size());
-  return std::fseek(f, from + (at - tail.begin()), SEEK_SET) == 0 &&
+  auto at = findTitleTag(tail.data(), tail.size());
+  if (!at) return false;
+  auto bytes = titleTagReplacement();
+  return std::fseek(f, from + static_cast<long>(*at), SEEK_SET) == 0 &&
          std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
 }
 
@@ -130,7 +146,7 @@ struct Box {
   size_t payload, end;
 };
 
-std::vector<Box> boxesIn(const std::vector<uint8_t>& b, size_t at, size_t end) {
+static std::vector<Box> boxesIn(const std::vector<uint8_t>& b, size_t at, size_t end) {
   std::vector<Box> boxes;
   while (at + 8 <= end) {
     uint64_t size = uint64_t{b[at]} << 24 | b[at + 1] << 16 | b[at + 2] << 8 | b[at + 3];
@@ -149,7 +165,8 @@ std::vector<Box> boxesIn(const std::vector<uint8_t>& b, size_t at, size_t end) {
   return boxes;
 }
 
-std::optional<Box> child(const std::vector<uint8_t>& b, const Box& parent, const char* type) {
+static std::optional<Box> child(const std::vector<uint8_t>& b, const Box& parent,
+                                const char* type) {
   for (const auto& box : boxesIn(b, parent.payload, parent.end))
     if (box.type == type) return box;
   return std::nullopt;
@@ -157,9 +174,7 @@ std::optional<Box> child(const std::vector<uint8_t>& b, const Box& parent, const
 
 // Clears "track enabled" in the tkhd of each text track of the moov (at the
 // start of a fragmented file).
-bool disableMp4TextTracks(FILE* f) {
-  std::vector<uint8_t> header(kHeaderBytes);
-  header.resize(std::fread(header.data(), 1, header.size(), f));
+static bool disableMp4TextTracks(std::vector<uint8_t>& header) {
   bool marked = false;
   for (const auto& moov : boxesIn(header, 0, header.size())) {
     if (moov.type != "moov") continue;
@@ -172,32 +187,39 @@ bool disableMp4TextTracks(FILE* f) {
         continue;
       std::string handler(reinterpret_cast<const char*>(header.data() + hdlr->payload + 8), 4);
       if (handler != "text" && handler != "sbtl" && handler != "subt") continue;
-      uint8_t flags = header[tkhd->payload + 3] & ~uint8_t{1};  // version, flags[3]
-      marked = std::fseek(f, static_cast<long>(tkhd->payload + 3), SEEK_SET) == 0 &&
-               std::fwrite(&flags, 1, 1, f) == 1;
+      header[tkhd->payload + 3] &= ~uint8_t{1};  // version, flags[3]
+      marked = true;
     }
   }
   return marked;
 }
 
+bool markTelemetryTrackInHeader(std::vector<uint8_t>& header, TrackContainer container) {
+  if (container == TrackContainer::kMp4) return disableMp4TextTracks(header);
+  auto found = findTrackName(header, 0, header.size(), kTelemetryTrackPlaceholder);
+  if (!found) return false;
+  auto bytes = replacement(kTelemetryTrackName, found->second);
+  if (!bytes) return false;
+  std::copy(bytes->begin(), bytes->end(), header.begin() + static_cast<long>(found->first));
+  // A streamable Matroska has its tags in the header too.
+  if (auto tag = findTitleTag(header.data(), header.size())) {
+    auto renamed = titleTagReplacement();
+    std::copy(renamed.begin(), renamed.end(), header.begin() + static_cast<long>(*tag));
+  }
+  return true;
+}
+
 bool markTelemetryTrack(const std::filesystem::path& file) {
   FILE* f = std::fopen(file.c_str(), "r+b");
   if (!f) return false;
-  if (file.extension() == ".mp4") {
-    bool marked = disableMp4TextTracks(f);
-    return std::fclose(f) == 0 && marked;
-  }
-  std::vector<uint8_t> header(kHeaderBytes);
+  auto container = file.extension() == ".mp4" ? TrackContainer::kMp4 : TrackContainer::kMatroska;
+  std::vector<uint8_t> header(kTelemetryTrackHeaderBytes);
   header.resize(std::fread(header.data(), 1, header.size(), f));
-  bool marked = false;
-  if (auto found = findTrackName(header, 0, header.size(), kTelemetryTrackPlaceholder)) {
-    if (auto bytes = replacement(kTelemetryTrackName, found->second)) {
-      marked = std::fseek(f, static_cast<long>(found->first), SEEK_SET) == 0 &&
-               std::fwrite(bytes->data(), 1, bytes->size(), f) == bytes->size();
-    }
-  }
+  // Written back whole: only the marked bytes differ.
+  bool marked = markTelemetryTrackInHeader(header, container) && std::fseek(f, 0, SEEK_SET) == 0 &&
+                std::fwrite(header.data(), 1, header.size(), f) == header.size();
   // Absent from a file cut short (the tags come last): the name stays.
-  if (marked) renameTitleTag(f);
+  if (marked && container == TrackContainer::kMatroska) renameTitleTag(f);
   return std::fclose(f) == 0 && marked;
 }
 

@@ -9,8 +9,11 @@
 // at the end of the file: nothing else in the file moves.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string_view>
+#include <vector>
 
 namespace wircam::recorder {
 
@@ -23,5 +26,13 @@ inline constexpr std::string_view kTelemetryTrackName = "telemetry";
 // True if the track was found and marked; false for a file without it (not
 // a recording, marked already, or cut before its header), left as it was.
 bool markTelemetryTrack(const std::filesystem::path& file);
+
+// The same on a stream's first bytes, before they leave (a streamed export
+// cannot go back): its header, the tracks (and a streamable Matroska's
+// tags) included, is in the first kTelemetryTrackHeaderBytes, before the
+// first cluster or fragment. True if marked.
+inline constexpr size_t kTelemetryTrackHeaderBytes = 64 * 1024;
+enum class TrackContainer { kMatroska, kMp4 };
+bool markTelemetryTrackInHeader(std::vector<uint8_t>& header, TrackContainer container);
 
 }  // namespace wircam::recorder

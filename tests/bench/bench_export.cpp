@@ -2,7 +2,9 @@
 //   wirc-sim --frames DIR (720p JPEGs) → wirc-recorder --segment 5
 // and then all of it joined into one file, three ways, side by side:
 //   wirc-export --format mkv, wirc-export --format mcap, and the stock way,
-//   ffmpeg -f concat -c copy of the same segments.
+//   ffmpeg -f concat -c copy of the same segments; then the same range as
+//   the recorder streams it over HTTP (GET /api/export) to curl, with the
+//   time to its first byte.
 // MB/s is the segments' bytes over the wall time (the median of 3 runs);
 // peak memory comes from wait4().
 // Usage: bench_export [SECONDS] [FPS]   (default 20 s at 60 fps)
@@ -10,6 +12,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -75,8 +78,9 @@ int main(int argc, char** argv) {
   pid_t recorder = spawn(
       (bin / "wirc-recorder").string() + " --device 127.0.0.1:" + std::to_string(port) + " --out " +
       (work / "rec").string() + " --segment 5 --duration " + std::to_string(seconds));
-  waitForUsage(recorder);
-  waitForUsage(sim);
+  auto longer = std::chrono::seconds(static_cast<long>(seconds) + 30);
+  waitForUsage(recorder, longer);
+  waitForUsage(sim, longer);
 
   auto index = nlohmann::json::parse(std::ifstream(work / "rec" / "index.json"), nullptr, false);
   if (!index.is_object() || index["segments"].empty()) {
@@ -126,6 +130,46 @@ int main(int argc, char** argv) {
     std::printf("%-32s | %8.1f | %8.2f | %8.1f | %15.2f | %.3f\n", way.name, rate, run->seconds,
                 static_cast<double>(run->maxRssKb) / 1024, rate / stock, size / stockBytes);
   }
+
+  // The same range streamed by the recorder (GET /api/export, mkv) to
+  // curl: how soon its first byte comes, its speed, and the recorder's
+  // peak memory (its whole life, idle included).
+  int httpPort = port + 1;
+  pid_t server =
+      spawn((bin / "wirc-recorder").string() + " --device 127.0.0.1:" + std::to_string(port) +
+                " --out " + (work / "rec").string() +
+                " --http 127.0.0.1:" + std::to_string(httpPort) + " --duration 900",
+            "/dev/null", (work / "server.log").string());
+  std::string url =
+      "http://127.0.0.1:" + std::to_string(httpPort) + "/api/export?format=mkv&camera=" + camera;
+  std::string curl = "curl -sf -o " + (work / "http.mkv").string() +
+                     " -w '%{time_starttransfer} %{time_total}' '" + url + "'";
+  std::vector<std::pair<double, double>> streamed;  // (first byte, all) seconds
+  for (int attempt = 0; attempt < 100 && streamed.size() < 3; ++attempt) {
+    FILE* out = popen(curl.c_str(), "r");
+    double first = 0, all = 0;
+    bool read = out && std::fscanf(out, "%lf %lf", &first, &all) == 2;
+    bool ok = out && pclose(out) == 0 && read;
+    if (ok)
+      streamed.push_back({first, all});
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));  // not listening yet
+  }
+  kill(-server, SIGINT);  // (stopGroup would reap it before its usage is read)
+  auto serverUsage = waitForUsage(server);
+  if (streamed.size() < 3) {
+    std::fprintf(stderr, "bench_export: GET %s failed (log: %s)\n", url.c_str(),
+                 (work / "server.log").c_str());
+    return 1;
+  }
+  std::sort(streamed.begin(), streamed.end(), [](auto& a, auto& b) { return a.second < b.second; });
+  double rate = megabytes / streamed[1].second;
+  std::printf("%-32s | %8.1f | %8.2f | %8.1f | %15.2f | %.3f\n", "GET /api/export (mkv, curl)",
+              rate, streamed[1].second, static_cast<double>(serverUsage.maxRssKb) / 1024,
+              rate / stock, static_cast<double>(fs::file_size(work / "http.mkv")) / stockBytes);
+  std::printf(
+      "GET /api/export: first byte after %.3f s (median of 3), the recorder's peak %.1f MB\n",
+      streamed[1].first, static_cast<double>(serverUsage.maxRssKb) / 1024);
   fs::remove_all(work);
   return 0;
 }

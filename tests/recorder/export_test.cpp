@@ -166,6 +166,37 @@ TEST_F(Export, AllOfItAsMatroskaIsEveryFrameUntouchedOnOneTimelineWithTheOutageA
   EXPECT_TRUE(loggedIn);
 }
 
+// --out -: the file on stdout as it is made (here into a file, which
+// wirc-export cannot go back over either): the same frames, the telemetry
+// track named and not shown, no .jsonl, and the summary on stderr.
+TEST_F(Export, StreamedToStdoutItHoldsWhatTheFileHolds) {
+  for (const char* format : {"mkv", "mcap"}) {
+    fs::path out = output(std::string("streamed.") + format);
+    // (Braced: runCommand's 2>&1 then takes the messages, not the file.)
+    auto ran = runCommand("{ " + exportCommand(recorder_->out(), *camera_,
+                                               std::string("--format ") + format + " --out - > '" +
+                                                   out.string() + "'; }"));
+    ASSERT_EQ(ran.exitCode, 0) << ran.output;
+    EXPECT_NE(ran.output.find("wirc-export: -: "), std::string::npos) << ran.output;
+    EXPECT_FALSE(fs::exists(fs::path(out).replace_extension(".jsonl")));
+    if (std::string(format) == "mcap") {
+      auto checked = runCommand("node '" MCAP_CHECK_DIR "/check.mjs' '" + out.string() + "'");
+      ASSERT_EQ(checked.exitCode, 0) << checked.output;
+      auto result = nlohmann::json::parse(checked.output);
+      EXPECT_EQ(result["invalid"], nlohmann::json::array());
+      EXPECT_EQ(result["images"].size(), recordedDigests().size());
+      continue;
+    }
+    EXPECT_EQ(frameDigests(out), recordedDigests());
+    EXPECT_EQ(ffmpegDecodeErrors(out), "");
+    EXPECT_EQ(runCommand("ffprobe -v error -select_streams s:0 -show_entries "
+                         "stream_disposition=default:stream_tags=title -of csv=p=0 '" +
+                         out.string() + "'")
+                  .output,
+              "0,telemetry\n");
+  }
+}
+
 TEST_F(Export, ARangeHoldsTheFramesOfTheSegmentsInIt) {
   auto index = segments();
   ASSERT_GE(index.size(), 4u);
@@ -504,6 +535,21 @@ TEST(ExportH264, EveryFormatCarriesTheRecordedH264Untouched) {
                          out.string() + "'")
                   .output,
               "h264\n")
+        << format;
+    // Streamed (as GET /api/export sends it): MP4 in fragments, Matroska
+    // without its index; the same frames, the telemetry track not shown.
+    fs::path streamed = recorder.out().parent_path() / (std::string("h264-streamed.") + format);
+    ran = runCommand("{ " + exportCommand(recorder.out(), camera,
+                                          std::string("--format ") + format + " --out - > '" +
+                                              streamed.string() + "'; }"));
+    ASSERT_EQ(ran.exitCode, 0) << ran.output;
+    EXPECT_EQ(frameDigests(streamed), recorded) << format;
+    EXPECT_EQ(ffmpegDecodeErrors(streamed), "") << format;
+    EXPECT_EQ(runCommand("ffprobe -v error -select_streams s:0 -show_entries "
+                         "stream_disposition=default -of csv=p=0 '" +
+                         streamed.string() + "'")
+                  .output,
+              "0\n")
         << format;
   }
   fs::path mcap = recorder.out().parent_path() / "h264.mcap";
