@@ -126,6 +126,12 @@ class Timeline {
   }
 
   bool started() const { return origin_.has_value(); }
+  // A frame at `utcNs` would repeat a moment already exported: no later
+  // than half a frame after the last one (two recorders stamp one frame of
+  // the device each on its own arrival, microseconds apart).
+  bool repeats(int64_t utcNs) const {
+    return request_.overlapping && lastUtc_ && utcNs < *lastUtc_ + step_ / 2;
+  }
   ExportReport report;
 
  private:
@@ -161,6 +167,7 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
   size_t nextLine = 0;
   uint64_t frames = 0;
   bool whole = false;  // read to its end: its lines after the last frame belong to it
+  bool afterRepeats = false;
   while (true) {
     auto frame = (*reader)->next();
     if (!frame) {
@@ -188,9 +195,15 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
     for (; nextLine < lines.size() && lines[nextLine].utcNs <= utc; ++nextLine)
       if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
     if (!timeline.inRange(utc)) continue;
+    if (timeline.repeats(utc)) {
+      afterRepeats = true;
+      continue;
+    }
     // H.264 begins on a key frame: the ones before it could not be decoded
-    // (every JPEG frame is one).
-    if (!timeline.started() && !(*frame)->key) continue;
+    // (every JPEG frame is one); so does the rest of a segment whose first
+    // frames repeated another's (another recorder's encoder made them).
+    if ((!timeline.started() || afterRepeats) && !(*frame)->key) continue;
+    afterRepeats = false;
     if (!caps) caps = gst_caps_ref((*reader)->caps());
     if (auto problem = timeline.frame((*frame)->buffer, utc, (*frame)->key, caps)) return problem;
     if (!onFrame()) return std::nullopt;  // stopped: the caller knows

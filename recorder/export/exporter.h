@@ -28,6 +28,10 @@ struct ExportRequest {
   // With a descriptor: the file streamed to it as it is made (see
   // ExportTarget), `out` only naming it, and no .jsonl.
   int stream = -1;
+  // Segments may overlap in time (a fleet's: two recorders held the vehicle
+  // at once while it moved): a frame less than half a frame after the last
+  // one taken is the same moment seen twice, and left out.
+  bool overlapping = false;
 };
 
 struct ExportReport {

@@ -9,9 +9,12 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 #include <string>
 
 #include "export/exporter.h"
+#include "export/fleet_fetch.h"
 
 namespace {
 
@@ -19,6 +22,7 @@ using namespace wircam::recorder;
 
 const char* kUsage =
     R"(Usage: wirc-export --recordings DIR --camera NAME [--start ISO8601] [--end ISO8601] --format mkv|mp4|mcap --out FILE|-
+       wirc-export --fleet MQTT_URL --vehicle NAME [--camera camN] [--http-token T] [--start …] [--end …] --format … --out …
 
 Writes one camera's recorded segments between two times as one file, the
 frames untouched (JPEG stays JPEG, H.264 stays H.264), on one timeline from
@@ -33,6 +37,13 @@ re-based in FILE's .jsonl beside it.
                      (+01:00); without a zone, local time. Default: all
   --format           mkv | mp4 (H.264 recordings) | mcap (Foxglove, Lichtblick:
                      /NAME/image, /NAME/tags, /NAME/telemetry, /NAME/log)
+  --fleet MQTT_URL   instead of --recordings: the segments of --vehicle from
+                     every recorder announced on the fleet's broker (fleet.md),
+                     fetched over HTTP(S), a dropped connection resumed;
+                     --camera then says which of its cameras (default cam0)
+  --vehicle NAME     with --fleet: the vehicle, by its serial or its name
+  --http-token T     with --fleet: the recorders' --http-token
+  --mqtt-cafile FILE with --fleet mqtts://: the broker's CA (PEM)
   --out FILE         the file to write (replaced); - streams it to stdout as
                      it is made (mkv without its index, mp4 fragmented; no
                      .jsonl), e.g. into ffplay, ssh or curl -T
@@ -65,6 +76,17 @@ std::string progressLine(uint64_t done, uint64_t total, uint64_t bytes,
   return line;
 }
 
+// Where a fleet's segments wait for the export; gone with it, however it
+// ends.
+struct ScratchFolder {
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("wirc-export-fleet-" + std::to_string(getpid()));
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+};
+
 int usageError(const std::string& problem) {
   std::fprintf(stderr, "wirc-export: %s\n(wirc-export --help for the options)\n", problem.c_str());
   return 2;
@@ -80,9 +102,15 @@ int main(int argc, char** argv) {
                                    {"end", required_argument, nullptr, 'e'},
                                    {"format", required_argument, nullptr, 'f'},
                                    {"out", required_argument, nullptr, 'o'},
+                                   {"fleet", required_argument, nullptr, 'F'},
+                                   {"vehicle", required_argument, nullptr, 'v'},
+                                   {"http-token", required_argument, nullptr, 't'},
+                                   {"mqtt-cafile", required_argument, nullptr, 'C'},
                                    {"help", no_argument, nullptr, 'h'},
                                    {nullptr, 0, nullptr, 0}};
   ExportRequest request;
+  std::optional<FleetFetchRequest> fleet;
+  std::string fleetUrl, caFile;
   bool formatGiven = false;
   int opt;
   while ((opt = getopt_long(argc, argv, "h", options, nullptr)) != -1) {
@@ -112,6 +140,20 @@ int main(int argc, char** argv) {
       case 'o':
         request.out = optarg;
         break;
+      case 'F':
+        fleetUrl = optarg;
+        break;
+      case 'v':
+        if (!fleet) fleet.emplace();
+        fleet->vehicle = optarg;
+        break;
+      case 't':
+        if (!fleet) fleet.emplace();
+        fleet->token = optarg;
+        break;
+      case 'C':
+        caFile = optarg;
+        break;
       case 'h':
         std::fputs(kUsage, stdout);
         return 0;
@@ -120,8 +162,21 @@ int main(int argc, char** argv) {
     }
   }
   if (optind < argc) return usageError(std::string("unexpected argument '") + argv[optind] + "'");
-  if (request.recordings.empty()) return usageError("--recordings DIR is needed");
-  if (request.camera.empty()) return usageError("--camera NAME is needed");
+  if (!fleetUrl.empty()) {
+    if (!fleet || fleet->vehicle.empty()) return usageError("--fleet needs --vehicle NAME");
+    if (!request.recordings.empty())
+      return usageError("--fleet and --recordings: the segments come from one or the other");
+    auto broker = parseMqttUrl(fleetUrl);
+    if (!broker) return usageError("--fleet: " + broker.error());
+    fleet->broker = *broker;
+    if (!caFile.empty()) fleet->broker.caFile = caFile;
+    if (!request.camera.empty()) fleet->camera = request.camera;
+  } else if (fleet) {
+    return usageError("--vehicle and --http-token go with --fleet MQTT_URL");
+  } else {
+    if (request.recordings.empty()) return usageError("--recordings DIR (or --fleet) is needed");
+    if (request.camera.empty()) return usageError("--camera NAME is needed");
+  }
   if (!formatGiven) return usageError("--format mkv|mp4|mcap is needed");
   if (request.out.empty()) return usageError("--out FILE is needed");
   if (request.start && request.end && *request.end < *request.start)
@@ -133,6 +188,30 @@ int main(int argc, char** argv) {
   stop.sa_handler = [](int) { stopRequested = 1; };
   sigaction(SIGINT, &stop, nullptr);
   sigaction(SIGTERM, &stop, nullptr);
+  // A fleet's segments first, into a folder of their own for the export.
+  std::optional<ScratchFolder> gathered;
+  if (fleet) {
+    gathered.emplace();
+    fleet->folder = gathered->path;
+    fleet->start = request.start;
+    fleet->end = request.end;
+    auto fetched = fetchFromFleet(*fleet, [](const std::string& line) {
+      std::fprintf(stderr, "wirc-export: %s\n", line.c_str());
+      return !stopRequested;
+    });
+    if (!fetched) {
+      std::fprintf(stderr, "wirc-export: %s\n", fetched.error().c_str());
+      return 1;
+    }
+    for (const auto& note : fetched->notes) std::fprintf(stderr, "wirc-export: %s\n", note.c_str());
+    std::fprintf(stderr, "wirc-export: %zu segments (%.1f MB) from %zu of %zu recorders\n",
+                 fetched->segments, static_cast<double>(fetched->bytes) / 1e6, fetched->holders,
+                 fetched->asked);
+    request.recordings = gathered->path;
+    request.camera = fetched->camera;
+    request.overlapping = true;
+  }
+
   bool toStdout = request.out == "-";
   if (toStdout) {
     if (isatty(STDOUT_FILENO)) return usageError("--out - would write the file to the terminal");

@@ -52,7 +52,8 @@ Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttU
       return unexpected("--mqtt-cafile " + url.caFile + ": " + lib.strerror(rc) +
                         " (a PEM file of the CA that signed the broker's certificate)");
   }
-  if (lib.willSet(handle, will.topic.c_str(), static_cast<int>(will.payload.size()),
+  if (!will.topic.empty() &&
+      lib.willSet(handle, will.topic.c_str(), static_cast<int>(will.payload.size()),
                   will.payload.data(), 1, true) != MOSQ_ERR_SUCCESS)
     return unexpected("cannot set the MQTT last will on '" + will.topic + "'");
   lib.connectCallbackSet(handle, onConnect);
@@ -137,8 +138,9 @@ void MqttClient::run() {
   }
   if (connected_) {
     // The last word, as the will would say it; then a clean goodbye.
-    lib_.publish(handle_, nullptr, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
-                 will_.payload.data(), 1, true);
+    if (!will_.topic.empty())
+      lib_.publish(handle_, nullptr, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
+                   will_.payload.data(), 1, true);
     for (int turn = 0; turn < 5 && lib_.wantWrite(handle_); ++turn) lib_.loop(handle_, 100, 1);
     lib_.disconnect(handle_);
     lib_.loop(handle_, 100, 1);

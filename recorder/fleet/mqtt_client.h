@@ -27,6 +27,7 @@ struct MosquittoLibrary;
 
 namespace wircam::recorder {
 
+// Without a topic, none (a client that only listens).
 struct MqttWill {
   std::string topic;
   std::string payload;

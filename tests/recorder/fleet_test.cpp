@@ -24,6 +24,7 @@
 #include "mqtt_broker.h"
 #include "recorder_process.h"
 #include "scene_frames.h"
+#include "shell_command.h"
 #include "signed_in_page.h"
 #include "wait_for.h"
 
@@ -130,6 +131,51 @@ double longestHole(const Json& recordings) {
     reached = std::max(reached, to);
   }
   return hole;
+}
+
+// Now moved by `deltaMs`, as ISO 8601 UTC with milliseconds.
+std::string isoNow(int64_t deltaMs) {
+  GDateTime* now = g_date_time_new_now_utc();
+  GDateTime* then = g_date_time_add(now, deltaMs * 1000);
+  gchar* text = g_date_time_format(then, "%Y-%m-%dT%H:%M:%S.%fZ");
+  std::string iso(text);
+  g_free(text);
+  g_date_time_unref(then);
+  g_date_time_unref(now);
+  return iso.substr(0, 23) + "Z";  // %f gives microseconds
+}
+
+double unixOf(const std::string& iso) {
+  GDateTime* time = g_date_time_new_from_iso8601(iso.c_str(), nullptr);
+  double seconds = g_date_time_to_unix(time) + g_date_time_get_microsecond(time) / 1e6;
+  g_date_time_unref(time);
+  return seconds;
+}
+
+// The frames of a merged history up to `end`, each moment once: two
+// recorders holding the vehicle at once got each of its frames, stamped
+// each on its own arrival, a few milliseconds apart at most (a frame is
+// 67 ms at 15 fps). Their digests in time order.
+template <typename FileOf>
+std::vector<std::string> momentsOf(const Json& recordings, const std::string& end, FileOf fileOf) {
+  std::vector<std::pair<double, std::string>> frames;
+  for (const auto& r : recordings) {
+    fs::path file = fileOf(r);
+    auto digests = frameDigests(file);
+    auto pts = contentsOf(file).framePts;
+    double start = unixOf(r["start_utc"]);
+    for (size_t i = 0; i < std::min(digests.size(), pts.size()); ++i)
+      frames.emplace_back(start + static_cast<double>(pts[i]) / 1e9, digests[i]);
+  }
+  std::sort(frames.begin(), frames.end());
+  std::vector<std::string> moments;
+  double last = -1, upTo = unixOf(end);
+  for (const auto& [time, digest] : frames) {
+    if (time > upTo || (last >= 0 && time - last < 0.02)) continue;
+    moments.push_back(digest);
+    last = time;
+  }
+  return moments;
 }
 
 TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledOneShowsOffline) {
@@ -264,6 +310,24 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
                     {{"Authorization", std::string("Bearer ") + kToken}, {"Range", "bytes=0-3"}});
   EXPECT_EQ(file.status, 206u);
   EXPECT_EQ(file.body, std::string("\x1a\x45\xdf\xa3", 4));  // Matroska's EBML magic
+
+  // Its whole drive exported from the fleet, as a stranger would from
+  // fleet.md: every moment either recorder recorded, once, up to a time
+  // whose segments are all finished (they last 2 s).
+  std::string end = isoNow(-5000);
+  fs::path exported = folder / "car2.mkv";
+  auto ran = runCommand(std::string(WIRC_EXPORT) + " --fleet " + broker.url() +
+                        " --vehicle S2 --http-token " + kToken + " --end " + end +
+                        " --format mkv --out '" + exported.string() + "'");
+  ASSERT_EQ(ran.exitCode, 0) << ran.output;
+  EXPECT_NE(ran.output.find("from 2 of 3 recorders"), std::string::npos) << ran.output;
+  history = getJson(third.url() + "api/fleet/recordings?vehicle=S2");
+  auto moments = momentsOf(history["recordings"], end, [&](const Json& r) {
+    return (r["recorder"] == first.id() ? folder / "first" : folder / "second") /
+           r["file"].get<std::string>();
+  });
+  EXPECT_EQ(frameDigests(exported), moments) << ran.output;
+  EXPECT_EQ(ffmpegDecodeErrors(exported), "");
 
   // The second recorder killed: offline within MQTT's keepalive (the broker
   // sees the socket go at once; a cut network would take 1.5 keepalives),
