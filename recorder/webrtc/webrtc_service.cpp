@@ -52,9 +52,6 @@ WebRtcService::WebRtcService(std::vector<Camera> cameras, Settings settings)
     : cameras_(std::move(cameras)),
       settings_(std::move(settings)),
       allowedHosts_(turnAddresses(settings_.servers.turn)) {
-  // Until the DTLS certificate is made no viewer can be prepared: a
-  // viewer's time to come up counts from then (sweep()).
-  dtls_certificate::makeAhead();
   sweepTimer_ = g_timeout_add(
       500,
       [](gpointer self) -> gboolean {
@@ -67,6 +64,8 @@ WebRtcService::WebRtcService(std::vector<Camera> cameras, Settings settings)
 WebRtcService::~WebRtcService() {
   alive_.reset();
   g_source_remove(sweepTimer_);
+  // The offers still waiting go with their requests, which the server ends.
+  if (certificateCheck_) g_source_remove(certificateCheck_);
   viewers_.clear();  // before their encoders
   encoders_.clear();
 }
@@ -89,6 +88,16 @@ const WebRtcService::Camera* WebRtcService::cameraNamed(const std::string& name)
 
 void WebRtcService::offer(const std::string& camera, std::string_view sdp,
                           const std::string& viewerAddress, Done done) {
+  // The DTLS certificate is made for the first offer, on a thread of its
+  // own (a quarter of a second of a core, seconds on a loaded or small
+  // machine, and most recorders never have a viewer): the offers wait for
+  // it, the main loop does not (webrtcbin would make it on it).
+  if (!dtls_certificate::made()) {
+    dtls_certificate::makeAhead();
+    waitingForCertificate_.push_back({camera, std::string(sdp), viewerAddress, std::move(done)});
+    if (!certificateCheck_) certificateCheck_ = g_timeout_add(10, offerWhenCertified, this);
+    return;
+  }
   const Camera* source = cameraNamed(camera);
   if (!source) return done(unexpected(Refusal{404, "no camera named '" + camera + "'"}));
   if (viewers_.size() >= kMaxViewers)
@@ -157,6 +166,16 @@ void WebRtcService::offer(const std::string& camera, std::string_view sdp,
           std::to_string(viewers_.size()) + " now");
 }
 
+gboolean WebRtcService::offerWhenCertified(gpointer self) {
+  auto* service = static_cast<WebRtcService*>(self);
+  if (!dtls_certificate::made()) return G_SOURCE_CONTINUE;
+  service->certificateCheck_ = 0;
+  auto waiting = std::exchange(service->waitingForCertificate_, {});
+  for (auto& offer : waiting)
+    service->offer(offer.camera, offer.sdp, offer.viewerAddress, std::move(offer.done));
+  return G_SOURCE_REMOVE;
+}
+
 bool WebRtcService::end(const std::string& camera, const std::string& session) {
   auto viewer = viewers_.find(session);
   if (viewer == viewers_.end() || viewer->second.camera != camera) return false;
@@ -174,7 +193,7 @@ void WebRtcService::sweep(std::chrono::steady_clock::time_point now) {
       if (now - viewer.peer->lastHeard() > settings_.idleTimeout) expired.push_back(session);
       continue;
     }
-    if (!viewer.downSince || !dtls_certificate::made()) viewer.downSince = now;
+    if (!viewer.downSince) viewer.downSince = now;
     if (now - *viewer.downSince > settings_.idleTimeout) expired.push_back(session);
   }
   for (const auto& session : expired) remove(session);

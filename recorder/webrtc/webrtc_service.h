@@ -77,9 +77,8 @@ class WebRtcService {
   size_t encoders() const { return encoders_.size(); }
 
   // Releases the viewers not connected, or silent, for longer than the idle
-  // timeout at `now` (not connected: counted from when the DTLS certificate
-  // exists, which the first viewer waits for); the service's own timer calls
-  // it twice a second.
+  // timeout at `now` (not connected: counted from their answer); the
+  // service's own timer calls it twice a second.
   void sweep(std::chrono::steady_clock::time_point now);
 
  private:
@@ -92,6 +91,8 @@ class WebRtcService {
   };
   void remove(const std::string& session);
   void removeLater(const std::string& session);
+  // Offers again those that waited for the DTLS certificate, once it is made.
+  static gboolean offerWhenCertified(gpointer self);
   const Camera* cameraNamed(const std::string& name) const;
 
   std::vector<Camera> cameras_;
@@ -101,6 +102,12 @@ class WebRtcService {
   std::map<std::string, std::unique_ptr<CameraEncoder>> encoders_;
   std::map<std::string, Viewer> viewers_;  // by session
   guint sweepTimer_ = 0;
+  struct WaitingOffer {
+    std::string camera, sdp, viewerAddress;
+    Done done;
+  };
+  std::vector<WaitingOffer> waitingForCertificate_;
+  guint certificateCheck_ = 0;
   std::shared_ptr<WebRtcService*> alive_ = std::make_shared<WebRtcService*>(this);
 };
 

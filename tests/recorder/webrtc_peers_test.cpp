@@ -124,9 +124,9 @@ TEST(WhepPeers, AnOfferTheViewerCannotAnswerInTimeIsAnsweredAllTheSame) {
   EXPECT_EQ(answered.status, 503u) << answered.body;
   EXPECT_NE(answered.body.find("could not be prepared in time"), std::string::npos)
       << answered.body;
-  // Not left hanging: answered after the DTLS certificate (made once at
-  // start, 0.1-0.4 s idle, up to 15 s on a loaded machine; the idle time
-  // counts from it) and the idle second. 10.6 s once beside ten suites and
+  // Not left hanging: answered after the DTLS certificate (made for the
+  // first offer, 0.2-0.4 s idle, up to 15 s on a loaded machine; the idle
+  // time counts from it) and the idle second. 10.6 s once beside ten suites and
   // a build.
   EXPECT_LT(Clock::now() - started, milliseconds(patience(milliseconds(20000))));
   // Whether it got as far as asking the STUN server depends on the load:
