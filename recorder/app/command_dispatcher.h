@@ -25,13 +25,18 @@ class CommandDispatcher {
   // Why it cannot be carried out (no such camera, it does not follow, it is
   // restarting), if so. `from` names the source in the log: "MQTT", "web".
   std::optional<std::string> apply(const FleetCommand& command, const char* from);
-  // Drive mode: whether the vehicle obeys, or nullopt when the camera has
-  // no wirccontrol (or none running).
-  std::optional<bool> drive(const std::string& camera, double steering, double throttle);
+  // Drive mode: following turned off first (left on, the vehicle would go
+  // back to the tag as soon as the driver let go); whether the vehicle
+  // obeys, or nullopt when the camera has no wirccontrol (or none running).
+  std::optional<bool> drive(const std::string& camera, double steering, double throttle,
+                            const char* from);
 
  private:
+  // A drive/set command, through drive(); why it was not obeyed, if so.
+  std::optional<std::string> driveBy(const FleetCommand& command, const char* from);
   FindCamera find_;
   Applied applied_;
+  std::optional<std::string> lastDriveRefusal_;  // logged; until a command is obeyed
 };
 
 }  // namespace wircam::recorder

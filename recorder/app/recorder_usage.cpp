@@ -69,8 +69,10 @@ MQTT topics (PREFIX/STREAM, STREAM as in the file names):
   PREFIX/STREAM/snapshot    with --mqtt-discovery: the newest JPEG, retained
   PREFIX/STREAM/follow/set  ON or OFF (takes effect at once; OFF = neutral)
   PREFIX/STREAM/target/set  a tag id (-1: the largest)
+  PREFIX/STREAM/drive/set   {"steering": -1..1, "throttle": -1..1}, held for
+                            the 250 ms dead-man: send one every 100 ms
   wircam-fleet/recorders/ID this recorder's announcement, retained (fleet.md)
-  wircam-fleet/vehicles/SERIAL/follow/set, .../target/set
+  wircam-fleet/vehicles/SERIAL/follow/set, .../target/set, .../drive/set
                             the same commands for a vehicle by its serial,
                             obeyed by the recorder that holds it
 

@@ -90,7 +90,7 @@ std::optional<std::string> Supervisor::startServers() {
         return fleet_ && fleet_->directory() ? fleet_->directory()->view() : nlohmann::json();
       };
     content.drive = [this](const std::string& camera, double steering, double throttle) {
-      return commands_.drive(camera, steering, throttle);
+      return commands_.drive(camera, steering, throttle, "web");
     };
     auto server = (*servers)->startWeb(
         *options_.http, std::move(content),
@@ -141,16 +141,7 @@ std::optional<std::string> Supervisor::startServers() {
                             .version = WIRCAM_VERSION};
     for (auto& c : cameras_) content.cameras.push_back(foxgloveCameraOf(*c));
     content.drive = [this](const std::string& camera, double steering, double throttle) {
-      // What the page does before it drives: left following, the car would
-      // go back to the tag as soon as the driver let go.
-      Camera* c = cameraNamed(camera);
-      if (c && (steering != 0 || throttle != 0)) {
-        auto control = c->report().control;
-        if (control && control->following)
-          commands_.apply({.kind = FleetCommand::Kind::kFollow, .stream = camera, .follow = false},
-                          "Foxglove");
-      }
-      return commands_.drive(camera, steering, throttle);
+      return commands_.drive(camera, steering, throttle, "Foxglove");
     };
     content.drivable = [this](const std::string& camera) {
       Camera* c = cameraNamed(camera);

@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "common/printable_text.h"
+#include "fleet/drive_command.h"
 
 namespace wircam::recorder {
 
@@ -38,8 +39,16 @@ Expected<FleetCommand, std::string> parseFleetCommand(const std::string& stream,
     parsed.kind = FleetCommand::Kind::kRequestControl;
     return parsed;
   }
+  if (command == "drive/set") {
+    auto drive = parseDriveCommand(payload);
+    if (!drive) return unexpected("drive/set: " + drive.error());
+    parsed.kind = FleetCommand::Kind::kDrive;
+    parsed.steering = drive->steering;
+    parsed.throttle = drive->throttle;
+    return parsed;
+  }
   return unexpected("unknown command '" + printableText(command) +
-                    "' (follow/set, target/set, request-control)");
+                    "' (follow/set, target/set, request-control, drive/set)");
 }
 
 }  // namespace wircam::recorder

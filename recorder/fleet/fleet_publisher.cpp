@@ -92,10 +92,10 @@ void FleetPublisher::republish(MqttClient& client) {
     client.subscribe(std::string(kFleetTopicRoot) + "+");
     for (const auto& prefix : directory_.prefixes()) follow(client, prefix);
   }
-  client.subscribe(settings_.prefix + "/+/follow/set");
-  client.subscribe(settings_.prefix + "/+/target/set");
-  client.subscribe(std::string(kVehicleTopicRoot) + "+/follow/set");
-  client.subscribe(std::string(kVehicleTopicRoot) + "+/target/set");
+  for (const char* command : {"follow/set", "target/set", "drive/set"}) {
+    client.subscribe(settings_.prefix + "/+/" + command);
+    client.subscribe(std::string(kVehicleTopicRoot) + "+/" + command);
+  }
   if (settings_.discovery) {
     for (const auto& stream : streamNames())
       for (const auto& [configTopic, config] : discoveryConfigs(*settings_.discovery, stream))

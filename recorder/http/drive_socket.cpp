@@ -1,6 +1,6 @@
 #include "http/drive_socket.h"
 
-#include "http/drive_command.h"
+#include "fleet/drive_command.h"
 
 namespace wircam::recorder {
 

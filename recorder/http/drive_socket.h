@@ -12,7 +12,7 @@
 #include <optional>
 #include <string>
 
-#include "http/drive_command.h"
+#include "fleet/drive_command.h"
 
 namespace wircam::recorder {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "http/drive_command.h"
+#include "fleet/drive_command.h"
 
 namespace wircam::recorder {
 

@@ -5,8 +5,8 @@
 // here as the WebSocket's are.
 #include <memory>
 
+#include "fleet/drive_command.h"
 #include "http/camera_feed.h"
-#include "http/drive_command.h"
 #include "http/http_responses.h"
 #include "http/http_server.h"
 

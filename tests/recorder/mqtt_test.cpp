@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <atomic>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -12,6 +13,7 @@
 #include "devices/wirc/device.h"
 #include "mqtt_broker.h"
 #include "recorder_process.h"
+#include "signed_in_page.h"
 #include "simulated_device.h"
 #include "test_certificates.h"
 #include "wait_for.h"
@@ -170,6 +172,46 @@ TEST(RecorderMqtt, FollowOffSendsTheCarToNeutralWithinOneCommandPeriod) {
   bool resumed = false;
   for (int i = 0; i < 300 && !resumed; ++i, std::this_thread::sleep_for(10ms)) resumed = moving();
   EXPECT_TRUE(resumed);
+}
+
+// Driving by hand over the broker, by the vehicle's serial (whichever
+// recorder holds it): a stream of drive/set messages drives the car and
+// takes it from the follower, as the page's drive mode does; when they stop,
+// wirccontrol's dead-man (250 ms) stops it.
+TEST(RecorderMqtt, DriveSetMessagesDriveTheCarAndTheirSilenceStopsIt) {
+  FollowedOverMqtt car;
+  ASSERT_TRUE(car.device);
+  ASSERT_TRUE(car.follow()) << car.recorder->log();
+  // The vehicle's identity is asked once the device is live.
+  ASSERT_TRUE(car.probe.waitFor(
+      "wircam/" + car.stream + "/status", [](auto& m) { return parsed(m)["vehicle"].is_object(); },
+      10s));
+  std::atomic<bool> driving{true};
+  std::thread driver([&] {
+    while (driving) {
+      car.probe.publish("wircam-fleet/vehicles/SIM0001/drive/set",
+                        R"({"steering": 1, "throttle": 1})");
+      std::this_thread::sleep_for(100ms);
+    }
+  });
+  bool drove = waitFor([&] {
+    auto pulses = car.device->outputs().pulses;
+    return pulses[kThrottle] > wirc::kPulseNeutral && pulses[kSteering] > wirc::kPulseNeutral;
+  });
+  bool tookFromFollower = car.probe.waitFor(
+      "wircam/" + car.stream + "/status", [](auto& m) { return parsed(m)["following"] == false; },
+      5s);
+  driving = false;
+  driver.join();
+  ASSERT_TRUE(drove) << car.recorder->log();
+  EXPECT_TRUE(tookFromFollower);
+  auto silent = untilNeutral(*car.device);
+  // The dead-man, a command period between two messages, and the polling.
+  EXPECT_LE(silent.count(), 250 + 100 + 100) << "neutral " << silent.count() << " ms after";
+  // A message it cannot take is said once, and leaves the car as it is.
+  car.probe.publish("wircam/" + car.stream + "/drive/set", R"({"steering": 3, "throttle": 0})");
+  EXPECT_TRUE(car.recorder->waitForText("drive/set: ", 5s)) << car.recorder->log();
+  EXPECT_EQ(car.device->outputs().pulses[kThrottle], wirc::kPulseNeutral);
 }
 
 TEST(RecorderMqtt, RejoinsABrokerRestartedMidRun) {

@@ -1,4 +1,4 @@
-#include "http/drive_command.h"
+#include "fleet/drive_command.h"
 
 #include <cmath>
 #include <nlohmann/json.hpp>

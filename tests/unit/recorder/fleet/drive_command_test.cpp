@@ -1,6 +1,6 @@
 // The drive mode's messages: a command is taken only when every field is
 // what it should be; anything else is refused (and the vehicle stops).
-#include "http/drive_command.h"
+#include "fleet/drive_command.h"
 
 #include <gtest/gtest.h>
 
