@@ -36,16 +36,19 @@ MuxedExport::~MuxedExport() {
 }
 
 std::optional<std::string> MuxedExport::start(GstCaps* caps) {
-  bool mkv = container_ == "mkv";
-  if (!mkv && gst_structure_has_name(gst_caps_get_structure(caps, 0), "image/jpeg"))
+  bool matroska = mkv();
+  if (!matroska && gst_structure_has_name(gst_caps_get_structure(caps, 0), "image/jpeg"))
     return "mp4 needs H.264 recordings: GStreamer's mp4mux cannot carry the camera's "
            "JPEG frames as they are (use mkv or mcap to keep them untouched)";
   // The text track is named as in the recordings (in Matroska a
   // placeholder, rewritten when the file is done: telemetry_track_flags.h).
-  // Streamed, nothing goes back over what left: Matroska without its index
-  // (which players do without), MP4 in fragments of a second.
-  std::string muxer = mkv ? (stream_ ? "matroskamux streamable=true" : "matroskamux")
-                          : (stream_ ? "mp4mux fragment-duration=1000 streamable=true" : "mp4mux");
+  // MP4 in fragments of a second, as the recordings are: its moov (which
+  // holds the text track's flags, marked in the first bytes) comes first,
+  // and a file cut short keeps what it has. Streamed, nothing goes back
+  // over what left: Matroska without its index (which players do without).
+  std::string muxer = matroska ? (stream_ ? "matroskamux streamable=true" : "matroskamux")
+                               : (stream_ ? "mp4mux fragment-duration=1000 streamable=true"
+                                          : "mp4mux fragment-duration=1000");
   std::string sink = "appsink name=out sync=false emit-signals=true";
   if (!stream_) {
     gchar* location = g_strescape(target_.path.c_str(), nullptr);
@@ -56,7 +59,8 @@ std::optional<std::string> MuxedExport::start(GstCaps* caps) {
       "appsrc name=video format=time ! mux.video_%u " + muxer + " name=mux ! " + sink +
       " appsrc name=text format=time caps=\"text/x-raw,format=(string)utf8\" ! taginject "
       "name=title tags=\"title=" +
-      std::string(mkv ? kTelemetryTrackPlaceholder : kTelemetryTrackName) + "\" ! mux.subtitle_%u";
+      std::string(matroska ? kTelemetryTrackPlaceholder : kTelemetryTrackName) +
+      "\" ! mux.subtitle_%u";
   GError* error = nullptr;
   pipeline_ = gst_parse_launch(description.c_str(), &error);
   if (error) {
@@ -106,8 +110,7 @@ bool MuxedExport::send(const uint8_t* data, size_t size) {
 
 bool MuxedExport::sendHeader() {
   headerSent_ = true;
-  markTelemetryTrackInHeader(
-      header_, container_ == "mkv" ? TrackContainer::kMatroska : TrackContainer::kMp4);
+  markTelemetryTrackInHeader(header_, mkv() ? TrackContainer::kMatroska : TrackContainer::kMp4);
   bool sent = stream_->write(header_.data(), header_.size());
   header_ = {};
   return sent;
@@ -134,7 +137,7 @@ uint64_t MuxedExport::bytesWritten() {
 
 GstPadProbeReturn MuxedExport::onText(GstPad* pad, GstPadProbeInfo* info, gpointer self) {
   if (!TelemetryTrack::isGap(GST_PAD_PROBE_INFO_BUFFER(info))) return GST_PAD_PROBE_OK;
-  return TelemetryTrack::passGap(pad, info, static_cast<MuxedExport*>(self)->container_ == "mkv");
+  return TelemetryTrack::passGap(pad, info, static_cast<MuxedExport*>(self)->mkv());
 }
 
 std::optional<std::string> MuxedExport::frame(GstBuffer* buffer, int64_t ptsNs, int64_t, bool) {
@@ -214,7 +217,8 @@ std::optional<std::string> MuxedExport::finish() {
   gst_element_set_state(pipeline_, GST_STATE_NULL);
   if (problem) return problem;
   if (!stream_) {
-    markTelemetryTrack(target_.path);
+    // (Its name ends in .partial until the export renames it.)
+    markTelemetryTrack(target_.path, mkv() ? TrackContainer::kMatroska : TrackContainer::kMp4);
     return std::nullopt;
   }
   // A stream shorter than a header's room.

@@ -40,6 +40,8 @@ class MuxedExport : public ExportSink {
   // Waits while the muxer is this far behind (a slow reader), unless it failed.
   std::optional<std::string> waitForRoom();
 
+  bool mkv() const { return container_ == "mkv"; }
+
   ExportTarget target_;
   std::string container_;
   GstElement* pipeline_ = nullptr;

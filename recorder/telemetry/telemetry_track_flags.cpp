@@ -210,9 +210,13 @@ bool markTelemetryTrackInHeader(std::vector<uint8_t>& header, TrackContainer con
 }
 
 bool markTelemetryTrack(const std::filesystem::path& file) {
+  return markTelemetryTrack(
+      file, file.extension() == ".mp4" ? TrackContainer::kMp4 : TrackContainer::kMatroska);
+}
+
+bool markTelemetryTrack(const std::filesystem::path& file, TrackContainer container) {
   FILE* f = std::fopen(file.c_str(), "r+b");
   if (!f) return false;
-  auto container = file.extension() == ".mp4" ? TrackContainer::kMp4 : TrackContainer::kMatroska;
   std::vector<uint8_t> header(kTelemetryTrackHeaderBytes);
   header.resize(std::fread(header.data(), 1, header.size(), f));
   // Written back whole: only the marked bytes differ.

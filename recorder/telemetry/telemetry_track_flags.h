@@ -23,16 +23,20 @@ inline constexpr std::string_view kTelemetryTrackPlaceholder = "telemetry-json-l
 // What it is called once marked.
 inline constexpr std::string_view kTelemetryTrackName = "telemetry";
 
+enum class TrackContainer { kMatroska, kMp4 };
+
 // True if the track was found and marked; false for a file without it (not
 // a recording, marked already, or cut before its header), left as it was.
+// The container by the file's extension (.mp4, else Matroska), or as given
+// (a file written under another name until it is whole).
 bool markTelemetryTrack(const std::filesystem::path& file);
+bool markTelemetryTrack(const std::filesystem::path& file, TrackContainer container);
 
 // The same on a stream's first bytes, before they leave (a streamed export
 // cannot go back): its header, the tracks (and a streamable Matroska's
 // tags) included, is in the first kTelemetryTrackHeaderBytes, before the
 // first cluster or fragment. True if marked.
 inline constexpr size_t kTelemetryTrackHeaderBytes = 64 * 1024;
-enum class TrackContainer { kMatroska, kMp4 };
 bool markTelemetryTrackInHeader(std::vector<uint8_t>& header, TrackContainer container);
 
 }  // namespace wircam::recorder

@@ -36,6 +36,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace wircam::recorder;
+using wircam::bench::cpuSecondsOf;
 using wircam::bench::spawn;
 using wircam::bench::stopGroup;
 using Clock = std::chrono::steady_clock;
@@ -43,21 +44,6 @@ using Clock = std::chrono::steady_clock;
 uint16_t freePort() {
   auto socket = wircam::listenTcp(wircam::SocketAddress::loopback(0));
   return socket ? wircam::localAddress(socket->get()).port() : uint16_t{0};
-}
-
-// User + system CPU seconds of a running process so far.
-double cpuSecondsOf(pid_t pid) {
-  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
-  auto fields = text.substr(text.rfind(')') + 2);
-  std::istringstream in(fields);
-  std::string field;
-  unsigned long long utime = 0, stime = 0;
-  for (int i = 3; i <= 15 && in >> field; ++i) {
-    if (i == 14) utime = std::stoull(field);
-    if (i == 15) stime = std::stoull(field);
-  }
-  return static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
 long residentKbOf(pid_t pid) {

@@ -38,6 +38,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using wircam::bench::cpuSecondsOf;
 using wircam::bench::spawn;
 using wircam::bench::stopGroup;
 using wircam::testing::DevToolsPage;
@@ -46,18 +47,6 @@ using Clock = std::chrono::steady_clock;
 uint16_t freePort() {
   auto socket = wircam::listenTcp(wircam::SocketAddress::loopback(0));
   return socket ? wircam::localAddress(socket->get()).port() : uint16_t{0};
-}
-
-// User + system CPU seconds so far, from /proc/PID/stat.
-double cpuSeconds(pid_t pid) {
-  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-  std::string text((std::istreambuf_iterator<char>(stat)), {});
-  std::istringstream in(text.substr(text.rfind(')') + 2));
-  std::string skip;
-  for (int i = 3; i < 14; ++i) in >> skip;
-  double user = 0, system = 0;
-  in >> user >> system;
-  return (user + system) / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
 // The page's helpers: the stamp read from a picture, and its age.
@@ -207,11 +196,11 @@ int main(int argc, char** argv) {
     }
     run(*page, kHelpers, 1);
     auto cpuWhile = [&](const std::string& script) {
-      double before = cpuSeconds(recorder);
+      double before = cpuSecondsOf(recorder);
       auto start = Clock::now();
       auto result = run(*page, script, seconds);
       double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-      return std::make_pair(result, 100.0 * (cpuSeconds(recorder) - before) / elapsed);
+      return std::make_pair(result, 100.0 * (cpuSecondsOf(recorder) - before) / elapsed);
     };
     auto [idle, idleCpu] = cpuWhile("new Promise(d => setTimeout(() => d(0), " +
                                     std::to_string(seconds * 1000) + "))");

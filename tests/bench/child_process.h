@@ -31,4 +31,8 @@ struct Usage {
 };
 Usage waitForUsage(pid_t pid, std::chrono::seconds giveUpAfter = std::chrono::seconds(60));
 
+// A running process's user + system CPU seconds so far (/proc/PID/stat),
+// for one that keeps running across measurements.
+double cpuSecondsOf(pid_t pid);
+
 }  // namespace wircam::bench

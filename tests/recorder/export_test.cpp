@@ -523,34 +523,29 @@ TEST(ExportH264, EveryFormatCarriesTheRecordedH264Untouched) {
   ASSERT_GT(recorded.size(), 60u);
   std::string camera = cameraName(device->port());
   for (const char* format : {"mp4", "mkv"}) {
-    fs::path out = recorder.out().parent_path() / (std::string("h264.") + format);
-    auto ran = runCommand(
-        exportCommand(recorder.out(), camera,
-                      std::string("--format ") + format + " --out '" + out.string() + "'"));
-    ASSERT_EQ(ran.exitCode, 0) << ran.output;
-    EXPECT_EQ(frameDigests(out), recorded) << format;
-    EXPECT_EQ(ffmpegDecodeErrors(out), "") << format;
-    EXPECT_EQ(runCommand("ffprobe -v error -select_streams v:0 -show_entries stream=codec_name "
-                         "-of csv=p=0 '" +
-                         out.string() + "'")
-                  .output,
-              "h264\n")
-        << format;
-    // Streamed (as GET /api/export sends it): MP4 in fragments, Matroska
-    // without its index; the same frames, the telemetry track not shown.
-    fs::path streamed = recorder.out().parent_path() / (std::string("h264-streamed.") + format);
-    ran = runCommand("{ " + exportCommand(recorder.out(), camera,
-                                          std::string("--format ") + format + " --out - > '" +
-                                              streamed.string() + "'; }"));
-    ASSERT_EQ(ran.exitCode, 0) << ran.output;
-    EXPECT_EQ(frameDigests(streamed), recorded) << format;
-    EXPECT_EQ(ffmpegDecodeErrors(streamed), "") << format;
-    EXPECT_EQ(runCommand("ffprobe -v error -select_streams s:0 -show_entries "
-                         "stream_disposition=default -of csv=p=0 '" +
-                         streamed.string() + "'")
-                  .output,
-              "0\n")
-        << format;
+    // To a file, and streamed (as GET /api/export sends it: MP4 in
+    // fragments, Matroska without its index): the same frames, the
+    // telemetry track not shown.
+    for (bool streamed : {false, true}) {
+      fs::path out = recorder.out().parent_path() /
+                     ((streamed ? "h264-streamed." : "h264.") + std::string(format));
+      std::string to =
+          streamed ? " --out - > '" + out.string() + "'; }" : " --out '" + out.string() + "'";
+      // (Braced: runCommand's 2>&1 then takes the messages, not the file.)
+      auto ran =
+          runCommand((streamed ? "{ " : "") +
+                     exportCommand(recorder.out(), camera, std::string("--format ") + format + to));
+      ASSERT_EQ(ran.exitCode, 0) << ran.output;
+      EXPECT_EQ(frameDigests(out), recorded) << out;
+      EXPECT_EQ(ffmpegDecodeErrors(out), "") << out;
+      EXPECT_EQ(
+          runCommand("ffprobe -v error -show_entries stream=codec_name:stream_disposition=default "
+                     "-of csv=p=0 '" +
+                     out.string() + "'")
+              .output,
+          "h264,1\n" + std::string(format == std::string("mp4") ? "mov_text" : "subrip") + ",0\n")
+          << out;
+    }
   }
   fs::path mcap = recorder.out().parent_path() / "h264.mcap";
   ASSERT_EQ(runCommand(exportCommand(recorder.out(), camera,
