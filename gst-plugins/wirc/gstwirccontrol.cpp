@@ -27,7 +27,10 @@
  * sends a command at once, within the same limits, and holds it for
  * `drive-timeout` ms (250 by default) while the follower keeps off; without
  * a newer one by then the vehicle goes to neutral, frames or not. Each is
- * posted as a `wirc-drive` element message (`reason`: command, dead-man).
+ * posted as a `wirc-drive` element message (`reason`: command, dead-man);
+ * while one holds, each frame's `wirc-control` message says `manual` and
+ * carries the command by hand (what the vehicle is sent), not the
+ * follower's.
  *
  * The vehicle may speak WiRC, RCOIP or BTEMP (`protocol`), whatever the
  * video comes from: the same follower, limits and failsafe steer all three.
@@ -54,9 +57,11 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "control_link.h"
@@ -98,6 +103,12 @@ struct WircControlState {
   std::atomic<bool> hasControl{false};
   // Commands by hand (the `drive` action); created in init().
   std::unique_ptr<gst::ManualDrive> manual;
+  // The last of them, for the per-frame control message while it holds:
+  // that message says what the vehicle is sent, not what the follower
+  // (kept off meanwhile) would send.
+  std::mutex manualMutex;
+  double manualSteering = 0, manualThrottle = 0;
+  guint manualSteeringPulse = 0, manualThrottlePulse = 0;
 };
 
 double meanEdge(const WircTag& tag) {
@@ -229,6 +240,14 @@ static gboolean gst_wirc_control_drive(GstWircControl* self, gdouble steering, g
   } else {
     GST_WARNING_OBJECT(self, "drive: steering and throttle must be numbers; neutral sent");
     reason = "not a number: neutral";
+  }
+  {
+    std::lock_guard lock(state->manualMutex);
+    bool sent = reason == std::string_view("command");
+    state->manualSteering = sent ? steering : 0;
+    state->manualThrottle = sent ? std::clamp(throttle, -1.0, 1.0) * settings.maxThrottle : 0;
+    state->manualSteeringPulse = pulses[settings.steeringChannel - 1];
+    state->manualThrottlePulse = pulses[settings.throttleChannel - 1];
   }
   state->manual->drive(session, pulses, neutral,
                        std::chrono::milliseconds(settings.driveTimeoutMs));
@@ -390,6 +409,16 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
          "robot has not answered the registration yet."));
   }
 
+  double sentSteering = command.steering, sentThrottle = command.throttle;
+  auto sentSteeringPulse = static_cast<guint>(command.steeringPulse);
+  auto sentThrottlePulse = static_cast<guint>(command.throttlePulse);
+  if (manual) {
+    std::lock_guard lock(state->manualMutex);
+    sentSteering = state->manualSteering;
+    sentThrottle = state->manualThrottle;
+    sentSteeringPulse = state->manualSteeringPulse;
+    sentThrottlePulse = state->manualThrottlePulse;
+  }
   gst_element_post_message(
       GST_ELEMENT(self),
       gst_message_new_element(
@@ -399,11 +428,9 @@ static GstFlowReturn gst_wirc_control_transform_ip(GstBaseTransform* transform, 
               "target-visible", G_TYPE_BOOLEAN, step.targetVisible, "enabled", G_TYPE_BOOLEAN,
               settings.enabled, "has-control", G_TYPE_BOOLEAN, state->hasControl.load(), "bearing",
               G_TYPE_DOUBLE, command.bearingRad, "distance", G_TYPE_DOUBLE, command.distance,
-              "steering", G_TYPE_DOUBLE, command.steering, "throttle", G_TYPE_DOUBLE,
-              command.throttle, "steering-pulse", G_TYPE_UINT,
-              static_cast<guint>(command.steeringPulse), "throttle-pulse", G_TYPE_UINT,
-              static_cast<guint>(command.throttlePulse), "manual", G_TYPE_BOOLEAN, manual,
-              nullptr)));
+              "steering", G_TYPE_DOUBLE, sentSteering, "throttle", G_TYPE_DOUBLE, sentThrottle,
+              "steering-pulse", G_TYPE_UINT, sentSteeringPulse, "throttle-pulse", G_TYPE_UINT,
+              sentThrottlePulse, "manual", G_TYPE_BOOLEAN, manual, nullptr)));
   return GST_FLOW_OK;
 }
 

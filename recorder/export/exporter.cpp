@@ -196,7 +196,9 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
       if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
     if (!timeline.inRange(utc)) continue;
     if (timeline.repeats(utc)) {
+      // So are its lines: the other recorder's of that moment are in.
       afterRepeats = true;
+      waiting.clear();
       continue;
     }
     // H.264 begins on a key frame: the ones before it could not be decoded
@@ -213,7 +215,7 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
   }
   // The lines after the last frame, up to the segment's end; of a segment
   // broken off or cut short, they tell of frames the export does not hold.
-  if (timeline.started() && whole) {
+  if (timeline.started() && whole && !afterRepeats) {
     for (; nextLine < lines.size(); ++nextLine)
       if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
     for (auto& line : waiting)

@@ -30,6 +30,14 @@ namespace {
 
 int64_t unixMsNow() { return g_get_real_time() / 1000; }
 
+// Why the MQTT client could not connect, from its log line (which goes
+// on about the recorder's retrying): " (Connection refused)".
+std::string brokersWord(const std::string& line) {
+  auto open = line.find('('), close = line.find(')', open);
+  if (open == std::string::npos || close == std::string::npos) return "";
+  return " " + line.substr(open, close - open + 1);
+}
+
 // The recorders announced on the broker, as a fleet recorder sees them
 // (GET /api/fleet's "recorders"), once the retained messages are in: 300 ms
 // after the last one, and at least 1 s after the connection.
@@ -70,7 +78,7 @@ Expected<Json, std::string> announcedRecorders(const MqttUrl& broker) {
   std::unique_lock guard(lock);
   if (!heard.wait_for(guard, std::chrono::seconds(10), [&] { return connectedAt.has_value(); }))
     return unexpected("cannot reach the fleet's broker " + broker.host + ":" +
-                      std::to_string(broker.port) + (lastWord.empty() ? "" : ": " + lastWord));
+                      std::to_string(broker.port) + " within 10 s" + brokersWord(lastWord));
   while (true) {
     auto now = Clock::now();
     if (now - *connectedAt >= milliseconds(1000) && now - lastMessage >= milliseconds(300)) break;
@@ -127,6 +135,7 @@ Expected<FleetFetchReport, std::string> fetchFromFleet(const FleetFetchRequest& 
   std::vector<Wanted> wanted;
   std::string suffix = "-" + request.camera;
   std::string vehicleName;
+  report.announced = recorders->size();
   for (const auto& recorder : *recorders) {
     std::string name = recorder.value("host", "") + " (" + recorder.value("id", "") + ")";
     if (!recorder.value("online", false)) {

@@ -29,9 +29,10 @@ struct FleetFetchRequest {
 };
 
 struct FleetFetchReport {
-  std::string camera;  // the segments' camera in the folder: "<vehicle>-cam<N>"
-  size_t asked = 0;    // recorders that answered
-  size_t holders = 0;  // of them, those that held segments in the range
+  std::string camera;    // the segments' camera in the folder: "<vehicle>-cam<N>"
+  size_t announced = 0;  // recorders on the broker, online or not
+  size_t asked = 0;      // recorders that answered
+  size_t holders = 0;    // of them, those that held segments in the range
   size_t segments = 0;
   uint64_t bytes = 0;
   std::vector<std::string> notes;  // recorders that were offline or did not answer

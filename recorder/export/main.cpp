@@ -204,9 +204,11 @@ int main(int argc, char** argv) {
       return 1;
     }
     for (const auto& note : fetched->notes) std::fprintf(stderr, "wirc-export: %s\n", note.c_str());
-    std::fprintf(stderr, "wirc-export: %zu segments (%.1f MB) from %zu of %zu recorders\n",
+    std::fprintf(stderr,
+                 "wirc-export: %zu segments (%.1f MB) from %zu recorders (%zu announced, %zu "
+                 "answered)\n",
                  fetched->segments, static_cast<double>(fetched->bytes) / 1e6, fetched->holders,
-                 fetched->asked);
+                 fetched->announced, fetched->asked);
     request.recordings = gathered->path;
     request.camera = fetched->camera;
     request.overlapping = true;

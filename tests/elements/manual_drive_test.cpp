@@ -41,7 +41,27 @@ TEST(ManualDrive, ACommandLeavesAtOnceWithinTheLimitsAndHoldsOffTheFollower) {
   gst_buffer_unref(gst_harness_push_and_pull(c.harness, bufferWithATagOnTheRight()));
   std::this_thread::sleep_for(milliseconds(50));
   EXPECT_EQ(c.pulse(kSteering), 2000);
-  auto reasons = c.driveReasons();
+  // The frame's wirc-control message says what the vehicle is sent: the
+  // command by hand, not the follower's (a recording's telemetry showed
+  // neutral while the car drove).
+  std::vector<std::string> reasons;
+  int controls = 0;
+  while (GstMessage* m = gst_bus_pop_filtered(c.bus, GST_MESSAGE_ELEMENT)) {
+    const GstStructure* s = gst_message_get_structure(m);
+    if (gst_structure_has_name(s, "wirc-drive"))
+      reasons.emplace_back(gst_structure_get_string(s, "reason"));
+    if (gst_structure_has_name(s, "wirc-control")) {
+      ++controls;
+      gboolean manual = FALSE;
+      guint steering = 0;
+      gst_structure_get_boolean(s, "manual", &manual);
+      gst_structure_get_uint(s, "steering-pulse", &steering);
+      EXPECT_TRUE(manual);
+      EXPECT_EQ(steering, 2000u);
+    }
+    gst_message_unref(m);
+  }
+  EXPECT_EQ(controls, 1);
   EXPECT_EQ(reasons, (std::vector<std::string>{"command", "command"}));
 }
 

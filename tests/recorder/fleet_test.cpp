@@ -320,7 +320,8 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
                         " --vehicle S2 --http-token " + kToken + " --end " + end +
                         " --format mkv --out '" + exported.string() + "'");
   ASSERT_EQ(ran.exitCode, 0) << ran.output;
-  EXPECT_NE(ran.output.find("from 2 of 3 recorders"), std::string::npos) << ran.output;
+  EXPECT_NE(ran.output.find("from 2 recorders (3 announced, 3 answered)"), std::string::npos)
+      << ran.output;
   history = getJson(third.url() + "api/fleet/recordings?vehicle=S2");
   auto moments = momentsOf(history["recordings"], end, [&](const Json& r) {
     return (r["recorder"] == first.id() ? folder / "first" : folder / "second") /
