@@ -315,4 +315,19 @@ Expected<ExportReport, ExportError> exportRange(const ExportRequest& request,
 
 fs::path partialPathOf(const fs::path& out) { return out.string() + ".partial"; }
 
+std::string compactTimeOf(int64_t unixNs) {
+  std::string compact;
+  for (char c : isoTimeOf(unixNs)) {
+    if (c == '.') break;
+    if (c != '-' && c != ':') compact += c;
+  }
+  return compact + "Z";
+}
+
+std::string fileNamePart(const std::string& text) {
+  std::string part;
+  for (char c : text) part += g_ascii_isalnum(c) || c == '-' || c == '.' ? c : '_';
+  return part;
+}
+
 }  // namespace wircam::recorder

@@ -64,6 +64,12 @@ struct ExportError {
   std::string message;
 };
 
+// For names of files: "2026-11-24T14:59:35.467Z" → "20261124T145935Z",
+// as the segments are named; and text with anything but letters, digits,
+// '-' and '.' made '_'.
+std::string compactTimeOf(int64_t unixNs);
+std::string fileNamePart(const std::string& text);
+
 // What an export's file is called until it is whole (and its .jsonl's,
 // likewise): `out` with ".partial" added.
 std::filesystem::path partialPathOf(const std::filesystem::path& out);

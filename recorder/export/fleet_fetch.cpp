@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "export/exporter.h"
 #include "export/http_fetcher.h"
 #include "fleet/fleet_announcement.h"
 #include "fleet/fleet_directory.h"
@@ -91,23 +92,6 @@ Expected<Json, std::string> announcedRecorders(const MqttUrl& broker) {
   return directory.view().value("recorders", Json::array());
 }
 
-// "car-7" → "car-7"; anything but letters, digits, '-' and '.' becomes '_'.
-std::string fileSafe(const std::string& text) {
-  std::string safe;
-  for (char c : text) safe += g_ascii_isalnum(c) || c == '-' || c == '.' ? c : '_';
-  return safe;
-}
-
-// "2026-11-24T14:59:35.467Z" → "20261124T145935Z", as in a segment's name.
-std::string compactTime(const std::string& iso) {
-  std::string compact;
-  for (char c : iso) {
-    if (c == '.' || c == 'Z') break;
-    if (c != '-' && c != ':') compact += c;
-  }
-  return compact + "Z";
-}
-
 bool overlaps(const Json& entry, const FleetFetchRequest& request) {
   auto begins = parseIsoTime(entry.value("start_utc", ""));
   if (!begins) return false;
@@ -181,7 +165,7 @@ Expected<FleetFetchReport, std::string> fetchFromFleet(const FleetFetchRequest& 
   // One camera in the folder, whichever recorder named it what; each
   // segment under its place in time (two recorders may start one in the
   // same second, while the vehicle moves from one to the other).
-  report.camera = fileSafe(vehicleName.empty() ? request.vehicle : vehicleName) + suffix;
+  report.camera = fileNamePart(vehicleName.empty() ? request.vehicle : vehicleName) + suffix;
   std::error_code error;
   fs::create_directories(request.folder, error);
   if (error) return unexpected("cannot make " + request.folder.string() + ": " + error.message());
@@ -189,8 +173,8 @@ Expected<FleetFetchReport, std::string> fetchFromFleet(const FleetFetchRequest& 
   for (size_t i = 0; i < wanted.size(); ++i) {
     const auto& [entry, base] = wanted[i];
     std::string file = entry.value("file", "");
-    std::string stem = report.camera + "-" + compactTime(entry.value("start_utc", "")) + "-" +
-                       std::to_string(i + 1);
+    std::string stem = report.camera + "-" + compactTimeOf(*parseIsoTime(entry["start_utc"])) +
+                       "-" + std::to_string(i + 1);
     std::string extension = fs::path(file).extension().string();  // .mkv or .mp4
     std::string path = entry.value("url", "");
     std::string url = base + path.substr(path.starts_with("/") ? 1 : 0);

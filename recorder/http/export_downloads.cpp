@@ -41,23 +41,11 @@ const char* contentTypeOf(ExportFormat format) {
   return "application/octet-stream";
 }
 
-// "2026-11-24T14:59:35.467Z" → "20261124T145935Z", for a file name.
-std::string compactTime(int64_t unixNs) {
-  std::string compact;
-  for (char c : isoTimeOf(unixNs)) {
-    if (c == '.') return compact + "Z";
-    if (c != '-' && c != ':') compact += c;
-  }
-  return compact;
-}
-
 // The name a browser saves the file as: the camera and the range (its
 // first frame to its planned end).
 std::string downloadName(const std::string& camera, const ExportStart& start, ExportFormat format) {
-  std::string name;
-  for (char c : camera) name += g_ascii_isalnum(c) || c == '-' || c == '.' ? c : '_';
-  return name + "_" + compactTime(start.firstUtcNs) + "-" + compactTime(start.lastUtcNs) + "." +
-         exportFormatName(format);
+  return fileNamePart(camera) + "_" + compactTimeOf(start.firstUtcNs) + "-" +
+         compactTimeOf(start.lastUtcNs) + "." + exportFormatName(format);
 }
 
 // A form-decoded query turns the '+' of "+01:00" into a space; no ISO 8601

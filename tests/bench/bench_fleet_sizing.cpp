@@ -28,9 +28,9 @@
 #include <vector>
 
 #include "child_process.h"
-#include "common/socket.h"
 #include "fleet/fleet_announcement.h"
 #include "fleet/mqtt_client.h"
+#include "free_port.h"
 
 namespace {
 
@@ -40,11 +40,6 @@ using wircam::bench::cpuSecondsOf;
 using wircam::bench::spawn;
 using wircam::bench::stopGroup;
 using Clock = std::chrono::steady_clock;
-
-uint16_t freePort() {
-  auto socket = wircam::listenTcp(wircam::SocketAddress::loopback(0));
-  return socket ? wircam::localAddress(socket->get()).port() : uint16_t{0};
-}
 
 long residentKbOf(pid_t pid) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
@@ -99,7 +94,7 @@ int main(int argc, char** argv) {
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-fleet-" + std::to_string(getpid()));
   fs::create_directories(work);
-  uint16_t brokerPort = freePort();
+  uint16_t brokerPort = wircam::testing::freeLoopbackPort();
   std::ofstream(work / "mosquitto.conf")
       << "listener " << brokerPort << " 127.0.0.1\nallow_anonymous true\npersistence false\n"
       << "max_queued_messages 100000\n";
@@ -176,7 +171,7 @@ int main(int argc, char** argv) {
   double stockCpu = measure("mosquitto_sub (stock)", stock, [] {});
   stopGroup(stock, SIGTERM);
 
-  uint16_t httpPort = freePort();
+  uint16_t httpPort = wircam::testing::freeLoopbackPort();
   pid_t recorder = spawn(
       (bin / "wirc-recorder").string() + " --device 127.0.0.1:1 --out " + (work / "rec").string() +
           " --http 127.0.0.1:" + std::to_string(httpPort) + " --mqtt mqtt://127.0.0.1:" + port +

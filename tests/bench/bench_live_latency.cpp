@@ -32,8 +32,8 @@
 #include <vector>
 
 #include "child_process.h"
-#include "common/socket.h"
 #include "devtools_page.h"
+#include "free_port.h"
 
 namespace {
 
@@ -43,11 +43,6 @@ using wircam::bench::spawn;
 using wircam::bench::stopGroup;
 using wircam::testing::DevToolsPage;
 using Clock = std::chrono::steady_clock;
-
-uint16_t freePort() {
-  auto socket = wircam::listenTcp(wircam::SocketAddress::loopback(0));
-  return socket ? wircam::localAddress(socket->get()).port() : uint16_t{0};
-}
 
 // The page's helpers: the stamp read from a picture, and its age.
 const char* kHelpers = R"JS(
@@ -179,7 +174,8 @@ int main(int argc, char** argv) {
   std::printf("%-8s | %-6s | %-7s | %-17s | %-8s | %s\n", "size", "view", "viewers",
               "latency median/p90", "kbit/s", "recorder CPU %");
   for (const char* size : {"352x288", "1280x720"}) {
-    uint16_t devicePort = freePort(), httpPort = freePort();
+    uint16_t devicePort = wircam::testing::freeLoopbackPort(),
+             httpPort = wircam::testing::freeLoopbackPort();
     pid_t sim = spawn((bin / "wirc-sim").string() + " --clock-stamp --size " + size + " --port " +
                       std::to_string(devicePort));
     std::this_thread::sleep_for(std::chrono::milliseconds(500));

@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "child_process.h"
-#include "common/socket.h"
+#include "free_port.h"
 
 namespace {
 
@@ -39,11 +39,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using wircam::bench::spawn;
 using wircam::bench::stopGroup;
-
-uint16_t freePort() {
-  auto socket = wircam::listenTcp(wircam::SocketAddress::loopback(0));
-  return socket ? wircam::localAddress(socket->get()).port() : uint16_t{0};
-}
 
 // A /proc/PID/status field in kB: VmRSS (now) or VmHWM (the peak).
 long statusKb(pid_t pid, const std::string& field) {
@@ -227,7 +222,7 @@ int main(int argc, char** argv) {
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-viewers-" + std::to_string(getpid()));
   fs::create_directories(work);
-  uint16_t devicePort = freePort();
+  uint16_t devicePort = wircam::testing::freeLoopbackPort();
   pid_t sim = spawn((bin / "wirc-sim").string() + " --port " + std::to_string(devicePort));
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const double warmUp = 3;  // login and the first frames before the viewers come
@@ -254,7 +249,7 @@ int main(int argc, char** argv) {
     std::vector<double> cpu;
     for (int count : {0, viewers}) {
       fs::remove_all(work / "rec");
-      uint16_t serverPort = freePort();
+      uint16_t serverPort = wircam::testing::freeLoopbackPort();
       pid_t recorder = spawn(
           (bin / "wirc-recorder").string() + " --device 127.0.0.1:" + std::to_string(devicePort) +
           " --out " + (work / "rec").string() + " --segment 600 " + server +
@@ -278,7 +273,7 @@ int main(int argc, char** argv) {
     cpuPerViewer[server] = (cpu[1] - cpu[0]) / seconds / (viewers / 2) * 100;
   }
   for (int count : {0, viewers}) {
-    uint16_t tcpPort = freePort();
+    uint16_t tcpPort = wircam::testing::freeLoopbackPort();
     pid_t launch =
         spawn("gst-launch-1.0 -q wircsrc host=127.0.0.1 port=" + std::to_string(devicePort) +
               " ! multipartmux boundary=wircframe ! tcpserversink host=127.0.0.1 port=" +

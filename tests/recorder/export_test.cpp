@@ -59,6 +59,16 @@ std::string shiftedIso(const std::string& iso, int64_t deltaMs) {
   return shifted;
 }
 
+// The text track's default flag and title, as ffprobe reads them:
+// "0,telemetry\n" when it is named and not shown.
+std::string telemetryTrackOf(const fs::path& file) {
+  return runCommand(
+             "ffprobe -v error -select_streams s:0 -show_entries "
+             "stream_disposition=default:stream_tags=title -of csv=p=0 '" +
+             file.string() + "'")
+      .output;
+}
+
 std::string exportCommand(const fs::path& recordings, const std::string& camera,
                           const std::string& rest) {
   return std::string(WIRC_EXPORT) + " --recordings '" + recordings.string() + "' --camera " +
@@ -141,11 +151,7 @@ TEST_F(Export, AllOfItAsMatroskaIsEveryFrameUntouchedOnOneTimelineWithTheOutageA
   EXPECT_NEAR(times.back(), recorded, 0.5);
   EXPECT_EQ(ffmpegDecodeErrors(out), "");
   // The telemetry: a named text track, and the same lines re-based beside.
-  EXPECT_EQ(runCommand("ffprobe -v error -select_streams s:0 -show_entries "
-                       "stream_disposition=default:stream_tags=title -of csv=p=0 '" +
-                       out.string() + "'")
-                .output,
-            "0,telemetry\n");
+  EXPECT_EQ(telemetryTrackOf(out), "0,telemetry\n");
   auto track = contentsOf(out).telemetry;
   std::ifstream jsonl(fs::path(out).replace_extension(".jsonl"));
   std::vector<nlohmann::json> lines;
@@ -189,11 +195,7 @@ TEST_F(Export, StreamedToStdoutItHoldsWhatTheFileHolds) {
     }
     EXPECT_EQ(frameDigests(out), recordedDigests());
     EXPECT_EQ(ffmpegDecodeErrors(out), "");
-    EXPECT_EQ(runCommand("ffprobe -v error -select_streams s:0 -show_entries "
-                         "stream_disposition=default:stream_tags=title -of csv=p=0 '" +
-                         out.string() + "'")
-                  .output,
-              "0,telemetry\n");
+    EXPECT_EQ(telemetryTrackOf(out), "0,telemetry\n");
   }
 }
 

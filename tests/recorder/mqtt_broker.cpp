@@ -8,21 +8,14 @@
 #include <fstream>
 #include <thread>
 
-#include "common/socket.h"
+#include "free_port.h"
 #include "wait_for.h"
 
 namespace wircam::testing {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-uint16_t freePort() {
-  auto socket = listenTcp(SocketAddress::loopback(0));
-  return socket ? localAddress(socket->get()).port() : 0;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 MosquittoBroker::MosquittoBroker(const std::string& user, const std::string& password,
                                  const fs::path& tls) {
@@ -42,11 +35,11 @@ MosquittoBroker::MosquittoBroker(const std::string& user, const std::string& pas
   // The free port may be taken by a test running beside this one before
   // mosquitto binds it: then it exits, and another port is tried.
   for (int attempt = 0; attempt < 5 && !running(); ++attempt) {
-    port_ = freePort();
+    port_ = freeLoopbackPort();
     std::ofstream config(folder_ / "mosquitto.conf");
     config << "listener " << port_ << " 127.0.0.1\npersistence false\n" << access;
     if (!tls.empty()) {
-      tlsPort_ = freePort();
+      tlsPort_ = freeLoopbackPort();
       config << "listener " << tlsPort_ << " 127.0.0.1\ncafile " << (tls / "ca.pem").string()
              << "\ncertfile " << (tls / "server.pem").string() << "\nkeyfile "
              << (tls / "server.key").string() << "\n";
