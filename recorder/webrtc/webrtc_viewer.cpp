@@ -2,6 +2,7 @@
 
 #include <gst/sdp/sdp.h>
 
+#include "gst_h264_start.h"
 #include "webrtc/main_loop_call.h"
 
 namespace wircam::recorder {
@@ -153,6 +154,7 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
           delete static_cast<std::shared_ptr<std::atomic<int64_t>>*>(heard);
         },
         GConnectFlags(0));
+  if (h264) startOnAnIdrOnceConnected();
   gst_element_sync_state_with_parent(webrtc_);
   gst_element_sync_state_with_parent(payloader_);
   gst_element_sync_state_with_parent(queue_);
@@ -165,6 +167,39 @@ WebRtcViewer::WebRtcViewer(CameraEncoder& encoder, const ViewerOffer& offer,
   // time its packets).
   gst_bin_recalculate_latency(encoder_.pipeline());
   negotiate(offer.sdp);
+}
+
+void WebRtcViewer::startOnAnIdrOnceConnected() {
+  // Read on the queue's streaming thread, written on webrtcbin's: neither
+  // may touch the viewer, which lives on the main loop.
+  using Flag = std::shared_ptr<std::atomic<bool>>;
+  auto connected = std::make_shared<std::atomic<bool>>(false);
+  handlers_.push_back(g_signal_connect_data(
+      webrtc_, "notify::connection-state",
+      G_CALLBACK(+[](GstElement* webrtc, GParamSpec*, gpointer flag) {
+        GstWebRTCPeerConnectionState state;
+        g_object_get(webrtc, "connection-state", &state, nullptr);
+        static_cast<Flag*>(flag)->get()->store(state == GST_WEBRTC_PEER_CONNECTION_STATE_CONNECTED);
+      }),
+      new Flag(connected), [](gpointer flag, GClosure*) { delete static_cast<Flag*>(flag); },
+      GConnectFlags(0)));
+  // Until the connection is up webrtcbin sends nothing, and what it was
+  // given is lost: the first frame to go is the first IDR after. An
+  // I-frame that is no IDR (an encoder's scene cut; h264parse flags it a
+  // key frame too) is no place to start, so it is decided from the
+  // bitstream. The payloader puts the SPS and PPS before it.
+  GstPad* queued = gst_element_get_static_pad(queue_, "src");
+  gst_pad_add_probe(
+      queued, GST_PAD_PROBE_TYPE_BUFFER,
+      [](GstPad* pad, GstPadProbeInfo* info, gpointer flag) {
+        if (!static_cast<Flag*>(flag)->get()->load()) return GST_PAD_PROBE_DROP;
+        GstCaps* caps = gst_pad_get_current_caps(pad);
+        bool starts = gst::h264StartsDecoding(GST_PAD_PROBE_INFO_BUFFER(info), caps);
+        if (caps) gst_caps_unref(caps);
+        return starts ? GST_PAD_PROBE_REMOVE : GST_PAD_PROBE_DROP;
+      },
+      new Flag(connected), [](gpointer flag) { delete static_cast<Flag*>(flag); });
+  gst_object_unref(queued);
 }
 
 void WebRtcViewer::negotiate(const std::string& offer) {

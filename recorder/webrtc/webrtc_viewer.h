@@ -74,6 +74,8 @@ class WebRtcViewer {
   // `call` on the main loop with the viewer, unless it is gone by then.
   static void handOver(gpointer handle, std::function<void(WebRtcViewer&)> call);
   gulong connect(gpointer instance, const char* signal, GCallback callback);
+  // H.264 as recorded: the viewer's first frame is an IDR it can start on.
+  void startOnAnIdrOnceConnected();
   void negotiate(const std::string& offer);
   void waitForCandidates(const std::string& answer);
   void answerIfGathered(AnswerGathering::Clock::time_point now);

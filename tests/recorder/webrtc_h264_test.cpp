@@ -6,22 +6,18 @@
 // payload type the offer gave Main, from the first viewer on; the
 // webrtcbin client decodes its frames (avdec_h264).
 #include <gst/gst.h>
-#include <gst/sdp/sdp.h>
-#define GST_USE_UNSTABLE_API
-#include <gst/webrtc/webrtc.h>
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <chrono>
 #include <fstream>
 #include <string>
-#include <thread>
 
 #include "http_fetch.h"
 #include "recorder_process.h"
 #include "signed_in_page.h"
 #include "simulated_device.h"
 #include "wait_for.h"
+#include "webrtcbin_viewer.h"
 
 namespace {
 
@@ -65,111 +61,6 @@ TEST(WhepH264, ChromiumsOwnOfferGetsTheMainStreamFromTheFirstViewerOn) {
     EXPECT_NE(answered.body.find("profile-level-id=4d"), std::string::npos) << answered.body;
   }
 }
-
-// Constrained Baseline (108) before Main (116).
-constexpr const char* kBaselineThenMain =
-    "application/x-rtp,media=video,encoding-name=H264,payload=108,clock-rate=90000,"
-    "packetization-mode=(string)1,profile-level-id=(string)42e01f,"
-    "level-asymmetry-allowed=(string)1;"
-    "application/x-rtp,media=video,encoding-name=H264,payload=116,clock-rate=90000,"
-    "packetization-mode=(string)1,profile-level-id=(string)4d001f,"
-    "level-asymmetry-allowed=(string)1";
-
-// VP8 (96) before Main (102), as a stranger's webrtcbin client offered.
-constexpr const char* kVp8ThenMain =
-    "application/x-rtp,media=video,encoding-name=VP8,payload=96,clock-rate=90000;"
-    "application/x-rtp,media=video,encoding-name=H264,payload=102,clock-rate=90000,"
-    "packetization-mode=(string)1,profile-level-id=(string)4d001f,"
-    "level-asymmetry-allowed=(string)1";
-
-// A webrtcbin that receives video offering `codecs` in their order, and
-// counts the frames avdec_h264 decodes.
-class WebRtcBinViewer {
- public:
-  explicit WebRtcBinViewer(const char* codecs = kBaselineThenMain) {
-    pipeline_ = gst_pipeline_new(nullptr);
-    webrtc_ = gst_element_factory_make("webrtcbin", nullptr);
-    gst_util_set_object_arg(G_OBJECT(webrtc_), "bundle-policy", "max-bundle");
-    gst_bin_add(GST_BIN(pipeline_), webrtc_);
-    // Its host candidate on loopback, where the recorder listens.
-    GstWebRTCICE* ice = nullptr;
-    g_object_get(webrtc_, "ice-agent", &ice, nullptr);
-    gboolean added = FALSE;
-    g_signal_emit_by_name(ice, "add-local-ip-address", "127.0.0.1", &added);
-    gst_object_unref(ice);
-    GstCaps* offered = gst_caps_from_string(codecs);
-    GstWebRTCRTPTransceiver* transceiver = nullptr;
-    g_signal_emit_by_name(webrtc_, "add-transceiver", GST_WEBRTC_RTP_TRANSCEIVER_DIRECTION_RECVONLY,
-                          offered, &transceiver);
-    gst_caps_unref(offered);
-    if (transceiver) gst_object_unref(transceiver);
-    g_signal_connect(webrtc_, "pad-added", G_CALLBACK(onPad), this);
-    gst_element_set_state(pipeline_, GST_STATE_PLAYING);
-  }
-  ~WebRtcBinViewer() {
-    gst_element_set_state(pipeline_, GST_STATE_NULL);
-    gst_object_unref(pipeline_);
-  }
-
-  // The offer, once its candidates are gathered.
-  std::string offer() {
-    GstPromise* promise = gst_promise_new();
-    g_signal_emit_by_name(webrtc_, "create-offer", nullptr, promise);
-    gst_promise_wait(promise);
-    GstWebRTCSessionDescription* offer = nullptr;
-    gst_structure_get(gst_promise_get_reply(promise), "offer", GST_TYPE_WEBRTC_SESSION_DESCRIPTION,
-                      &offer, nullptr);
-    gst_promise_unref(promise);
-    g_signal_emit_by_name(webrtc_, "set-local-description", offer, nullptr);
-    gst_webrtc_session_description_free(offer);
-    waitFor([this] {
-      GstWebRTCICEGatheringState state;
-      g_object_get(webrtc_, "ice-gathering-state", &state, nullptr);
-      return state == GST_WEBRTC_ICE_GATHERING_STATE_COMPLETE;
-    });
-    GstWebRTCSessionDescription* local = nullptr;
-    g_object_get(webrtc_, "local-description", &local, nullptr);
-    gchar* text = gst_sdp_message_as_text(local->sdp);
-    std::string sdp = text;
-    g_free(text);
-    gst_webrtc_session_description_free(local);
-    return sdp;
-  }
-  void answer(const std::string& sdp) {
-    GstSDPMessage* message = nullptr;
-    gst_sdp_message_new_from_text(sdp.c_str(), &message);
-    GstWebRTCSessionDescription* answer =
-        gst_webrtc_session_description_new(GST_WEBRTC_SDP_TYPE_ANSWER, message);
-    g_signal_emit_by_name(webrtc_, "set-remote-description", answer, nullptr);
-    gst_webrtc_session_description_free(answer);
-  }
-  int decoded() const { return decoded_; }
-
- private:
-  static void onPad(GstElement*, GstPad* pad, WebRtcBinViewer* self) {
-    if (GST_PAD_DIRECTION(pad) != GST_PAD_SRC) return;
-    GstElement* decode = gst_parse_bin_from_description(
-        "rtph264depay ! h264parse ! avdec_h264 ! fakesink name=frames signal-handoffs=true "
-        "sync=false",
-        TRUE, nullptr);
-    GstElement* frames = gst_bin_get_by_name(GST_BIN(decode), "frames");
-    g_signal_connect(frames, "handoff",
-                     G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, WebRtcBinViewer* viewer) {
-                       ++viewer->decoded_;
-                     }),
-                     self);
-    gst_object_unref(frames);
-    gst_bin_add(GST_BIN(self->pipeline_), decode);
-    gst_element_sync_state_with_parent(decode);
-    GstPad* sink = gst_element_get_static_pad(decode, "sink");
-    gst_pad_link(pad, sink);
-    gst_object_unref(sink);
-  }
-
-  GstElement* pipeline_ = nullptr;
-  GstElement* webrtc_ = nullptr;
-  std::atomic<int> decoded_ = 0;
-};
 
 TEST(WhepH264, AWebrtcbinViewerOfferingBaselineFirstDecodesTheRecordingsMainStream) {
   if (!gst_element_factory_find("avdec_h264"))
