@@ -90,6 +90,10 @@ struct WircSrcState {
   int height = 0;
   Clock::time_point nextStats;
   GstClockTime lastPts = GST_CLOCK_TIME_NONE;  // the newest frame's, on the streaming thread
+  // When the last frame was taken, and the frames' interval (smoothed): the
+  // link's keepalive rides on this thread's turns (shareTurn).
+  std::optional<Clock::time_point> lastFrameTaken;
+  Clock::duration frameInterval{};
   // Whether the pipeline's clock reads CLOCK_MONOTONIC, asked once per clock
   // (a property read per frame cost more than the rest of the timestamp).
   const GstClock* typedClock = nullptr;
@@ -250,6 +254,7 @@ static gboolean gst_wirc_src_start(GstBaseSrc* base) {
   }
   state->width = state->height = 0;
   state->lastPts = GST_CLOCK_TIME_NONE;
+  state->lastFrameTaken.reset();
   state->typedClock = nullptr;  // a new clock may come at a freed one's address
   state->loginDeadline = Clock::now() + std::chrono::milliseconds(settings.loginTimeoutMs + 500);
   state->nextStats = Clock::now() + std::chrono::milliseconds(settings.statsIntervalMs);
@@ -418,6 +423,18 @@ static GstClockTime frame_timestamp(GstWircSrc* self, Clock::time_point firstPac
   return last;
 }
 
+// This thread wakes for every frame anyway: a keepalive due before the
+// next frame leaves on this turn, and the link's event loop sleeps on (at
+// CIF/15 its keepalive timer was 0.7 wake-ups a frame, a third of the
+// receiving process's CPU).
+static void share_turn_with_link(WircSrcState* state) {
+  auto now = Clock::now();
+  if (state->lastFrameTaken)
+    state->frameInterval = (3 * state->frameInterval + (now - *state->lastFrameTaken)) / 4;
+  state->lastFrameTaken = now;
+  state->session->shareTurn(state->frameInterval);
+}
+
 static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
   auto* self = GST_WIRC_SRC(pushsrc);
   auto* state = self->state;
@@ -452,6 +469,7 @@ static GstFlowReturn gst_wirc_src_create(GstPushSrc* pushsrc, GstBuffer** out) {
     }
   }
   publishStats(self);
+  share_turn_with_link(state);
 
   GstClockTime pts = frame_timestamp(self, frame->firstPacketTime);
   bool discont = frame->discont;

@@ -98,6 +98,15 @@ void printRow(const char* label, const char* receiver, const Result& r) {
               static_cast<unsigned long long>(r.frames));
 }
 
+// "max PCD gap        100 ms" in wirc-sim's summary → "100 ms".
+std::string longestPcdGapIn(const fs::path& summary) {
+  std::ifstream in(summary);
+  for (std::string line; std::getline(in, line);)
+    if (auto at = line.find("max PCD gap"); at != std::string::npos)
+      return line.substr(line.find_first_not_of(' ', at + 11));
+  return "unknown";
+}
+
 double ratio(double ours, double stock) { return stock > 0 ? ours / stock : 0; }
 
 }  // namespace
@@ -132,13 +141,19 @@ int main(int argc, char** argv) {
     // Ports from the pid keep parallel runs apart.
     int port = 10000 + getpid() % 20000;  // below the ephemeral ports (32768 and up)
 
+    // The simulator's summary at its end says the longest gap between two
+    // commands (PCD) it heard: the keepalive's, however they were sent.
+    fs::path summary = dir.string() + "-sim.txt";
     pid_t sender = spawn(sim + " --bind 127.0.0.1 --port " + std::to_string(port) + " --fps " +
-                         std::to_string(c.fps) + " --frames " + dir.string());
+                             std::to_string(c.fps) + " --frames " + dir.string(),
+                         summary.string());
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     auto wircam = receive(
         "wircsrc host=127.0.0.1 port=" + std::to_string(port) + " ! fakesink name=sink sync=false",
         seconds);
     stop(sender);
+    std::string longestPcdGap = longestPcdGapIn(summary);
+    fs::remove(summary);
 
     int rtpPort = port + 1;
     // multifilesrc does not timestamp: identity's sleep paces it instead.
@@ -160,9 +175,11 @@ int main(int argc, char** argv) {
     std::snprintf(label, sizeof label, "%dx%d@%d", c.width, c.height, c.fps);
     printRow(label, "wircsrc", wircam);
     printRow(label, "udpsrc ! rtpjpegdepay", rtp);
-    std::printf("%-12s wircsrc ÷ stock: whole %.2f×, streaming thread %.2f×\n", label,
-                ratio(wircam.cpuPerFrameUs, rtp.cpuPerFrameUs),
-                ratio(wircam.streamingUsPerFrame, rtp.streamingUsPerFrame));
+    std::printf(
+        "%-12s wircsrc ÷ stock: whole %.2f×, streaming thread %.2f×; keepalive on, "
+        "longest PCD gap %s\n",
+        label, ratio(wircam.cpuPerFrameUs, rtp.cpuPerFrameUs),
+        ratio(wircam.streamingUsPerFrame, rtp.streamingUsPerFrame), longestPcdGap.c_str());
   }
   return 0;
 }

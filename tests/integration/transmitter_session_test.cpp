@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <mutex>
+#include <thread>
 
 #include "devices/wirc/device.h"
 #include "misbehaving_peers.h"
@@ -201,6 +202,46 @@ TEST(TransmitterSession, SendsAChangedCommandAtOnceAndKeepsTheWatchdogFedWhileNo
   EXPECT_EQ(device->stats().failsafeEntries, 0u);
   EXPECT_FALSE(device->outputs().failsafe);
   EXPECT_EQ(session->status().state, link::LinkState::Live);
+}
+
+// A stream's receive loop lends the link its turns (every 66 ms, as at
+// 15 fps): the keepalives leave on them, and the link's event loop wakes
+// only for the device's status reports (two a second), not for its
+// keepalive timer (ten a second). When the turns stop, the timer feeds the
+// device's watchdog again.
+TEST(TransmitterSession, KeepalivesRideOnAStreamsTurnsAndTheEventLoopSleeps) {
+  auto device = startDevice();
+  link::EventLoop loop;
+  auto acquired = TransmitterSession::acquire(sessionFor(*device), "test", loop);
+  ASSERT_TRUE(acquired) << acquired.error();
+  auto session = *acquired;
+  ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
+  ASSERT_TRUE(waitFor([&] { return session->status().hasControl; }));
+  session->shareTurn(milliseconds(66));
+  uint64_t wakeUps = loop.wakeUps();
+  uint64_t reports = device->stats().psdSent;
+  uint64_t commands = device->stats().pcdReceived;
+  // A turn this machine let come late (past the keepalive's early margin)
+  // leaves the keepalive to the timer: one wake-up it may take.
+  int late = 0;
+  auto last = std::chrono::steady_clock::now();
+  for (int turn = 0; turn < 30; ++turn) {
+    std::this_thread::sleep_for(milliseconds(66));
+    auto now = std::chrono::steady_clock::now();
+    if (now - last > milliseconds(85)) ++late;
+    last = now;
+    session->shareTurn(milliseconds(66));
+  }
+  uint64_t woke = loop.wakeUps() - wakeUps;
+  uint64_t reported = device->stats().psdSent - reports;
+  EXPECT_LE(woke, reported + late + 2) << reported << " status reports, " << late << " late turns";
+  EXPECT_GE(device->stats().pcdReceived - commands, 29u);
+  // Without turns, the timer: ten keepalives a second.
+  commands = device->stats().pcdReceived;
+  std::this_thread::sleep_for(milliseconds(1000));
+  EXPECT_GE(device->stats().pcdReceived - commands, 8u);
+  EXPECT_EQ(device->stats().failsafeEntries, 0u);
+  session.reset();  // logs out on the loop, before it goes
 }
 
 TEST(TransmitterSession, ClampsCommandsIntoThePulseRange) {

@@ -38,6 +38,14 @@ std::optional<Pulses> CommandPacer::poll(Clock::time_point now) {
                    !lastSent_ || now - lastSentTime_ >= config_.keepalive - config_.keepaliveEarly);
 }
 
+std::optional<Pulses> CommandPacer::pollAhead(Clock::time_point now, Clock::duration ahead) {
+  // Believed at most half the keepalive: a turn that comes sooner than
+  // expected sends no more than two keepalives a period.
+  Clock::duration early =
+      std::clamp<Clock::duration>(ahead, config_.keepaliveEarly, config_.keepalive / 2);
+  return sendIfDue(now, !lastSent_ || now - lastSentTime_ >= config_.keepalive - early);
+}
+
 CommandPacer::Clock::time_point CommandPacer::nextDeadline(Clock::time_point now) const {
   if (!lastSent_) return now;
   auto next = lastSentTime_ + config_.keepalive;

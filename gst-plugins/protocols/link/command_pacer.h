@@ -35,6 +35,11 @@ class CommandPacer {
   std::optional<Pulses> offer(const Pulses& pulses, Clock::time_point now);
   // From the link's timer: the pulses to send now, if any are due.
   std::optional<Pulses> poll(Clock::time_point now);
+  // On a turn a thread takes anyway (a stream's receive loop), its next
+  // expected `ahead` (at most half the keepalive is believed): the pulses
+  // to send now, if a keepalive would fall due before that turn, so that
+  // the link's timer need not wake for it.
+  std::optional<Pulses> pollAhead(Clock::time_point now, Clock::duration ahead);
   // When poll() has something to send next, seen from `now`.
   Clock::time_point nextDeadline(Clock::time_point now) const;
   // Forget what was sent (a new login): the next poll sends at once.

@@ -5,6 +5,7 @@
 #include <sys/eventfd.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
+#include <sys/timerfd.h>
 #include <unistd.h>
 
 #include <array>
@@ -18,10 +19,20 @@ EventLoop& EventLoop::shared() {
   return *loop;
 }
 
+namespace {
+// The epoll data of the loop's own descriptors; entries' ids start at 1.
+constexpr uint64_t kWakeData = 0;
+constexpr uint64_t kAlarmData = ~uint64_t{0};
+}  // namespace
+
 EventLoop::EventLoop()
-    : epoll_(epoll_create1(EPOLL_CLOEXEC)), wake_(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)) {
-  epoll_event event{.events = EPOLLIN, .data = {.u64 = 0}};
-  epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, wake_.get(), &event);
+    : epoll_(epoll_create1(EPOLL_CLOEXEC)),
+      wake_(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)),
+      alarm_(timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK)) {
+  epoll_event wake{.events = EPOLLIN, .data = {.u64 = kWakeData}};
+  epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, wake_.get(), &wake);
+  epoll_event alarm{.events = EPOLLIN, .data = {.u64 = kAlarmData}};
+  epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, alarm_.get(), &alarm);
   thread_ = std::thread([this] { run(); });
 }
 
@@ -66,17 +77,12 @@ EventLoop::Id EventLoop::addTimer(Callback callback) {
 }
 
 void EventLoop::arm(Id id, Clock::time_point when) {
-  bool earliest;
-  {
-    std::lock_guard lock(mutex_);
-    auto it = entries_.find(id);
-    if (it == entries_.end()) return;
-    unqueue(it->second);
-    earliest = timers_.empty() || when < timers_.begin()->first;
-    it->second.queued = timers_.emplace(when, id);
-  }
-  // The loop sleeps until its earliest timer: wake it only to sleep less.
-  if (earliest && !inLoopThread()) wake();
+  std::lock_guard lock(mutex_);
+  auto it = entries_.find(id);
+  if (it == entries_.end()) return;
+  unqueue(it->second);
+  it->second.queued = timers_.emplace(when, id);
+  followEarliestTimer();
 }
 
 void EventLoop::armIfEarlier(Id id, Clock::time_point when) {
@@ -91,13 +97,32 @@ void EventLoop::armIfEarlier(Id id, Clock::time_point when) {
 void EventLoop::disarm(Id id) {
   std::lock_guard lock(mutex_);
   auto it = entries_.find(id);
-  if (it != entries_.end()) unqueue(it->second);
+  if (it == entries_.end()) return;
+  unqueue(it->second);
+  followEarliestTimer();
 }
 
 void EventLoop::unqueue(Entry& entry) {
   if (!entry.queued) return;
   timers_.erase(*entry.queued);
   entry.queued.reset();
+}
+
+void EventLoop::followEarliestTimer() {
+  std::optional<Clock::time_point> earliest;
+  if (!timers_.empty()) earliest = timers_.begin()->first;
+  if (earliest == alarmTime_) return;
+  alarmTime_ = earliest;
+  itimerspec due{};  // all zero: disarmed
+  if (earliest) {
+    // steady_clock is CLOCK_MONOTONIC. A time in the past (invoke() arms
+    // at time_point::min()) fires at once; zero would disarm.
+    auto ns = std::max<int64_t>(
+        1,
+        std::chrono::duration_cast<std::chrono::nanoseconds>(earliest->time_since_epoch()).count());
+    due.it_value = {.tv_sec = ns / 1000000000, .tv_nsec = ns % 1000000000};
+  }
+  timerfd_settime(alarm_.get(), TFD_TIMER_ABSTIME, &due, nullptr);
 }
 
 void EventLoop::waitUntilIdle(Id id, std::unique_lock<std::mutex>& lock) {
@@ -111,6 +136,7 @@ void EventLoop::remove(Id id) {
   if (it == entries_.end()) return;
   if (it->second.fd >= 0) epoll_ctl(epoll_.get(), EPOLL_CTL_DEL, it->second.fd, nullptr);
   unqueue(it->second);
+  followEarliestTimer();
   // Destroyed here, outside the lock, once the loop has let go of it.
   Entry entry = std::move(it->second);
   entries_.erase(it);
@@ -133,15 +159,6 @@ void EventLoop::invoke(const Callback& task) {
   remove(timer);
 }
 
-int EventLoop::msUntilNextTimer(Clock::time_point now) const {
-  if (timers_.empty()) return -1;
-  auto due = timers_.begin()->first;
-  if (due <= now) return 0;
-  // Rounded up: waking a little late is fine, waking early spins.
-  auto us = std::chrono::duration_cast<std::chrono::microseconds>(due - now).count();
-  return static_cast<int>(std::min<int64_t>((us + 999) / 1000, 60000));
-}
-
 // The loop feeds the vehicles' watchdogs (the WiRC drops a transmitter
 // whose PCD stop for 800 ms): on processors busy with video it must not
 // queue behind the streaming threads. nice -10 needs CAP_SYS_NICE or an
@@ -155,13 +172,12 @@ void EventLoop::run() {
   std::array<epoll_event, 64> events;
   std::vector<Id> due;
   for (;;) {
-    int timeout;
     {
       std::lock_guard lock(mutex_);
       if (stopping_) return;
-      timeout = msUntilNextTimer(Clock::now());
     }
-    int count = epoll_wait(epoll_.get(), events.data(), static_cast<int>(events.size()), timeout);
+    int count = epoll_wait(epoll_.get(), events.data(), static_cast<int>(events.size()), -1);
+    ++wakeUps_;
 
     // Each callback runs with running_ set, so remove() can wait for it.
     auto runEntry = [&](Id id, uint32_t ready) {
@@ -187,14 +203,19 @@ void EventLoop::run() {
     };
 
     for (int i = 0; i < count; ++i) {
-      if (events[i].data.u64 == 0) {
+      uint64_t data = events[i].data.u64;
+      if (data == kWakeData || data == kAlarmData) {
         uint64_t value;
-        if (read(wake_.get(), &value, sizeof value) < 0) {
+        if (read(data == kWakeData ? wake_.get() : alarm_.get(), &value, sizeof value) < 0) {
           // Spurious: nothing to drain.
+        }
+        if (data == kAlarmData) {
+          std::lock_guard lock(mutex_);
+          alarmTime_.reset();  // spent: set again below
         }
         continue;
       }
-      runEntry(events[i].data.u64, events[i].events);
+      runEntry(data, events[i].events);
     }
 
     due.clear();
@@ -207,6 +228,7 @@ void EventLoop::run() {
         timers_.erase(timers_.begin());
         due.push_back(id);
       }
+      followEarliestTimer();
     }
     for (Id id : due) runEntry(id, 0);
   }

@@ -4,6 +4,7 @@
 // block; anything may be registered or removed from any thread.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -45,6 +46,9 @@ class EventLoop {
   //
   // Timers due within kCoalesce of the one that wakes the loop fire with it
   // (early): 200 links' keepalives share wake-ups instead of each paying one.
+  // The loop sleeps on a timerfd set to its earliest timer, so a timer
+  // moved later from another thread (a keepalive another thread's turn
+  // sent) never wakes it, and one moved earlier wakes it only when due.
   static constexpr std::chrono::milliseconds kCoalesce{10};
   Id addTimer(Callback callback);
   void arm(Id timer, Clock::time_point when);
@@ -60,6 +64,8 @@ class EventLoop {
   // there. Tasks must not block, so the wait is bounded by the loop's work.
   void invoke(const Callback& task);
   bool inLoopThread() const { return std::this_thread::get_id() == thread_.get_id(); }
+  // How often the loop thread has woken (for tests and benchmarks).
+  uint64_t wakeUps() const { return wakeUps_; }
 
  private:
   using TimerQueue = std::multimap<Clock::time_point, Id>;
@@ -75,10 +81,12 @@ class EventLoop {
   void wake();
   void waitUntilIdle(Id id, std::unique_lock<std::mutex>& lock);
   void unqueue(Entry& entry);
-  int msUntilNextTimer(Clock::time_point now) const;
+  // Sets the timerfd to the earliest timer, if that changed.
+  void followEarliestTimer();
 
   UniqueFd epoll_;
   UniqueFd wake_;
+  UniqueFd alarm_;  // a timerfd: the earliest timer's due time
   std::thread thread_;
 
   // Guards everything below; never held while a callback runs.
@@ -89,6 +97,8 @@ class EventLoop {
   Id nextId_ = 1;
   Id running_ = 0;  // the entry whose callback runs now
   bool stopping_ = false;
+  std::optional<Clock::time_point> alarmTime_;  // what alarm_ is set to, if it has not fired
+  std::atomic<uint64_t> wakeUps_ = 0;
 };
 
 }  // namespace wircam::link

@@ -499,6 +499,25 @@ void TransmitterSession::setCommand(const link::Pulses& pulses) {
                 impl_->pacerTimer_);
 }
 
+void TransmitterSession::shareTurn(Clock::duration untilNextTurn) {
+  auto now = Clock::now();
+  std::optional<link::Pulses> due;
+  {
+    std::lock_guard lock(impl_->mutex_);
+    const auto& status = impl_->machine_.status();
+    if (status.state != link::LinkState::Live || !status.hasControl ||
+        !impl_->machine_.controlAddress())
+      return;
+    due = impl_->pacer_.pollAhead(now, untilNextTurn);
+    if (!due) return;  // the timer stands
+    // Later than it stood: the loop sleeps on (EventLoop's timerfd). Under
+    // the lock, so a change another thread sets meanwhile arms its own
+    // earlier time after this.
+    impl_->loop_.arm(impl_->pacerTimer_, impl_->pacer_.nextDeadline(now));
+  }
+  impl_->sendPcd(*due);
+}
+
 void TransmitterSession::requestControl() {
   uint8_t id;
   {

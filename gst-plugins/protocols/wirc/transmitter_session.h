@@ -94,6 +94,13 @@ class TransmitterSession : public link::VehicleLink {
   TransmitterSession& operator=(const TransmitterSession&) = delete;
 
   void setCommand(const link::Pulses& pulses) override;
+  // A thread that wakes anyway (wircsrc's receive loop, at each frame)
+  // lends the link its turn: a keepalive that would fall due before its
+  // next one (`untilNextTurn` from now) leaves now, from this thread, and
+  // the link's timer moves to the keepalive after, so the event loop does
+  // not wake for it. The timer still sends whatever no turn did: the gaps
+  // between commands are the keepalive's at most, video or not.
+  void shareTurn(std::chrono::steady_clock::duration untilNextTurn);
   void requestControl() override;
   link::LinkStatus status() const override;
   SessionStatus sessionStatus() const;

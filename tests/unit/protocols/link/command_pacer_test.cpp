@@ -83,6 +83,37 @@ TEST_F(CommandPacerTest, NeverLeavesAGapLongerThanTheKeepaliveWhileNothingChange
   }
 }
 
+// Turns of another thread every 66 ms (a stream at 15 fps, its follower
+// renewing the same command each frame): the keepalive leaves on the turn
+// before it would fall due, never later than the keepalive, and the link's
+// timer (next deadline) is never due before the next turn.
+TEST_F(CommandPacerTest, AKeepaliveRidesOnTheTurnBeforeItWouldFallDue) {
+  pacer.offer(steer(1700), at(0));
+  auto last = at(0);
+  for (int ms = 66; ms < 2000; ms += 66) {
+    EXPECT_LE(at(ms) - last, milliseconds(100)) << "at " << ms << " ms";
+    EXPECT_EQ(pacer.offer(steer(1700), at(ms)), std::nullopt);
+    if (pacer.pollAhead(at(ms), milliseconds(66))) last = at(ms);
+    EXPECT_GE(pacer.nextDeadline(at(ms)), at(ms + 66)) << "the timer would wake at " << ms;
+  }
+  // At 30 fps every other turn: the keepalive is not sent more than it must.
+  int sent = 0;
+  for (int ms = 2000; ms < 3000; ms += 33) {
+    pacer.offer(steer(1700), at(ms));
+    sent += pacer.pollAhead(at(ms), milliseconds(33)) ? 1 : 0;
+  }
+  EXPECT_LE(sent, 16);
+}
+
+// A turn that says the next comes late (a slow frame rate, a stall) is
+// believed for half the keepalive at most, so that turns coming faster
+// than said do not send a keepalive each.
+TEST_F(CommandPacerTest, ATurnIsBelievedForHalfTheKeepaliveAtMost) {
+  pacer.offer(steer(1700), at(0));
+  EXPECT_EQ(pacer.pollAhead(at(40), milliseconds(500)), std::nullopt);
+  EXPECT_EQ(pacer.pollAhead(at(50), milliseconds(500)), steer(1700));
+}
+
 TEST_F(CommandPacerTest, ClampsEveryPulseIntoTheProtocolRange) {
   Pulses wild = neutralPulses();
   wild[0] = 0;

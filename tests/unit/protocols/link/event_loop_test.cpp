@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <future>
+#include <thread>
 
 namespace wircam::link {
 namespace {
@@ -42,6 +43,32 @@ TEST(EventLoop, ADisarmedTimerDoesNotFire) {
   loop.arm(loop.addTimer([&] { later.set_value(); }), Clock::now() + milliseconds(40));
   later.get_future().wait();
   EXPECT_FALSE(fired);
+}
+
+// What lets another thread send a keepalive on its own turn: moving the
+// link's timer later from that thread costs the loop no wake-up, and a
+// timer moved earlier still fires at its time.
+TEST(EventLoop, ATimerMovedLaterFromAnotherThreadDoesNotWakeTheLoop) {
+  EventLoop loop;
+  std::atomic<int> fired{0};
+  auto id = loop.addTimer([&] { ++fired; });
+  loop.arm(id, Clock::now() + milliseconds(60));
+  loop.invoke([] {});  // the loop sleeps from here
+  uint64_t before = loop.wakeUps();
+  for (int turn = 0; turn < 20; ++turn) {
+    std::this_thread::sleep_for(milliseconds(10));
+    loop.arm(id, Clock::now() + milliseconds(60));
+  }
+  EXPECT_EQ(loop.wakeUps(), before);
+  EXPECT_EQ(fired, 0);
+  std::promise<void> done;
+  auto early = loop.addTimer([&] { done.set_value(); });
+  auto set = Clock::now();
+  loop.arm(early, set + milliseconds(20));
+  ASSERT_EQ(done.get_future().wait_for(milliseconds(2000)), std::future_status::ready);
+  EXPECT_GE(Clock::now() - set, milliseconds(20) - EventLoop::kCoalesce);
+  loop.remove(early);
+  loop.remove(id);
 }
 
 TEST(EventLoop, CallsAWatchWhenItsDescriptorIsReady) {
