@@ -126,9 +126,13 @@ class Timeline {
   }
 
   bool started() const { return origin_.has_value(); }
-  // A frame at `utcNs` would repeat a moment already exported: no later
-  // than half a frame after the last one (two recorders stamp one frame of
-  // the device each on its own arrival, microseconds apart).
+  // A frame at `utcNs` of a segment that has given the export no frame yet
+  // would repeat a moment already exported: no later than half a frame
+  // after the last one (two recorders stamp one frame of the device each on
+  // its own arrival, microseconds apart). Once a segment's frames are
+  // taken, the rest of it follows them in time: none repeats, however close
+  // two came (a sender that was late for one frame and on time for the
+  // next).
   bool repeats(int64_t utcNs) const {
     return request_.overlapping && lastUtc_ && utcNs < *lastUtc_ + step_ / 2;
   }
@@ -168,6 +172,7 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
   uint64_t frames = 0;
   bool whole = false;  // read to its end: its lines after the last frame belong to it
   bool afterRepeats = false;
+  bool taking = false;  // a frame of this segment is in the export
   while (true) {
     auto frame = (*reader)->next();
     if (!frame) {
@@ -195,7 +200,7 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
     for (; nextLine < lines.size() && lines[nextLine].utcNs <= utc; ++nextLine)
       if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
     if (!timeline.inRange(utc)) continue;
-    if (timeline.repeats(utc)) {
+    if (!taking && timeline.repeats(utc)) {
       // So are its lines: the other recorder's of that moment are in.
       afterRepeats = true;
       waiting.clear();
@@ -208,6 +213,7 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
     afterRepeats = false;
     if (!caps) caps = gst_caps_ref((*reader)->caps());
     if (auto problem = timeline.frame((*frame)->buffer, utc, (*frame)->key, caps)) return problem;
+    taking = true;
     if (!onFrame()) return std::nullopt;  // stopped: the caller knows
     for (auto& line : waiting)
       if (auto problem = timeline.line(line)) return problem;
