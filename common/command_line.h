@@ -1,0 +1,82 @@
+// A tool's command line, each option declared once: its name, what value
+// follows it, its default, its help and how its value is read and checked.
+// Parsing (getopt_long's table), --help's list and the documentation's
+// Markdown tables all come from the declaration, so they cannot disagree
+// (wirc-recorder's own table, recorder/app/option_table.h, also says which
+// options a reload takes and which a [device] group may set).
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/expected.h"
+
+namespace wircam::command_line {
+
+// Why a value was refused ("wants a number in 1..255, not 'x'"), or nothing.
+using Problem = std::optional<std::string>;
+// Reads an option's value (null for a flag) into the tool's settings.
+using Apply = std::function<Problem(const char* value)>;
+
+struct Option {
+  const char* name;      // --name
+  const char* value;     // what follows it in --help ("N", "wirc|rcoip"); null: a flag
+  const char* fallback;  // the default, as the help says it; null: none worth saying
+  const char* help;      // `code` and [text](link) are stripped for --help
+  Apply apply;
+};
+
+struct Section {
+  const char* title;  // heads the options in --help and a table in the docs
+  std::vector<Option> options;
+};
+
+class CommandLine {
+ public:
+  CommandLine(std::string program, std::vector<Section> sections);
+
+  // Reads argv[1..] (argv[0] is the program, or the command before these
+  // options): each option's value applied, in the order given. The
+  // arguments that are not options, or the first problem as a usage error
+  // says it ("--fps wants a number in 0.1..240, not 'x'"). --help and -h
+  // are the caller's: `helpAsked` says whether one was given.
+  Expected<std::vector<std::string>, std::string> parse(int argc, char** argv,
+                                                        bool* helpAsked = nullptr) const;
+  // --help's list of options, section by section.
+  std::string help() const;
+  // One section's Markdown table (| option | default | what it does |), as
+  // the docs hold it between <!-- NAME options: SECTION --> and
+  // <!-- /options -->.
+  std::string markdown(const std::string& section) const;
+  const std::vector<Section>& sections() const { return sections_; }
+
+ private:
+  std::string program_;
+  std::vector<Section> sections_;
+};
+
+// Readers of the common kinds of value, each saying a refusal the same way.
+Apply number(double& field, double low, double high);
+template <typename Whole>
+Apply whole(Whole& field, double low, double high) {
+  return [&field, low, high](const char* value) -> Problem {
+    double read = 0;
+    if (auto problem = number(read, low, high)(value)) return problem;
+    if (read != static_cast<double>(static_cast<long long>(read)))
+      return "wants a whole number, not '" + std::string(value) + "'";
+    field = static_cast<Whole>(read);
+    return std::nullopt;
+  };
+}
+Apply text(std::string& field);
+Apply optionalText(std::optional<std::string>& field);
+Apply flag(bool& field);
+// One of `choices`, said as "is A, B or C" when it is not.
+Apply oneOf(std::string& field, std::vector<std::string> choices);
+
+// --help's text without Markdown: `code` → code, [text](link) → text.
+std::string plainText(const std::string& markdown);
+
+}  // namespace wircam::command_line
