@@ -64,8 +64,8 @@ std::string plainText(const std::string& markdown) {
   return out;
 }
 
-CommandLine::CommandLine(std::string program, std::vector<Section> sections)
-    : program_(std::move(program)), sections_(std::move(sections)) {}
+CommandLine::CommandLine(std::vector<Section> sections, size_t helpColumn)
+    : sections_(std::move(sections)), helpColumn_(helpColumn) {}
 
 Expected<std::vector<std::string>, std::string> CommandLine::parse(int argc, char** argv,
                                                                    bool* helpAsked) const {
@@ -103,7 +103,8 @@ Expected<std::vector<std::string>, std::string> CommandLine::parse(int argc, cha
 }
 
 std::string CommandLine::help() const {
-  constexpr size_t kColumn = 23, kWidth = 79;
+  constexpr size_t kWidth = 79;
+  const size_t kColumn = helpColumn_;
   std::string out;
   for (const auto& section : sections_) {
     out += std::string("\n") + section.title + ":\n";

@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/expected.h"
@@ -35,7 +36,8 @@ struct Section {
 
 class CommandLine {
  public:
-  CommandLine(std::string program, std::vector<Section> sections);
+  // --help's text starts at `helpColumn` (after the option and its value).
+  explicit CommandLine(std::vector<Section> sections, size_t helpColumn = 23);
 
   // Reads argv[1..] (argv[0] is the program, or the command before these
   // options): each option's value applied, in the order given. The
@@ -53,8 +55,8 @@ class CommandLine {
   const std::vector<Section>& sections() const { return sections_; }
 
  private:
-  std::string program_;
   std::vector<Section> sections_;
+  size_t helpColumn_;
 };
 
 // Readers of the common kinds of value, each saying a refusal the same way.
@@ -70,11 +72,38 @@ Apply whole(Whole& field, double low, double high) {
     return std::nullopt;
   };
 }
+// A whole number that sets an optional field.
+template <typename Whole>
+Apply optionalWhole(std::optional<Whole>& field, double low, double high) {
+  return [&field, low, high](const char* value) -> Problem {
+    Whole read{};
+    if (auto problem = whole(read, low, high)(value)) return problem;
+    field = read;
+    return std::nullopt;
+  };
+}
 Apply text(std::string& field);
 Apply optionalText(std::optional<std::string>& field);
 Apply flag(bool& field);
 // One of `choices`, said as "is A, B or C" when it is not.
 Apply oneOf(std::string& field, std::vector<std::string> choices);
+
+// One of the choices' names, setting the field to what it means.
+template <typename T>
+Apply choice(T& field, std::vector<std::pair<std::string, T>> choices) {
+  return [&field, choices](const char* value) -> Problem {
+    std::vector<std::string> names;
+    for (const auto& [name, meaning] : choices) {
+      if (name == value) {
+        field = meaning;
+        return std::nullopt;
+      }
+      names.push_back(name);
+    }
+    std::string unused;
+    return oneOf(unused, names)(value);
+  };
+}
 
 // --help's text without Markdown: `code` → code, [text](link) → text.
 std::string plainText(const std::string& markdown);

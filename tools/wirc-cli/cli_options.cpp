@@ -1,15 +1,18 @@
 #include "cli_options.h"
 
-#include <getopt.h>
-
 #include <cstdio>
 #include <cstdlib>
 
 namespace wircam::cli {
 
+using command_line::Apply;
+using command_line::Problem;
+using command_line::whole;
 using std::chrono::milliseconds;
 
-const char* const kUsage = R"(Usage: wirc-cli COMMAND [OPTIONS]
+namespace {
+
+constexpr const char* kCommands = R"(Usage: wirc-cli COMMAND [OPTIONS]
 
 Talk to a WiRC device (or wirc-sim) from the shell.
 
@@ -83,19 +86,115 @@ Marvelmind indoor positions:
                                to PORT; --units cm|mm: what to ask for (default
                                cm); --timestamp 64|ms: the dashboard's unit
                                (default 1/64 s, as the protocol text)
+)";
 
-Connection options (all commands but decode/encode):
-  --protocol wirc|rcoip|btemp  what the vehicle speaks (default wirc)
-  --host ADDR                  device address (default: discover)
-  --port N                     control port (default 1984)
-  --device NAME                when discovering: the name or serial to pick
-  --discovery-address ADDR     where discovery is sent (default 255.255.255.255)
-  --name NAME                  transmitter name (default wirc-cli)
-  --priority N                 transmitter priority 0..255 (default 0)
-  --timeout MS                 discovery/login/answer timeout (default 3000)
+constexpr const char* kOutro = R"(
+  -h, --help                   show this text
 
 Exit codes: 0 success, 1 failure (device unreachable, refused, ERR), 2 bad usage.
 )";
+
+std::vector<command_line::Section> sections(Options& o) {
+  auto& p = o.positions;
+  return {
+      {"Connection options (all commands but decode, encode and compare-commands)",
+       {
+           {"protocol", "wirc|rcoip|btemp", "wirc", "what the vehicle speaks",
+            command_line::oneOf(o.protocol, {"wirc", "rcoip", "btemp"})},
+           {"host", "ADDR", "discover", "the device's address", command_line::text(o.host)},
+           {"port", "N", "1984; rcoip 9048, btemp 16980", "its control port",
+            [&o](const char* value) -> Problem {
+              o.portGiven = true;
+              return whole(o.port, 1, 65535)(value);
+            }},
+           {"device", "NAME", nullptr, "when discovering: the name or serial to pick",
+            command_line::text(o.device)},
+           {"discovery-address", "ADDR", "255.255.255.255", "where discovery is sent",
+            command_line::text(o.discoveryAddress)},
+           {"name", "NAME", "wirc-cli", "transmitter name", command_line::text(o.name)},
+           {"priority", "N", "0", "transmitter priority 0..255", whole(o.priority, 0, 255)},
+           {"timeout", "MS", "3000", "discovery, login and answer timeout",
+            [&o](const char* value) -> Problem {
+              int ms = 0;
+              if (auto problem = whole(ms, 10, 600000)(value)) return problem;
+              o.timeout = milliseconds(ms);
+              return std::nullopt;
+            }},
+       }},
+      {"Command options",
+       {
+           {"periods", "US,...", nullptr, "configure: channel periods (CCFG), 12 values or one",
+            command_line::optionalText(o.periods)},
+           {"failsafe", "US,...", nullptr, "configure: failsafe values (FCFG), 12 values or one",
+            command_line::optionalText(o.failsafe)},
+           {"ssid", "S", nullptr, "wifi: the network's name", command_line::optionalText(o.ssid)},
+           {"country", "CC", nullptr,
+            "wifi: the two-letter country code the radio's channels and power obey (HU, US)",
+            command_line::optionalText(o.country)},
+           {"password-stdin", nullptr, nullptr,
+            "wifi: read the password from stdin (never printed or logged)",
+            command_line::flag(o.passwordStdin)},
+           {"station", nullptr, nullptr, "wifi: join the network instead of making one",
+            command_line::flag(o.station)},
+           {"channel", "N", "1", "wifi: the radio channel, 1..165", whole(o.channel, 1, 165)},
+           {"destination", "D", nullptr, "extout: null, uart, spi-data, spi-command or a number",
+            command_line::optionalText(o.destination)},
+           {"data", "HEX", nullptr, "extout: the bytes, at most 254",
+            command_line::optionalText(o.data)},
+           {"md5", "HEX", nullptr, "firmware-update: the image's MD5, 32 hex digits",
+            command_line::optionalText(o.md5)},
+           {"camera", "N", "0", "stream: the camera", whole(o.camera, 0, 255)},
+           {"out", "FILE.mjpeg|DIR", nullptr,
+            "stream: frames concatenated into a file, or one JPEG each into a folder",
+            command_line::optionalText(o.out)},
+           {"frames", "N", nullptr, "stream: stop after N frames",
+            command_line::optionalWhole(o.frames, 1, 100000000)},
+           {"duration", "S", nullptr, "stream, drive: how long (drive: at most 10 s)",
+            command_line::number(o.duration, 0, 100000000)},
+           {"to-port", "P", nullptr,
+            "stream: have the device stream to UDP port P of this host, for another app",
+            command_line::optionalWhole(o.toPort, 1, 65535)},
+           {"steering", "US", nullptr, "drive: the steering pulse (channel 1), 800..2200",
+            command_line::optionalWhole(o.steering, 800, 2200)},
+           {"throttle", "US", nullptr, "drive: the throttle pulse (channel 2), 800..2200",
+            command_line::optionalWhole(o.throttle, 800, 2200)},
+           {"raw", nullptr, nullptr, "decode, encode: raw bytes instead of hex text",
+            command_line::flag(o.raw)},
+           {"json", nullptr, nullptr, "compare-commands: one JSON object",
+            command_line::flag(o.json)},
+       }},
+      {"Marvelmind positions options",
+       {
+           {"marvelmind", "HOST:PORT", nullptr, "the dashboard", command_line::text(p.dashboard)},
+           {"beacon", "ADDR[,ADDR...]", nullptr, "the beacons whose positions to print",
+            command_line::text(p.beacons)},
+           {"count", "N", "10", "how many new positions to print", whole(p.count, 1, 100000000)},
+           {"listen", "PORT", nullptr, "stream mode: the dashboard pushes to PORT",
+            command_line::optionalWhole(p.listenPort, 0, 65535)},
+           {"rate", "HZ", "10", "how often to ask", command_line::number(p.rate, 1, 100)},
+           {"units", "cm|mm", "cm", "what to ask for",
+            command_line::choice<marvelmind::Resolution>(
+                p.resolution, {{"cm", marvelmind::Resolution::kCentimetres},
+                               {"mm", marvelmind::Resolution::kMillimetres}})},
+           {"timestamp", "64|ms", "64", "the dashboard's unit: 1/64 s as the protocol text, or ms",
+            command_line::choice<marvelmind::TimestampUnit>(
+                p.timestampUnit, {{"64", marvelmind::TimestampUnit::kSixtyFourths},
+                                  {"ms", marvelmind::TimestampUnit::kMilliseconds}})},
+       }},
+  };
+}
+
+}  // namespace
+
+command_line::CommandLine cliCommandLine(Options& options) {
+  // Its help lines up with the commands' above it.
+  return command_line::CommandLine(sections(options), 31);
+}
+
+std::string cliUsage() {
+  Options unused;
+  return kCommands + cliCommandLine(unused).help() + kOutro;
+}
 
 [[noreturn]] void usageError(const std::string& message) {
   std::fprintf(stderr, "wirc-cli: %s (see wirc-cli --help)\n", message.c_str());
@@ -117,203 +216,16 @@ long integer(const char* text, const char* what, long min, long max) {
 }
 
 Options parse(int argc, char** argv) {
-  enum {
-    kHost = 1000,
-    kPort,
-    kDevice,
-    kDiscovery,
-    kName,
-    kPriority,
-    kTimeout,
-    kPeriods,
-    kFailsafe,
-    kSsid,
-    kPasswordStdin,
-    kStation,
-    kChannel,
-    kCountry,
-    kCamera,
-    kOut,
-    kFrames,
-    kDuration,
-    kSteering,
-    kThrottle,
-    kRaw,
-    kJson,
-    kToPort,
-    kDestination,
-    kData,
-    kMd5,
-    kProtocol,
-    kMarvelmind,
-    kBeacon,
-    kCount,
-    kListen,
-    kRate,
-    kUnits,
-    kTimestampUnit
-  };
-  static const option options[] = {{"host", required_argument, nullptr, kHost},
-                                   {"port", required_argument, nullptr, kPort},
-                                   {"device", required_argument, nullptr, kDevice},
-                                   {"discovery-address", required_argument, nullptr, kDiscovery},
-                                   {"name", required_argument, nullptr, kName},
-                                   {"priority", required_argument, nullptr, kPriority},
-                                   {"timeout", required_argument, nullptr, kTimeout},
-                                   {"periods", required_argument, nullptr, kPeriods},
-                                   {"failsafe", required_argument, nullptr, kFailsafe},
-                                   {"ssid", required_argument, nullptr, kSsid},
-                                   {"password-stdin", no_argument, nullptr, kPasswordStdin},
-                                   {"station", no_argument, nullptr, kStation},
-                                   {"channel", required_argument, nullptr, kChannel},
-                                   {"country", required_argument, nullptr, kCountry},
-                                   {"camera", required_argument, nullptr, kCamera},
-                                   {"out", required_argument, nullptr, kOut},
-                                   {"frames", required_argument, nullptr, kFrames},
-                                   {"duration", required_argument, nullptr, kDuration},
-                                   {"steering", required_argument, nullptr, kSteering},
-                                   {"throttle", required_argument, nullptr, kThrottle},
-                                   {"raw", no_argument, nullptr, kRaw},
-                                   {"json", no_argument, nullptr, kJson},
-                                   {"to-port", required_argument, nullptr, kToPort},
-                                   {"destination", required_argument, nullptr, kDestination},
-                                   {"data", required_argument, nullptr, kData},
-                                   {"md5", required_argument, nullptr, kMd5},
-                                   {"protocol", required_argument, nullptr, kProtocol},
-                                   {"marvelmind", required_argument, nullptr, kMarvelmind},
-                                   {"beacon", required_argument, nullptr, kBeacon},
-                                   {"count", required_argument, nullptr, kCount},
-                                   {"listen", required_argument, nullptr, kListen},
-                                   {"rate", required_argument, nullptr, kRate},
-                                   {"units", required_argument, nullptr, kUnits},
-                                   {"timestamp", required_argument, nullptr, kTimestampUnit},
-                                   {"help", no_argument, nullptr, 'h'},
-                                   {nullptr, 0, nullptr, 0}};
   Options o;
-  optind = 2;
-  int opt;
-  while ((opt = getopt_long(argc, argv, "h", options, nullptr)) != -1) {
-    switch (opt) {
-      case 'h':
-        std::fputs(kUsage, stdout);
-        std::exit(0);
-      case kHost:
-        o.host = optarg;
-        break;
-      case kPort:
-        o.port = static_cast<uint16_t>(integer(optarg, "--port", 1, 65535));
-        o.portGiven = true;
-        break;
-      case kProtocol:
-        o.protocol = optarg;
-        if (o.protocol != "wirc" && o.protocol != "rcoip" && o.protocol != "btemp")
-          usageError("--protocol is wirc, rcoip or btemp, not '" + o.protocol + "'");
-        break;
-      case kDevice:
-        o.device = optarg;
-        break;
-      case kDiscovery:
-        o.discoveryAddress = optarg;
-        break;
-      case kName:
-        o.name = optarg;
-        break;
-      case kPriority:
-        o.priority = static_cast<uint8_t>(integer(optarg, "--priority", 0, 255));
-        break;
-      case kTimeout:
-        o.timeout = milliseconds(integer(optarg, "--timeout", 10, 600000));
-        break;
-      case kPeriods:
-        o.periods = optarg;
-        break;
-      case kFailsafe:
-        o.failsafe = optarg;
-        break;
-      case kSsid:
-        o.ssid = optarg;
-        break;
-      case kPasswordStdin:
-        o.passwordStdin = true;
-        break;
-      case kStation:
-        o.station = true;
-        break;
-      case kChannel:
-        o.channel = static_cast<int>(integer(optarg, "--channel", 1, 165));
-        break;
-      case kCountry:
-        o.country = optarg;
-        break;
-      case kCamera:
-        o.camera = static_cast<int>(integer(optarg, "--camera", 0, 255));
-        break;
-      case kOut:
-        o.out = optarg;
-        break;
-      case kFrames:
-        o.frames = static_cast<int>(integer(optarg, "--frames", 1, 100000000));
-        break;
-      case kDuration:
-        o.duration = static_cast<double>(integer(optarg, "--duration", 0, 100000000));
-        break;
-      case kSteering:
-        o.steering = static_cast<int>(integer(optarg, "--steering", 800, 2200));
-        break;
-      case kThrottle:
-        o.throttle = static_cast<int>(integer(optarg, "--throttle", 800, 2200));
-        break;
-      case kJson:
-        o.json = true;
-        break;
-      case kRaw:
-        o.raw = true;
-        break;
-      case kToPort:
-        o.toPort = static_cast<uint16_t>(integer(optarg, "--to-port", 1, 65535));
-        break;
-      case kDestination:
-        o.destination = optarg;
-        break;
-      case kData:
-        o.data = optarg;
-        break;
-      case kMd5:
-        o.md5 = optarg;
-        break;
-      case kMarvelmind:
-        o.positions.dashboard = optarg;
-        break;
-      case kBeacon:
-        o.positions.beacons = optarg;
-        break;
-      case kCount:
-        o.positions.count = static_cast<int>(integer(optarg, "--count", 1, 100000000));
-        break;
-      case kListen:
-        o.positions.listenPort = static_cast<uint16_t>(integer(optarg, "--listen", 0, 65535));
-        break;
-      case kRate:
-        o.positions.rate = static_cast<double>(integer(optarg, "--rate", 1, 100));
-        break;
-      case kUnits:
-        if (std::string(optarg) != "cm" && std::string(optarg) != "mm")
-          usageError("--units is cm or mm");
-        o.positions.resolution = std::string(optarg) == "mm" ? marvelmind::Resolution::kMillimetres
-                                                             : marvelmind::Resolution::kCentimetres;
-        break;
-      case kTimestampUnit:
-        if (std::string(optarg) != "64" && std::string(optarg) != "ms")
-          usageError("--timestamp is 64 (1/64 s) or ms");
-        o.positions.timestampUnit = std::string(optarg) == "ms"
-                                        ? marvelmind::TimestampUnit::kMilliseconds
-                                        : marvelmind::TimestampUnit::kSixtyFourths;
-        break;
-      default:
-        usageError("unknown option");
-    }
+  bool help = false;
+  // argv[1] is the command: the options follow it.
+  auto rest = cliCommandLine(o).parse(argc - 1, argv + 1, &help);
+  if (!rest) usageError(rest.error());
+  if (help) {
+    std::fputs(cliUsage().c_str(), stdout);
+    std::exit(0);
   }
-  for (int i = optind; i < argc; ++i) o.positional.emplace_back(argv[i]);
+  o.positional = std::move(*rest);
   return o;
 }
 

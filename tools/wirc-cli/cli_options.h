@@ -8,12 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "common/command_line.h"
 #include "positions_command.h"
 #include "wirc/messages.h"
 
 namespace wircam::cli {
-
-extern const char* const kUsage;
 
 struct Options {
   std::string protocol = "wirc";
@@ -37,6 +36,11 @@ struct Options {
   std::vector<std::string> positional;
   cli::PositionsOptions positions;
 };
+
+// The declaration of its options (each once), read into `options` (which
+// must outlive it), and the whole of --help.
+command_line::CommandLine cliCommandLine(Options& options);
+std::string cliUsage();
 
 // Bad usage: the message on stderr, exit code 2.
 [[noreturn]] void usageError(const std::string& message);

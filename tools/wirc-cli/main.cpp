@@ -109,7 +109,7 @@ int cousin(const std::string& command, const Options& o) {
 int main(int argc, char** argv) {
   std::string command = argc > 1 ? argv[1] : "help";
   if (command == "help" || command == "--help" || command == "-h") {
-    std::fputs(kUsage, stdout);
+    std::fputs(cliUsage().c_str(), stdout);
     return 0;
   }
   Options o = parse(argc, argv);

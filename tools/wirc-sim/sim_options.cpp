@@ -59,23 +59,6 @@ Apply tagIds(std::vector<int>& field) {
   };
 }
 
-// A choice that sets something other than a string.
-template <typename T>
-Apply choice(T& field, std::vector<std::pair<std::string, T>> choices) {
-  return [&field, choices](const char* value) -> Problem {
-    std::vector<std::string> names;
-    for (const auto& [name, meaning] : choices) {
-      if (name == value) {
-        field = meaning;
-        return std::nullopt;
-      }
-      names.push_back(name);
-    }
-    std::string said;
-    return command_line::oneOf(said, names)(value);
-  };
-}
-
 std::vector<command_line::Section> sections(SimOptions& o) {
   auto& device = o.device;
   auto& scene = o.scene;
@@ -130,7 +113,7 @@ std::vector<command_line::Section> sections(SimOptions& o) {
        {
            {"scene", "follow|static", "follow",
             "follow: the car drives by PCD; static: the car stays put, the target still moves",
-            choice<bool>(scene.carFixed, {{"follow", false}, {"static", true}})},
+            command_line::choice<bool>(scene.carFixed, {{"follow", false}, {"static", true}})},
            {"clock-stamp", nullptr, nullptr,
             "draw the wall clock's milliseconds (mod 2^32) as 32 black/white blocks across the "
             "top of each frame, most significant first, for latency measurements",
@@ -180,12 +163,7 @@ std::vector<command_line::Section> sections(SimOptions& o) {
             command_line::oneOf(o.control, {"wirc", "rcoip", "btemp"})},
            {"control-port", "N", "9048 for rcoip, 16980 for btemp",
             "UDP port of that receiver or robot (0 = pick a free one, printed)",
-            [&o](const char* value) -> Problem {
-              uint16_t port = 0;
-              if (auto problem = whole(port, 0, 65535)(value)) return problem;
-              o.controlPort = port;
-              return std::nullopt;
-            }},
+            command_line::optionalWhole(o.controlPort, 0, 65535)},
            {"steering-channel", "N", "1", "PCD channel steering the car, 1..8 (2000 = left)",
             whole(scene.steeringChannel, 1, 8)},
            {"throttle-channel", "N", "2", "PCD channel driving the car, 1..8 (1500 = stop)",
@@ -236,14 +214,14 @@ std::vector<command_line::Section> sections(SimOptions& o) {
             })},
            {"marvelmind-push-units", "cm|mm", "cm", "what the pushes carry",
             onDashboard([](DashboardConfig& d) {
-              return choice<marvelmind::Resolution>(d.pushResolution,
-                                                    {{"cm", marvelmind::Resolution::kCentimetres},
-                                                     {"mm", marvelmind::Resolution::kMillimetres}});
+              return command_line::choice<marvelmind::Resolution>(
+                  d.pushResolution, {{"cm", marvelmind::Resolution::kCentimetres},
+                                     {"mm", marvelmind::Resolution::kMillimetres}});
             })},
            {"marvelmind-timestamp", "64|ms", "64",
             "timestamp unit: 1/64 s as the protocol text says, or ms as newer dashboards",
             onDashboard([](DashboardConfig& d) {
-              return choice<marvelmind::TimestampUnit>(
+              return command_line::choice<marvelmind::TimestampUnit>(
                   d.timestampUnit, {{"64", marvelmind::TimestampUnit::kSixtyFourths},
                                     {"ms", marvelmind::TimestampUnit::kMilliseconds}});
             })},
@@ -294,7 +272,7 @@ received, the longest PCD gap, failsafe entries, and how well the car followed.
 }  // namespace
 
 command_line::CommandLine simCommandLine(SimOptions& options) {
-  return command_line::CommandLine("wirc-sim", sections(options));
+  return command_line::CommandLine(sections(options));
 }
 
 std::string simUsage() {

@@ -16,8 +16,7 @@ struct Settings {
 };
 
 CommandLine declared(Settings& s) {
-  return CommandLine("tool",
-                     {{"Things",
+  return CommandLine({{"Things",
                        {{"rate", "HZ", "1", "how often, `per second`", number(s.rate, 0.5, 10)},
                         {"count", "N", nullptr, "how many", whole(s.count, 1, 5)},
                         {"mode", "a|b", "a", "which [way](x.md)", oneOf(s.mode, {"a", "b"})},

@@ -1,5 +1,5 @@
-// wirc-sim's options as declared: read as the tool reads them, and
-// docs/tools.md's tables held to the declaration.
+// wirc-sim's and wirc-cli's options as declared: read as the tools read
+// them, and docs/tools.md's tables held to the declarations.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -7,10 +7,41 @@
 #include <fstream>
 #include <sstream>
 
+#include "cli_options.h"
 #include "sim_options.h"
 
 namespace wircam::sim {
 namespace {
+
+// Each section's table in the page, between <!-- TOOL options: SECTION -->
+// and <!-- /options -->, is the declaration's; WIRCAM_UPDATE_DOCS=1
+// rewrites them.
+void expectDocumentedIn(const char* page, const std::string& tool,
+                        const command_line::CommandLine& line) {
+  auto path = std::filesystem::path(WIRCAM_SOURCE_DIR) / page;
+  std::ifstream in(path);
+  std::stringstream read;
+  read << in.rdbuf();
+  std::string text = read.str();
+  bool update = std::getenv("WIRCAM_UPDATE_DOCS") != nullptr;
+  for (const auto& section : line.sections()) {
+    std::string open = "<!-- " + tool + " options: " + section.title + " -->\n";
+    size_t begin = text.find(open);
+    ASSERT_NE(begin, std::string::npos) << page << " lacks " << open;
+    begin += open.size();
+    size_t end = text.find("<!-- /options -->", begin);
+    ASSERT_NE(end, std::string::npos);
+    std::string expected = line.markdown(section.title);
+    if (update) {
+      text.replace(begin, end - begin, expected);
+      continue;
+    }
+    EXPECT_EQ(text.substr(begin, end - begin), expected)
+        << page << "'s " << section.title << " table is not " << tool
+        << "'s: WIRCAM_UPDATE_DOCS=1 ctest -R Options.TheDocumentations";
+  }
+  if (update) std::ofstream(path) << text;
+}
 
 Expected<std::optional<SimOptions>, std::string> parse(std::vector<std::string> args) {
   args.insert(args.begin(), "wirc-sim");
@@ -58,34 +89,24 @@ TEST(SimOptions, HelpIsAskedForAndListsEveryOption) {
           << option.name;
 }
 
-// Each section's table in docs/tools.md, between <!-- wirc-sim options:
-// SECTION --> and <!-- /options -->, is the declaration's.
 TEST(SimOptions, TheDocumentationsTablesAreTheDeclarations) {
-  auto page = std::filesystem::path(WIRCAM_SOURCE_DIR) / "docs/tools.md";
-  std::ifstream in(page);
-  std::stringstream read;
-  read << in.rdbuf();
-  std::string text = read.str();
-  bool update = std::getenv("WIRCAM_UPDATE_DOCS") != nullptr;
   SimOptions unused;
-  auto line = simCommandLine(unused);
-  for (const auto& section : line.sections()) {
-    std::string open = std::string("<!-- wirc-sim options: ") + section.title + " -->\n";
-    size_t begin = text.find(open);
-    ASSERT_NE(begin, std::string::npos) << "docs/tools.md lacks " << open;
-    begin += open.size();
-    size_t end = text.find("<!-- /options -->", begin);
-    ASSERT_NE(end, std::string::npos);
-    std::string expected = line.markdown(section.title);
-    if (update) {
-      text.replace(begin, end - begin, expected);
-      continue;
-    }
-    EXPECT_EQ(text.substr(begin, end - begin), expected)
-        << "docs/tools.md's " << section.title
-        << " table is not wirc-sim's: WIRCAM_UPDATE_DOCS=1 ctest -R SimOptions";
-  }
-  if (update) std::ofstream(page) << text;
+  expectDocumentedIn("docs/tools.md", "wirc-sim", simCommandLine(unused));
+}
+
+TEST(CliOptions, TheDocumentationsTablesAreTheDeclarations) {
+  cli::Options unused;
+  expectDocumentedIn("docs/tools.md", "wirc-cli", cli::cliCommandLine(unused));
+}
+
+TEST(CliOptions, RefusesInItsOwnWords) {
+  cli::Options unused;
+  auto line = cli::cliCommandLine(unused);
+  std::vector<std::string> args = {"drive", "--steering", "2300"};
+  std::vector<char*> argv;
+  for (auto& arg : args) argv.push_back(arg.data());
+  EXPECT_EQ(line.parse(3, argv.data()).error(),
+            "--steering wants a number in 800..2200, not '2300'");
 }
 
 }  // namespace
