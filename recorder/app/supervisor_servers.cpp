@@ -85,10 +85,17 @@ std::optional<std::string> Supervisor::startServers() {
     content.openSegments = [this] { return openSegments(); };
     content.command = [this](const FleetCommand& c) { return commands_.apply(c, "web"); };
     content.reload = [this] { return reload(); };
-    if (options_.fleet)
+    if (options_.fleet) {
       content.fleet = [this] {
         return fleet_ && fleet_->directory() ? fleet_->directory()->view() : nlohmann::json();
       };
+      content.commandVehicle = [this](const std::string& serial, const std::string& command,
+                                      const std::string& payload) -> std::optional<std::string> {
+        if (!fleet_ || !fleet_->connected() || !fleet_->commandVehicle(serial, command, payload))
+          return "the MQTT broker is not connected: the command cannot reach the vehicle";
+        return std::nullopt;
+      };
+    }
     content.drive = [this](const std::string& camera, double steering, double throttle) {
       return commands_.drive(camera, steering, throttle, "web");
     };

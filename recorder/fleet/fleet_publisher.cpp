@@ -123,6 +123,11 @@ void FleetPublisher::follow(MqttClient& client, const std::string& prefix) {
   client.subscribe(prefix + "/+/status");
 }
 
+bool FleetPublisher::commandVehicle(const std::string& serial, const std::string& command,
+                                    const std::string& payload) {
+  return client_->publish(kVehicleTopicRoot + serial + "/" + command, payload);
+}
+
 bool FleetPublisher::fleetMessage(const std::string& topicName, const std::string& payload) {
   if (!settings_.fleet) return false;
   int64_t now = g_get_real_time() / 1000;

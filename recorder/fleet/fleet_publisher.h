@@ -57,6 +57,11 @@ class FleetPublisher {
   void snapshot(const std::string& stream, const std::string& jpeg);
   // The cameras a reload left (Home Assistant's configs follow).
   void setStreams(const std::vector<std::string>& streams);
+  // A command for a vehicle wherever it is (wircam-fleet/vehicles/SERIAL/
+  // COMMAND, not retained): the recorder holding it applies it, this one
+  // too. Whether it was handed to the broker.
+  bool commandVehicle(const std::string& serial, const std::string& command,
+                      const std::string& payload);
   // Retained at wircam-fleet/recorders/ID, now and at each connection.
   void announce(const Announcement& announcement);
   // With --fleet: the fleet as the broker tells it; else null.

@@ -29,6 +29,16 @@ Route routeOf(std::string_view path) {
   if (path == "/metrics") return {Kind::Metrics, ""};
   if (path == "/api/fleet") return {Kind::Fleet, ""};
   if (path == "/api/fleet/recordings") return {Kind::FleetRecordings, ""};
+  constexpr std::string_view kVehicles = "/api/fleet/vehicles/";
+  if (path.starts_with(kVehicles)) {
+    auto rest = path.substr(kVehicles.size());
+    auto slash = rest.find('/');
+    if (slash != std::string_view::npos && slash > 0) {
+      auto action = rest.substr(slash + 1);
+      if (action == "follow" || action == "target" || action == "drive")
+        return {Kind::FleetVehicleCommand, std::string(rest.substr(0, slash)), std::string(action)};
+    }
+  }
   constexpr std::string_view kRecordingEntry = "/api/recordings/";
   if (path.starts_with(kRecordingEntry) && path.size() > kRecordingEntry.size())
     return {Kind::RecordingEntry, std::string(path.substr(kRecordingEntry.size()))};
@@ -75,6 +85,7 @@ const char* allowedMethods(Route::Kind kind) {
     case Kind::WhepSession:
       return "DELETE";
     case Kind::CameraCommand:
+    case Kind::FleetVehicleCommand:
     case Kind::Whep:
     case Kind::ConfigReload:
       return "POST";

@@ -16,26 +16,31 @@ struct Route {
     Live,
     RecordingList,
     Recording,
-    Cameras,          // GET /api/cameras
-    Snapshot,         // GET /api/cameras/NAME/snapshot.jpg
-    RecordingIndex,   // GET /api/recordings
-    RecordingEntry,   // /api/recordings/FILE (DELETE only)
-    CameraCommand,    // POST /api/cameras/NAME/{follow,target,request-control}
-    Drive,            // GET /api/cameras/NAME/drive: the drive mode's WebSocket
-    Whep,             // POST /api/cameras/NAME/whep: a WebRTC viewer's offer (WHEP)
-    WhepSession,      // DELETE /api/cameras/NAME/whep/SESSION: its end
-    Playback,         // GET /play/FILE.mjpg?from=SECONDS: a recording replayed as MJPEG
-    Export,           // GET /api/export?camera=&start=&end=&format=: a range as one file
-    ConfigReload,     // POST /api/config/reload: the config file read again
-    Metrics,          // GET /metrics: Prometheus's text format
-    Fleet,            // GET /api/fleet: every recorder of the fleet (--fleet)
-    FleetRecordings,  // GET /api/fleet/recordings?vehicle=&camera=&day=: theirs, merged
-    ApiNotFound,      // any other /api/ path: 404 with JSON
+    Cameras,              // GET /api/cameras
+    Snapshot,             // GET /api/cameras/NAME/snapshot.jpg
+    RecordingIndex,       // GET /api/recordings
+    RecordingEntry,       // /api/recordings/FILE (DELETE only)
+    CameraCommand,        // POST /api/cameras/NAME/{follow,target,request-control}
+    Drive,                // GET /api/cameras/NAME/drive: the drive mode's WebSocket
+    Whep,                 // POST /api/cameras/NAME/whep: a WebRTC viewer's offer (WHEP)
+    WhepSession,          // DELETE /api/cameras/NAME/whep/SESSION: its end
+    Playback,             // GET /play/FILE.mjpg?from=SECONDS: a recording replayed as MJPEG
+    Export,               // GET /api/export?camera=&start=&end=&format=: a range as one file
+    ConfigReload,         // POST /api/config/reload: the config file read again
+    Metrics,              // GET /metrics: Prometheus's text format
+    Fleet,                // GET /api/fleet: every recorder of the fleet (--fleet)
+    FleetRecordings,      // GET /api/fleet/recordings?vehicle=&camera=&day=: theirs, merged
+    FleetVehicleCommand,  // POST /api/fleet/vehicles/SERIAL/{follow,target,drive}
+    ApiNotFound,          // any other /api/ path: 404 with JSON
     NotFound
   };
   Kind kind = Kind::NotFound;
-  std::string name;    // the camera (Live, Snapshot, CameraCommand, Drive) or the file
-  std::string action;  // CameraCommand: follow, target or request-control; WhepSession: its id
+  // The camera (Live, Snapshot, CameraCommand, Drive), the file, or the
+  // vehicle's serial (FleetVehicleCommand).
+  std::string name;
+  // CameraCommand: follow, target or request-control; FleetVehicleCommand:
+  // follow, target or drive; WhepSession: its id.
+  std::string action;
 };
 
 // `path` as libsoup hands it over (percent-decoded).

@@ -319,6 +319,8 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
   if (method == "DELETE" && allowedMethods(route.kind))
     return self->deleteRecording(message, route.name);
   if (route.kind == Route::Kind::CameraCommand) return self->serveCommand(message, route, query);
+  if (route.kind == Route::Kind::FleetVehicleCommand)
+    return self->serveVehicleCommand(message, route, query);
   if (route.kind == Route::Kind::ConfigReload) return self->serveReload(message);
   switch (route.kind) {
     case Route::Kind::Login:
@@ -363,6 +365,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       return self->refuseDriveUnlessAllowed(message, route.name);
     case Route::Kind::RecordingEntry:
     case Route::Kind::CameraCommand:
+    case Route::Kind::FleetVehicleCommand:
     case Route::Kind::ConfigReload:
     case Route::Kind::Whep:
     case Route::Kind::WhepSession:

@@ -71,6 +71,12 @@ struct WebContent {
   // With --fleet: GET /api/fleet's {"recorders": [...]} (fleet/fleet_directory.h),
   // which GET /api/fleet/recordings asks; null without.
   std::function<nlohmann::json()> fleet;
+  // With --fleet: a command for a vehicle wherever it is, handed to the
+  // broker (fleet_publisher.h: `command` as "follow/set", a checked
+  // payload); why not, if it cannot be.
+  std::function<std::optional<std::string>(const std::string& serial, const std::string& command,
+                                           const std::string& payload)>
+      commandVehicle;
   // The WebRTC live view (WHEP at /api/cameras/NAME/whep), with these ICE
   // servers and each camera's VP8 rate.
   bool webrtc = false;

@@ -304,4 +304,31 @@ void DevToolsPage::closeTab() {
   call("Page.close", nlohmann::json::object(), std::chrono::milliseconds(2000));
 }
 
+std::pair<double, double> DevToolsPage::centreOf(const std::string& selector) {
+  auto box = evaluate("(() => { const r = document.querySelector('" + selector +
+                      "').getBoundingClientRect(); return [r.x + r.width / 2, "
+                      "r.y + r.height / 2]; })()");
+  if (!box.is_array()) return {0, 0};
+  return {box[0].get<double>(), box[1].get<double>()};
+}
+
+bool DevToolsPage::clickOn(const std::string& selector) {
+  // A click lands where the element was a moment before: under load the
+  // page can lay out again in between (a first frame, a new row), and the
+  // click misses (seen on fresh clones). The page counts the clicks that
+  // reach the element; a missed one is made again, up to three times.
+  evaluate(
+      "if (window.clickWatch) document.removeEventListener('click', window.clickWatch, true); "
+      "window.clicksReached = 0; window.clickWatch = e => { if (e.target.closest('" +
+      selector +
+      "')) ++window.clicksReached; }; "
+      "document.addEventListener('click', window.clickWatch, true)");
+  for (int attempt = 0; attempt < 3 && evaluate("window.clicksReached") == 0; ++attempt) {
+    evaluate("document.querySelector('" + selector + "').scrollIntoView({block: 'center'})");
+    auto [x, y] = centreOf(selector);
+    click(x, y);
+  }
+  return evaluate("window.clicksReached") == 1;
+}
+
 }  // namespace wircam::testing

@@ -14,6 +14,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace wircam::testing {
@@ -46,6 +47,11 @@ class DevToolsPage {
   bool setCookie(const std::string& name, const std::string& value, const std::string& url);
   void key(const char* type, const std::string& key);  // type: keyDown or keyUp
   void click(double x, double y);
+  // The centre of the first element `selector` names, in page pixels.
+  std::pair<double, double> centreOf(const std::string& selector);
+  // Clicks it as a user would; whether the click reached it (made again
+  // if the page moved it meanwhile).
+  bool clickOn(const std::string& selector);
   // The left button pressed at one point, moved and released at another.
   void drag(double fromX, double fromY, double toX, double toY);
   bool screenshot(const std::filesystem::path& png);

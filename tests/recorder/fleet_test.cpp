@@ -402,4 +402,52 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
   fs::remove_all(folder);
 }
 
+// From the fleet section of one recorder's page, a vehicle another
+// recorder holds is driven by its serial: the command goes to this
+// recorder, through the broker, to the one that steers it; follow goes off
+// first, the arrow key drives it, and letting go stops it. The vehicle
+// of this page's own recorder is left alone.
+TEST(Fleet, ThePagesFleetSectionDrivesAVehicleAnotherRecorderHolds) {
+  if (!chromiumInstalled()) GTEST_SKIP() << "chromium is not installed";
+  MosquittoBroker broker;
+  ASSERT_TRUE(broker.running());
+  auto held = startVehicle("car-a", "SA");
+  auto own = startVehicle("car-b", "SB");
+  ASSERT_TRUE(held && own);
+  fs::path folder = fs::temp_directory_path() / ("wircam-fleet-drive-" + std::to_string(getpid()));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  Member holder(folder, "holder", broker, {{"cara", held->port()}}, false,
+                "detect=tag36h11\nfollow=true\n");
+  Member fleet(folder, "fleet", broker, {{"carb", own->port()}}, true);
+  ASSERT_FALSE(holder.url().empty() || fleet.url().empty()) << holder.process().log();
+  auto page = DevToolsPage::launch(shotPath("fleet-drive"), 1000, 1000);
+  ASSERT_TRUE(page);
+  ASSERT_TRUE(page->setCookie("wircam_token", kToken, fleet.url()));
+  ASSERT_TRUE(page->navigate(fleet.url()));
+  const std::string card = ".fleet-camera[data-camera=\"cara-cam0\"]";
+  ASSERT_TRUE(page->waitUntil(
+      "!!document.querySelector('" + card + " .fleet-controls:not([hidden])')", 20s))
+      << fleet.process().log();
+  ASSERT_TRUE(page->clickOn(card + " .fleet-drive"));
+  ASSERT_TRUE(page->waitUntil("document.querySelector('" + card + "').dataset.driving === 'true'"))
+      << page->evaluate("document.querySelector('" + card + " .fleet-message').textContent");
+  constexpr int kThrottle = 1;  // channel 2
+  // Follow off, nothing pressed: the driver's neutral.
+  EXPECT_TRUE(
+      waitFor([&] { return held->outputs().pulses[kThrottle] == wirc::kPulseNeutral; }, 5s));
+  page->key("keyDown", "ArrowUp");
+  EXPECT_TRUE(waitFor([&] { return held->outputs().pulses[kThrottle] > wirc::kPulseNeutral; }, 5s))
+      << holder.process().log();
+  page->key("keyUp", "ArrowUp");
+  EXPECT_TRUE(
+      waitFor([&] { return held->outputs().pulses[kThrottle] == wirc::kPulseNeutral; }, 5s));
+  EXPECT_EQ(own->outputs().pulses[kThrottle], wirc::kPulseNeutral);
+  // The holding recorder's status says its vehicle no longer follows.
+  EXPECT_TRUE(page->waitUntil("document.querySelector('" + card +
+                              " .fleet-follow').textContent === 'following: off'"));
+  page->screenshot(shotPath("fleet-drive.png"));
+  fs::remove_all(folder);
+}
+
 }  // namespace

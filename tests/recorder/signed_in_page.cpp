@@ -134,31 +134,4 @@ SignedInPage::SignedInPage(uint16_t port, std::vector<std::string> extra,
   EXPECT_TRUE(page->navigate(url));
 }
 
-std::pair<double, double> SignedInPage::centreOf(const std::string& selector) {
-  auto box = page->evaluate("(() => { const r = document.querySelector('" + selector +
-                            "').getBoundingClientRect(); return [r.x + r.width / 2, "
-                            "r.y + r.height / 2]; })()");
-  if (!box.is_array()) return {0, 0};
-  return {box[0].get<double>(), box[1].get<double>()};
-}
-
-bool SignedInPage::clickOn(const std::string& selector) {
-  // A click lands where the element was a moment before: under load the
-  // page can lay out again in between (a first frame, a new row), and the
-  // click misses (seen on fresh clones). The page counts the clicks that
-  // reach the element; a missed one is made again, up to three times.
-  page->evaluate(
-      "if (window.clickWatch) document.removeEventListener('click', window.clickWatch, true); "
-      "window.clicksReached = 0; window.clickWatch = e => { if (e.target.closest('" +
-      selector +
-      "')) ++window.clicksReached; }; "
-      "document.addEventListener('click', window.clickWatch, true)");
-  for (int attempt = 0; attempt < 3 && page->evaluate("window.clicksReached") == 0; ++attempt) {
-    page->evaluate("document.querySelector('" + selector + "').scrollIntoView({block: 'center'})");
-    auto [x, y] = centreOf(selector);
-    page->click(x, y);
-  }
-  return page->evaluate("window.clicksReached") == 1;
-}
-
 }  // namespace wircam::testing

@@ -60,11 +60,7 @@ struct SignedInPage {
   // profile folder.
   SignedInPage(uint16_t port, std::vector<std::string> extra, const std::string& profile,
                bool withToken = true);
-  // The centre of the first element `selector` names, in page pixels.
-  std::pair<double, double> centreOf(const std::string& selector);
-  // Clicks it as a user would; whether the click reached it (made again
-  // if the page moved it meanwhile).
-  bool clickOn(const std::string& selector);
+  bool clickOn(const std::string& selector) { return page->clickOn(selector); }
 };
 
 }  // namespace wircam::testing

@@ -1,6 +1,7 @@
 const kDrivePeriodMs = 100;
 const keys = { ArrowUp: false, ArrowDown: false, ArrowLeft: false, ArrowRight: false };
 let driving = null;  // { name, link, timer, seq, sent: Map(seq → time), view }
+let drivingElsewhere = false;  // the fleet section drives a vehicle (fleet_view.js)
 
 function addControls(view, name) {
   const box = document.createElement("div");
@@ -142,7 +143,7 @@ function stopDriving(why) {
 
 for (const type of ["keydown", "keyup"])
   window.addEventListener(type, event => {
-    if (!driving || !(event.key in keys)) return;
+    if (!(driving || drivingElsewhere) || !(event.key in keys)) return;
     keys[event.key] = type === "keydown";
     event.preventDefault();
   });

@@ -4,10 +4,12 @@
 // snapshot.jpg, about once a second, with its token in an Authorization
 // header: CORS), so no video crosses this recorder. The token is this
 // page's own unless a recorder refuses it; then one for that recorder is
-// asked for here and kept in this browser.
+// asked for here and kept in this browser. Follow and drive go through
+// this recorder and the broker to whichever recorder holds the vehicle.
 
 const fleetViews = new Map();  // recorder id → {box, cameras: Map(name → view)}
 const fleetPictureMs = 1000;
+let fleetDriving = null;  // { serial, view, timer, busy }
 
 function fleetToken(recorderId) {
   const own = (document.cookie.match(/(?:^|; )wircam_token=([^;]*)/) || [])[1];
@@ -42,10 +44,20 @@ function fleetCameraView(recorderView, name) {
   box.className = "fleet-camera";
   box.dataset.camera = name;
   box.innerHTML = `<div class="head"><b></b><span class="badge"></span></div>` +
-                  `<img alt="live picture"><div class="stats"></div>`;
+                  `<img alt="live picture"><div class="stats"></div>` +
+                  `<div class="fleet-controls" hidden><button class="fleet-follow"></button>` +
+                  `<button class="fleet-drive">drive</button>` +
+                  `<span class="fleet-message"></span></div>`;
   box.querySelector("b").textContent = name;
   recorderView.box.querySelector(".fleet-cameras").appendChild(box);
-  view = { box, img: box.querySelector("img"), busy: false, shownAt: 0 };
+  view = { box, img: box.querySelector("img"), busy: false, shownAt: 0, serial: "",
+           following: false };
+  box.querySelector(".fleet-follow").addEventListener("click", () =>
+      commandFleetVehicle(view, `follow?on=${!view.following}`));
+  box.querySelector(".fleet-drive").addEventListener("click", () => {
+    if (fleetDriving && fleetDriving.view === view) return stopFleetDriving("stopped");
+    startFleetDriving(view);
+  });
   recorderView.cameras.set(name, view);
   return view;
 }
@@ -75,6 +87,7 @@ function showFleetRecorder(recorder) {
     cameraView.box.querySelector(".stats").textContent =
         `${vehicle} · ${(status.fps || 0).toFixed(1)} fps · ` +
         `${status.battery_v ? status.battery_v.toFixed(2) + " V" : "battery ?"}`;
+    showFleetControls(cameraView, camera, recorder.online);
     if (state === "live") fetchFleetPicture(recorder, camera.name, cameraView, view);
   }
   for (const [name, cameraView] of view.cameras)
@@ -105,6 +118,77 @@ async function fetchFleetPicture(recorder, name, view, recorderView) {
     view.busy = false;
   }
 }
+
+// Follow and drive for a camera's vehicle, by its serial: this recorder
+// hands them to the broker, and the recorder that holds the vehicle now
+// applies them (docs/fleet.md), wherever it moved.
+function showFleetControls(view, camera, online) {
+  const serial = camera.vehicle && camera.vehicle.serial;
+  const controls = view.box.querySelector(".fleet-controls");
+  controls.hidden = !serial || !online;
+  if (!serial) return;
+  view.serial = serial;
+  view.following = !!(camera.status && camera.status.following);
+  const follow = controls.querySelector(".fleet-follow");
+  follow.textContent = view.following ? "following: on" : "following: off";
+  follow.classList.toggle("on", view.following);
+}
+
+async function commandFleetVehicle(view, command) {
+  const message = view.box.querySelector(".fleet-message");
+  try {
+    const response = await fetch(
+        `/api/fleet/vehicles/${encodeURIComponent(view.serial)}/${command}`, { method: "POST" });
+    if (!response.ok) {
+      message.textContent = (await response.json()).error;
+      return false;
+    }
+    if (!fleetDriving || fleetDriving.view !== view) message.textContent = "";
+    return true;
+  } catch (error) {
+    message.textContent = "this recorder did not answer";
+    return false;
+  }
+}
+
+// A command every period while driving, changed or not: the holding
+// recorder's dead-man stops the vehicle 250 ms after the last.
+async function startFleetDriving(view) {
+  if (fleetDriving) stopFleetDriving("driving another vehicle");
+  if (driving) stopDriving("driving a fleet vehicle");
+  // Following off first, as the camera's own drive button does.
+  if (!(await commandFleetVehicle(view, "follow?on=false"))) return;
+  fleetDriving = { view, busy: false, timer: 0 };
+  drivingElsewhere = true;
+  view.box.dataset.driving = "true";
+  view.box.querySelector(".fleet-drive").classList.add("on");
+  view.box.querySelector(".fleet-message").textContent =
+      `driving ${view.serial} through the broker: arrow keys or gamepad`;
+  fleetDriving.timer = setInterval(async () => {
+    const drive = fleetDriving;
+    if (!drive || drive.busy) return;  // one on its way at a time
+    drive.busy = true;
+    const { steering, throttle } = driveCommand();
+    await commandFleetVehicle(view, `drive?steering=${steering}&throttle=${throttle}`);
+    drive.busy = false;
+  }, kDrivePeriodMs);
+}
+
+function stopFleetDriving(why) {
+  if (!fleetDriving) return;
+  const { view, timer } = fleetDriving;
+  fleetDriving = null;
+  drivingElsewhere = false;
+  clearInterval(timer);
+  commandFleetVehicle(view, "drive?steering=0&throttle=0");
+  view.box.dataset.driving = "false";
+  view.box.querySelector(".fleet-drive").classList.remove("on");
+  view.box.querySelector(".fleet-message").textContent = `not driving (${why})`;
+}
+
+document.addEventListener("visibilitychange", () => {
+  if (document.hidden) stopFleetDriving("the tab was hidden");
+});
 
 async function refreshFleet() {
   const response = await fetch("/api/fleet");

@@ -413,6 +413,17 @@ try {
   await check("fleet recordings, no token", "GET", urlA + "api/fleet/recordings", { expect: 401 });
   await check("B fleet, not one", "GET", urlB + "api/fleet", { expect: 404 });
   await check("B fleet recordings, not one", "GET", urlB + "api/fleet/recordings", { expect: 404 });
+  // A vehicle's commands through the broker, by its serial (A holds it).
+  const vehicle = urlA + "api/fleet/vehicles/SIM0001/";
+  await check("fleet follow", "POST", vehicle + "follow?on=true", { headers: bearer, expect: 202 });
+  await check("fleet target", "POST", vehicle + "target?id=0", { headers: bearer, expect: 202 });
+  await check("fleet drive", "POST", vehicle + "drive?steering=0&throttle=0",
+    { headers: bearer, expect: 202 });
+  await check("fleet drive, bad", "POST", vehicle + "drive?steering=left&throttle=0",
+    { headers: bearer, expect: 400 });
+  await check("fleet follow, no token", "POST", vehicle + "follow?on=true", { expect: 401 });
+  await check("B fleet drive, not one", "POST", urlB + "api/fleet/vehicles/SIM0001/drive?steering=0&throttle=0",
+    { expect: 404 });
 
   // Unknown API path: JSON 404 (not a path of the document)
   const unknown = await request("GET", urlA + "api/nothing", { headers: bearer });

@@ -92,6 +92,20 @@ TEST(HttpRoutes, NamesTheControlDriveAndPlaybackResources) {
   EXPECT_EQ(routeOf("/play/.mjpg").kind, Kind::NotFound);
 }
 
+TEST(HttpRoutes, NamesAFleetVehiclesCommandsBySerial) {
+  for (const char* action : {"follow", "target", "drive"}) {
+    auto command = routeOf(std::string("/api/fleet/vehicles/W000123/") + action);
+    EXPECT_EQ(command.kind, Kind::FleetVehicleCommand) << action;
+    EXPECT_EQ(command.name, "W000123");
+    EXPECT_EQ(command.action, action);
+  }
+  EXPECT_STREQ(allowedMethods(Kind::FleetVehicleCommand), "POST");
+  for (const char* other :
+       {"/api/fleet/vehicles/W000123", "/api/fleet/vehicles//drive",
+        "/api/fleet/vehicles/W000123/request-control", "/api/fleet/vehicles/a/b/drive"})
+    EXPECT_EQ(routeOf(other).kind, Kind::ApiNotFound) << other;
+}
+
 TEST(HttpRoutes, ServesOnlyPlainNamesOfRecordings) {
   EXPECT_TRUE(isRecordingName("rover-cam0-000.mkv"));
   EXPECT_TRUE(isRecordingName("rover-cam0-000.jsonl"));
