@@ -86,8 +86,8 @@ std::optional<std::string> Supervisor::startServers() {
     content.command = [this](const FleetCommand& c) { return commands_.apply(c, "web"); };
     content.reload = [this] { return reload(); };
     if (options_.fleet) {
-      content.fleet = [this] {
-        return fleet_ && fleet_->directory() ? fleet_->directory()->view() : nlohmann::json();
+      content.fleet = [this](const FleetViewScope& scope) {
+        return fleet_ && fleet_->directory() ? fleet_->directory()->view(scope) : nlohmann::json();
       };
       content.commandVehicle = [this](const std::string& serial, const std::string& command,
                                       const std::string& payload) -> std::optional<std::string> {

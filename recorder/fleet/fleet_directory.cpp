@@ -99,33 +99,44 @@ std::vector<std::string> FleetDirectory::prefixes() const {
   return all;
 }
 
-nlohmann::json FleetDirectory::view() const {
+nlohmann::json FleetDirectory::view(const FleetViewScope& scope) const {
   std::lock_guard lock(mutex_);
   std::vector<const Recorder*> ordered;
-  for (const auto& [id, recorder] : recorders_) ordered.push_back(&recorder);
+  for (const auto& [id, recorder] : recorders_)
+    if (!scope.recorder || *scope.recorder == id) ordered.push_back(&recorder);
   std::stable_sort(ordered.begin(), ordered.end(),
                    [](auto* a, auto* b) { return a->announcement.host < b->announcement.host; });
   nlohmann::json recorders = nlohmann::json::array();
   for (const Recorder* r : ordered) {
     const auto& a = r->announcement;
     nlohmann::json cameras = nlohmann::json::array();
+    size_t live = 0;
     for (const auto& c : a.cameras) {
-      nlohmann::json camera = {
-          {"name", c.name}, {"vehicle", toJson(c.vehicle)}, {"rtsp_path", c.rtspPath}};
       auto status = r->statuses.find(c.name);
       // What its recorder last said; a recorder offline says nothing now.
-      camera["state"] = online(*r) && status != r->statuses.end()
-                            ? status->second.value("state", "unknown")
-                            : "unknown";
-      camera["status"] = status != r->statuses.end() ? status->second : nlohmann::json();
-      cameras.push_back(std::move(camera));
+      std::string state = online(*r) && status != r->statuses.end()
+                              ? status->second.value("state", "unknown")
+                              : "unknown";
+      live += state == "live" ? 1 : 0;
+      if (!scope.cameras) continue;
+      cameras.push_back(
+          {{"name", c.name},
+           {"vehicle", toJson(c.vehicle)},
+           {"rtsp_path", c.rtspPath},
+           {"state", state},
+           {"status", status != r->statuses.end() ? status->second : nlohmann::json()}});
     }
     nlohmann::json entry = toJson(a);
     entry.erase("seen_utc");
     entry.erase("seen_unix_ms");
     entry["online"] = online(*r);
     entry["last_seen_utc"] = SegmentPlanner::isoUtc(r->lastSeenUnixMs);
-    entry["cameras"] = std::move(cameras);
+    entry["camera_count"] = a.cameras.size();
+    entry["cameras_live"] = live;
+    if (scope.cameras)
+      entry["cameras"] = std::move(cameras);
+    else
+      entry.erase("cameras");  // the announcement's own list
     recorders.push_back(std::move(entry));
   }
   return {{"recorders", recorders}};

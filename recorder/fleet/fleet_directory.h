@@ -16,6 +16,14 @@
 
 namespace wircam::recorder {
 
+// What GET /api/fleet asks for: the whole fleet, one recorder, or the
+// recorders without their cameras (a fleet of thousands of cameras is
+// shown a recorder at a time).
+struct FleetViewScope {
+  std::optional<std::string> recorder;  // by id: that one alone
+  bool cameras = true;                  // false: each recorder's camera counts only
+};
+
 class FleetDirectory {
  public:
   // A message on wircam-fleet/recorders/ID; the recorder's MQTT prefix when
@@ -29,8 +37,9 @@ class FleetDirectory {
 
   // The prefixes to subscribe to again after a new connection.
   std::vector<std::string> prefixes() const;
-  // GET /api/fleet: {"recorders": [...]}, by host, then id.
-  nlohmann::json view() const;
+  // GET /api/fleet: {"recorders": [...]}, by host, then id; each with its
+  // camera_count and cameras_live, and its cameras unless left out.
+  nlohmann::json view(const FleetViewScope& scope = {}) const;
 
  private:
   struct Recorder {

@@ -1,27 +1,12 @@
 // HttpServer's control of the vehicles: follow, target and control-right
 // commands, and who may drive; all behind the access token.
-#include <algorithm>
-#include <nlohmann/json.hpp>
-
 #include "common/printable_text.h"
-#include "fleet/fleet_announcement.h"
 #include "http/camera_feed.h"
 #include "http/http_responses.h"
 #include "http/http_routes.h"
 #include "http/http_server.h"
 
 namespace wircam::recorder {
-
-namespace {
-
-// A serial that names one level of an MQTT topic, and nothing more.
-bool fitsOneTopicLevel(const std::string& serial) {
-  return !serial.empty() && serial.size() <= 64 &&
-         std::all_of(serial.begin(), serial.end(),
-                     [](char c) { return c > ' ' && c < 127 && c != '/' && c != '+' && c != '#'; });
-}
-
-}  // namespace
 
 // Control and deletion are always behind the token: without one set, nobody
 // may (the page is then open to anyone who can reach this machine's port).
@@ -62,53 +47,6 @@ void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GH
     if (camera.value("name", "") == route.name)
       return respond(message, SOUP_STATUS_OK, "application/json", camera.dump());
   respond(message, SOUP_STATUS_OK, "application/json", "{}");
-}
-
-void HttpServer::serveVehicleCommand(SoupServerMessage* message, const Route& route,
-                                     GHashTable* query) {
-  if (!content_.commandVehicle)
-    return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
-                            "this recorder was not started with --fleet (and --mqtt)");
-  if (refusedWithoutToken(message, "controlling a vehicle")) return;
-  auto lookup = [&](const char* key) -> std::string {
-    const char* value = queryValue(query, key);
-    return value ? value : "";
-  };
-  // The payloads the vehicle's topics take, checked here as its recorder
-  // would check them (a bad one is refused now, not logged over there).
-  std::string command = route.action + "/set", payload;
-  if (route.action == "follow") {
-    std::string on = lookup("on");
-    if (on != "true" && on != "false")
-      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "follow takes on=true or on=false");
-    payload = on == "true" ? "ON" : "OFF";
-  } else if (route.action == "target") {
-    payload = lookup("id");
-  } else {
-    payload = nlohmann::json{{"steering", std::strtod(lookup("steering").c_str(), nullptr)},
-                             {"throttle", std::strtod(lookup("throttle").c_str(), nullptr)}}
-                  .dump();
-    for (const char* key : {"steering", "throttle"}) {
-      std::string value = lookup(key);
-      char* end = nullptr;
-      std::strtod(value.c_str(), &end);
-      if (value.empty() || *end != '\0')
-        return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
-                                "drive takes steering=S&throttle=T, each -1..1");
-    }
-  }
-  auto parsed = parseFleetCommand(route.name, command, payload);
-  if (!parsed) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, parsed.error());
-  if (!fitsOneTopicLevel(route.name))
-    return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
-                            "a vehicle's serial is up to 64 printable characters, without / + #");
-  if (auto refused = content_.commandVehicle(route.name, command, payload))
-    return respondJsonError(message, SOUP_STATUS_SERVICE_UNAVAILABLE, *refused);
-  respond(message, SOUP_STATUS_ACCEPTED, "application/json",
-          nlohmann::json{{"vehicle", route.name},
-                         {"topic", kVehicleTopicRoot + route.name + "/" + command},
-                         {"payload", payload}}
-              .dump());
 }
 
 void HttpServer::serveReload(SoupServerMessage* message) {

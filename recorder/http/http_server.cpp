@@ -87,8 +87,10 @@ Expected<std::unique_ptr<HttpServer>, std::string> HttpServer::start(
       [connections = self->connections_.get()](SoupServerMessage* message) {
         return connections->socketOf(message);
       });
-  self->fleetRecordings_ =
-      std::make_unique<FleetRecordings>(self->content_.fleet, self->content_.token);
+  self->fleetRecordings_ = std::make_unique<FleetRecordings>(
+      self->content_.fleet ? [fleet = self->content_.fleet] { return fleet({}); }
+                           : std::function<nlohmann::json()>(),
+      self->content_.token);
   self->url_ = std::string(self->connections_->tls() ? "https://" : "http://") +
                address.listenHost() + ":" + std::to_string(self->connections_->port()) + "/";
 
@@ -352,7 +354,7 @@ void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* 
       if (!self->content_.fleet)
         return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
                                 "this recorder was not started with --fleet (and --mqtt)");
-      return respond(message, SOUP_STATUS_OK, "application/json", self->content_.fleet().dump());
+      return self->serveFleet(message, query);
     case Route::Kind::FleetRecordings:
       return self->fleetRecordings_->serve(message, query);
     case Route::Kind::Metrics:

@@ -98,7 +98,9 @@ class HttpServer : public WebServer {
   void sendTo(Client& client, GBytes* chunk);
   void sendFrame(const std::string& camera, GstBuffer* jpeg);
   void serveReload(SoupServerMessage* message);  // http_control.cpp
-  // POST /api/fleet/vehicles/SERIAL/ACTION (http_control.cpp).
+  // GET /api/fleet[?recorder=ID][&cameras=false].
+  void serveFleet(SoupServerMessage* message, GHashTable* query);
+  // POST /api/fleet/vehicles/SERIAL/ACTION (http_fleet.cpp, as serveFleet).
   void serveVehicleCommand(SoupServerMessage* message, const Route& route, GHashTable* query);
   // Ends these streaming responses (their camera removed) and forgets them.
   void endStreams(std::vector<std::unique_ptr<Client>>& clients);

@@ -23,6 +23,7 @@
 #include "camera/frame_tap.h"
 #include "common/expected.h"
 #include "fleet/fleet_command.h"
+#include "fleet/fleet_directory.h"
 #include "live/ice_servers.h"
 #include "live/server_address.h"
 
@@ -69,8 +70,8 @@ struct WebContent {
   // unchanged}), or why nothing did.
   std::function<Expected<nlohmann::json, std::string>()> reload;
   // With --fleet: GET /api/fleet's {"recorders": [...]} (fleet/fleet_directory.h),
-  // which GET /api/fleet/recordings asks; null without.
-  std::function<nlohmann::json()> fleet;
+  // the whole of which GET /api/fleet/recordings asks; null without.
+  std::function<nlohmann::json(const FleetViewScope&)> fleet;
   // With --fleet: a command for a vehicle wherever it is, handed to the
   // broker (fleet_publisher.h: `command` as "follow/set", a checked
   // payload); why not, if it cannot be.

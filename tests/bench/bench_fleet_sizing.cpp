@@ -178,13 +178,14 @@ int main(int argc, char** argv) {
           " --mqtt-prefix bench/fleet --fleet --duration 600",
       "/dev/null", (work / "recorder.log").string());
   std::this_thread::sleep_for(std::chrono::seconds(3));  // its retained messages in
-  std::string ask =
-      "curl -s -o " + (work / "fleet.json").string() +
-      " -w '%{time_total} %{size_download}' http://127.0.0.1:" + std::to_string(httpPort) +
-      "/api/fleet";
-  std::vector<double> asked;
-  double bytes = 0;
-  double fleetCpu = measure("wirc-recorder --fleet", recorder, [&] {
+  // GET `path` five times, half a second apart: the median time in ms and
+  // the size of the answer (kept in fleet.json).
+  auto askFiveTimes = [&](const std::string& path) -> std::pair<double, double> {
+    std::string ask =
+        "curl -s -o " + (work / "fleet.json").string() +
+        " -w '%{time_total} %{size_download}' http://127.0.0.1:" + std::to_string(httpPort) + path;
+    std::vector<double> asked;
+    double bytes = 0;
     for (int i = 0; i < 5; ++i) {
       FILE* out = popen(ask.c_str(), "r");
       double time = 0;
@@ -192,7 +193,16 @@ int main(int argc, char** argv) {
       if (out) pclose(out);
       std::this_thread::sleep_for(std::chrono::milliseconds(500));
     }
-  });
+    std::sort(asked.begin(), asked.end());
+    return {asked.empty() ? 0.0 : asked[asked.size() / 2] * 1000, bytes};
+  };
+  // A page of the whole fleet a recorder at a time (fleet_view.js): the
+  // recorders with their counts, and one recorder's cameras.
+  auto counts = askFiveTimes("/api/fleet?cameras=false");
+  auto one = askFiveTimes("/api/fleet?recorder=bench-recorder-0");
+  std::pair<double, double> whole;
+  double fleetCpu =
+      measure("wirc-recorder --fleet", recorder, [&] { whole = askFiveTimes("/api/fleet"); });
   auto view = nlohmann::json::parse(std::ifstream(work / "fleet.json"), nullptr, false);
   size_t seen = 0, live = 0, online = 0;
   if (view.is_object())
@@ -202,14 +212,16 @@ int main(int argc, char** argv) {
       online += r.value("online", false) ? 1 : 0;
       for (const auto& c : r["cameras"]) live += c.value("state", "") == "live" ? 1 : 0;
     }
-  std::sort(asked.begin(), asked.end());
   std::printf("wirc-recorder --fleet: %.2fx the stock reader's CPU\n",
               stockCpu > 0 ? fleetCpu / stockCpu : 0.0);
   std::printf(
-      "GET /api/fleet: %.0f ms (median of %zu), %.1f MB; %zu of %d recorders online, "
+      "GET /api/fleet: %.0f ms (median of 5), %.1f MB; %zu of %d recorders online, "
       "%zu of %d cameras live\n",
-      asked.empty() ? 0.0 : asked[asked.size() / 2] * 1000, asked.size(), bytes / 1e6, online,
-      recorders, live, recorders * cameras);
+      whole.first, whole.second / 1e6, online, recorders, live, recorders * cameras);
+  std::printf("GET /api/fleet?cameras=false: %.0f ms, %.1f kB (%.3fx the whole's time)\n",
+              counts.first, counts.second / 1e3, whole.first > 0 ? counts.first / whole.first : 0);
+  std::printf("GET /api/fleet?recorder=ID: %.0f ms, %.1f kB (%.3fx the whole's time)\n", one.first,
+              one.second / 1e3, whole.first > 0 ? one.first / whole.first : 0);
   uint64_t dropped = 0;
   for (const auto& member : fleet) dropped += member.client->stats().dropped;
   std::printf("statuses dropped by the simulated recorders' clients (unsent over %llu): %llu\n",

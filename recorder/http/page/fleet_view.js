@@ -10,6 +10,10 @@
 const fleetViews = new Map();  // recorder id → {box, cameras: Map(name → view)}
 const fleetPictureMs = 1000;
 let fleetDriving = null;  // { serial, view, timer, busy }
+// A fleet of more cameras than this opens with each recorder's cameras
+// hidden: the page then asks only for the recorders the user opens (a
+// view of the whole of 25,600 cameras is 8 MB, asked every second).
+const fleetOpenUpTo = 64;
 
 function fleetToken(recorderId) {
   const own = (document.cookie.match(/(?:^|; )wircam_token=([^;]*)/) || [])[1];
@@ -23,7 +27,8 @@ function fleetRecorderView(recorder) {
   box.className = "fleet-recorder";
   box.dataset.id = recorder.id;
   box.innerHTML = `<div class="head"><b></b><span class="badge"></span><span class="since">` +
-                  `</span><span class="transport"></span></div><div class="fleet-token" hidden>` +
+                  `</span><span class="count"></span><button class="fleet-open"></button>` +
+                  `<span class="transport"></span></div><div class="fleet-token" hidden>` +
                   `<input type="password" placeholder="its access token"><button>use</button>` +
                   `</div><div class="fleet-cameras"></div>`;
   const input = box.querySelector(".fleet-token input");
@@ -32,7 +37,11 @@ function fleetRecorderView(recorder) {
     box.querySelector(".fleet-token").hidden = true;
   });
   document.getElementById("fleet-recorders").appendChild(box);
-  view = { box, cameras: new Map() };
+  view = { box, cameras: new Map(), open: undefined };
+  box.querySelector(".fleet-open").addEventListener("click", () => {
+    view.open = !view.open;
+    refreshFleet();
+  });
   fleetViews.set(recorder.id, view);
   return view;
 }
@@ -62,8 +71,7 @@ function fleetCameraView(recorderView, name) {
   return view;
 }
 
-function showFleetRecorder(recorder) {
-  const view = fleetRecorderView(recorder);
+function showFleetRecorderHead(recorder, view) {
   const head = view.box.querySelector(".head");
   head.querySelector("b").textContent = recorder.host;
   const badge = head.querySelector(".badge");
@@ -72,7 +80,14 @@ function showFleetRecorder(recorder) {
   head.querySelector(".since").textContent =
       recorder.online ? "" : "last seen " + new Date(recorder.last_seen_utc).toLocaleString();
   head.querySelector(".transport").textContent = `${recorder.mqtt_prefix} · ${recorder.version}`;
+  head.querySelector(".count").textContent =
+      `${recorder.cameras_live} of ${recorder.camera_count} cameras live`;
+  head.querySelector(".fleet-open").textContent = view.open ? "hide cameras" : "show cameras";
   view.box.dataset.online = recorder.online;
+  view.box.dataset.open = view.open;
+}
+
+function showFleetCameras(recorder, view) {
   const names = new Set();
   for (const camera of recorder.cameras) {
     names.add(camera.name);
@@ -92,6 +107,7 @@ function showFleetRecorder(recorder) {
   }
   for (const [name, cameraView] of view.cameras)
     if (!names.has(name)) {
+      if (fleetDriving && fleetDriving.view === cameraView) stopFleetDriving("its camera went");
       cameraView.box.remove();
       view.cameras.delete(name);
     }
@@ -190,8 +206,10 @@ document.addEventListener("visibilitychange", () => {
   if (document.hidden) stopFleetDriving("the tab was hidden");
 });
 
+// The recorders without their cameras, then the cameras of each recorder
+// that is open, one request each.
 async function refreshFleet() {
-  const response = await fetch("/api/fleet");
+  const response = await fetch("/api/fleet?cameras=false");
   if (!response.ok) return false;  // not a fleet recorder
   const fleet = await response.json();
   document.getElementById("fleet").hidden = false;
@@ -201,10 +219,26 @@ async function refreshFleet() {
       view.box.remove();
       fleetViews.delete(id);
     }
-  fleet.recorders.forEach(showFleetRecorder);
+  const cameras = fleet.recorders.reduce((sum, r) => sum + r.camera_count, 0);
+  await Promise.all(fleet.recorders.map(async recorder => {
+    const view = fleetRecorderView(recorder);
+    if (view.open === undefined) view.open = cameras <= fleetOpenUpTo;
+    showFleetRecorderHead(recorder, view);
+    if (!view.open) return showFleetCameras({ ...recorder, cameras: [] }, view);
+    const one = await fetch(`/api/fleet?recorder=${encodeURIComponent(recorder.id)}`);
+    if (!one.ok) return;  // gone meanwhile
+    const [full] = (await one.json()).recorders;
+    if (full && view.open) showFleetCameras(full, view);
+  }));
   return true;
 }
 
 async function startFleet() {
-  if (await refreshFleet()) setInterval(refreshFleet, fleetPictureMs);
+  if (!(await refreshFleet())) return;
+  let refreshing = false;  // a slow answer is not asked again over itself
+  setInterval(async () => {
+    if (refreshing) return;
+    refreshing = true;
+    try { await refreshFleet(); } finally { refreshing = false; }
+  }, fleetPictureMs);
 }

@@ -396,6 +396,19 @@ try {
   await check("fleet recordings, bad day", "GET", urlA + "api/fleet/recordings?day=tuesday",
     { headers: bearer, expect: 400 });
   await check("fleet, no token", "GET", urlA + "api/fleet", { expect: 401 });
+  const counts = (await check("fleet, counts only", "GET", urlA + "api/fleet?cameras=false",
+    { headers: bearer, expect: 200 })).json;
+  const idA = counts?.recorders?.[0]?.id;
+  if (!idA || counts.recorders[0].cameras !== undefined || counts.recorders[0].camera_count !== 1)
+    problem(`fleet?cameras=false: ${JSON.stringify(counts).slice(0, 300)}`);
+  const one = (await check("fleet, one recorder", "GET", `${urlA}api/fleet?recorder=${enc(idA)}`,
+    { headers: bearer, expect: 200 })).json;
+  if (one?.recorders?.length !== 1 || one.recorders[0].cameras?.length !== 1)
+    problem(`fleet?recorder=: ${JSON.stringify(one).slice(0, 300)}`);
+  await check("fleet, no such recorder", "GET", urlA + "api/fleet?recorder=nope",
+    { headers: bearer, expect: 404 });
+  await check("fleet, bad cameras", "GET", urlA + "api/fleet?cameras=maybe",
+    { headers: bearer, expect: 400 });
   // Another recorder's page reads these across origins (CORS).
   const origin = { Origin: "http://other-recorder.example:8080" };
   for (const url of [urlA + "api/fleet", urlA + "api/cameras", urlA + "api/status",

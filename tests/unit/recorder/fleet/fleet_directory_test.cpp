@@ -96,6 +96,31 @@ TEST(FleetDirectory, ARecorderIsOnlineFromItsAvailabilityWithItsCamerasStates) {
   EXPECT_EQ(view[0]["cameras"][0]["status"]["state"], "live");
 }
 
+// A fleet too large to show whole is read a recorder at a time: the
+// recorders with their counts, then one recorder's cameras.
+TEST(FleetDirectory, IsViewedARecorderAtATimeOrWithCountsAlone) {
+  FleetDirectory fleet;
+  fleet.announced("wircam-fleet/recorders/a1", toJson(recorderOf("a1", "lab/a", "cam-a", 1)).dump(),
+                  1000);
+  fleet.announced("wircam-fleet/recorders/b2", toJson(recorderOf("b2", "lab/b", "cam-b", 1)).dump(),
+                  1000);
+  fleet.heard("lab/a/available", "online", 2000);
+  fleet.heard("lab/a/cam-a/status", R"({"state":"live"})", 2000);
+  auto counts = fleet.view({.cameras = false})["recorders"];
+  ASSERT_EQ(counts.size(), 2u);
+  for (const auto& r : counts) {
+    EXPECT_FALSE(r.contains("cameras")) << r.dump();
+    EXPECT_EQ(r["camera_count"], 1);
+  }
+  EXPECT_EQ(counts[0]["cameras_live"], 1);  // node-a1 first, by host
+  EXPECT_EQ(counts[1]["cameras_live"], 0);
+  auto one = fleet.view({.recorder = "b2"})["recorders"];
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0]["id"], "b2");
+  EXPECT_EQ(one[0]["cameras"][0]["name"], "cam-b");
+  EXPECT_TRUE(fleet.view({.recorder = "nope"})["recorders"].empty());
+}
+
 TEST(FleetDirectory, ARetainedAnnouncementOfADeadRecorderSaysWhenItWasSeen) {
   FleetDirectory fleet;
   fleet.announced("wircam-fleet/recorders/a1",
