@@ -16,30 +16,6 @@ std::string synopsis(const Option& option) {
   return text;
 }
 
-// Words filled into lines of `width`, each after `indent` spaces but the
-// first, which continues `first`.
-std::string wrap(std::string first, const std::string& text, size_t indent, size_t width) {
-  std::istringstream words(text);
-  std::string word, out, line = std::move(first);
-  bool fresh = true;  // no word on this line yet
-  while (words >> word) {
-    if (!fresh && line.size() + 1 + word.size() > width) {
-      out += line + "\n";
-      line = std::string(indent, ' ');
-      fresh = true;
-    }
-    line += (fresh ? "" : " ") + word;
-    fresh = false;
-  }
-  return out + line + "\n";
-}
-
-std::string cell(std::string text) {
-  for (size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2))
-    text.replace(at, 1, "\\|");
-  return text;
-}
-
 std::string withDefault(const Option& option) {
   std::string help = option.help;
   if (option.fallback) help += std::string(" (default ") + option.fallback + ")";
@@ -62,6 +38,28 @@ std::string plainText(const std::string& markdown) {
     out += c;
   }
   return out;
+}
+
+std::string tableCell(std::string text) {
+  for (size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2))
+    text.replace(at, 1, "\\|");
+  return text;
+}
+
+std::string wrapped(std::string first, const std::string& text, size_t indent, size_t width) {
+  std::istringstream words(text);
+  std::string word, out, line = std::move(first);
+  bool fresh = true;  // no word on this line yet
+  while (words >> word) {
+    if (!fresh && line.size() + 1 + word.size() > width) {
+      out += line + "\n";
+      line = std::string(indent, ' ');
+      fresh = true;
+    }
+    line += (fresh ? "" : " ") + word;
+    fresh = false;
+  }
+  return out + line + "\n";
 }
 
 CommandLine::CommandLine(std::vector<Section> sections, size_t helpColumn)
@@ -111,7 +109,7 @@ std::string CommandLine::help() const {
     for (const auto& option : section.options) {
       std::string head = "  " + synopsis(option);
       head += head.size() + 1 < kColumn ? std::string(kColumn - head.size(), ' ') : " ";
-      out += wrap(head, plainText(withDefault(option)), kColumn, kWidth);
+      out += wrapped(head, plainText(withDefault(option)), kColumn, kWidth);
     }
   }
   return out;
@@ -122,8 +120,9 @@ std::string CommandLine::markdown(const std::string& title) const {
   for (const auto& section : sections_) {
     if (title != section.title) continue;
     for (const auto& option : section.options)
-      out += "| `" + cell(synopsis(option)) + "` | " +
-             (option.fallback ? cell(option.fallback) : "") + " | " + cell(option.help) + " |\n";
+      out += "| `" + tableCell(synopsis(option)) + "` | " +
+             (option.fallback ? tableCell(option.fallback) : "") + " | " + tableCell(option.help) +
+             " |\n";
   }
   return out;
 }

@@ -107,5 +107,10 @@ Apply choice(T& field, std::vector<std::pair<std::string, T>> choices) {
 
 // --help's text without Markdown: `code` → code, [text](link) → text.
 std::string plainText(const std::string& markdown);
+// Text for a cell of a Markdown table: its bars escaped.
+std::string tableCell(std::string text);
+// `text`'s words filled into lines of `width`, the first continuing
+// `first`, the others after `indent` spaces.
+std::string wrapped(std::string first, const std::string& text, size_t indent, size_t width);
 
 }  // namespace wircam::command_line

@@ -29,8 +29,7 @@ void HttpServer::serveFleet(SoupServerMessage* message, GHashTable* query) {
   if (const char* recorder = queryValue(query, "recorder")) scope.recorder = recorder;
   if (const char* cameras = queryValue(query, "cameras")) {
     if (g_strcmp0(cameras, "true") != 0 && g_strcmp0(cameras, "false") != 0)
-      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
-                              "cameras takes true or false");
+      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "cameras takes true or false");
     scope.cameras = g_strcmp0(cameras, "true") == 0;
   }
   auto view = content_.fleet(scope);

@@ -1,6 +1,6 @@
 // The WebRTC service in this process, serving an H.264 camera whose encoder
-// makes non-IDR I-frames (x264 at scene cuts: here every frame of noise is
-// one) between IDRs a second apart, to a webrtcbin viewer we did not write.
+// makes non-IDR I-frames between IDRs (scene_cut_h264.h), to a webrtcbin
+// viewer we did not write.
 // Whenever a viewer joins, the first frame it receives is an IDR with its
 // SPS and PPS: an I-frame that is not an IDR is no place for a decoder to
 // start (its picture parameter set may be none the viewer has).
@@ -12,6 +12,7 @@
 #include "camera/frame_tap.h"
 #include "common/h264_access_unit.h"
 #include "main_loop_until.h"
+#include "scene_cut_h264.h"
 #include "webrtc/webrtc_service.h"
 #include "webrtcbin_viewer.h"
 
@@ -25,19 +26,9 @@ using namespace std::chrono_literals;
 TEST(WebRtcH264Start, AViewerJoiningBetweenIdrsStartsOnAnIdrThoughIFramesComeBefore) {
   if (!gst_element_factory_find("avdec_h264") || !gst_element_factory_find("x264enc"))
     GTEST_SKIP() << "x264enc or avdec_h264 (gstreamer1.0-plugins-ugly, -libav) is not installed";
-  GstElement* pipeline = gst_parse_launch(
-      "videotestsrc pattern=snow is-live=true ! video/x-raw,width=160,height=120,framerate=30/1 "
-      "! x264enc tune=zerolatency speed-preset=veryfast key-int-max=30 "
-      "option-string=keyint=30:min-keyint=30:scenecut=100 ! h264parse "
-      "! video/x-h264,stream-format=avc,alignment=au,profile=main ! fakesink name=out",
-      nullptr);
-  ASSERT_TRUE(pipeline);
   FrameTap jpeg, encoded;
-  GstElement* out = gst_bin_get_by_name(GST_BIN(pipeline), "out");
-  GstPad* pad = gst_element_get_static_pad(out, "sink");
-  encoded.attachPad(pad);
-  gst_object_unref(pad);
-  gst_object_unref(out);
+  GstElement* pipeline = sceneCutH264Into(encoded);
+  ASSERT_TRUE(pipeline);
   gst_element_set_state(pipeline, GST_STATE_PLAYING);
   {
     WebRtcService::Settings settings;

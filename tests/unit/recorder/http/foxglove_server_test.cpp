@@ -14,6 +14,7 @@
 #include "common/h264_access_unit.h"
 #include "gst_h264_start.h"
 #include "main_loop_until.h"
+#include "scene_cut_h264.h"
 #include "websocket_test_client.h"
 
 namespace wircam::recorder {
@@ -77,25 +78,15 @@ TEST(FoxgloveServer, CamerasAddedAndRemovedAreAdvertisedAndUnadvertisedToEveryCl
   EXPECT_EQ((*server)->stats().clients, 1u);
 }
 
-// An encoder that makes non-IDR I-frames (x264 at scene cuts: here every
-// frame of noise is one) between IDRs a second apart, its H.264 handed to
-// the server as the recorder's is: a client that subscribes mid-stream gets
-// an IDR with its SPS and PPS first, never an I-frame it cannot decode.
+// An encoder that makes non-IDR I-frames between IDRs (scene_cut_h264.h),
+// its H.264 handed to the server as the recorder's is: a client that
+// subscribes mid-stream gets an IDR with its SPS and PPS first, never an
+// I-frame it cannot decode.
 TEST(FoxgloveServer, AnH264SubscriberStartsOnAnIdrThoughIFramesComeBefore) {
   gst_init(nullptr, nullptr);
-  GstElement* pipeline = gst_parse_launch(
-      "videotestsrc pattern=snow is-live=true ! video/x-raw,width=160,height=120,framerate=30/1 "
-      "! x264enc tune=zerolatency speed-preset=veryfast key-int-max=30 "
-      "option-string=keyint=30:min-keyint=30:scenecut=100 ! h264parse "
-      "! video/x-h264,stream-format=avc,alignment=au ! fakesink name=out",
-      nullptr);
-  ASSERT_TRUE(pipeline);
   FrameTap jpeg, encoded;
-  GstElement* out = gst_bin_get_by_name(GST_BIN(pipeline), "out");
-  GstPad* pad = gst_element_get_static_pad(out, "sink");
-  encoded.attachPad(pad);
-  gst_object_unref(pad);
-  gst_object_unref(out);
+  GstElement* pipeline = testing::sceneCutH264Into(encoded);
+  ASSERT_TRUE(pipeline);
   FoxgloveContent content;
   content.cameras = {{"rover-cam0", &jpeg, &encoded}};
   content.drive = [](const std::string&, double, double) { return std::optional<bool>(); };
