@@ -88,8 +88,10 @@ Expected<std::vector<std::string>, std::string> CommandLine::parse(int argc, cha
     }
     if (found == '?' || found == ':') {
       std::string given = argv[optind - 1];
-      if (found == ':' || (optopt >= 1000 && optopt < 1000 + static_cast<int>(byIndex.size())))
-        return unexpected(given + " wants a value");
+      bool known = optopt >= 1000 && optopt < 1000 + static_cast<int>(byIndex.size());
+      if (known && !byIndex[static_cast<size_t>(optopt - 1000)]->value)
+        return unexpected(given.substr(0, given.find('=')) + " takes no value");
+      if (found == ':' || known) return unexpected(given + " wants a value");
       return unexpected("unknown option " + given);
     }
     const Option& declared = *byIndex[static_cast<size_t>(found - 1000)];
@@ -108,8 +110,14 @@ std::string CommandLine::help() const {
     out += std::string("\n") + section.title + ":\n";
     for (const auto& option : section.options) {
       std::string head = "  " + synopsis(option);
-      head += head.size() + 1 < kColumn ? std::string(kColumn - head.size(), ' ') : " ";
-      out += wrapped(head, plainText(withDefault(option)), kColumn, kWidth);
+      bool longHead = head.size() + 1 > kColumn;
+      if (!longHead) head += std::string(kColumn - head.size(), ' ');
+      // A long option and value get a line of their own.
+      if (longHead)
+        out += head + "\n" +
+               wrapped(std::string(kColumn, ' '), plainText(withDefault(option)), kColumn, kWidth);
+      else
+        out += wrapped(head, plainText(withDefault(option)), kColumn, kWidth);
     }
   }
   return out;
@@ -127,15 +135,28 @@ std::string CommandLine::markdown(const std::string& title) const {
   return out;
 }
 
+std::string rangeText(double low, double high) {
+  // Whole bounds as whole numbers (4294967295, not 4.29497e+09).
+  auto said = [](double bound) {
+    std::ostringstream text;
+    if (bound == std::floor(bound) && std::fabs(bound) < 1e15)
+      text << static_cast<long long>(bound);
+    else
+      text << bound;
+    return text.str();
+  };
+  return said(low) + ".." + said(high);
+}
+
 Apply number(double& field, double low, double high) {
   return [&field, low, high](const char* value) -> Problem {
     char* end = nullptr;
     double read = std::strtod(value, &end);
-    if (end == value || *end != '\0' || !std::isfinite(read) || read < low || read > high) {
-      std::ostringstream message;
-      message << "wants a number in " << low << ".." << high << ", not '" << value << "'";
-      return message.str();
-    }
+    // Decimal only: strtod would also read 0x10 as 16.
+    bool decimal = std::string_view(value).find_first_of("xX") == std::string_view::npos;
+    if (end == value || *end != '\0' || !decimal || !std::isfinite(read) || read < low ||
+        read > high)
+      return "wants a number in " + rangeText(low, high) + ", not '" + value + "'";
     field = read;
     return std::nullopt;
   };

@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -61,13 +62,20 @@ class CommandLine {
 
 // Readers of the common kinds of value, each saying a refusal the same way.
 Apply number(double& field, double low, double high);
+// "0..4294967295", as refusals say a range.
+std::string rangeText(double low, double high);
+// Digits only (an optional minus first): not 1e3, not 0x10, not 1.5.
 template <typename Whole>
 Apply whole(Whole& field, double low, double high) {
   return [&field, low, high](const char* value) -> Problem {
+    std::string_view text = value;
+    bool digits = !text.empty() &&
+                  text.find_first_not_of("0123456789", text[0] == '-') == std::string_view::npos &&
+                  text != "-";
     double read = 0;
-    if (auto problem = number(read, low, high)(value)) return problem;
-    if (read != static_cast<double>(static_cast<long long>(read)))
-      return "wants a whole number, not '" + std::string(value) + "'";
+    if (!digits || number(read, low, high)(value))
+      return "wants a whole number in " + rangeText(low, high) + ", not '" + std::string(text) +
+             "'";
     field = static_cast<Whole>(read);
     return std::nullopt;
   };

@@ -2,6 +2,7 @@
 // benchmarks. See --help.
 #include <gst/gst.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -26,6 +27,8 @@
 using namespace wircam;
 
 namespace {
+
+constexpr int kReplayNice = -10;
 
 [[noreturn]] void usageError(const std::string& message) {
   std::fprintf(stderr, "wirc-sim: %s (see wirc-sim --help)\n", message.c_str());
@@ -108,6 +111,12 @@ int main(int argc, char** argv) {
   sim::FollowScene* follow = nullptr;
   sim::ReplayScene* replayed = nullptr;
   if (o.replayPath) {
+    // A replay is a measurement of timing: each frame at its recorded time.
+    // On a machine busy with the recorder, detection or anything else, its
+    // threads (made from this one, so of its priority) wake ahead of that
+    // work where allowed (CAP_SYS_NICE or RLIMIT_NICE), as the recorder's
+    // link loop does; elsewhere they keep the process's priority.
+    setpriority(PRIO_PROCESS, 0, kReplayNice);
     gst_init(&argc, &argv);
     auto drive = sim::RecordedDrive::open(*o.replayPath, o.replayCamera);
     if (!drive) {

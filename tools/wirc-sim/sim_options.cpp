@@ -100,8 +100,7 @@ std::vector<command_line::Section> sections(SimOptions& o) {
               device.pcdTimeout = std::chrono::milliseconds(ms);
               return std::nullopt;
             }},
-           {"duration", "S", "until stopped",
-            "stop after S seconds (SIGINT and SIGTERM stop it too)",
+           {"duration", "S", nullptr, "stop after S seconds; without it, at SIGINT or SIGTERM",
             [&o](const char* value) -> Problem {
               double seconds = 0;
               if (auto problem = number(seconds, 0, 1e7)(value)) return problem;
@@ -263,7 +262,7 @@ receives; --frames streams JPEG files instead.
 )";
 
 constexpr const char* kOutro = R"(
-  -h, --help             show this text
+  -h, --help           show this text
 
 On exit (SIGINT, SIGTERM or --duration) it prints a summary: frames sent, PCD
 received, the longest PCD gap, failsafe entries, and how well the car followed.

@@ -49,7 +49,14 @@ TEST(CommandLine, RefusesInTheToolsWordsNamingTheOption) {
   EXPECT_EQ(parse(s, {"tool", "--rate", "11"}).error(),
             "--rate wants a number in 0.5..10, not '11'");
   EXPECT_EQ(parse(s, {"tool", "--count", "2.5"}).error(),
-            "--count wants a whole number, not '2.5'");
+            "--count wants a whole number in 1..5, not '2.5'");
+  EXPECT_EQ(parse(s, {"tool", "--count", "0x2"}).error(),
+            "--count wants a whole number in 1..5, not '0x2'");
+  EXPECT_EQ(parse(s, {"tool", "--count", "1e0"}).error(),
+            "--count wants a whole number in 1..5, not '1e0'");
+  EXPECT_EQ(parse(s, {"tool", "--rate", "0x5"}).error(),
+            "--rate wants a number in 0.5..10, not '0x5'");
+  EXPECT_EQ(parse(s, {"tool", "--loud=1"}).error(), "--loud takes no value");
   EXPECT_EQ(parse(s, {"tool", "--mode", "c"}).error(), "--mode is a or b, not 'c'");
   EXPECT_EQ(parse(s, {"tool", "--rate"}).error(), "--rate wants a value");
   EXPECT_EQ(parse(s, {"tool", "--nope"}).error(), "unknown option --nope");

@@ -106,7 +106,7 @@ TEST(CliOptions, RefusesInItsOwnWords) {
   std::vector<char*> argv;
   for (auto& arg : args) argv.push_back(arg.data());
   EXPECT_EQ(line.parse(3, argv.data()).error(),
-            "--steering wants a number in 800..2200, not '2300'");
+            "--steering wants a whole number in 800..2200, not '2300'");
 }
 
 }  // namespace
