@@ -76,6 +76,20 @@ TEST(WircCli, WifiNeedsACountryCode) {
   EXPECT_NE(run.output.find("--country"), std::string::npos) << run.output;
 }
 
+// Found by a stranger's trial: `decode extra` and `info … extra` went on
+// as if nothing were there.
+TEST(WircCli, RefusesAnArgumentACommandDoesNotTake) {
+  for (const char* line : {"decode extra", "info --host 127.0.0.1 --port 9 extra",
+                           "drive --protocol rcoip --host 127.0.0.1 extra"}) {
+    auto run = wircCli(line);
+    EXPECT_EQ(run.exitCode, 2) << line << "\n" << run.output;
+    EXPECT_NE(run.output.find("takes no argument, not 'extra'"), std::string::npos) << run.output;
+  }
+  auto run = wircCli("request-control --host 127.0.0.1 --port 9");
+  EXPECT_EQ(run.exitCode, 2) << run.output;
+  EXPECT_NE(run.output.find("request-control takes 1 argument"), std::string::npos) << run.output;
+}
+
 TEST(WircCli, ExtoutSendsBytesToANamedDestination) {
   auto device = std::move(*Device::start({.port = 0}, nullptr));
   auto run = wircCli("extout --destination uart --data 'de ad be ef' --host 127.0.0.1 --port " +

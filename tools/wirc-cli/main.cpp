@@ -19,7 +19,7 @@ namespace {
 struct Command {
   const char* name;
   int (*run)(const Options&);
-  int arguments = -1;  // positional arguments it takes; -1: not checked
+  int arguments = 0;  // positional arguments it takes; -1: checked by the command
 };
 
 // compare-commands RECORDED... REPLAYED: exit 1 when a file cannot be read.
@@ -73,7 +73,7 @@ constexpr Command kWircCommands[] = {
     {"drive", drive},
     {"decode", decode},
     {"encode", encode},
-    {"compare-commands", compareCommandFiles},
+    {"compare-commands", compareCommandFiles, -1},
 };
 
 int positions(Options& o) {
@@ -113,12 +113,24 @@ int main(int argc, char** argv) {
     return 0;
   }
   Options o = parse(argc, argv);
-  if (command == "positions") return positions(o);
-  if (o.protocol != "wirc") return cousin(command, o);
+  // An argument a command does not take is a mistake, not to be ignored.
+  auto takes = [&](size_t arguments) {
+    if (o.positional.size() == arguments) return;
+    if (arguments == 0) usageError(command + " takes no argument, not '" + o.positional[0] + "'");
+    usageError(command + " takes " + std::to_string(arguments) + " argument" +
+               (arguments == 1 ? "" : "s"));
+  };
+  if (command == "positions") {
+    takes(0);
+    return positions(o);
+  }
+  if (o.protocol != "wirc") {
+    takes(0);
+    return cousin(command, o);
+  }
   for (const Command& c : kWircCommands) {
     if (command != c.name) continue;
-    if (c.arguments >= 0 && o.positional.size() != static_cast<size_t>(c.arguments))
-      usageError(command + " takes " + std::to_string(c.arguments) + " argument(s)");
+    if (c.arguments >= 0) takes(static_cast<size_t>(c.arguments));
     return c.run(o);
   }
   usageError("unknown command '" + command + "'");
