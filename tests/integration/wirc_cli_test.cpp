@@ -1,9 +1,11 @@
 // wirc-cli as a user runs it, against the simulated device.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -88,6 +90,20 @@ TEST(WircCli, RefusesAnArgumentACommandDoesNotTake) {
   auto run = wircCli("request-control --host 127.0.0.1 --port 9");
   EXPECT_EQ(run.exitCode, 2) << run.output;
   EXPECT_NE(run.output.find("request-control takes 1 argument"), std::string::npos) << run.output;
+}
+
+// A stream of a camera the device lacks is refused before the file is
+// made (a stranger found an empty one left behind).
+TEST(WircCli, AStreamOfACameraTheDeviceLacksLeavesNoFile) {
+  auto device = std::move(*Device::start({.port = 0}, nullptr));
+  auto out = std::filesystem::temp_directory_path() /
+             ("wirc-cli-no-camera-" + std::to_string(getpid()) + ".mjpeg");
+  auto run = wircCli("stream --camera 1 --frames 3 --host 127.0.0.1 --port " +
+                     std::to_string(device->port()) + " --out " + out.string());
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("the device has 1 camera: --camera 0"), std::string::npos)
+      << run.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 TEST(WircCli, ExtoutSendsBytesToANamedDestination) {

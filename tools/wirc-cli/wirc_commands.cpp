@@ -137,16 +137,20 @@ int stream(const Options& o) {
   if (!o.out) usageError("stream needs --out FILE.mjpeg or --out DIR");
   if (!o.frames && o.duration <= 0) usageError("stream needs --frames N or --duration S");
   namespace fs = std::filesystem;
+  auto session = login(o);
+  auto cameras = session->sessionStatus().cameraCount;
+  if (o.camera >= cameras)
+    fail("the device has " + std::to_string(cameras) +
+         (cameras == 1 ? " camera: --camera 0"
+                       : " cameras: --camera 0.." + std::to_string(cameras - 1)));
+  // Made once there is something to write into it: a refusal leaves no
+  // empty file behind.
   bool toFolder = fs::is_directory(*o.out);
   std::ofstream file;
   if (!toFolder) {
     file.open(*o.out, std::ios::binary);
     if (!file) fail("cannot write '" + *o.out + "'");
   }
-  auto session = login(o);
-  auto cameras = session->sessionStatus().cameraCount;
-  if (o.camera >= cameras)
-    fail("the device has " + std::to_string(cameras) + " camera(s); use --camera 0..");
   auto socket = bindUdp(*SocketAddress::resolve("", 0));
   if (!socket) fail(socket.error());
   int size = 8 << 20;
