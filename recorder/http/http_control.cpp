@@ -1,5 +1,8 @@
 // HttpServer's control of the vehicles: follow, target and control-right
 // commands, and who may drive; all behind the access token.
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+
 #include "common/printable_text.h"
 #include "http/camera_feed.h"
 #include "http/http_responses.h"
@@ -17,25 +20,40 @@ bool HttpServer::refusedWithoutToken(SoupServerMessage* message, const char* wha
   return true;
 }
 
-void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query) {
-  if (refusedWithoutToken(message, "controlling the vehicle")) return;
+Expected<std::pair<std::string, std::string>, std::string> HttpServer::topicCommandOf(
+    const std::string& action, GHashTable* query) {
   auto lookup = [&](const char* key) -> std::string {
     const char* value = queryValue(query, key);
     return value ? value : "";
   };
-  // The same commands as over MQTT, with their checks.
-  std::string command = "request-control", payload;
-  if (route.action == "follow") {
+  if (action == "follow") {
     std::string on = lookup("on");
     if (on != "true" && on != "false")
-      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "follow takes on=true or on=false");
-    command = "follow/set";
-    payload = on == "true" ? "ON" : "OFF";
-  } else if (route.action == "target") {
-    command = "target/set";
-    payload = lookup("id");
+      return unexpected(std::string("follow takes on=true or on=false"));
+    return std::pair<std::string, std::string>("follow/set", on == "true" ? "ON" : "OFF");
   }
-  auto parsed = parseFleetCommand(route.name, command, payload);
+  if (action == "target") return std::pair<std::string, std::string>("target/set", lookup("id"));
+  if (action == "drive") {
+    nlohmann::json drive;
+    for (const char* key : {"steering", "throttle"}) {
+      std::string value = lookup(key);
+      char* end = nullptr;
+      double read = std::strtod(value.c_str(), &end);
+      if (value.empty() || *end != '\0')
+        return unexpected(std::string("drive takes steering=S&throttle=T, each -1..1"));
+      drive[key] = read;
+    }
+    return std::pair<std::string, std::string>("drive/set", drive.dump());
+  }
+  return std::pair<std::string, std::string>("request-control", "");
+}
+
+void HttpServer::serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query) {
+  if (refusedWithoutToken(message, "controlling the vehicle")) return;
+  // The same commands as over MQTT, with their checks.
+  auto command = topicCommandOf(route.action, query);
+  if (!command) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, command.error());
+  auto parsed = parseFleetCommand(route.name, command->first, command->second);
   if (!parsed) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, parsed.error());
   if (auto refused = content_.command(*parsed)) {
     bool unknown = std::none_of(feeds_.begin(), feeds_.end(),

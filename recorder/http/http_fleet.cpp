@@ -1,7 +1,6 @@
 // HttpServer's fleet endpoints (--fleet): the fleet's view, whole or a
 // recorder at a time, and commands for a vehicle wherever it is.
 #include <algorithm>
-#include <cstdlib>
 #include <nlohmann/json.hpp>
 
 #include "fleet/fleet_announcement.h"
@@ -45,33 +44,12 @@ void HttpServer::serveVehicleCommand(SoupServerMessage* message, const Route& ro
     return respondJsonError(message, SOUP_STATUS_NOT_FOUND,
                             "this recorder was not started with --fleet (and --mqtt)");
   if (refusedWithoutToken(message, "controlling a vehicle")) return;
-  auto lookup = [&](const char* key) -> std::string {
-    const char* value = queryValue(query, key);
-    return value ? value : "";
-  };
   // The payloads the vehicle's topics take, checked here as its recorder
   // would check them (a bad one is refused now, not logged over there).
-  std::string command = route.action + "/set", payload;
-  if (route.action == "follow") {
-    std::string on = lookup("on");
-    if (on != "true" && on != "false")
-      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "follow takes on=true or on=false");
-    payload = on == "true" ? "ON" : "OFF";
-  } else if (route.action == "target") {
-    payload = lookup("id");
-  } else {
-    payload = nlohmann::json{{"steering", std::strtod(lookup("steering").c_str(), nullptr)},
-                             {"throttle", std::strtod(lookup("throttle").c_str(), nullptr)}}
-                  .dump();
-    for (const char* key : {"steering", "throttle"}) {
-      std::string value = lookup(key);
-      char* end = nullptr;
-      std::strtod(value.c_str(), &end);
-      if (value.empty() || *end != '\0')
-        return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
-                                "drive takes steering=S&throttle=T, each -1..1");
-    }
-  }
+  auto topicCommand = topicCommandOf(route.action, query);
+  if (!topicCommand)
+    return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, topicCommand.error());
+  const auto& [command, payload] = *topicCommand;
   auto parsed = parseFleetCommand(route.name, command, payload);
   if (!parsed) return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, parsed.error());
   if (!fitsOneTopicLevel(route.name))

@@ -80,6 +80,11 @@ class HttpServer : public WebServer {
   void serveRecordings(SoupServerMessage* message, const std::string& name);
   void servePlayback(SoupServerMessage* message, const std::string& name, GHashTable* query);
   void serveCommand(SoupServerMessage* message, const Route& route, GHashTable* query);
+  // A command's query (follow?on=, target?id=, drive?steering=&throttle=,
+  // request-control) as the MQTT topic leaf and payload that carry it, or
+  // why it is not one (http_control.cpp).
+  static Expected<std::pair<std::string, std::string>, std::string> topicCommandOf(
+      const std::string& action, GHashTable* query);
   // Answers with the reason when a drive-mode WebSocket may not open;
   // otherwise leaves the request to libsoup's upgrade.
   void refuseDriveUnlessAllowed(SoupServerMessage* message, const std::string& camera);
