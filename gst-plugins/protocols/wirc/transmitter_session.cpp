@@ -157,6 +157,12 @@ class TransmitterSession::Impl {
   void onDiscoveryAnswer();
   void onPsd();
   void onPacerTimer();
+  // Whether commands reach the vehicle now: logged in, holding the control
+  // right, the device's address known. Under mutex_.
+  bool steering() const {
+    const auto& status = machine_.status();
+    return status.state == link::LinkState::Live && status.hasControl && machine_.controlAddress();
+  }
   void closeConnection();
   bool sendControl(const Message& message);
   void sendPcd(const link::Pulses& pulses);
@@ -383,9 +389,7 @@ void TransmitterSession::Impl::onPacerTimer() {
   link::PacedStep step;
   {
     std::lock_guard lock(mutex_);
-    const auto& status = machine_.status();
-    if (status.state != link::LinkState::Live || !status.hasControl || !machine_.controlAddress())
-      return;
+    if (!steering()) return;
     step = link::PacedStep::poll(pacer_, now);
   }
   step.carryOut([this](const link::Pulses& pulses) { sendPcd(pulses); }, loop_, pacerTimer_);
@@ -489,9 +493,7 @@ void TransmitterSession::setCommand(const link::Pulses& pulses) {
   {
     std::lock_guard lock(impl_->mutex_);
     step = link::PacedStep::offer(impl_->pacer_, pulses, now);
-    const auto& status = impl_->machine_.status();
-    steering = status.state == link::LinkState::Live && status.hasControl &&
-               impl_->machine_.controlAddress();
+    steering = impl_->steering();
   }
   if (!steering) return;  // kept for when the control right comes
   // A change leaves now, from this thread: no wait for a tick.
@@ -504,10 +506,7 @@ void TransmitterSession::shareTurn(Clock::duration untilNextTurn) {
   std::optional<link::Pulses> due;
   {
     std::lock_guard lock(impl_->mutex_);
-    const auto& status = impl_->machine_.status();
-    if (status.state != link::LinkState::Live || !status.hasControl ||
-        !impl_->machine_.controlAddress())
-      return;
+    if (!impl_->steering()) return;
     due = impl_->pacer_.pollAhead(now, untilNextTurn);
     if (!due) return;  // the timer stands
     // Later than it stood: the loop sleeps on (EventLoop's timerfd). Under
