@@ -1,16 +1,11 @@
 #include "devtools_page.h"
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <fstream>
 #include <iostream>
 #include <thread>
 #include <vector>
 
-#include "headless_chromium.h"
+#include "chromium_browser.h"
 #include "wait_for.h"
 
 namespace wircam::testing {
@@ -31,80 +26,38 @@ class ContextScope {
   GMainContext* context_;
 };
 
-std::string httpGet(SoupSession* session, const std::string& url, const char* method = "GET") {
-  SoupMessage* message = soup_message_new(method, url.c_str());
-  if (!message) return "";
-  GBytes* body = soup_session_send_and_read(session, message, nullptr, nullptr);
-  std::string text;
-  if (body) {
-    gsize size = 0;
-    const char* data = static_cast<const char*>(g_bytes_get_data(body, &size));
-    text.assign(data, size);
-    g_bytes_unref(body);
-  }
-  g_object_unref(message);
-  return text;
-}
-
 }  // namespace
 
 std::unique_ptr<DevToolsPage> DevToolsPage::launch(const std::filesystem::path& profile, int width,
                                                    int height,
                                                    const std::vector<std::string>& extraFlags) {
+  ChromiumBrowser* browser = ChromiumBrowser::shared(profile.parent_path(), extraFlags);
+  if (!browser) return nullptr;
   std::unique_ptr<DevToolsPage> page(new DevToolsPage());
-  page->profile_ = processProfile(profile);
-  std::error_code ignored;
-  std::filesystem::remove_all(page->profile_, ignored);
-  std::filesystem::create_directories(page->profile_);
-  std::vector<std::string> args = {"chromium"};
-  for (auto& flag : chromiumFlags(page->profile_, width, height)) args.push_back(flag);
-  args.insert(args.end(), extraFlags.begin(), extraFlags.end());
-  // A hidden or idle tab must keep its timers at speed.
-  args.insert(args.end(),
-              {"--disable-background-timer-throttling", "--disable-renderer-backgrounding",
-               "--remote-debugging-address=127.0.0.1", "--remote-debugging-port=0", "about:blank"});
-  page->chromium_ = fork();
-  if (page->chromium_ == 0) {
-    std::vector<char*> argv;
-    for (auto& arg : args) argv.push_back(arg.data());
-    argv.push_back(nullptr);
-    int null = open("/dev/null", O_WRONLY);
-    dup2(null, STDOUT_FILENO);
-    dup2(null, STDERR_FILENO);
-    execvp("chromium", argv.data());
-    _exit(127);
-  }
-  // Chromium writes its port and the browser's path here once listening.
-  auto portFile = page->profile_ / "DevToolsActivePort";
-  std::string port;
-  for (auto until = Clock::now() + std::chrono::seconds(20); Clock::now() < until;) {
-    std::ifstream in(portFile);
-    if (in && std::getline(in, port) && !port.empty()) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  if (port.empty()) {
-    std::cerr << "chromium wrote no DevToolsActivePort\n";
-    return nullptr;
-  }
   ContextScope scope(page->context_);
   page->session_ = soup_session_new();
-  auto base = "http://127.0.0.1:" + port;
-  // The first tab: the page to drive.
-  nlohmann::json targets;
-  for (auto until = Clock::now() + std::chrono::seconds(10); Clock::now() < until;) {
-    targets = nlohmann::json::parse(httpGet(page->session_, base + "/json/list"), nullptr, false);
-    if (targets.is_array() &&
-        std::any_of(targets.begin(), targets.end(), [](auto& t) { return t["type"] == "page"; }))
-      break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  page->browser_ = page->connect(browser->webSocketUrl());
+  if (!page->browser_) {
+    std::cerr << "cannot attach to chromium at " << browser->webSocketUrl() << "\n";
+    return nullptr;
   }
-  for (const auto& target : targets.is_array() ? targets : nlohmann::json::array())
-    if (target["type"] == "page") {
-      page->targetId_ = target["id"];
-      if (page->attach(target["webSocketDebuggerUrl"]) && page->keepsFocus() && page->warmUp())
-        return page;
-    }
-  std::cerr << "cannot attach to a chromium tab at " << base << "\n";
+  // A context of its own: no cookie, storage or cache of another test's.
+  auto context = page->callOn(page->browser_, "Target.createBrowserContext");
+  page->browserContextId_ = context.value("browserContextId", "");
+  auto target = page->callOn(page->browser_, "Target.createTarget",
+                             {{"url", "about:blank"},
+                              {"browserContextId", page->browserContextId_},
+                              {"newWindow", true},
+                              {"width", width},
+                              {"height", height}});
+  page->targetId_ = target.value("targetId", "");
+  if (page->targetId_.empty()) {
+    std::cerr << "chromium made no page: " << context.dump() << " " << target.dump() << "\n";
+    return nullptr;
+  }
+  page->socket_ = page->connect(browser->pageWebSocketUrl(page->targetId_));
+  if (page->socket_ && page->keepsFocus() && page->warmUp()) return page;
+  std::cerr << "cannot attach to chromium's page " << page->targetId_ << "\n";
   return nullptr;
 }
 
@@ -141,7 +94,7 @@ bool DevToolsPage::warmUp() {
   return false;
 }
 
-bool DevToolsPage::attach(const std::string& webSocketUrl) {
+SoupWebsocketConnection* DevToolsPage::connect(const std::string& webSocketUrl) {
   SoupMessage* message = soup_message_new("GET", webSocketUrl.c_str());
   struct Result {
     SoupWebsocketConnection* socket = nullptr;
@@ -158,11 +111,11 @@ bool DevToolsPage::attach(const std::string& webSocketUrl) {
   auto until = Clock::now() + std::chrono::seconds(10);
   while (!result.done && Clock::now() < until) g_main_context_iteration(context_, TRUE);
   g_object_unref(message);
-  if (!result.socket) return false;
-  socket_ = result.socket;
+  if (!result.socket) return nullptr;
   // Screenshots are a few hundred kB.
-  soup_websocket_connection_set_max_incoming_payload_size(socket_, 64 << 20);
-  g_signal_connect(socket_, "message",
+  soup_websocket_connection_set_max_incoming_payload_size(result.socket, 64 << 20);
+  // Both sockets' answers land here; their ids come from one counter.
+  g_signal_connect(result.socket, "message",
                    G_CALLBACK(+[](SoupWebsocketConnection*, gint, GBytes* bytes, gpointer data) {
                      auto* self = static_cast<DevToolsPage*>(data);
                      gsize size = 0;
@@ -173,37 +126,41 @@ bool DevToolsPage::attach(const std::string& webSocketUrl) {
                        self->replies_[std::to_string(reply["id"].get<int>())] = reply;
                    }),
                    this);
-  return true;
+  return result.socket;
 }
 
 DevToolsPage::~DevToolsPage() {
   {
     ContextScope scope(context_);
-    if (socket_) {
-      soup_websocket_connection_close(socket_, SOUP_WEBSOCKET_CLOSE_NORMAL, nullptr);
-      g_object_unref(socket_);
-    }
+    // The context's pages close with it: the browser is left as it was.
+    if (!browserContextId_.empty())
+      callOn(browser_, "Target.disposeBrowserContext", {{"browserContextId", browserContextId_}},
+             std::chrono::seconds(5));
+    for (SoupWebsocketConnection* socket : {socket_, browser_})
+      if (socket) {
+        soup_websocket_connection_close(socket, SOUP_WEBSOCKET_CLOSE_NORMAL, nullptr);
+        g_object_unref(socket);
+      }
     if (session_) g_object_unref(session_);
     while (g_main_context_iteration(context_, FALSE)) {
     }
   }
   g_main_context_unref(context_);
-  if (chromium_ > 0) {
-    kill(chromium_, SIGKILL);
-    waitpid(chromium_, nullptr, 0);
-  }
-  std::error_code ignored;
-  std::filesystem::remove_all(profile_, ignored);
 }
 
 nlohmann::json DevToolsPage::call(const std::string& method, nlohmann::json params,
                                   std::chrono::milliseconds timeout) {
-  if (!socket_ || soup_websocket_connection_get_state(socket_) != SOUP_WEBSOCKET_STATE_OPEN)
+  return callOn(socket_, method, std::move(params), timeout);
+}
+
+nlohmann::json DevToolsPage::callOn(SoupWebsocketConnection* socket, const std::string& method,
+                                    nlohmann::json params, std::chrono::milliseconds timeout) {
+  if (!socket || soup_websocket_connection_get_state(socket) != SOUP_WEBSOCKET_STATE_OPEN)
     return {{"error", "not connected"}};
   ContextScope scope(context_);
   int id = nextId_++;
   soup_websocket_connection_send_text(
-      socket_, nlohmann::json{{"id", id}, {"method", method}, {"params", params}}.dump().c_str());
+      socket, nlohmann::json{{"id", id}, {"method", method}, {"params", params}}.dump().c_str());
   auto key = std::to_string(id);
   for (auto until = Clock::now() + patience(timeout); Clock::now() < until;) {
     if (replies_.contains(key)) {
@@ -241,6 +198,17 @@ bool DevToolsPage::waitUntil(const std::string& expression, std::chrono::millise
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return false;
+}
+
+bool DevToolsPage::allowDownloads(const std::filesystem::path& folder) {
+  // The browser's to set, for the context (a page's session sets only the
+  // default context's).
+  auto allowed = callOn(browser_, "Browser.setDownloadBehavior",
+                        {{"behavior", "allow"},
+                         {"browserContextId", browserContextId_},
+                         {"downloadPath", folder.string()}});
+  if (allowed.contains("error")) std::cerr << "downloads refused: " << allowed.dump() << "\n";
+  return !allowed.contains("error");
 }
 
 bool DevToolsPage::setCookie(const std::string& name, const std::string& value,

@@ -21,10 +21,12 @@ namespace wircam::testing {
 
 class DevToolsPage {
  public:
-  // Starts chromium with a fresh profile in `profile` (removed at the end)
-  // and `extraFlags`, attaches to its first tab and loads a first page on a
-  // start-up budget of its own (45 s), apart from what the test then
-  // bounds; nullptr (with the reason on stderr) if it cannot.
+  // A page of `width`×`height` in a browser context of its own (fresh
+  // cookies, storage and cache) of the program's Chromium (ChromiumBrowser:
+  // one for each set of `extraFlags`, its profile beside `profile`), that
+  // has loaded a first page on a start-up budget of its own (45 s), apart
+  // from what the test then bounds; nullptr (with the reason on stderr) if
+  // it cannot. Its context is closed with it.
   static std::unique_ptr<DevToolsPage> launch(const std::filesystem::path& profile, int width,
                                               int height,
                                               const std::vector<std::string>& extraFlags = {});
@@ -44,6 +46,8 @@ class DevToolsPage {
   // Polls `expression` until it is true.
   bool waitUntil(const std::string& expression,
                  std::chrono::milliseconds timeout = std::chrono::seconds(10));
+  // Downloads from this page's context go to `folder`.
+  bool allowDownloads(const std::filesystem::path& folder);
   bool setCookie(const std::string& name, const std::string& value, const std::string& url);
   void key(const char* type, const std::string& key);  // type: keyDown or keyUp
   void click(double x, double y);
@@ -62,17 +66,20 @@ class DevToolsPage {
 
  private:
   DevToolsPage() = default;
-  bool attach(const std::string& webSocketUrl);
+  SoupWebsocketConnection* connect(const std::string& webSocketUrl);
+  nlohmann::json callOn(SoupWebsocketConnection* socket, const std::string& method,
+                        nlohmann::json params = nlohmann::json::object(),
+                        std::chrono::milliseconds timeout = std::chrono::seconds(10));
   // Keeps the page focused whatever its window does (key events).
   bool keepsFocus();
   // Loads a first page with its own start-up budget (DevToolsPage::launch).
   bool warmUp();
 
-  std::filesystem::path profile_;
-  pid_t chromium_ = -1;
   GMainContext* context_ = g_main_context_new();
   SoupSession* session_ = nullptr;
-  SoupWebsocketConnection* socket_ = nullptr;
+  SoupWebsocketConnection* browser_ = nullptr;  // the browser's own target
+  SoupWebsocketConnection* socket_ = nullptr;   // the page's
+  std::string browserContextId_;
   std::string targetId_;
   int nextId_ = 1;
   nlohmann::json replies_ = nlohmann::json::object();  // id → message

@@ -42,9 +42,7 @@ TEST(WebExport, TheDaysTimelinePlaysAcrossSegmentsAndARangeDownloadsAsAFileThatP
   fs::path downloads = shotPath("web-export-downloads");
   fs::remove_all(downloads);
   fs::create_directories(downloads);
-  auto allowed = page.call("Browser.setDownloadBehavior",
-                           {{"behavior", "allow"}, {"downloadPath", downloads.string()}});
-  ASSERT_FALSE(allowed.contains("error")) << allowed.dump();
+  ASSERT_TRUE(page.allowDownloads(downloads));
 
   // A point at a fraction of the timeline's time axis, in its segments'
   // row, once it is scrolled into view (the player opening moves it).
