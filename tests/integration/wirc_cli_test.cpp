@@ -92,6 +92,61 @@ TEST(WircCli, RefusesAnArgumentACommandDoesNotTake) {
   EXPECT_NE(run.output.find("request-control takes 1 argument"), std::string::npos) << run.output;
 }
 
+// Found by a stranger's trial: an option of another command (an --ssid
+// given to info, --json to decode, --host to positions) was ignored; and
+// what the device would refuse was refused only after logging in. Port 9
+// (discard): nothing listens, so a refusal must come before any login.
+TEST(WircCli, RefusesAnotherCommandsOptionAndWhatTheDeviceWouldRefuseBeforeLoggingIn) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"info --host 127.0.0.1 --port 9 --ssid lab", "info does not take --ssid"},
+      {"decode --json", "decode does not take --json"},
+      {"positions --host 127.0.0.1 --marvelmind 127.0.0.1:9 --beacon 5",
+       "positions does not take --host"},
+      {"drive --protocol rcoip --host 127.0.0.1 --steering 1500 --throttle 1500 --md5 00",
+       "drive does not take --md5"},
+      {"set-name --host 127.0.0.1 --port 9 "
+       "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa",
+       "at most 64"},
+      {"wifi --ssid lab --country USA --host 127.0.0.1 --port 9", "not 'USA'"},
+      {"wifi --ssid lab --country 12 --host 127.0.0.1 --port 9", "not '12'"},
+  };
+  for (const auto& [line, said] : cases) {
+    auto run = wircCli(line);
+    EXPECT_EQ(run.exitCode, 2) << line << "\n" << run.output;
+    EXPECT_NE(run.output.find(said), std::string::npos) << line << "\n" << run.output;
+  }
+}
+
+// Found by a stranger's trial: decode printed nothing and exited 0 for
+// input that held no message, and encode filled a misspelt field with 0.
+TEST(WircCli, DecodeSaysWhatIsNoMessageAndEncodeWantsEveryField) {
+  auto junk = runCommand("printf 'hello world' | " + std::string(WIRCAM_BIN_DIR) +
+                         "/wirc-cli decode --raw");
+  EXPECT_EQ(junk.exitCode, 1) << junk.output;
+  EXPECT_NE(junk.output.find(R"("error":"garbage")"), std::string::npos) << junk.output;
+  auto cut = runCommand("echo 'AA BB 01' | " + std::string(WIRCAM_BIN_DIR) + "/wirc-cli decode");
+  EXPECT_EQ(cut.exitCode, 1) << cut.output;
+  EXPECT_NE(cut.output.find(R"("error":"truncated")"), std::string::npos) << cut.output;
+  auto misspelt = runCommand(R"(echo '{"type":"STST","camra":1,"port":5000}' | )" +
+                             std::string(WIRCAM_BIN_DIR) + "/wirc-cli encode");
+  EXPECT_EQ(misspelt.exitCode, 1) << misspelt.output;
+  EXPECT_NE(misspelt.output.find(R"("camra" is no field of STST)"), std::string::npos)
+      << misspelt.output;
+}
+
+TEST(WircCli, HelpFitsAnEightyColumnTerminal) {
+  auto help = wircCli("--help");
+  EXPECT_EQ(help.exitCode, 0);
+  std::istringstream lines(help.output);
+  std::string line;
+  while (std::getline(lines, line)) {
+    // Characters, not bytes (µ, Δ, ±).
+    size_t width = 0;
+    for (unsigned char c : line) width += (c & 0xC0) != 0x80;
+    EXPECT_LE(width, 79u) << line;
+  }
+}
+
 // A stream of a camera the device lacks is refused before the file is
 // made (a stranger found an empty one left behind).
 TEST(WircCli, AStreamOfACameraTheDeviceLacksLeavesNoFile) {

@@ -75,16 +75,32 @@ bool holdsAFraction(const nlohmann::json& json) {
   return false;
 }
 
-// The field a value did not fit (nlohmann wraps 300 into a uint8_t as 44):
-// the message written back must say what the input said.
-std::optional<std::string> misfit(const nlohmann::json& input, const wirc::Message& message) {
+// What is wrong with the input's fields, as the message written back shows
+// them: a key that is no field of the message (a misspelt one would
+// otherwise be left at its default), a field left out (no silent default
+// either), or a value the field cannot hold (nlohmann wraps 300 into a
+// uint8_t as 44). WCFG takes its password, which it writes back only as
+// passwordLength.
+std::optional<std::string> fieldProblem(const std::string& type, const nlohmann::json& input,
+                                        const wirc::Message& message) {
   nlohmann::json written = std::visit([](const auto& m) { return nlohmann::json(m); }, message);
-  if (!written.is_object()) return std::nullopt;
+  if (!written.is_object()) written = nlohmann::json::object();
+  bool isWcfg = std::holds_alternative<wirc::Wcfg>(message);
+  std::string fields;
+  for (const auto& [key, value] : written.items())
+    if (!(isWcfg && key == "passwordLength")) fields += (fields.empty() ? "" : ", ") + key;
+  if (isWcfg) fields += ", password";
+  std::string known = " (" + type + "'s fields: " + (fields.empty() ? "none" : fields) + ")";
   for (const auto& [key, value] : input.items()) {
-    if (key == "type" || key == "password" || !written.contains(key)) continue;
+    if (key == "type" || (isWcfg && key == "password")) continue;
+    if (!written.contains(key) || (isWcfg && key == "passwordLength"))
+      return "\"" + key + "\" is no field of " + type + known;
     if (written[key] != value)
       return "\"" + key + "\": " + value.dump() + " does not fit the field";
   }
+  for (const auto& [key, value] : written.items())
+    if (!input.contains(key) && !(isWcfg && key == "passwordLength"))
+      return type + " needs \"" + key + "\"" + known;
   return std::nullopt;
 }
 
@@ -98,7 +114,7 @@ Expected<wirc::Message, std::string> messageOfType(const std::string& type,
     if (wirc::commandName(static_cast<uint8_t>(T::kCommand)) != type)
       return messageOfType<I + 1>(type, json);
     wirc::Message message{json.get<T>()};
-    if (auto field = misfit(json, message)) return unexpected(*field);
+    if (auto problem = fieldProblem(type, json, message)) return unexpected(*problem);
     return message;
   }
 }

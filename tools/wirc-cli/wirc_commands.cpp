@@ -6,6 +6,7 @@
 #include <poll.h>
 #include <sys/socket.h>
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -258,6 +259,26 @@ int decode(const Options& o) {
       std::cout << error.dump() << "\n";
     }
   });
+  // Bytes that were no message (skipped before a frame's start) or the
+  // start of one the input cut off: said as errors too, not passed over.
+  if (auto skipped = parser.stats().garbageBytes) {
+    ++errors;
+    std::cout << nlohmann::json{{"error", "garbage"},
+                                {"bytes", skipped},
+                                {"message", std::to_string(skipped) +
+                                                " bytes were no message (no AA BB before them)"}}
+                     .dump()
+              << "\n";
+  }
+  if (auto cut = parser.pendingBytes()) {
+    ++errors;
+    std::cout << nlohmann::json{{"error", "truncated"},
+                                {"bytes", cut},
+                                {"message",
+                                 "the input ends " + std::to_string(cut) + " bytes into a message"}}
+                     .dump()
+              << "\n";
+  }
   return errors > 0 ? 1 : 0;
 }
 
@@ -302,8 +323,11 @@ int configure(const Options& o) {
 }
 
 int setName(const Options& o) {
+  wirc::Dcfg message{.name = o.positional[0]};
+  // Refused before the login: what the device would refuse is a usage error.
+  if (auto invalid = wirc::validate(message)) usageError(invalid->message());
   auto session = login(o);
-  sendConfiguration(*session, wirc::Dcfg{.name = o.positional[0]}, milliseconds(500));
+  sendConfiguration(*session, message, milliseconds(500));
   std::printf("the device takes the name '%s' at its next restart\n", o.positional[0].c_str());
   return 0;
 }
@@ -336,17 +360,20 @@ int wifi(const Options& o) {
   if (!o.ssid) usageError("wifi needs --ssid");
   // The radio's legal channels and power depend on it: no silent default.
   if (!o.country) usageError("wifi needs --country CC, the two-letter country code (e.g. HU)");
+  if (o.country->size() != 2 || !std::isalpha(static_cast<unsigned char>((*o.country)[0])) ||
+      !std::isalpha(static_cast<unsigned char>((*o.country)[1])))
+    usageError("--country wants a two-letter country code (e.g. HU), not '" + *o.country + "'");
   std::string password;
   if (o.passwordStdin) std::getline(std::cin, password);
+  wirc::Wcfg message{.ssid = *o.ssid,
+                     .password = password,
+                     .accessPoint = !o.station,
+                     .secured = !password.empty(),
+                     .channel = static_cast<uint8_t>(o.channel),
+                     .country = *o.country};
+  if (auto invalid = wirc::validate(message)) usageError(invalid->message());
   auto session = login(o);
-  sendConfiguration(*session,
-                    wirc::Wcfg{.ssid = *o.ssid,
-                               .password = password,
-                               .accessPoint = !o.station,
-                               .secured = !password.empty(),
-                               .channel = static_cast<uint8_t>(o.channel),
-                               .country = *o.country},
-                    milliseconds(500));
+  sendConfiguration(*session, message, milliseconds(500));
   std::printf("WiFi settings sent (password %s); they apply after the device restarts\n",
               password.empty() ? "none: open network" : "set");
   return 0;

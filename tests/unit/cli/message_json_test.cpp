@@ -19,6 +19,24 @@ TEST(MessageJson, RefusesAValueTheFieldCannotHold) {
   EXPECT_FALSE(fromJson(nlohmann::json::parse(R"({"type":"EST","camera":-1})")).has_value());
 }
 
+TEST(MessageJson, RefusesAMisspeltFieldAndAMissingOneInsteadOfADefault) {
+  auto misspelt = fromJson(nlohmann::json::parse(R"({"type":"STST","camra":1,"port":5000})"));
+  ASSERT_FALSE(misspelt.has_value());
+  EXPECT_EQ(misspelt.error(), "\"camra\" is no field of STST (STST's fields: camera, port)");
+  auto missing = fromJson(nlohmann::json::parse(R"({"type":"STST","camera":1})"));
+  ASSERT_FALSE(missing.has_value());
+  EXPECT_EQ(missing.error(), "STST needs \"port\" (STST's fields: camera, port)");
+  // A message without fields takes none.
+  EXPECT_TRUE(fromJson(nlohmann::json::parse(R"({"type":"TLR"})")).has_value());
+  EXPECT_FALSE(fromJson(nlohmann::json::parse(R"({"type":"TLR","x":1})")).has_value());
+  // WCFG takes its password, and what decode writes (passwordLength) is not input.
+  auto wifi = fromJson(nlohmann::json::parse(
+      R"({"type":"WCFG","ssid":"car","password":"secret12","accessPoint":true,)"
+      R"("secured":true,"channel":6,"country":"HU"})"));
+  ASSERT_TRUE(wifi.has_value()) << wifi.error();
+  EXPECT_EQ(std::get<wirc::Wcfg>(*wifi).password, "secret12");
+}
+
 TEST(MessageJson, RefusesFractions) {
   auto message = fromJson(nlohmann::json::parse(R"({"type":"EST","camera":90500.2})"));
   ASSERT_FALSE(message.has_value());
