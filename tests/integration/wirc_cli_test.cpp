@@ -43,6 +43,14 @@ TEST(WircCli, RequestControlExitsOneWithTheReasonWhenTheDeviceDenies) {
   EXPECT_NE(run.output.find("boss"), std::string::npos) << run.output;
 }
 
+TEST(WircCli, RequestControlForAConnectionNobodyHoldsSaysSo) {
+  auto device = std::move(*Device::start({.port = 0}, nullptr));
+  auto run = wircCli("request-control 9 --host 127.0.0.1 --port " + std::to_string(device->port()));
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("no transmitter is logged in as connection 9"), std::string::npos)
+      << run.output;
+}
+
 TEST(WircCli, RequestControlExitsZeroWhenGranted) {
   auto device = std::move(*Device::start({.port = 0}, nullptr));
   auto run = wircCli("request-control 1 --host 127.0.0.1 --port " + std::to_string(device->port()) +

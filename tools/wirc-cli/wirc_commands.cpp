@@ -6,6 +6,7 @@
 #include <poll.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -59,7 +60,16 @@ int requestControlFor(const Options& o, uint8_t id) {
   if (!came)
     fail("no answer to the control request within " + std::to_string(o.timeout.count()) + " ms");
   auto answer = future.get();
-  if (!answer.granted) fail("control request denied: " + answer.reason);
+  if (!answer.granted) {
+    // The device's denial has no reason field: a connection nobody holds
+    // is told apart from one the priorities keep, by the device's list.
+    auto list = session->listTransmitters(o.timeout);
+    if (list && std::none_of(list->begin(), list->end(),
+                             [id](const auto& t) { return t.connectionId == id; }))
+      fail("control request denied: no transmitter is logged in as connection " +
+           std::to_string(id) + " (wirc-cli transmitters lists them)");
+    fail("control request denied: " + answer.reason);
+  }
   std::printf("control right given to connection %u\n", id);
   return 0;
 }

@@ -161,8 +161,10 @@ LoginActions LoginMachine::onMessage(const Message& message, Clock::time_point n
 LoginActions LoginMachine::controlRight(const Agr& agr) {
   LoginActions actions;
   bool had = status_.hasControl;
-  bool answersRequest = controlRequests_ > 0;
-  if (answersRequest) --controlRequests_;
+  bool answersRequest =
+      !controlRequests_.empty() && (agr.notification == AccessNotification::Denied ||
+                                    agr.connectionId == controlRequests_.front());
+  if (answersRequest) controlRequests_.pop_front();
   switch (agr.notification) {
     case AccessNotification::Granted:
       status_.hasControl = true;
@@ -197,8 +199,8 @@ LoginActions LoginMachine::deviceError(const Err& err, Clock::time_point now) {
   ++status_.errorsReceived;
   errors_.push_back(err);
   if (errors_.size() > 16) errors_.erase(errors_.begin());
-  if (err.command == static_cast<uint8_t>(Command::Areq) && controlRequests_ > 0) {
-    --controlRequests_;
+  if (err.command == static_cast<uint8_t>(Command::Areq) && !controlRequests_.empty()) {
+    controlRequests_.pop_front();
     actions.push_back(Emit{link::ControlRequestAnswered{false, errorCodeMeaning(err.code)}});
   }
   actions.push_back(
@@ -283,7 +285,7 @@ LoginActions LoginMachine::fail(const std::string& why, Clock::time_point now, R
   status_.state = state;
   status_.reason = why;
   controlAddress_.reset();
-  controlRequests_ = 0;
+  controlRequests_.clear();
   if (!retry) {
     phase_ = Phase::Closed;
     return actions;
@@ -329,7 +331,7 @@ bool LoginMachine::hasCamera(uint8_t camera) const {
 
 LoginActions LoginMachine::requestControl(uint8_t connectionId) {
   if (!connected()) return {Emit{link::ControlRequestAnswered{false, "not logged in"}}};
-  ++controlRequests_;
+  controlRequests_.push_back(connectionId);
   return {Send{Areq{connectionId}}};
 }
 

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <chrono>
+#include <deque>
 #include <map>
 #include <optional>
 #include <string>
@@ -159,7 +160,11 @@ class LoginMachine {
   bool listComplete_ = false;
   std::vector<Err> errors_;
   uint64_t failedAttempts_ = 0;
-  int controlRequests_ = 0;  // AREQ sent and not answered yet
+  // The connections named by AREQs sent and not answered yet, oldest first.
+  // An AGR answers the oldest when it denies it or names that connection as
+  // the controller: the AGR a login brings (control to the first
+  // transmitter) is no answer to a request for another connection.
+  std::deque<uint8_t> controlRequests_;
 };
 
 }  // namespace wircam::wirc

@@ -261,6 +261,23 @@ TEST_F(LoginMachineTest, TheControlRightItsRequestsAndTheirAnswers) {
   EXPECT_FALSE(machine_.status().hasControl);
 }
 
+// A stranger's trial: `wirc-cli request-control 9` (no connection 9)
+// said "control right given to connection 9". The AGR that gave the right
+// to the CLI at its login came after the AREQ left and was taken for the
+// answer; the device's denial came next and was passed over.
+TEST_F(LoginMachineTest, AnAgrNamingAnotherConnectionIsNoAnswerToARequest) {
+  loginAt(milliseconds(0));
+  machine_.requestControl(9);
+  auto ownGrant = machine_.onMessage(
+      Agr{.connectionId = 1, .name = "me", .notification = AccessNotification::Granted}, now_);
+  EXPECT_NE(findEvent<link::ControlRightChanged>(ownGrant), nullptr);
+  EXPECT_EQ(findEvent<link::ControlRequestAnswered>(ownGrant), nullptr);
+  auto denied = machine_.onMessage(
+      Agr{.connectionId = 1, .name = "me", .notification = AccessNotification::Denied}, now_);
+  ASSERT_NE(findEvent<link::ControlRequestAnswered>(denied), nullptr);
+  EXPECT_FALSE(findEvent<link::ControlRequestAnswered>(denied)->granted);
+}
+
 TEST_F(LoginMachineTest, AGrantedRequestSaysTheRightChangedBeforeItAnswers) {
   // wirccontrol posts the answer with the right it holds then: answered
   // first, a granted request read "has-control=false, request=granted" (a
