@@ -77,17 +77,13 @@ std::string FleetPublisher::topic(const std::string& stream, const char* leaf) c
   return settings_.prefix + "/" + stream + "/" + leaf;
 }
 
-// On the MQTT thread, at each connection: who we are, what we know, and
-// what we listen to.
+// On the MQTT thread, at each connection: what we listen to, what we know,
+// who we are, and last that we are online. The broker takes a client's
+// packets in order, so whoever sees "online" finds our subscriptions in
+// place: a command sent on seeing it was lost when "online" went first
+// (a test under load found the recorder deaf to three commands).
 void FleetPublisher::republish(MqttClient& client) {
   sessionClient_ = &client;
-  client.publish(settings_.prefix + "/available", "online", true, 1);
-  {
-    std::lock_guard lock(retainedMutex_);
-    for (const auto& [stream, status] : retained_)
-      client.publish(topic(stream, "status"), status, true);
-    if (!announcement_.empty()) client.publish(announcementTopic_, announcement_, true, 1);
-  }
   if (settings_.fleet) {
     client.subscribe(std::string(kFleetTopicRoot) + "+");
     for (const auto& prefix : directory_.prefixes()) follow(client, prefix);
@@ -96,13 +92,19 @@ void FleetPublisher::republish(MqttClient& client) {
     client.subscribe(settings_.prefix + "/+/" + command);
     client.subscribe(std::string(kVehicleTopicRoot) + "+/" + command);
   }
-  if (settings_.discovery) {
+  // Our earlier configs come back retained: those of cameras gone are cleared.
+  if (settings_.discovery) client.subscribe(discoverySubscription(*settings_.discovery));
+  {
+    std::lock_guard lock(retainedMutex_);
+    for (const auto& [stream, status] : retained_)
+      client.publish(topic(stream, "status"), status, true);
+    if (!announcement_.empty()) client.publish(announcementTopic_, announcement_, true, 1);
+  }
+  if (settings_.discovery)
     for (const auto& stream : streamNames())
       for (const auto& [configTopic, config] : discoveryConfigs(*settings_.discovery, stream))
         client.publish(configTopic, config, true, 1);
-    // Our earlier configs come back retained: those of cameras gone are cleared.
-    client.subscribe(discoverySubscription(*settings_.discovery));
-  }
+  client.publish(settings_.prefix + "/available", "online", true, 1);
 }
 
 // A retained config of this recorder for a camera it no longer has: an
