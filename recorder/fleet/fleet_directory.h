@@ -22,6 +22,9 @@ namespace wircam::recorder {
 struct FleetViewScope {
   std::optional<std::string> recorder;  // by id: that one alone
   bool cameras = true;                  // false: each recorder's camera counts only
+  // Only the cameras whose name, vehicle name or serial, or recorder's host
+  // or id holds this (case aside), and only the recorders that have one.
+  std::optional<std::string> match;
 };
 
 class FleetDirectory {

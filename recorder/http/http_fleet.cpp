@@ -1,6 +1,7 @@
 // HttpServer's fleet endpoints (--fleet): the fleet's view, whole or a
 // recorder at a time, and commands for a vehicle wherever it is.
 #include <algorithm>
+#include <cstring>
 #include <nlohmann/json.hpp>
 
 #include "fleet/fleet_announcement.h"
@@ -30,6 +31,12 @@ void HttpServer::serveFleet(SoupServerMessage* message, GHashTable* query) {
     if (g_strcmp0(cameras, "true") != 0 && g_strcmp0(cameras, "false") != 0)
       return respondJsonError(message, SOUP_STATUS_BAD_REQUEST, "cameras takes true or false");
     scope.cameras = g_strcmp0(cameras, "true") == 0;
+  }
+  if (const char* match = queryValue(query, "match")) {
+    if (!*match || std::strlen(match) > 128)
+      return respondJsonError(message, SOUP_STATUS_BAD_REQUEST,
+                              "match takes 1 to 128 characters of a camera, vehicle or recorder");
+    scope.match = match;
   }
   auto view = content_.fleet(scope);
   if (scope.recorder && view.value("recorders", nlohmann::json::array()).empty())

@@ -200,6 +200,8 @@ int main(int argc, char** argv) {
   // recorders with their counts, and one recorder's cameras.
   auto counts = askFiveTimes("/api/fleet?cameras=false");
   auto one = askFiveTimes("/api/fleet?recorder=bench-recorder-0");
+  // The page's search: a vehicle's serial (here on a camera of each recorder).
+  auto found = askFiveTimes("/api/fleet?match=S217");
   std::pair<double, double> whole;
   double fleetCpu =
       measure("wirc-recorder --fleet", recorder, [&] { whole = askFiveTimes("/api/fleet"); });
@@ -222,6 +224,8 @@ int main(int argc, char** argv) {
               counts.first, counts.second / 1e3, whole.first > 0 ? counts.first / whole.first : 0);
   std::printf("GET /api/fleet?recorder=ID: %.0f ms, %.1f kB (%.3fx the whole's time)\n", one.first,
               one.second / 1e3, whole.first > 0 ? one.first / whole.first : 0);
+  std::printf("GET /api/fleet?match=S217: %.0f ms, %.1f kB (%.3fx the whole's time)\n", found.first,
+              found.second / 1e3, whole.first > 0 ? found.first / whole.first : 0);
   uint64_t dropped = 0;
   for (const auto& member : fleet) dropped += member.client->stats().dropped;
   std::printf("statuses dropped by the simulated recorders' clients (unsent over %llu): %llu\n",

@@ -271,9 +271,29 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
         page->evaluate("document.querySelectorAll('.fleet-recorder[data-online=true]').length"), 3);
     page->evaluate("document.getElementById('fleet').scrollIntoView()");
     page->screenshot(shotPath("fleet-page.png"));
+    // "Where is S3?": typed into the search, only its camera shows; cleared,
+    // all four again.
+    const std::string shown =
+        "[...document.querySelectorAll('.fleet-recorder:not([hidden]) .fleet-camera')]"
+        ".map(c => c.dataset.camera).join(',')";
+    page->evaluate("document.getElementById('fleet-search').focus()");
+    for (char c : std::string("s3")) page->call("Input.insertText", {{"text", std::string(1, c)}});
+    EXPECT_TRUE(page->waitUntil(shown + " === 'car3-cam0'", 10s)) << page->evaluate(shown);
+    EXPECT_EQ(page->evaluate("document.getElementById('fleet-found').textContent"),
+              "1 camera found");
+    page->evaluate(
+        "const box = document.getElementById('fleet-search'); box.value = '';"
+        "box.dispatchEvent(new Event('input'))");
+    EXPECT_TRUE(page->waitUntil(shown + ".split(',').length === 4", 10s)) << page->evaluate(shown);
   }
   // A recorder without --fleet says so.
   EXPECT_EQ(fetch(first.url() + "api/fleet", "GET", kAuthorized).status, 404u);
+  // Searched by the API as by the page.
+  auto found = getJson(third.url() + "api/fleet?match=s3")["recorders"];
+  ASSERT_EQ(found.size(), 1u) << found.dump();
+  ASSERT_EQ(found[0]["cameras"].size(), 1u) << found.dump();
+  EXPECT_EQ(found[0]["cameras"][0]["name"], "car3-cam0");
+  EXPECT_EQ(fetch(third.url() + "api/fleet?match=", "GET", kAuthorized).status, 400u);
 
   // car2 drives from the first recorder to the second: the second takes it
   // on (a reload), then the first lets it go (another).

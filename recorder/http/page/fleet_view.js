@@ -206,9 +206,39 @@ document.addEventListener("visibilitychange", () => {
   if (document.hidden) stopFleetDriving("the tab was hidden");
 });
 
+// What the search box asks for: the recorders that have a match, each
+// with its matching cameras only, the others hidden (the server searches:
+// one request, whatever the fleet's size).
+async function showFleetMatches(text) {
+  const response = await fetch(`/api/fleet?match=${encodeURIComponent(text)}`);
+  if (!response.ok) return response.status !== 404;
+  const matched = (await response.json()).recorders;
+  const ids = new Set(matched.map(r => r.id));
+  for (const [id, view] of fleetViews)
+    if (!ids.has(id)) {
+      view.box.hidden = true;
+      showFleetCameras({ cameras: [] }, view);
+    }
+  let found = 0;
+  for (const recorder of matched) {
+    const view = fleetRecorderView(recorder);
+    view.box.hidden = false;
+    showFleetRecorderHead(recorder, view);
+    showFleetCameras(recorder, view);
+    found += recorder.cameras.length;
+  }
+  document.getElementById("fleet").hidden = false;
+  document.getElementById("fleet-found").textContent =
+      found ? `${found} camera${found === 1 ? "" : "s"} found` : "no camera matches";
+  return true;
+}
+
 // The recorders without their cameras, then the cameras of each recorder
-// that is open, one request each.
+// that is open, one request each; or, while the search box holds text,
+// the cameras that match it.
 async function refreshFleet() {
+  const search = document.getElementById("fleet-search").value.trim();
+  if (search) return showFleetMatches(search);
   const response = await fetch("/api/fleet?cameras=false");
   if (!response.ok) return false;  // not a fleet recorder
   const fleet = await response.json();
@@ -219,10 +249,12 @@ async function refreshFleet() {
       view.box.remove();
       fleetViews.delete(id);
     }
+  document.getElementById("fleet-found").textContent = "";
   const cameras = fleet.recorders.reduce((sum, r) => sum + r.camera_count, 0);
   await Promise.all(fleet.recorders.map(async recorder => {
     const view = fleetRecorderView(recorder);
     if (view.open === undefined) view.open = cameras <= fleetOpenUpTo;
+    view.box.hidden = false;
     showFleetRecorderHead(recorder, view);
     if (!view.open) return showFleetCameras({ ...recorder, cameras: [] }, view);
     const one = await fetch(`/api/fleet?recorder=${encodeURIComponent(recorder.id)}`);
@@ -236,9 +268,16 @@ async function refreshFleet() {
 async function startFleet() {
   if (!(await refreshFleet())) return;
   let refreshing = false;  // a slow answer is not asked again over itself
-  setInterval(async () => {
+  const refresh = async () => {
     if (refreshing) return;
     refreshing = true;
     try { await refreshFleet(); } finally { refreshing = false; }
-  }, fleetPictureMs);
+  };
+  setInterval(refresh, fleetPictureMs);
+  // A search shows as it is typed, a pause after the last key.
+  let typing = 0;
+  document.getElementById("fleet-search").addEventListener("input", () => {
+    clearTimeout(typing);
+    typing = setTimeout(refresh, 250);
+  });
 }

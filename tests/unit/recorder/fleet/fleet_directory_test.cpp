@@ -121,6 +121,30 @@ TEST(FleetDirectory, IsViewedARecorderAtATimeOrWithCountsAlone) {
   EXPECT_TRUE(fleet.view({.recorder = "nope"})["recorders"].empty());
 }
 
+// "Where is car 7?" among thousands of cameras: the ones whose name,
+// vehicle or serial holds the text (case aside), or all a recorder's when
+// its host or id does; recorders without one left out.
+TEST(FleetDirectory, IsSearchedByCameraVehicleSerialOrRecorder) {
+  FleetDirectory fleet;
+  auto a = recorderOf("a1", "lab/a", "garage-cam0", 1);
+  a.cameras.push_back({"garage-cam1", VehicleIdentity{"rover-2", "R2D2"}, ""});
+  fleet.announced("wircam-fleet/recorders/a1", toJson(a).dump(), 1000);
+  fleet.announced("wircam-fleet/recorders/b2",
+                  toJson(recorderOf("b2", "lab/b", "yard-cam0", 1)).dump(), 1000);
+  auto bySerial = fleet.view({.match = "r2d"})["recorders"];
+  ASSERT_EQ(bySerial.size(), 1u);
+  ASSERT_EQ(bySerial[0]["cameras"].size(), 1u);
+  EXPECT_EQ(bySerial[0]["cameras"][0]["name"], "garage-cam1");
+  EXPECT_EQ(bySerial[0]["camera_count"], 2);  // the recorder's own count, whole
+  auto byVehicle = fleet.view({.match = "CAR-7"})["recorders"];
+  ASSERT_EQ(byVehicle.size(), 2u);  // car-7 is seen by a camera of each
+  EXPECT_EQ(byVehicle[0]["cameras"].size(), 1u);
+  auto byRecorder = fleet.view({.match = "node-b2"})["recorders"];
+  ASSERT_EQ(byRecorder.size(), 1u);
+  EXPECT_EQ(byRecorder[0]["cameras"][0]["name"], "yard-cam0");
+  EXPECT_TRUE(fleet.view({.match = "nothing like it"})["recorders"].empty());
+}
+
 TEST(FleetDirectory, ARetainedAnnouncementOfADeadRecorderSaysWhenItWasSeen) {
   FleetDirectory fleet;
   fleet.announced("wircam-fleet/recorders/a1",
