@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "http/request_head_gate.h"
+#include "http/head_watch_stream.h"
 
 namespace wircam::recorder {
 
@@ -121,20 +121,7 @@ gboolean HttpConnections::onIncoming(GSocketService*, GSocketConnection* connect
   g_object_weak_ref(G_OBJECT(connection), onConnectionGone,
                     new GoneWatch{self, endpoint, connection, self->alive_});
   g_clear_object(&remote);
-  // HTTPS: libsoup gets the TLS stream over the connection at once (its
-  // head is encrypted). Plain HTTP: once its first head is seen to be
-  // within libsoup's bound, or answered 414/431 if not.
-  if (self->certificate_) {
-    self->handOn(connection);
-  } else {
-    std::weak_ptr<bool> alive = self->alive_;
-    gateRequestHead(connection, [self, alive](GSocketConnection* gated) {
-      if (alive.lock())
-        self->handOn(gated);
-      else
-        g_io_stream_close(G_IO_STREAM(gated), nullptr, nullptr);
-    });
-  }
+  self->handOn(connection);
   return TRUE;
 }
 
@@ -174,12 +161,18 @@ void HttpConnections::handOn(GSocketConnection* connection) {
   GError* error = nullptr;
   // HTTPS: libsoup gets the TLS stream over the connection (which it keeps
   // alive: the slot is still the connection's). The handshake happens on
-  // the first read.
+  // the first read. Plain or not, each request head it reads is within its
+  // bound or answered 414/431 (head_watch_stream.h).
   GIOStream* stream = G_IO_STREAM(g_object_ref(connection));
   if (certificate_) {
     GIOStream* tls = g_tls_server_connection_new(stream, certificate_, &error);
     g_object_unref(stream);
     stream = tls;
+  }
+  if (stream) {
+    GIOStream* watched = watchRequestHeads(stream, connection);
+    g_object_unref(stream);
+    stream = watched;
   }
   if (!stream || !local || !remote ||
       !soup_server_accept_iostream(server_, stream, local, remote, &error))

@@ -13,6 +13,7 @@
 #include "http/http_responses.h"
 #include "http/http_routes.h"
 #include "http/page_resources.h"
+#include "http/request_head_framer.h"
 #include "log_line.h"
 #include "record/telemetry_log.h"
 #include "recording/playback_stream.h"
@@ -287,9 +288,23 @@ void HttpServer::onHeaders(SoupServer*, SoupServerMessage* message, const char* 
       nullptr);
 }
 
+// 414 when the request line alone is over the bound, 431 otherwise; the
+// connection closed (the head's rest is dropped meanwhile).
+void HttpServer::answerOverlongHead(SoupServerMessage* message, GHashTable* query) {
+  bool line = g_strcmp0(queryValue(query, "part"), "line") == 0;
+  soup_message_headers_replace(soup_server_message_get_response_headers(message), "Connection",
+                               "close");
+  respondJsonError(message, line ? SOUP_STATUS_REQUEST_URI_TOO_LONG : 431,
+                   line ? "the request line is over 64 KiB: shorten the URL's query"
+                        : "the request's line and header fields are over 64 KiB together: send "
+                          "fewer or shorter headers");
+}
+
 void HttpServer::onRequest(SoupServer*, SoupServerMessage* message, const char* path,
                            GHashTable* query, gpointer data) {
   auto* self = static_cast<HttpServer*>(data);
+  // What stands for a request head over libsoup's bound (request_head_framer.h).
+  if (g_strcmp0(path, kOverlongHeadPath) == 0) return answerOverlongHead(message, query);
   auto route = routeOf(path);
   std::string method = soup_server_message_get_method(message);
   if (sharedAcrossOrigins(route.kind) && !self->content_.token.empty()) {

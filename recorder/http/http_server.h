@@ -70,6 +70,7 @@ class HttpServer : public WebServer {
   static void onHeaders(SoupServer*, SoupServerMessage* message, const char* path, GHashTable*,
                         gpointer self);
   static void onRequestEnded(SoupServer*, SoupServerMessage* message, gpointer self);
+  static void answerOverlongHead(SoupServerMessage* message, GHashTable* query);
   std::string page() const;  // the live view page with the current state
   bool authorised(SoupServerMessage* message) const;
   void serveLive(SoupServerMessage* message, const std::string& camera);
