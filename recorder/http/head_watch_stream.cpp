@@ -205,6 +205,70 @@ static void wircam_head_watch_input_pollable_init(GPollableInputStreamInterface*
   iface->read_nonblocking = readNonblocking;
 }
 
+// The stream libsoup is given: the watched input and the connection's
+// output. Closed on the caller's thread, even when asked asynchronously
+// (libsoup's WebSockets do): GIOStream's default would close it on a
+// worker thread, one more thread for the server to keep.
+struct WircamHeadWatchIOStream {
+  GIOStream parent;
+  GInputStream* input;    // owned
+  GOutputStream* output;  // owned
+};
+struct WircamHeadWatchIOStreamClass {
+  GIOStreamClass parent_class;
+};
+G_DEFINE_TYPE(WircamHeadWatchIOStream, wircam_head_watch_io_stream, G_TYPE_IO_STREAM)
+
+namespace {
+
+WircamHeadWatchIOStream* ioOf(gpointer stream) {
+  return reinterpret_cast<WircamHeadWatchIOStream*>(stream);
+}
+
+GInputStream* inputOf(GIOStream* stream) { return ioOf(stream)->input; }
+GOutputStream* outputOf(GIOStream* stream) { return ioOf(stream)->output; }
+
+gboolean closeBoth(GIOStream* stream, GCancellable* cancellable, GError**) {
+  // The output first (what libsoup wrote is flushed), then the input, whose
+  // closing closes the connection (or drains it first).
+  g_output_stream_close(outputOf(stream), cancellable, nullptr);
+  g_input_stream_close(inputOf(stream), cancellable, nullptr);
+  return TRUE;
+}
+
+void closeNow(GIOStream* stream, int, GCancellable* cancellable, GAsyncReadyCallback callback,
+              gpointer data) {
+  GTask* task = g_task_new(stream, cancellable, callback, data);
+  g_task_return_boolean(task, closeBoth(stream, cancellable, nullptr));
+  g_object_unref(task);
+}
+
+gboolean closedNow(GIOStream*, GAsyncResult* result, GError** error) {
+  return g_task_propagate_boolean(G_TASK(result), error);
+}
+
+void finalizeIo(GObject* object) {
+  g_clear_object(&ioOf(object)->input);
+  g_clear_object(&ioOf(object)->output);
+  G_OBJECT_CLASS(wircam_head_watch_io_stream_parent_class)->finalize(object);
+}
+
+}  // namespace
+
+static void wircam_head_watch_io_stream_class_init(WircamHeadWatchIOStreamClass* klass) {
+  G_OBJECT_CLASS(klass)->finalize = finalizeIo;
+  G_IO_STREAM_CLASS(klass)->get_input_stream = inputOf;
+  G_IO_STREAM_CLASS(klass)->get_output_stream = outputOf;
+  G_IO_STREAM_CLASS(klass)->close_fn = closeBoth;
+  G_IO_STREAM_CLASS(klass)->close_async = closeNow;
+  G_IO_STREAM_CLASS(klass)->close_finish = closedNow;
+}
+
+static void wircam_head_watch_io_stream_init(WircamHeadWatchIOStream* self) {
+  self->input = nullptr;
+  self->output = nullptr;
+}
+
 namespace wircam::recorder {
 
 GIOStream* watchRequestHeads(GIOStream* stream, GSocketConnection* connection) {
@@ -213,10 +277,10 @@ GIOStream* watchRequestHeads(GIOStream* stream, GSocketConnection* connection) {
                                      FALSE, nullptr));
   input->watched = G_IO_STREAM(g_object_ref(stream));
   input->connection = G_SOCKET_CONNECTION(g_object_ref(connection));
-  GIOStream* watched =
-      g_simple_io_stream_new(G_INPUT_STREAM(input), g_io_stream_get_output_stream(stream));
-  g_object_unref(input);
-  return watched;
+  auto* watched = ioOf(g_object_new(wircam_head_watch_io_stream_get_type(), nullptr));
+  watched->input = G_INPUT_STREAM(input);
+  watched->output = G_OUTPUT_STREAM(g_object_ref(g_io_stream_get_output_stream(stream)));
+  return G_IO_STREAM(watched);
 }
 
 }  // namespace wircam::recorder
