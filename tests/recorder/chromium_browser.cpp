@@ -49,6 +49,9 @@ bool ChromiumBrowser::start(const std::vector<std::string>& extraFlags) {
     // Gone with the test program, even one that crashed.
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent) _exit(127);
+    // Its singleton socket's folder goes with the profile, not into /tmp
+    // (a killed browser leaves it behind: thousands over a day of runs).
+    setenv("TMPDIR", profile_.c_str(), 1);
     std::vector<char*> argv;
     for (auto& arg : args) argv.push_back(arg.data());
     argv.push_back(nullptr);
