@@ -104,7 +104,17 @@ void expectAHungPageStopsTheCar(DevToolsPage& page, const wirc::Device& device) 
 
 void expectAClosedTabStopsTheCar(DevToolsPage& page, const wirc::Device& device) {
   page.call("Debugger.resume");
-  ASSERT_TRUE(waitFor([&] { return device.outputs().pulses[kThrottle] > 1500; }));
+  // The key pressed again, as its user would after a hang. Once, on a
+  // loaded machine, the car was at neutral before the hang already and the
+  // resumed page did not drive: a window that loses focus lets go of its
+  // keys (control.js), focus emulation or not. If it no longer drives at
+  // all, the page says why.
+  page.key("keyDown", "ArrowUp");
+  ASSERT_TRUE(waitFor([&] { return device.outputs().pulses[kThrottle] > 1500; }))
+      << "the resumed page does not drive: "
+      << page.evaluate(
+             "`${document.querySelector('.drive-info').textContent}, keys "
+             "${JSON.stringify(keys)}, focused ${document.hasFocus()}`");
   page.closeTab();
   auto closed = untilNeutral(device);
   // The dead-man (250 ms after the last command, which left up to 100 ms
