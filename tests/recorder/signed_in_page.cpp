@@ -87,15 +87,25 @@ void expectJunkStopsTheCarAtOnce(DevToolsPage& page, const wirc::Device& device)
   EXPECT_EQ(page.evaluate("window.answer.neutral"), true);
 }
 
+namespace {
+
+// What the page says of its driving, for a failure's message.
+std::string driveStateOf(DevToolsPage& page) {
+  return page
+      .evaluate(
+          "`${document.querySelector('.drive-info').textContent}, keys "
+          "${JSON.stringify(keys)}, focused ${document.hasFocus()}`")
+      .dump();
+}
+
+}  // namespace
+
 void expectAHungPageStopsTheCar(DevToolsPage& page, const wirc::Device& device) {
   // Driving ahead when it hangs (seen at the car: else a car already at
   // neutral would pass without a dead-man lapse).
   page.key("keyDown", "ArrowUp");
   ASSERT_TRUE(waitFor([&] { return device.outputs().pulses[kThrottle] > 1500; }))
-      << "drive mode no longer drives: "
-      << page.evaluate(
-             "`${document.querySelector('.drive-info').textContent}, keys "
-             "${JSON.stringify(keys)}, focused ${document.hasFocus()}`");
+      << "drive mode no longer drives: " << driveStateOf(page);
   page.pauseScripts();
   auto hung = untilNeutral(device);
   EXPECT_LE(hung.count(), 250 + 100 + 100) << "neutral " << hung.count() << " ms after the hang";
@@ -111,10 +121,7 @@ void expectAClosedTabStopsTheCar(DevToolsPage& page, const wirc::Device& device)
   // all, the page says why.
   page.key("keyDown", "ArrowUp");
   ASSERT_TRUE(waitFor([&] { return device.outputs().pulses[kThrottle] > 1500; }))
-      << "the resumed page does not drive: "
-      << page.evaluate(
-             "`${document.querySelector('.drive-info').textContent}, keys "
-             "${JSON.stringify(keys)}, focused ${document.hasFocus()}`");
+      << "the resumed page does not drive: " << driveStateOf(page);
   page.closeTab();
   auto closed = untilNeutral(device);
   // The dead-man (250 ms after the last command, which left up to 100 ms

@@ -271,24 +271,17 @@ int decode(const Options& o) {
   });
   // Bytes that were no message (skipped before a frame's start) or the
   // start of one the input cut off: said as errors too, not passed over.
-  if (auto skipped = parser.stats().garbageBytes) {
+  auto sayLeftOver = [&](const char* kind, size_t bytes, const std::string& message) {
     ++errors;
-    std::cout << nlohmann::json{{"error", "garbage"},
-                                {"bytes", skipped},
-                                {"message", std::to_string(skipped) +
-                                                " bytes were no message (no AA BB before them)"}}
-                     .dump()
+    std::cout << nlohmann::json{{"error", kind}, {"bytes", bytes}, {"message", message}}.dump()
               << "\n";
-  }
-  if (auto cut = parser.pendingBytes()) {
-    ++errors;
-    std::cout << nlohmann::json{{"error", "truncated"},
-                                {"bytes", cut},
-                                {"message",
-                                 "the input ends " + std::to_string(cut) + " bytes into a message"}}
-                     .dump()
-              << "\n";
-  }
+  };
+  if (auto skipped = parser.stats().garbageBytes)
+    sayLeftOver("garbage", skipped,
+                std::to_string(skipped) + " bytes were no message (no AA BB before them)");
+  if (auto cut = parser.pendingBytes())
+    sayLeftOver("truncated", cut,
+                "the input ends " + std::to_string(cut) + " bytes into a message");
   return errors > 0 ? 1 : 0;
 }
 
@@ -370,8 +363,11 @@ int wifi(const Options& o) {
   if (!o.ssid) usageError("wifi needs --ssid");
   // The radio's legal channels and power depend on it: no silent default.
   if (!o.country) usageError("wifi needs --country CC, the two-letter country code (e.g. HU)");
-  if (o.country->size() != 2 || !std::isalpha(static_cast<unsigned char>((*o.country)[0])) ||
-      !std::isalpha(static_cast<unsigned char>((*o.country)[1])))
+  // (The protocol's field is "2 characters and a zero byte"; codes are letters.)
+  bool twoLetters =
+      o.country->size() == 2 && std::all_of(o.country->begin(), o.country->end(),
+                                            [](unsigned char c) { return std::isalpha(c) != 0; });
+  if (!twoLetters)
     usageError("--country wants a two-letter country code (e.g. HU), not '" + *o.country + "'");
   std::string password;
   if (o.passwordStdin) std::getline(std::cin, password);
