@@ -22,7 +22,10 @@ ChromiumBrowser* ChromiumBrowser::shared(const std::filesystem::path& folder,
   // Ended (killed, its profile removed) when the program exits.
   static std::map<std::vector<std::string>, std::unique_ptr<ChromiumBrowser>> browsers;
   auto& browser = browsers[extraFlags];
-  if (browser && waitpid(browser->pid_, nullptr, WNOHANG) == 0) return browser.get();
+  if (browser) {
+    if (waitpid(browser->pid_, nullptr, WNOHANG) == 0) return browser.get();
+    browser->pid_ = -1;  // gone and reaped: its number may be another's now
+  }
   browser.reset(new ChromiumBrowser());
   browser->profile_ =
       processProfile(folder / ("chromium-profile-" + std::to_string(browsers.size())));
