@@ -161,8 +161,9 @@ std::vector<OptionSpec> recordingRows() {
        .help = "how much of a camera's video may wait for a slow disk (`100K`..`1G`); past "
                "it the newest frames are dropped from the file, counted in `/api/status` "
                "(`recording_dropped`), `/metrics` and the log, while the live view, detection "
-               "and following go on. `0`: no queue, a thread less per camera, but a disk that "
-               "stalls then stalls the camera's source and branches too",
+               "and following go on. One thread writes the files of every camera on a "
+               "filesystem. `0`: each camera writes its own on its source's thread, so a disk "
+               "that stalls then stalls the camera's source and branches too",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          auto bytes = byteSize(value);
          if (!bytes || (*bytes != 0 && (*bytes < 100'000 || *bytes > 1'000'000'000)))

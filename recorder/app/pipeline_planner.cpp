@@ -34,7 +34,8 @@ MuxerSpec muxerOf(Container container) {
 
 // What the frames pass through on their way to the file, ending in the
 // element named `tail`.
-std::string encoder(const RecorderOptions& options, const std::string& tail) {
+std::string encoder(const RecorderOptions& options, const std::string& head,
+                    const std::string& tail) {
   if (options.codec == Codec::kJpeg) return "";
   // zerolatency: no B-frames and no look-ahead, so the live recording does
   // not lag. The recorder asks for a key frame at each cut and every 0.5 s
@@ -42,7 +43,8 @@ std::string encoder(const RecorderOptions& options, const std::string& tail) {
   // as "avc" only, and the file is linked after the caps are settled. Main
   // profile: what browsers decode over WebRTC (Chromium and Safari offer
   // it), so the live view passes the recording's frames on as they are.
-  return "tjpegdec ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
+  return "tjpegdec name=" + head +
+         " ! videoconvert ! x264enc speed-preset=veryfast tune=zerolatency bitrate=" +
          std::to_string(options.h264Kbps) +
          " key-int-max=60 ! h264parse ! capsfilter name=" + tail +
          " caps=\"video/x-h264,stream-format=avc,alignment=au,profile=main\" ";
@@ -125,23 +127,16 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
            " camera=" + std::to_string(camera) + " wait-for-device=true ";
       if (device.positions) d += "! " + positionsOf(*device.positions, stream.positions);
       if (branches) d += "! tee name=" + tee + " ";
-      // The file's own queue: a slow disk holds up neither the source nor
-      // the other branches; past its bound it drops (camera/queue_drops.h).
-      // Without it (--record-queue 0) the frames reach the file on the
-      // source's thread: a thread less per camera.
+      // The files are written by their filesystem's thread (a slow disk
+      // holds up neither the source nor the other branches; past its
+      // bound a camera's frames are dropped, camera/disk_writer.h).
+      // Without it (--record-queue 0), on the source's thread.
+      stream.recordBound = options.recordQueueBytes;
       std::string toFile = branches ? tee + ". ! " : "! ";
-      if (options.recordQueueBytes > 0) {
-        stream.recordQueue = "rq";
-        d += toFile + "queue name=" + stream.recordQueue +
-             " max-size-buffers=0 max-size-time=0 max-size-bytes=" +
-             std::to_string(options.recordQueueBytes) + " ";
-        toFile = "! ";
-      }
       if (plan.transcoded) {
         stream.videoTail = "enc";
-        d += toFile + encoder(options, stream.videoTail);
-      } else if (!stream.recordQueue.empty()) {
-        stream.videoTail = stream.recordQueue;
+        stream.planPoint = "recdec";
+        d += toFile + encoder(options, stream.planPoint, stream.videoTail);
       } else {
         stream.videoTail = branches ? tee : device.positions ? stream.positions : stream.source;
       }

@@ -65,8 +65,9 @@ struct RecorderOptions {
   // The telemetry as a text track in each file too (always in the sidecar).
   // Without it a stream is one thread and no hand-off per frame.
   bool telemetryTrack = true;
-  // Each camera's recording queue: what waits for a slow disk, in bytes;
-  // past it frames are dropped (and counted).
+  // How much of each camera's video may wait for a slow disk, in bytes;
+  // past it frames are dropped (and counted). 0: written on the camera's
+  // own thread.
   uint64_t recordQueueBytes = 8'000'000;
   unsigned h264Kbps = 2000;
   std::string detectFamily;  // empty: no detection

@@ -133,7 +133,7 @@ class Camera {
   static gboolean onDeadline(gpointer self);
   bool play();
   void publishState();
-  // The recording queue's drops: into the report, and the log.
+  // The frames dropped for the disk: into the report, and the log.
   void reportDrops();
 
   StreamPlan plan_;
@@ -152,7 +152,7 @@ class Camera {
   guint deadlineTimer_ = 0;  // at machine_.nextDeadline()
   uint64_t filesClosed_ = 0;
   uint64_t framesSeen_ = 0;      // the frames that came for the files, at the last tick
-  uint64_t earlierDropped_ = 0;  // by the recording queues of past runs
+  uint64_t earlierDropped_ = 0;  // for the disk, in past runs
   std::optional<CameraHealth::Clock::time_point> dropLogged_;
   GstClockTime statsTime_ = GST_CLOCK_TIME_NONE;  // of the last wirc-stats
   bool everLive_ = false;                         // logged in at least once

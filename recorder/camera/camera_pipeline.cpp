@@ -27,20 +27,24 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
   camera->track_ = std::make_unique<TelemetryTrack>(camera->element(plan.telemetrySource),
                                                     plan.muxer.textGapEvents);
   camera->telemetry_ = std::make_unique<TelemetryRouter>(*camera->planner_, *camera->track_);
+  if (plan.recordBound > 0) {
+    auto writer = DiskWriter::of(files.folder);
+    if (!writer) return unexpected(writer.error());
+    camera->disk_ = {std::move(*writer), std::make_shared<DiskBudget>(plan.recordBound)};
+  }
   camera->writer_ = std::make_unique<SegmentWriter>(
       SegmentWriter::Parts{.pipeline = camera->pipeline_,
                            .source = camera->element(plan.source),
-                           .planPoint = camera->element(plan.recordQueue),
+                           .planPoint = camera->element(plan.planPoint),
                            .videoTail = camera->element(plan.videoTail),
                            .textTail = camera->element(plan.telemetryTail),
                            .muxer = plan.muxer,
+                           .disk = camera->disk_,
                            .transcoded = files.transcoded},
       *camera->planner_, *camera->track_, [self = camera.get()] {
         self->telemetry_->onFrame();
         self->framesPlanned_.fetch_add(1, std::memory_order_relaxed);
       });
-  if (GstElement* queue = camera->element(plan.recordQueue))
-    camera->drops_ = std::make_unique<QueueDrops>(queue);
   if (frames && !plan.liveSink.empty()) {
     frames->attach(camera->element(plan.liveSink));
     camera->frames_ = frames;
@@ -61,7 +65,6 @@ CameraPipeline::~CameraPipeline() {
   if (encoded_) encoded_->detach();
   // The writer holds the elements' pads: before the pipeline goes.
   writer_.reset();
-  drops_.reset();
   telemetry_.reset();
   track_.reset();
   gst_object_unref(pipeline_);

@@ -12,9 +12,9 @@
 #include <optional>
 #include <string>
 
+#include "camera/disk_writer.h"
 #include "camera/frame_tap.h"
 #include "camera/pipeline_plan.h"
-#include "camera/queue_drops.h"
 #include "camera/segment_writer.h"
 #include "common/expected.h"
 #include "record/segment_planner.h"
@@ -55,12 +55,13 @@ class CameraPipeline {
   bool hasFrames() const { return planner_->current().has_value(); }
   // Frames that reached the files' planner so far (any thread).
   uint64_t framesPlanned() const { return framesPlanned_.load(); }
-  // The frames the recording queue dropped for want of room (its file
-  // behind), this run.
-  uint64_t framesDropped() const { return drops_ ? drops_->dropped() : 0; }
+  // The frames dropped for want of room (their disk behind), this run.
+  uint64_t framesDropped() const { return disk_.budget ? disk_.budget->framesDropped() : 0; }
   // The frames that came for the files: the camera's health counts these,
   // not the ones written (a slow disk is not a camera without video).
-  uint64_t framesArrived() const { return drops_ ? drops_->arrived() : framesPlanned(); }
+  uint64_t framesArrived() const {
+    return disk_.budget ? disk_.budget->framesArrived() : framesPlanned();
+  }
 
  private:
   CameraPipeline() = default;
@@ -68,11 +69,11 @@ class CameraPipeline {
   GstElement* pipeline_ = nullptr;
   FrameTap* frames_ = nullptr;
   FrameTap* encoded_ = nullptr;
+  CameraDisk disk_;
   std::unique_ptr<SegmentPlanner> planner_;
   std::unique_ptr<TelemetryTrack> track_;
   std::unique_ptr<TelemetryRouter> telemetry_;
   std::unique_ptr<SegmentWriter> writer_;
-  std::unique_ptr<QueueDrops> drops_;
   std::atomic<uint64_t> framesPlanned_{0};
 };
 

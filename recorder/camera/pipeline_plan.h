@@ -31,9 +31,13 @@ struct StreamPlan {
   int camera = 0;
   std::string name;    // "<device>-cam<N>", also in file names and the live view
   std::string source;  // wircsrc
-  // The recording branch's queue (bounded in bytes, camera/queue_drops.h):
-  // frames are planned into files as they leave it. Empty: at the source.
-  std::string recordQueue;
+  // The encoder's first element: frames are planned into files (or
+  // dropped for the disk) as they enter it. Empty: as they leave videoTail.
+  std::string planPoint;
+  // How much of the camera's video may wait for its disk, in bytes
+  // (camera/disk_writer.h); past it frames are dropped and counted. 0: the
+  // files are written on the camera's own thread (a filesink).
+  uint64_t recordBound = 0;
   std::string videoTail;        // the last element before the files' muxer (a tee: a new pad)
   std::string telemetrySource;  // appsrc of the files' text track (empty: no track)
   std::string telemetryTail;    // the last element before the muxer on the text track

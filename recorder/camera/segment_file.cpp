@@ -1,33 +1,61 @@
 #include "camera/segment_file.h"
 
+#include <cerrno>
+#include <cstring>
+#include <utility>
+
+#include "camera/disk_sink.h"
+
 namespace wircam::recorder {
 
-Expected<std::unique_ptr<SegmentFile>, std::string> SegmentFile::open(GstElement* pipeline,
-                                                                      const MuxerSpec& muxer,
-                                                                      const std::string& path,
-                                                                      GstClockTime start,
-                                                                      uint64_t number) {
+Expected<GstElement*, std::string> SegmentFile::makeSink(const CameraDisk& disk) {
+  if (disk.writer) {
+    auto file = DiskWriter::open(path_);
+    if (!file) {
+      // On the bus, as filesink's would be: the camera starts again (or,
+      // the disk full, stops).
+      int why = file.error();
+      int code = why == ENOSPC || why == EDQUOT ? GST_RESOURCE_ERROR_NO_SPACE_LEFT
+                                                : GST_RESOURCE_ERROR_OPEN_WRITE;
+      std::string message = "cannot open " + path_ + ": " + std::strerror(why);
+      GError* error = g_error_new_literal(GST_RESOURCE_ERROR, code, message.c_str());
+      gst_element_post_message(pipeline_,
+                               gst_message_new_error(GST_OBJECT(pipeline_), error, nullptr));
+      g_error_free(error);
+      return unexpected(message);
+    }
+    return makeDiskSink(disk.writer, std::move(*file), disk.budget, [this] { postClosed(); });
+  }
+  GstElement* sink = gst_element_factory_make("filesink", nullptr);
+  if (!sink) return unexpected(std::string("no filesink (gst-plugins-good)"));
+  writtenBySink_ = true;
+  // filesink would gather 64 KB before it writes: minutes of a low-rate
+  // stream that a crash would lose; the muxers write in pieces of a frame
+  // or more. Not async: a sink added to a playing pipeline must not take
+  // it back to PAUSED until its first frame.
+  g_object_set(sink, "location", path_.c_str(), "async", FALSE, nullptr);
+  gst_util_set_object_arg(G_OBJECT(sink), "buffer-mode", "unbuffered");
+  return sink;
+}
+
+Expected<std::unique_ptr<SegmentFile>, std::string> SegmentFile::open(
+    GstElement* pipeline, const MuxerSpec& muxer, const CameraDisk& disk, const std::string& path,
+    GstClockTime start, uint64_t number) {
   std::unique_ptr<SegmentFile> file(new SegmentFile);
   file->pipeline_ = pipeline;
   file->path_ = path;
   file->start_ = start;
   file->number_ = number;
   file->muxer_ = gst_element_factory_make(muxer.factory.c_str(), nullptr);
-  file->sink_ = gst_element_factory_make("filesink", nullptr);
-  if (!file->muxer_ || !file->sink_) {
-    if (file->muxer_) gst_object_unref(file->muxer_);
-    if (file->sink_) gst_object_unref(file->sink_);
-    file->muxer_ = file->sink_ = nullptr;
-    return unexpected("no " + muxer.factory + " or filesink (gst-plugins-good)");
+  if (!file->muxer_) return unexpected("no " + muxer.factory + " (gst-plugins-good)");
+  auto sink = file->makeSink(disk);
+  if (!sink) {
+    gst_object_unref(std::exchange(file->muxer_, nullptr));
+    return unexpected(sink.error());
   }
+  file->sink_ = *sink;
   for (const auto& [name, value] : muxer.properties)
     gst_util_set_object_arg(G_OBJECT(file->muxer_), name.c_str(), value.c_str());
-  // filesink would gather 64 KB before it writes: minutes of a low-rate
-  // stream that a crash would lose; the muxers write in pieces of a frame
-  // or more. Not async: a sink added to a playing pipeline must not take
-  // it back to PAUSED until its first frame.
-  g_object_set(file->sink_, "location", path.c_str(), "async", FALSE, nullptr);
-  gst_util_set_object_arg(G_OBJECT(file->sink_), "buffer-mode", "unbuffered");
   gst_bin_add_many(GST_BIN(pipeline), file->muxer_, file->sink_, nullptr);
   gst_element_link(file->muxer_, file->sink_);
   GstPad* sinkPad = gst_element_get_static_pad(file->sink_, "sink");
@@ -70,12 +98,15 @@ GstPadProbeReturn SegmentFile::onSinkEvent(GstPad*, GstPadProbeInfo* info, gpoin
   auto* self = static_cast<SegmentFile*>(data);
   if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_OK;
   self->closed_ = true;
-  gst_element_post_message(
-      self->sink_,
-      gst_message_new_element(GST_OBJECT(self->sink_),
-                              gst_structure_new(kClosedMessage, "location", G_TYPE_STRING,
-                                                self->path_.c_str(), nullptr)));
+  if (self->writtenBySink_) self->postClosed();
   return GST_PAD_PROBE_OK;
+}
+
+void SegmentFile::postClosed() {
+  gst_element_post_message(
+      sink_, gst_message_new_element(GST_OBJECT(sink_),
+                                     gst_structure_new(kClosedMessage, "location", G_TYPE_STRING,
+                                                       path_.c_str(), nullptr)));
 }
 
 }  // namespace wircam::recorder

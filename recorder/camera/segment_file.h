@@ -1,11 +1,13 @@
 // One recorded file in a camera's pipeline: a muxer of GStreamer's own and a
-// filesink, added while the pipeline plays and removed once the file is
-// finished. Its inputs are shifted by the file's first frame's running
-// time, so that its timeline begins at 0.
+// sink (the filesystem's DiskWriter's, or a filesink), added while the
+// pipeline plays and removed once the file is finished. Its inputs are
+// shifted by the file's first frame's running time, so that its timeline
+// begins at 0.
 //
-// When the filesink has seen EOS (the muxer has finished the file) it posts
-// an element message named kClosedMessage with the file's "location"; the
-// camera then takes the file out of the pipeline on the main loop.
+// Once the file is written (the muxer has finished it and its bytes are
+// on the disk) the sink posts an element message named kClosedMessage with
+// the file's "location"; the camera then takes the file out of the
+// pipeline on the main loop.
 #pragma once
 
 #include <gst/gst.h>
@@ -15,6 +17,7 @@
 #include <memory>
 #include <string>
 
+#include "camera/disk_writer.h"
 #include "camera/pipeline_plan.h"
 #include "common/expected.h"
 
@@ -25,13 +28,11 @@ class SegmentFile {
   static constexpr const char* kOpenedMessage = "wircam-file-opened";
   static constexpr const char* kClosedMessage = "wircam-file-closed";
 
-  // In `pipeline`, playing, writing `path`; posts kOpenedMessage. `number`
-  // is the file's (TelemetryTrack::fileOpened's).
-  static Expected<std::unique_ptr<SegmentFile>, std::string> open(GstElement* pipeline,
-                                                                  const MuxerSpec& muxer,
-                                                                  const std::string& path,
-                                                                  GstClockTime start,
-                                                                  uint64_t number);
+  // In `pipeline`, playing, writing `path` to `disk`; posts
+  // kOpenedMessage. `number` is the file's (TelemetryTrack::fileOpened's).
+  static Expected<std::unique_ptr<SegmentFile>, std::string> open(
+      GstElement* pipeline, const MuxerSpec& muxer, const CameraDisk& disk, const std::string& path,
+      GstClockTime start, uint64_t number);
   // Out of the pipeline (NULL first). Not on a thread that streams into it.
   ~SegmentFile();
   SegmentFile(const SegmentFile&) = delete;
@@ -54,6 +55,9 @@ class SegmentFile {
   SegmentFile() = default;
   static void end(GstPad* input, std::atomic<bool>& ended);
   static GstPadProbeReturn onSinkEvent(GstPad* pad, GstPadProbeInfo* info, gpointer self);
+  void postClosed();
+  // The sink for `path`, or an error.
+  Expected<GstElement*, std::string> makeSink(const CameraDisk& disk);
 
   GstElement* pipeline_ = nullptr;  // borrowed
   GstElement* muxer_ = nullptr;     // owned by the pipeline while in it
@@ -64,6 +68,7 @@ class SegmentFile {
   GstClockTime start_ = 0;
   uint64_t number_ = 0;
   std::atomic<bool> videoEnded_{false}, textEnded_{false}, closed_{false};
+  bool writtenBySink_ = false;  // a filesink: on the disk as the muxer ends
 };
 
 }  // namespace wircam::recorder

@@ -56,13 +56,13 @@ SegmentWriter::SegmentWriter(Parts parts, SegmentPlanner& planner, TelemetryTrac
       afterFrame_(std::move(afterFrame)) {
   gst_segment_init(&sourceSegment_, GST_FORMAT_TIME);
   gst_segment_init(&videoSegment_, GST_FORMAT_TIME);
-  sourcePad_ =
-      gst_element_get_static_pad(parts_.planPoint ? parts_.planPoint : parts_.source, "src");
   videoPad_ = gst_element_get_static_pad(parts_.videoTail, "src");
   if (!videoPad_) {  // a tee: the file's branch is a pad of its own
     videoPad_ = gst_element_request_pad_simple(parts_.videoTail, "src_%u");
     videoPadRequested_ = true;
   }
+  sourcePad_ = parts_.planPoint ? gst_element_get_static_pad(parts_.planPoint, "sink")
+                                : GST_PAD(gst_object_ref(videoPad_));
   if (parts_.textTail) textPad_ = gst_element_get_static_pad(parts_.textTail, "src");
   // The frame must be planned (and its file opened) before it is routed:
   // on one pad, in one probe.
@@ -89,8 +89,8 @@ SegmentWriter::~SegmentWriter() {
 }
 
 GstPadProbeReturn SegmentWriter::onSourceData(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
-  static_cast<SegmentWriter*>(data)->planFrame(pad, info);
-  return GST_PAD_PROBE_OK;
+  return static_cast<SegmentWriter*>(data)->planFrame(pad, info) ? GST_PAD_PROBE_OK
+                                                                 : GST_PAD_PROBE_DROP;
 }
 
 GstPadProbeReturn SegmentWriter::onVideoOut(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
@@ -100,7 +100,7 @@ GstPadProbeReturn SegmentWriter::onVideoOut(GstPad* pad, GstPadProbeInfo* info, 
 GstPadProbeReturn SegmentWriter::onSourceDataAndVideoOut(GstPad* pad, GstPadProbeInfo* info,
                                                          gpointer data) {
   auto* self = static_cast<SegmentWriter*>(data);
-  self->planFrame(pad, info);
+  if (!self->planFrame(pad, info)) return GST_PAD_PROBE_DROP;
   return self->routeFrame(pad, info);
 }
 
@@ -108,11 +108,27 @@ GstPadProbeReturn SegmentWriter::onTextOut(GstPad* pad, GstPadProbeInfo* info, g
   return static_cast<SegmentWriter*>(data)->routeText(pad, info);
 }
 
-void SegmentWriter::planFrame(GstPad* pad, GstPadProbeInfo* info) {
-  if (isEvent(info)) return keepSegment(info, sourceSegment_);
+bool SegmentWriter::noRoomFor(GstBuffer* frame) {
+  DiskBudget* budget = parts_.disk.budget.get();
+  if (!budget) return false;
+  budget->arrived();
+  // A frame that depends on a dropped one would not decode: the drop goes
+  // on to the next key frame.
+  bool key = !GST_BUFFER_FLAG_IS_SET(frame, GST_BUFFER_FLAG_DELTA_UNIT);
+  dropping_ = budget->full() || (dropping_ && !key);
+  if (dropping_) budget->dropped();
+  return dropping_;
+}
+
+bool SegmentWriter::planFrame(GstPad* pad, GstPadProbeInfo* info) {
+  if (isEvent(info)) {
+    keepSegment(info, sourceSegment_);
+    return true;
+  }
   GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  if (noRoomFor(buffer)) return false;
   GstClockTime time = runningTimeOf(sourceSegment_, buffer);
-  if (!GST_CLOCK_TIME_IS_VALID(time)) return;
+  if (!GST_CLOCK_TIME_IS_VALID(time)) return true;
   auto cut = planner_.onFrame(time, [this, time] { return unixMsOf(parts_.source, time); });
   // The encoder makes this very frame a key frame (the event travels just
   // ahead of it): at a cut, and every kKeyFrameInterval, whatever the frame
@@ -123,20 +139,27 @@ void SegmentWriter::planFrame(GstPad* pad, GstPadProbeInfo* info) {
   if (cut == SegmentPlanner::Cut::kFirst) lastKeyFrame_ = time;
   bool due = time >= lastKeyFrame_ + kKeyFrameInterval;
   if (parts_.transcoded && (cut == SegmentPlanner::Cut::kNext || due)) {
-    gst_pad_push_event(pad, gst_video_event_new_downstream_force_key_unit(
-                                GST_BUFFER_PTS(buffer), GST_CLOCK_TIME_NONE, time, TRUE, 0));
+    GstEvent* keyFrame = gst_video_event_new_downstream_force_key_unit(
+        GST_BUFFER_PTS(buffer), GST_CLOCK_TIME_NONE, time, TRUE, 0);
+    // Into the encoder's chain: ahead of the frame, on its thread.
+    if (GST_PAD_IS_SINK(pad))
+      gst_pad_send_event(pad, keyFrame);
+    else
+      gst_pad_push_event(pad, keyFrame);
     lastKeyFrame_ = time;
   }
   if (cut != SegmentPlanner::Cut::kNone) open(time);
   afterFrame_();
   track_.heartbeat(time);
+  return true;
 }
 
 void SegmentWriter::open(GstClockTime start) {
   auto planned = planner_.current();
   if (!planned) return;
   MutexLock lock(mutex_);
-  auto file = SegmentFile::open(parts_.pipeline, parts_.muxer, planned->path, start, opened_ + 1);
+  auto file = SegmentFile::open(parts_.pipeline, parts_.muxer, parts_.disk, planned->path, start,
+                                opened_ + 1);
   if (!file) {
     // Its error is on the bus too, and the camera starts again.
     logLine(std::string(GST_OBJECT_NAME(parts_.pipeline)) + ": " + file.error());

@@ -1,8 +1,9 @@
 // Writes one stream's frames and telemetry into the files the
-// SegmentPlanner plans, each file a muxer and a filesink of its own
+// SegmentPlanner plans, each file a muxer and a sink of its own
 // (SegmentFile), with no queue and no thread of its own:
-// - a probe where the frames leave the recording queue (or the source)
-//   shows each to the planner;
+// - a probe where the frames enter the recording (the encoder, or where
+//   they leave for the file) drops each frame its disk has no room for
+//   (CameraDisk's budget) and shows the others to the planner;
 //   at a cut it opens the next file there and then (forcing a key frame
 //   first when the stream is transcoded, as every 0.5 s), and after each
 //   frame it sends the text track's heartbeat;
@@ -36,12 +37,14 @@ class SegmentWriter {
   struct Parts {
     GstElement* pipeline;
     GstElement* source;  // wircsrc: its end ends the recording
-    // Frames are planned as they leave it (the recording queue, so that a
-    // frame it drops is never planned); null: the source.
+    // Frames are planned (or dropped for the disk) as they enter it: the
+    // encoder, so that a dropped frame is never encoded; null: as they
+    // leave videoTail.
     GstElement* planPoint;
     GstElement* videoTail;  // frames leave it for the file (a tee: by a pad of their own)
     GstElement* textTail;   // the telemetry leaves it for the file (null: no text track)
     MuxerSpec muxer;
+    CameraDisk disk;
     bool transcoded;  // key frames come from an encoder that can be asked for one
   };
   // `afterFrame` runs on the source's thread once each frame is planned.
@@ -68,7 +71,11 @@ class SegmentWriter {
   static GstPadProbeReturn onSourceDataAndVideoOut(GstPad* pad, GstPadProbeInfo* info,
                                                    gpointer self);
   static GstPadProbeReturn onTextOut(GstPad* pad, GstPadProbeInfo* info, gpointer self);
-  void planFrame(GstPad* pad, GstPadProbeInfo* info);
+  // False: the frame is dropped (its disk is behind).
+  bool planFrame(GstPad* pad, GstPadProbeInfo* info);
+  // The frame's disk has no room for it, or a frame before it that it
+  // depends on was dropped; counted.
+  bool noRoomFor(GstBuffer* frame);
   GstPadProbeReturn routeFrame(GstPad* pad, GstPadProbeInfo* info);
   GstPadProbeReturn routeText(GstPad* pad, GstPadProbeInfo* info);
   // The text goes to file `number` from now on; false: it has no file.
@@ -96,6 +103,7 @@ class SegmentWriter {
   GstSegment sourceSegment_{};     // the source's segment, on its thread
   GstSegment videoSegment_{};      // the frames' segment where they leave, on that thread
   GstClockTime lastKeyFrame_ = 0;  // asked of the encoder, on the source's thread
+  bool dropping_ = false;          // until a key frame, on the source's thread
 
   mutable Mutex mutex_;
   std::deque<std::unique_ptr<SegmentFile>> files_ WIRCAM_GUARDED_BY(mutex_);  // oldest first

@@ -37,8 +37,8 @@ struct CameraReport {
   // The source's figures, from its last wirc-stats.
   uint64_t frames = 0, incomplete = 0, bytes = 0;
   uint64_t commandsSent = 0;  // PCD to the WiRC vehicle, keepalives included
-  // Frames received but not recorded: the recording queue was full (the
-  // file fell behind the camera: a slow or stalled disk).
+  // Frames received but not recorded: what waited for the camera's disk
+  // had reached its bound (a slow or stalled disk).
   uint64_t recordingDropped = 0;
   double fps = 0, kbps = 0;
   unsigned batteryMv = 0;

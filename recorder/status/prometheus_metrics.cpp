@@ -72,8 +72,8 @@ std::string prometheusText(const RecorderMetrics& m) {
              "Frames lost because packets of them never came (the stream's loss).");
   out.perCamera<uint64_t>(m.cameras, [](Report c) { return c.incomplete; });
   out.family("wircam_recording_dropped_frames_total", "counter",
-             "Frames received but not recorded: the camera's recording queue was full (its "
-             "file behind: a slow or stalled disk).");
+             "Frames received but not recorded: the camera's bytes waiting for its disk "
+             "had reached --record-queue (a slow or stalled disk).");
   out.perCamera<uint64_t>(m.cameras, [](Report c) { return c.recordingDropped; });
   out.family("wircam_received_bytes_total", "counter", "JPEG bytes received from the device.");
   out.perCamera<uint64_t>(m.cameras, [](Report c) { return c.bytes; });

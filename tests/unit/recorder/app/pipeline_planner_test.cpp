@@ -32,11 +32,12 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   const auto& d = plan.description();
   EXPECT_TRUE(has(d, "wircsrc name=" + s.source + " host=10.0.0.2 port=1984"));
   EXPECT_TRUE(has(d, "wait-for-device=true"));
-  // The frames reach the file through its own bounded queue (a slow disk
-  // holds up nothing else), no tee (the SegmentWriter puts each file in).
-  EXPECT_EQ(s.videoTail, s.recordQueue);
-  EXPECT_TRUE(has(d, "! queue name=" + s.recordQueue +
-                         " max-size-buffers=0 max-size-time=0 max-size-bytes=8000000"));
+  // The frames go from the source to the file (the SegmentWriter puts each
+  // in), no tee and no queue: the disk's thread writes them, within 8 MB.
+  EXPECT_EQ(s.videoTail, s.source);
+  EXPECT_TRUE(s.planPoint.empty());
+  EXPECT_EQ(s.recordBound, 8'000'000u);
+  EXPECT_FALSE(has(d, "queue"));
   EXPECT_FALSE(has(d, "tee"));
   EXPECT_FALSE(has(d, "splitmuxsink"));
   EXPECT_EQ(s.muxer.factory, "matroskamux");
@@ -53,6 +54,8 @@ TEST(PipelinePlan, H264InMp4IsTranscodedAndKeepsTheTextTrack) {
       optionsOf({"--device", "rover", "--out", "/rec", "--codec", "h264", "--format", "mp4"}));
   EXPECT_TRUE(plan.transcoded);
   EXPECT_TRUE(has(plan.description(), "x264enc"));
+  // Frames are planned (or dropped for the disk) before they are decoded.
+  EXPECT_TRUE(has(plan.description(), "tjpegdec name=" + plan.streams[0].planPoint + " !"));
   EXPECT_EQ(plan.streams[0].muxer.factory, "mp4mux");
   EXPECT_TRUE(has(plan.description(), "title=telemetry\""));
   // The muxers take H.264 as avc only: the encoder's output says so.
@@ -68,13 +71,12 @@ TEST(PipelinePlan, WithoutTheTelemetryTrackAStreamIsItsSourceAlone) {
   EXPECT_TRUE(s.telemetrySource.empty() && s.telemetryTail.empty());
   EXPECT_FALSE(has(plan.description(), "appsrc"));
   EXPECT_FALSE(has(plan.description(), "taginject"));
-  EXPECT_EQ(s.videoTail, s.recordQueue);  // the source, then the file's queue
-  // Without the queue: the camera's one thread, the source's.
+  EXPECT_EQ(s.videoTail, s.source);
+  // --record-queue 0: the files are written on the source's thread.
   auto lean = planPipeline(optionsOf({"--device", "10.0.0.2", "--out", "/rec", "--telemetry-track",
                                       "off", "--record-queue", "0"}));
   EXPECT_EQ(lean.streams[0].videoTail, lean.streams[0].source);
-  EXPECT_TRUE(lean.streams[0].recordQueue.empty());
-  EXPECT_FALSE(has(lean.description(), "queue"));
+  EXPECT_EQ(lean.streams[0].recordBound, 0u);
 }
 
 PipelinePlan twoFollowedDevicesOfTwoCameras() {
@@ -95,10 +97,9 @@ TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
   EXPECT_EQ(names.size(), 4u);
   EXPECT_FALSE(plan.streams[0].controller.empty());
   EXPECT_TRUE(plan.streams[1].controller.empty());
-  // Branches: the file's frames leave the tee by a pad of their own, into
-  // their queue.
-  EXPECT_TRUE(has(plan.streams[0].description,
-                  "tee name=t t. ! queue name=" + plan.streams[0].recordQueue));
+  // Branches: the file's frames leave the tee by a pad of their own.
+  EXPECT_EQ(plan.streams[0].videoTail, "t");
+  EXPECT_TRUE(has(plan.streams[0].description, "tee name=t "));
   EXPECT_FALSE(plan.streams[2].controller.empty());
   EXPECT_TRUE(has(plan.description(), "family=tag36h11"));
 }

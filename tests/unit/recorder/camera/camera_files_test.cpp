@@ -211,17 +211,17 @@ GstElement* muxerIn(GstElement* pipeline) {
   return found;
 }
 
-// A disk that stops taking data: the muxer's output blocked by a pad probe.
-// The recording queue fills to its bound, then drops and counts; the live
-// branch (and detection, hence following) keeps getting every new frame.
-TEST_F(CameraFilesTest,
-       AStalledMuxerFillsTheBoundedQueueWhichDropsAndCountsWhileTheLiveViewGoesOn) {
+// A disk that stops taking data: its writer's thread held. The camera's
+// bytes wait up to their bound, then its frames are dropped and counted;
+// the live branch (and detection, hence following) keeps getting every new
+// frame, since the muxer only hands the bytes over.
+TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileTheLiveViewGoesOn) {
   StreamPlan p = plan();
   p.description +=
-      " ! tee name=t t. ! queue name=rq max-size-buffers=0 max-size-time=0 "
-      "max-size-bytes=150000 t. ! queue max-size-buffers=1000 ! appsink name=live "
+      " ! tee name=t t. ! queue max-size-buffers=1000 ! appsink name=live "
       "sync=false async=false";
-  p.recordQueue = p.videoTail = "rq";
+  p.videoTail = "t";
+  p.recordBound = 150000;
   p.liveSink = "live";
   Observed observed;
   CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = {}};
@@ -234,10 +234,10 @@ TEST_F(CameraFilesTest,
   push(0, at(0));
   GstElement* muxer = nullptr;
   ASSERT_TRUE(runMainLoopUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
-  GstPad* output = gst_element_get_static_pad(muxer, "src");
-  gulong stall = gst_pad_add_probe(
-      output, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
-      [](GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
+  gst_object_unref(muxer);
+  auto disk = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(disk) << disk.error();
+  (*disk)->hold();
   const size_t kFrames = 120;
   for (size_t i = 1; i < kFrames; ++i) push(i, at(i));
   // Every frame reaches the live branch: the source never waits for the disk.
@@ -250,9 +250,7 @@ TEST_F(CameraFilesTest,
       },
       5s));
   // The disk comes back: what waited is written, the rest stays counted.
-  gst_pad_remove_probe(output, stall);
-  gst_object_unref(output);
-  gst_object_unref(muxer);
+  (*disk)->release();
   (*camera)->stop();
   ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 10s));
   uint64_t recorded = 0;

@@ -1,0 +1,162 @@
+#include "camera/disk_writer.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <map>
+
+namespace wircam::recorder {
+
+namespace {
+
+// The thread gathers writes for up to kGather once woken (by the first
+// write after a pause), or until kGatherBytes wait, and writes them in one
+// go: at 256 cameras a wake-up per 20 ms instead of one per frame a camera.
+// 20 ms of video is what a crash can lose beyond what the muxer holds.
+constexpr auto kGather = std::chrono::milliseconds(20);
+constexpr uint64_t kGatherBytes = 1 << 20;
+
+std::mutex registryMutex;
+std::map<dev_t, std::weak_ptr<DiskWriter>>& registry() {
+  static auto* writers = new std::map<dev_t, std::weak_ptr<DiskWriter>>;
+  return *writers;
+}
+
+}  // namespace
+
+class DiskWriter::File {
+ public:
+  File(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}
+  ~File() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  File(const File&) = delete;
+  File& operator=(const File&) = delete;
+
+ private:
+  friend class DiskWriter;
+  int fd_;
+  const std::string path_;
+  int waiting_ = 0;  // writes handed over, not done (the writer's mutex_)
+  std::atomic<int> error_{0};
+};
+
+Expected<std::shared_ptr<DiskWriter>, std::string> DiskWriter::of(const std::string& folder) {
+  struct stat info {};
+  if (stat(folder.c_str(), &info) != 0)
+    return unexpected("cannot write into " + folder + ": " + std::strerror(errno));
+  std::lock_guard lock(registryMutex);
+  auto& known = registry()[info.st_dev];
+  if (auto writer = known.lock()) return writer;
+  std::shared_ptr<DiskWriter> writer(new DiskWriter(info.st_dev));
+  known = writer;
+  return writer;
+}
+
+DiskWriter::DiskWriter(dev_t device) : device_(device), thread_([this] { run(); }) {}
+
+DiskWriter::~DiskWriter() {
+  {
+    std::lock_guard lock(mutex_);
+    ending_ = true;
+  }
+  wake_.notify_one();
+  thread_.join();
+  std::lock_guard lock(registryMutex);
+  auto found = registry().find(device_);
+  if (found != registry().end() && found->second.expired()) registry().erase(found);
+}
+
+Expected<std::shared_ptr<DiskWriter::File>, int> DiskWriter::open(const std::string& path) {
+  int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return unexpected(errno);
+  return std::make_shared<File>(fd, path);
+}
+
+void DiskWriter::write(const std::shared_ptr<File>& file, uint64_t offset, GstBuffer* bytes,
+                       const std::shared_ptr<DiskBudget>& budget) {
+  uint64_t size = gst_buffer_get_size(bytes);
+  budget->handedOver(size);
+  bool first;
+  {
+    std::lock_guard lock(mutex_);
+    first = writes_.empty();
+    ++file->waiting_;
+    bytesWaiting_ += size;
+    writes_.push_back({file, offset, gst_buffer_ref(bytes), budget});
+  }
+  if (first) wake_.notify_one();
+}
+
+int DiskWriter::close(const std::shared_ptr<File>& file) {
+  std::unique_lock lock(mutex_);
+  ++closing_;
+  wake_.notify_one();
+  done_.wait(lock, [&] { return file->waiting_ == 0; });
+  --closing_;
+  if (file->fd_ >= 0 && ::close(file->fd_) != 0 && file->error_ == 0) file->error_ = errno;
+  file->fd_ = -1;
+  return file->error_;
+}
+
+int DiskWriter::errorOf(const File& file) { return file.error_; }
+
+void DiskWriter::hold() {
+  std::lock_guard lock(mutex_);
+  held_ = true;
+}
+
+void DiskWriter::release() {
+  {
+    std::lock_guard lock(mutex_);
+    held_ = false;
+  }
+  wake_.notify_one();
+}
+
+void DiskWriter::run() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [&] { return (ending_ || !writes_.empty()) && !held_; });
+    if (writes_.empty()) return;  // ending, all written
+    wake_.wait_for(lock, kGather,
+                   [&] { return ending_ || closing_ > 0 || bytesWaiting_ >= kGatherBytes; });
+    std::deque<Write> batch;
+    batch.swap(writes_);
+    bytesWaiting_ = 0;
+    lock.unlock();
+    for (const Write& write : batch) perform(write);
+    lock.lock();
+    for (const Write& write : batch) --write.file->waiting_;
+    done_.notify_all();
+  }
+}
+
+void DiskWriter::perform(const Write& write) {
+  File& file = *write.file;
+  uint64_t size = gst_buffer_get_size(write.bytes);
+  GstMapInfo map;
+  // After a file's first error its other writes are let go: a full disk
+  // fails them all, and the muxer's error ends the file.
+  if (file.error_ == 0 && file.fd_ >= 0 && gst_buffer_map(write.bytes, &map, GST_MAP_READ)) {
+    size_t done = 0;
+    while (done < map.size) {
+      ssize_t n = pwrite(file.fd_, map.data + done, map.size - done,
+                         static_cast<off_t>(write.offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        file.error_ = n < 0 ? errno : ENOSPC;
+        break;
+      }
+      done += static_cast<size_t>(n);
+    }
+    gst_buffer_unmap(write.bytes, &map);
+  }
+  gst_buffer_unref(write.bytes);
+  write.budget->written(size);
+}
+
+}  // namespace wircam::recorder

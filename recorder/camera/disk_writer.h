@@ -1,0 +1,107 @@
+// Writes the recorded files of every camera on one filesystem from one
+// thread (one per st_dev, shared while used): a camera's muxer hands its
+// bytes over on the camera's own thread and goes on, so a slow or stalled
+// disk holds up the cameras writing to it only through their DiskBudget
+// (past it their frames are dropped and counted), never their threads, and
+// a camera costs no thread of its own for its files.
+#pragma once
+
+#include <gst/gst.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "common/expected.h"
+
+namespace wircam::recorder {
+
+// How much of one camera's video may wait for its disk, in bytes; what
+// came and what was dropped past it. Shared by the camera's files and the
+// writes in flight (any thread).
+class DiskBudget {
+ public:
+  explicit DiskBudget(uint64_t bound) : bound_(bound) {}
+  bool full() const { return waiting_.load(std::memory_order_relaxed) >= bound_; }
+  uint64_t waiting() const { return waiting_.load(std::memory_order_relaxed); }
+  void handedOver(uint64_t bytes) { waiting_.fetch_add(bytes, std::memory_order_relaxed); }
+  void written(uint64_t bytes) { waiting_.fetch_sub(bytes, std::memory_order_relaxed); }
+
+  // Frames that came for the files (recorded or dropped), and those dropped.
+  void arrived() { arrived_.fetch_add(1, std::memory_order_relaxed); }
+  void dropped() { dropped_.fetch_add(1, std::memory_order_relaxed); }
+  uint64_t framesArrived() const { return arrived_.load(std::memory_order_relaxed); }
+  uint64_t framesDropped() const { return dropped_.load(std::memory_order_relaxed); }
+
+ private:
+  const uint64_t bound_;
+  std::atomic<uint64_t> waiting_{0}, arrived_{0}, dropped_{0};
+};
+
+class DiskWriter {
+ public:
+  // A file open for writing: its descriptor, the writes still waiting, and
+  // the first error a write met (errno; 0: none).
+  class File;
+
+  // The writer of the filesystem `folder` is on: made at the first use,
+  // shared while any camera holds it.
+  static Expected<std::shared_ptr<DiskWriter>, std::string> of(const std::string& folder);
+  ~DiskWriter();  // after what was handed over is written
+  DiskWriter(const DiskWriter&) = delete;
+  DiskWriter& operator=(const DiskWriter&) = delete;
+
+  // `path`, created or emptied, on the caller's thread; or why not (errno).
+  static Expected<std::shared_ptr<File>, int> open(const std::string& path);
+  // `bytes` (a reference is taken) at `offset` of `file`, on the writer's
+  // thread, in the order handed over; counted in `budget` until written.
+  void write(const std::shared_ptr<File>& file, uint64_t offset, GstBuffer* bytes,
+             const std::shared_ptr<DiskBudget>& budget);
+  // Waits until every write handed over for `file` is done, then closes
+  // it. Returns the first error its writes met (errno; 0: none).
+  int close(const std::shared_ptr<File>& file);
+  // The error `file`'s writes have met so far (0: none), any thread.
+  static int errorOf(const File& file);
+
+  // A disk that stops taking data, for tests: the thread writes nothing
+  // from hold() until release().
+  void hold();
+  void release();
+
+ private:
+  explicit DiskWriter(dev_t device);
+  struct Write {
+    std::shared_ptr<File> file;
+    uint64_t offset;
+    GstBuffer* bytes;
+    std::shared_ptr<DiskBudget> budget;
+  };
+  void run();
+  static void perform(const Write& write);
+
+  const dev_t device_;
+  // Guards writes_, ending_, idle_ and each File's count of writes waiting.
+  std::mutex mutex_;
+  std::condition_variable wake_;  // writes to do, or the end
+  std::condition_variable done_;  // a file's writes are all done
+  std::deque<Write> writes_;
+  uint64_t bytesWaiting_ = 0;
+  int closing_ = 0;  // callers of close() waiting: no gathering then
+  bool held_ = false;
+  bool ending_ = false;
+  std::thread thread_;
+};
+
+// Where a camera's files go: handed to its filesystem's writer within its
+// budget; without a writer, through a filesink on the camera's own thread.
+struct CameraDisk {
+  std::shared_ptr<DiskWriter> writer;
+  std::shared_ptr<DiskBudget> budget;
+};
+
+}  // namespace wircam::recorder
