@@ -7,6 +7,7 @@
 #pragma once
 
 #include <gst/gst.h>
+#include <sys/uio.h>
 
 #include <atomic>
 #include <condition_variable>
@@ -16,6 +17,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "common/expected.h"
 
@@ -82,7 +84,10 @@ class DiskWriter {
     std::shared_ptr<DiskBudget> budget;
   };
   void run();
-  static void perform(const Write& write);
+  // Writes batch[first] and the writes after it that continue it in its
+  // file; returns how many.
+  static size_t performRun(const std::deque<Write>& batch, size_t first);
+  static void writeAll(File& file, std::vector<iovec>& pieces, uint64_t offset);
 
   const dev_t device_;
   // Guards writes_, ending_, idle_ and each File's count of writes waiting.

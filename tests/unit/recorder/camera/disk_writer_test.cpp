@@ -1,0 +1,110 @@
+// The thread that writes a filesystem's recorded files: bytes land at the
+// offsets the muxer gave them, in order (a seek back overwrites), a
+// camera's budget counts what waits, a full disk is the file's error, and
+// the cameras of one filesystem share one writer.
+#include "camera/disk_writer.h"
+
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace wircam::recorder;
+
+GstBuffer* bytesOf(const std::string& text) {
+  return gst_buffer_new_memdup(text.data(), text.size());
+}
+
+std::string contentOf(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+class DiskWriterTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    gst_init(nullptr, nullptr);
+    folder_ = fs::temp_directory_path() / ("disk-writer-" + std::to_string(getpid()));
+    fs::create_directories(folder_);
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+
+  // Hands `text` over at `offset`, as the sink does.
+  void write(DiskWriter& writer, const std::shared_ptr<DiskWriter::File>& file, uint64_t offset,
+             const std::string& text) {
+    GstBuffer* bytes = bytesOf(text);
+    writer.write(file, offset, bytes, budget_);
+    gst_buffer_unref(bytes);
+  }
+
+  fs::path folder_;
+  std::shared_ptr<DiskBudget> budget_ = std::make_shared<DiskBudget>(100);
+};
+
+TEST_F(DiskWriterTest, BytesLandAtTheirOffsetsInOrderAndASeekBackOverwrites) {
+  auto writer = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(writer) << writer.error();
+  auto file = DiskWriter::open((folder_ / "a.mkv").string());
+  ASSERT_TRUE(file);
+  write(**writer, *file, 0, "header--");
+  write(**writer, *file, 8, "frame1");
+  write(**writer, *file, 14, "frame2");
+  write(**writer, *file, 0, "HEADER");  // the muxer's end: its size and index
+  EXPECT_EQ((*writer)->close(*file), 0);
+  EXPECT_EQ(contentOf(folder_ / "a.mkv"), "HEADER--frame1frame2");
+  EXPECT_EQ(budget_->waiting(), 0u);
+}
+
+TEST_F(DiskWriterTest, AHeldDiskKeepsTheBytesInTheCamerasBudgetUntilItWritesThem) {
+  auto writer = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(writer);
+  auto file = DiskWriter::open((folder_ / "b.mkv").string());
+  ASSERT_TRUE(file);
+  (*writer)->hold();
+  write(**writer, *file, 0, std::string(60, 'x'));
+  EXPECT_FALSE(budget_->full());
+  write(**writer, *file, 60, std::string(60, 'y'));
+  EXPECT_EQ(budget_->waiting(), 120u);
+  EXPECT_TRUE(budget_->full()) << "past its bound the camera drops";
+  (*writer)->release();
+  EXPECT_EQ((*writer)->close(*file), 0);
+  EXPECT_EQ(budget_->waiting(), 0u);
+  EXPECT_EQ(fs::file_size(folder_ / "b.mkv"), 120u);
+}
+
+TEST_F(DiskWriterTest, AFullDiskIsTheFilesErrorAndItsCloseSaysSo) {
+  auto writer = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(writer);
+  // /dev/full: a device that takes no byte, as a full disk.
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this machine";
+  auto file = DiskWriter::open("/dev/full");
+  ASSERT_TRUE(file);
+  write(**writer, *file, 0, "frame");
+  EXPECT_EQ((*writer)->close(*file), ENOSPC);
+  EXPECT_EQ(DiskWriter::errorOf(**file), ENOSPC);
+  EXPECT_EQ(budget_->waiting(), 0u) << "what failed is no longer waiting";
+}
+
+TEST_F(DiskWriterTest, TheCamerasOfOneFilesystemShareOneWriterAndAMissingFolderIsAnError) {
+  fs::create_directories(folder_ / "other");
+  auto one = DiskWriter::of(folder_.string());
+  auto two = DiskWriter::of((folder_ / "other").string());
+  ASSERT_TRUE(one && two);
+  EXPECT_EQ(one->get(), two->get());
+  auto missing = DiskWriter::of((folder_ / "missing").string());
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().find("missing"), std::string::npos) << missing.error();
+  auto unopened = DiskWriter::open((folder_ / "missing" / "c.mkv").string());
+  ASSERT_FALSE(unopened);
+  EXPECT_EQ(unopened.error(), ENOENT);
+}
+
+}  // namespace
