@@ -127,16 +127,33 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
            " camera=" + std::to_string(camera) + " wait-for-device=true ";
       if (device.positions) d += "! " + positionsOf(*device.positions, stream.positions);
       if (branches) d += "! tee name=" + tee + " ";
-      // The files are written by their filesystem's thread (a slow disk
-      // holds up neither the source nor the other branches; past its
-      // bound a camera's frames are dropped, camera/disk_writer.h).
-      // Without it (--record-queue 0), on the source's thread.
-      stream.recordBound = options.recordQueueBytes;
+      // A slow disk must hold up neither the source nor the other
+      // branches; past --record-queue a camera's frames are dropped.
+      // - Without the text track, the muxer runs on the source's thread
+      //   and hands its bytes to the filesystem's writer, the camera's
+      //   bound in bytes (camera/disk_writer.h): one thread a camera.
+      // - With it, the muxer waits for the text's thread before it takes
+      //   a frame (GstCollectPads), and on saturated processors that
+      //   thread runs late: the file's frames cross a queue of their own
+      //   (bounded in bytes, camera/queue_drops.h), so that it is the
+      //   queue's thread that waits, never the source's.
+      // --record-queue 0: on the source's thread, whatever the disk does.
       std::string toFile = branches ? tee + ". ! " : "! ";
+      if (options.recordQueueBytes > 0 && options.telemetryTrack) {
+        stream.recordQueue = "rq";
+        d += toFile + "queue name=" + stream.recordQueue +
+             " max-size-buffers=0 max-size-time=0 max-size-bytes=" +
+             std::to_string(options.recordQueueBytes) + " ";
+        toFile = "! ";
+      } else {
+        stream.recordBound = options.recordQueueBytes;
+      }
       if (plan.transcoded) {
         stream.videoTail = "enc";
         stream.planPoint = "recdec";
         d += toFile + encoder(options, stream.planPoint, stream.videoTail);
+      } else if (!stream.recordQueue.empty()) {
+        stream.videoTail = stream.recordQueue;
       } else {
         stream.videoTail = branches ? tee : device.positions ? stream.positions : stream.source;
       }

@@ -45,6 +45,8 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
         self->telemetry_->onFrame();
         self->framesPlanned_.fetch_add(1, std::memory_order_relaxed);
       });
+  if (GstElement* queue = camera->element(plan.recordQueue))
+    camera->drops_ = std::make_unique<QueueDrops>(queue);
   if (frames && !plan.liveSink.empty()) {
     frames->attach(camera->element(plan.liveSink));
     camera->frames_ = frames;
@@ -65,6 +67,7 @@ CameraPipeline::~CameraPipeline() {
   if (encoded_) encoded_->detach();
   // The writer holds the elements' pads: before the pipeline goes.
   writer_.reset();
+  drops_.reset();
   telemetry_.reset();
   track_.reset();
   gst_object_unref(pipeline_);

@@ -2,15 +2,15 @@
 
 #include <fcntl.h>
 #include <pthread.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
-#include <sys/syscall.h>
 #include <sys/uio.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <map>
+
+#include "common/thread_priority.h"
 
 namespace wircam::recorder {
 
@@ -22,7 +22,6 @@ namespace {
 // 20 ms of video is what a crash can lose beyond what the muxer holds.
 constexpr auto kGather = std::chrono::milliseconds(20);
 constexpr uint64_t kGatherBytes = 1 << 20;
-constexpr int kWriterNice = -10;
 // Writes of one file that follow each other on it go out in one call.
 constexpr size_t kMaxRun = 64;
 
@@ -128,10 +127,8 @@ void DiskWriter::run() {
   pthread_setname_np(pthread_self(), "wircam-disk");
   // One thread writes what a thread a camera wrote before: on processors
   // busy with video, at an equal share, it would fall behind the cameras
-  // (their bounds fill, then their frames drop). nice -10 needs
-  // CAP_SYS_NICE or an RLIMIT_NICE that allows it (the service's
-  // LimitNICE=); without either it keeps the process's priority.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kWriterNice);
+  // (their bounds fill, then their frames drop).
+  runThisThreadAhead();
   std::unique_lock lock(mutex_);
   while (true) {
     wake_.wait(lock, [&] { return (ending_ || !writes_.empty()) && !held_; });

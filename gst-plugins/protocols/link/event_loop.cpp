@@ -3,14 +3,14 @@
 #include <pthread.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
 #include <sys/timerfd.h>
 #include <unistd.h>
 
 #include <array>
 #include <future>
 #include <vector>
+
+#include "common/thread_priority.h"
 
 namespace wircam::link {
 
@@ -161,14 +161,10 @@ void EventLoop::invoke(const Callback& task) {
 
 // The loop feeds the vehicles' watchdogs (the WiRC drops a transmitter
 // whose PCD stop for 800 ms): on processors busy with video it must not
-// queue behind the streaming threads. nice -10 needs CAP_SYS_NICE or an
-// RLIMIT_NICE that allows it (the service's LimitNICE=); without either
-// the loop keeps the process's priority.
-constexpr int kLoopNice = -10;
-
+// queue behind the streaming threads.
 void EventLoop::run() {
   pthread_setname_np(pthread_self(), "wircam-links");
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kLoopNice);
+  runThisThreadAhead();
   std::array<epoll_event, 64> events;
   std::vector<Id> due;
   for (;;) {

@@ -32,12 +32,13 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   const auto& d = plan.description();
   EXPECT_TRUE(has(d, "wircsrc name=" + s.source + " host=10.0.0.2 port=1984"));
   EXPECT_TRUE(has(d, "wait-for-device=true"));
-  // The frames go from the source to the file (the SegmentWriter puts each
-  // in), no tee and no queue: the disk's thread writes them, within 8 MB.
-  EXPECT_EQ(s.videoTail, s.source);
-  EXPECT_TRUE(s.planPoint.empty());
-  EXPECT_EQ(s.recordBound, 8'000'000u);
-  EXPECT_FALSE(has(d, "queue"));
+  // With the text track the frames reach the file through its own bounded
+  // queue (the muxer waits for the text's thread: the queue's thread
+  // waits, not the source's), no tee (the SegmentWriter puts each file in).
+  EXPECT_EQ(s.videoTail, s.recordQueue);
+  EXPECT_TRUE(has(d, "! queue name=" + s.recordQueue +
+                         " max-size-buffers=0 max-size-time=0 max-size-bytes=8000000"));
+  EXPECT_EQ(s.recordBound, 0u);
   EXPECT_FALSE(has(d, "tee"));
   EXPECT_FALSE(has(d, "splitmuxsink"));
   EXPECT_EQ(s.muxer.factory, "matroskamux");
@@ -71,7 +72,12 @@ TEST(PipelinePlan, WithoutTheTelemetryTrackAStreamIsItsSourceAlone) {
   EXPECT_TRUE(s.telemetrySource.empty() && s.telemetryTail.empty());
   EXPECT_FALSE(has(plan.description(), "appsrc"));
   EXPECT_FALSE(has(plan.description(), "taginject"));
+  // Without it, from the source to the muxer, no queue: the disk's thread
+  // writes the bytes, within 8 MB. One thread a camera.
   EXPECT_EQ(s.videoTail, s.source);
+  EXPECT_TRUE(s.recordQueue.empty());
+  EXPECT_EQ(s.recordBound, 8'000'000u);
+  EXPECT_FALSE(has(plan.description(), "queue"));
   // --record-queue 0: the files are written on the source's thread.
   auto lean = planPipeline(optionsOf({"--device", "10.0.0.2", "--out", "/rec", "--telemetry-track",
                                       "off", "--record-queue", "0"}));
@@ -97,9 +103,10 @@ TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
   EXPECT_EQ(names.size(), 4u);
   EXPECT_FALSE(plan.streams[0].controller.empty());
   EXPECT_TRUE(plan.streams[1].controller.empty());
-  // Branches: the file's frames leave the tee by a pad of their own.
-  EXPECT_EQ(plan.streams[0].videoTail, "t");
-  EXPECT_TRUE(has(plan.streams[0].description, "tee name=t "));
+  // Branches: the file's frames leave the tee by a pad of their own, into
+  // their queue.
+  EXPECT_TRUE(has(plan.streams[0].description,
+                  "tee name=t t. ! queue name=" + plan.streams[0].recordQueue));
   EXPECT_FALSE(plan.streams[2].controller.empty());
   EXPECT_TRUE(has(plan.description(), "family=tag36h11"));
 }

@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <set>
 #include <thread>
 
 #include "camera/camera.h"
@@ -104,11 +105,13 @@ class CameraFilesTest : public ::testing::Test {
     };
   }
 
-  // Scene frame `index` at `pts`.
-  void push(size_t index, GstClockTime pts) {
+  // Scene frame `index` at `pts`; `delta`: flagged as depending on the
+  // frames before it (as H.264's between key frames).
+  void push(size_t index, GstClockTime pts, bool delta = false) {
     const auto& jpeg =
         wircam::testing::sceneFrames()[index % wircam::testing::sceneFrames().size()];
     GstBuffer* buffer = gst_buffer_new_memdup(jpeg.data(), jpeg.size());
+    if (delta) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DELTA_UNIT);
     GST_BUFFER_PTS(buffer) = GST_BUFFER_DTS(buffer) = pts;
     GST_BUFFER_DURATION(buffer) = GST_SECOND / 15;
     pushed_.push_back(md5Of(jpeg.data(), jpeg.size()));
@@ -211,6 +214,65 @@ GstElement* muxerIn(GstElement* pipeline) {
   return found;
 }
 
+// With the text track, the frames cross a queue of their own to the file.
+// A disk that stops taking data: the muxer's output blocked by a pad probe.
+// The recording queue fills to its bound, then drops and counts; the live
+// branch (and detection, hence following) keeps getting every new frame.
+TEST_F(CameraFilesTest,
+       AStalledMuxerFillsTheBoundedQueueWhichDropsAndCountsWhileTheLiveViewGoesOn) {
+  StreamPlan p = plan();
+  p.description +=
+      " ! tee name=t t. ! queue name=rq max-size-buffers=0 max-size-time=0 "
+      "max-size-bytes=150000 t. ! queue max-size-buffers=1000 ! appsink name=live "
+      "sync=false async=false";
+  p.recordQueue = p.videoTail = "rq";
+  p.liveSink = "live";
+  Observed observed;
+  CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = {}};
+  auto camera = Camera::create(p, files, {}, observed, onTestClock());
+  ASSERT_TRUE(camera) << camera.error();
+  std::atomic<int> live{0};
+  (*camera)->frames()->listen([&](GstSample*) { ++live; });
+  ASSERT_TRUE((*camera)->start());
+  auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
+  push(0, at(0));
+  GstElement* muxer = nullptr;
+  ASSERT_TRUE(runMainLoopUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
+  GstPad* output = gst_element_get_static_pad(muxer, "src");
+  gulong stall = gst_pad_add_probe(
+      output, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
+      [](GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
+  const size_t kFrames = 120;
+  for (size_t i = 1; i < kFrames; ++i) push(i, at(i));
+  // Every frame reaches the live branch: the source never waits for the disk.
+  ASSERT_TRUE(runMainLoopUntil([&] { return live.load() == static_cast<int>(kFrames); }, 5s))
+      << live.load() << " of " << kFrames << " frames reached the live view";
+  ASSERT_TRUE(runMainLoopUntil(
+      [&] {
+        (*camera)->tick();
+        return (*camera)->report().recordingDropped > 0;
+      },
+      5s));
+  // The disk comes back: what waited is written, the rest stays counted.
+  gst_pad_remove_probe(output, stall);
+  gst_object_unref(output);
+  gst_object_unref(muxer);
+  (*camera)->stop();
+  ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 10s));
+  uint64_t recorded = 0;
+  for (const auto& [file, segment] : observed.closed) recorded += segment.frames;
+  CameraReport report = (*camera)->report();
+  EXPECT_GT(report.recordingDropped, kFrames / 2) << "a 150 KB bound holds a few frames";
+  EXPECT_EQ(recorded + report.recordingDropped, kFrames) << "every frame recorded or counted";
+  // And users see the count: /api/status and /metrics.
+  EXPECT_EQ(statusJson(report, "")["recording_dropped"], report.recordingDropped);
+  std::string metrics = prometheusText({.version = "test", .cameras = {report}});
+  EXPECT_NE(metrics.find("wircam_recording_dropped_frames_total{stream=\"bench-cam0\"} " +
+                         std::to_string(report.recordingDropped)),
+            std::string::npos)
+      << metrics;
+}
+
 // A disk that stops taking data: its writer's thread held. The camera's
 // bytes wait up to their bound, then its frames are dropped and counted;
 // the live branch (and detection, hence following) keeps getting every new
@@ -265,6 +327,75 @@ TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileT
                          std::to_string(report.recordingDropped)),
             std::string::npos)
       << metrics;
+}
+
+// Waits until `disk` has written all it was handed so far: it writes in
+// order, so a byte of a file of our own handed over now is written last.
+void waitUntilWritten(wircam::recorder::DiskWriter& disk, const fs::path& folder) {
+  auto marker = DiskWriter::open((folder / "marker").string());
+  ASSERT_TRUE(marker);
+  GstBuffer* byte = gst_buffer_new_memdup("x", 1);
+  disk.write(*marker, 0, byte, std::make_shared<DiskBudget>(1));
+  gst_buffer_unref(byte);
+  disk.close(*marker);
+  fs::remove(folder / "marker");
+}
+
+// A frame that depends on a dropped one would not decode: once the disk
+// has dropped one, the frames after it are dropped too, up to the next key
+// frame, even when the disk has room again.
+TEST_F(CameraFilesTest, AfterADropForTheDiskTheFileResumesOnlyAtAKeyFrame) {
+  StreamPlan p = plan();
+  p.recordBound = 150000;
+  Observed observed;
+  CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = {}};
+  auto camera = Camera::create(p, files, {}, observed, onTestClock());
+  ASSERT_TRUE(camera) << camera.error();
+  ASSERT_TRUE((*camera)->start());
+  auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
+  const size_t kGop = 10, kFrames = 100;
+  auto isKey = [&](size_t frame) { return frame % kGop == 0; };
+  push(0, at(0));
+  GstElement* muxer = nullptr;
+  ASSERT_TRUE(runMainLoopUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
+  gst_object_unref(muxer);
+  auto disk = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(disk) << disk.error();
+  (*disk)->hold();
+  for (size_t i = 1; i <= 45; ++i) push(i, at(i), !isKey(i));
+  // The held disk came back once these frames have all left the source
+  // (while it was held the bound filled and the rest were dropped) and
+  // what waited is written: the next frames find room.
+  ASSERT_TRUE(runMainLoopUntil(
+      [&] {
+        guint64 waiting = 1;
+        g_object_get(source_, "current-level-buffers", &waiting, nullptr);
+        return waiting == 0;
+      },
+      5s));
+  (*disk)->release();
+  waitUntilWritten(**disk, folder_);
+  for (size_t i = 46; i < kFrames; ++i) push(i, at(i), !isKey(i));
+  (*camera)->stop();
+  ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 10s));
+  // (The drops leave a gap: the file after it is another.)
+  std::set<size_t> recorded;
+  for (const auto& [file, planned] : observed.closed)
+    for (const auto& [md5, pts] : framesOf(file))
+      recorded.insert(
+          static_cast<size_t>(gst_util_uint64_scale_round(planned.start + pts, 15, GST_SECOND)));
+  EXPECT_GT((*camera)->report().recordingDropped, 0u);
+  EXPECT_EQ(recorded.size() + (*camera)->report().recordingDropped, kFrames);
+  size_t resumed = 0;
+  for (size_t frame : recorded) {
+    if (frame > 0 && !recorded.count(frame - 1)) {
+      ++resumed;
+      EXPECT_TRUE(isKey(frame)) << "frame " << frame << " follows a dropped one";
+    }
+  }
+  EXPECT_GT(resumed, 0u) << "the file went on after the drops";
+  EXPECT_FALSE(recorded.count(46)) << "a delta frame after the disk came back";
+  EXPECT_TRUE(recorded.count(50)) << "the next key frame";
 }
 
 }  // namespace
