@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <thread>
 
@@ -118,6 +119,15 @@ class CameraFilesTest : public ::testing::Test {
     ASSERT_EQ(gst_app_src_push_buffer(GST_APP_SRC(source_), buffer), GST_FLOW_OK);
   }
 
+  // Records 120 frames through a disk that stops taking data (`stall`,
+  // once the first file is open) and comes back (`resume`): the live branch
+  // (and detection, hence following) gets every frame, the file what fits
+  // in its bound, and every frame is recorded or counted, in /api/status
+  // and /metrics too.
+  void expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(StreamPlan plan,
+                                                              const std::function<void()>& stall,
+                                                              const std::function<void()>& resume);
+
   fs::path folder_;
   GstClock* clock_ = nullptr;
   GstElement* source_ = nullptr;
@@ -214,18 +224,8 @@ GstElement* muxerIn(GstElement* pipeline) {
   return found;
 }
 
-// With the text track, the frames cross a queue of their own to the file.
-// A disk that stops taking data: the muxer's output blocked by a pad probe.
-// The recording queue fills to its bound, then drops and counts; the live
-// branch (and detection, hence following) keeps getting every new frame.
-TEST_F(CameraFilesTest,
-       AStalledMuxerFillsTheBoundedQueueWhichDropsAndCountsWhileTheLiveViewGoesOn) {
-  StreamPlan p = plan();
-  p.description +=
-      " ! tee name=t t. ! queue name=rq max-size-buffers=0 max-size-time=0 "
-      "max-size-bytes=150000 t. ! queue max-size-buffers=1000 ! appsink name=live "
-      "sync=false async=false";
-  p.recordQueue = p.videoTail = "rq";
+void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
+    StreamPlan p, const std::function<void()>& stall, const std::function<void()>& resume) {
   p.liveSink = "live";
   Observed observed;
   CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = {}};
@@ -238,10 +238,8 @@ TEST_F(CameraFilesTest,
   push(0, at(0));
   GstElement* muxer = nullptr;
   ASSERT_TRUE(runMainLoopUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
-  GstPad* output = gst_element_get_static_pad(muxer, "src");
-  gulong stall = gst_pad_add_probe(
-      output, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
-      [](GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
+  gst_object_unref(muxer);
+  stall();
   const size_t kFrames = 120;
   for (size_t i = 1; i < kFrames; ++i) push(i, at(i));
   // Every frame reaches the live branch: the source never waits for the disk.
@@ -254,9 +252,7 @@ TEST_F(CameraFilesTest,
       },
       5s));
   // The disk comes back: what waited is written, the rest stays counted.
-  gst_pad_remove_probe(output, stall);
-  gst_object_unref(output);
-  gst_object_unref(muxer);
+  resume();
   (*camera)->stop();
   ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 10s));
   uint64_t recorded = 0;
@@ -264,7 +260,6 @@ TEST_F(CameraFilesTest,
   CameraReport report = (*camera)->report();
   EXPECT_GT(report.recordingDropped, kFrames / 2) << "a 150 KB bound holds a few frames";
   EXPECT_EQ(recorded + report.recordingDropped, kFrames) << "every frame recorded or counted";
-  // And users see the count: /api/status and /metrics.
   EXPECT_EQ(statusJson(report, "")["recording_dropped"], report.recordingDropped);
   std::string metrics = prometheusText({.version = "test", .cameras = {report}});
   EXPECT_NE(metrics.find("wircam_recording_dropped_frames_total{stream=\"bench-cam0\"} " +
@@ -273,10 +268,36 @@ TEST_F(CameraFilesTest,
       << metrics;
 }
 
-// A disk that stops taking data: its writer's thread held. The camera's
-// bytes wait up to their bound, then its frames are dropped and counted;
-// the live branch (and detection, hence following) keeps getting every new
-// frame, since the muxer only hands the bytes over.
+// With the text track the frames cross a queue of their own to the file;
+// the disk stalls as the muxer's output blocked by a pad probe.
+TEST_F(CameraFilesTest,
+       AStalledMuxerFillsTheBoundedQueueWhichDropsAndCountsWhileTheLiveViewGoesOn) {
+  StreamPlan p = plan();
+  p.description +=
+      " ! tee name=t t. ! queue name=rq max-size-buffers=0 max-size-time=0 "
+      "max-size-bytes=150000 t. ! queue max-size-buffers=1000 ! appsink name=live "
+      "sync=false async=false";
+  p.recordQueue = p.videoTail = "rq";
+  GstPad* output = nullptr;
+  gulong stall = 0;
+  expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
+      p,
+      [&] {
+        GstElement* muxer = muxerIn(pipeline_);
+        output = gst_element_get_static_pad(muxer, "src");
+        gst_object_unref(muxer);
+        stall = gst_pad_add_probe(
+            output, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
+            [](GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
+      },
+      [&] {
+        gst_pad_remove_probe(output, stall);
+        gst_object_unref(output);
+      });
+}
+
+// Without it the muxer hands the bytes to the disk's writer; the disk
+// stalls as that writer held. The camera's bytes wait up to their bound.
 TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileTheLiveViewGoesOn) {
   StreamPlan p = plan();
   p.description +=
@@ -284,49 +305,10 @@ TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileT
       "sync=false async=false";
   p.videoTail = "t";
   p.recordBound = 150000;
-  p.liveSink = "live";
-  Observed observed;
-  CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = {}};
-  auto camera = Camera::create(p, files, {}, observed, onTestClock());
-  ASSERT_TRUE(camera) << camera.error();
-  std::atomic<int> live{0};
-  (*camera)->frames()->listen([&](GstSample*) { ++live; });
-  ASSERT_TRUE((*camera)->start());
-  auto at = [](size_t frame) { return gst_util_uint64_scale(frame, GST_SECOND, 15); };
-  push(0, at(0));
-  GstElement* muxer = nullptr;
-  ASSERT_TRUE(runMainLoopUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
-  gst_object_unref(muxer);
   auto disk = DiskWriter::of(folder_.string());
   ASSERT_TRUE(disk) << disk.error();
-  (*disk)->hold();
-  const size_t kFrames = 120;
-  for (size_t i = 1; i < kFrames; ++i) push(i, at(i));
-  // Every frame reaches the live branch: the source never waits for the disk.
-  ASSERT_TRUE(runMainLoopUntil([&] { return live.load() == static_cast<int>(kFrames); }, 5s))
-      << live.load() << " of " << kFrames << " frames reached the live view";
-  ASSERT_TRUE(runMainLoopUntil(
-      [&] {
-        (*camera)->tick();
-        return (*camera)->report().recordingDropped > 0;
-      },
-      5s));
-  // The disk comes back: what waited is written, the rest stays counted.
-  (*disk)->release();
-  (*camera)->stop();
-  ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 10s));
-  uint64_t recorded = 0;
-  for (const auto& [file, segment] : observed.closed) recorded += segment.frames;
-  CameraReport report = (*camera)->report();
-  EXPECT_GT(report.recordingDropped, kFrames / 2) << "a 150 KB bound holds a few frames";
-  EXPECT_EQ(recorded + report.recordingDropped, kFrames) << "every frame recorded or counted";
-  // And users see the count: /api/status and /metrics.
-  EXPECT_EQ(statusJson(report, "")["recording_dropped"], report.recordingDropped);
-  std::string metrics = prometheusText({.version = "test", .cameras = {report}});
-  EXPECT_NE(metrics.find("wircam_recording_dropped_frames_total{stream=\"bench-cam0\"} " +
-                         std::to_string(report.recordingDropped)),
-            std::string::npos)
-      << metrics;
+  expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
+      p, [&] { (*disk)->hold(); }, [&] { (*disk)->release(); });
 }
 
 // Waits until `disk` has written all it was handed so far: it writes in
