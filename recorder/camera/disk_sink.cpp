@@ -14,9 +14,10 @@ struct DiskSinkState {
   std::shared_ptr<wircam::recorder::DiskWriter::File> file;
   std::shared_ptr<wircam::recorder::DiskBudget> budget;
   std::function<void()> closed;
-  uint64_t offset = 0;  // where the muxer writes next
-  // (A sink stopped before the muxer's end lets its writes go on: the file
-  // is closed after the last, when the writer lets go of it.)
+  uint64_t offset = 0;  // where the muxer writes next, on the streaming thread
+  // The muxer has ended and the file is closed. (A sink stopped before
+  // that lets its writes go on: the file is closed after the last, when
+  // the writer lets go of it.)
   bool finished = false;
 };
 
@@ -92,26 +93,15 @@ gboolean event(GstBaseSink* sink, GstEvent* event) {
   return GST_BASE_SINK_CLASS(wircam_disk_sink_parent_class)->event(sink, event);
 }
 
+// The muxers write a file's size and index at its start once it ends, if
+// the sink says it can seek (as filesink does).
 gboolean query(GstBaseSink* sink, GstQuery* query) {
-  switch (GST_QUERY_TYPE(query)) {
-    case GST_QUERY_SEEKING: {
-      GstFormat format;
-      gst_query_parse_seeking(query, &format, nullptr, nullptr, nullptr);
-      gst_query_set_seeking(query, format, format == GST_FORMAT_BYTES, 0, -1);
-      return TRUE;
-    }
-    case GST_QUERY_POSITION: {
-      GstFormat format;
-      gst_query_parse_position(query, &format, nullptr);
-      if (format != GST_FORMAT_BYTES && format != GST_FORMAT_DEFAULT) break;
-      gst_query_set_position(query, GST_FORMAT_BYTES,
-                             static_cast<gint64>(WIRCAM_DISK_SINK(sink)->state->offset));
-      return TRUE;
-    }
-    default:
-      break;
-  }
-  return GST_BASE_SINK_CLASS(wircam_disk_sink_parent_class)->query(sink, query);
+  if (GST_QUERY_TYPE(query) != GST_QUERY_SEEKING)
+    return GST_BASE_SINK_CLASS(wircam_disk_sink_parent_class)->query(sink, query);
+  GstFormat format;
+  gst_query_parse_seeking(query, &format, nullptr, nullptr, nullptr);
+  gst_query_set_seeking(query, format, format == GST_FORMAT_BYTES, 0, -1);
+  return TRUE;
 }
 
 void finalize(GObject* object) {

@@ -35,8 +35,8 @@ class DiskBudget {
   void written(uint64_t bytes) { waiting_.fetch_sub(bytes, std::memory_order_relaxed); }
 
   // Frames that came for the files (recorded or dropped), and those dropped.
-  void arrived() { arrived_.fetch_add(1, std::memory_order_relaxed); }
-  void dropped() { dropped_.fetch_add(1, std::memory_order_relaxed); }
+  void countArrival() { arrived_.fetch_add(1, std::memory_order_relaxed); }
+  void countDrop() { dropped_.fetch_add(1, std::memory_order_relaxed); }
   uint64_t framesArrived() const { return arrived_.load(std::memory_order_relaxed); }
   uint64_t framesDropped() const { return dropped_.load(std::memory_order_relaxed); }
 

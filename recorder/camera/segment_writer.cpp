@@ -111,12 +111,14 @@ GstPadProbeReturn SegmentWriter::onTextOut(GstPad* pad, GstPadProbeInfo* info, g
 bool SegmentWriter::noRoomFor(GstBuffer* frame) {
   DiskBudget* budget = parts_.disk.budget.get();
   if (!budget) return false;
-  budget->arrived();
+  budget->countArrival();
   // A frame that depends on a dropped one would not decode: the drop goes
-  // on to the next key frame.
+  // on to the next key frame. (The recorder's frames are JPEG here, each
+  // a key frame, H.264 being encoded after this point; a source of
+  // encoded frames is not.)
   bool key = !GST_BUFFER_FLAG_IS_SET(frame, GST_BUFFER_FLAG_DELTA_UNIT);
   dropping_ = budget->full() || (dropping_ && !key);
-  if (dropping_) budget->dropped();
+  if (dropping_) budget->countDrop();
   return dropping_;
 }
 
