@@ -13,6 +13,30 @@ namespace {
 using namespace wircam::testing;
 using std::chrono::milliseconds;
 
+// What the client's elements said went wrong (errors and warnings on its
+// bus), for the failure's message: "0 frames" alone does not tell a SETUP
+// refused from packets that never came.
+std::string troubleOn(GstElement* pipeline) {
+  std::string said;
+  GstBus* bus = gst_element_get_bus(pipeline);
+  while (GstMessage* message = gst_bus_pop_filtered(
+             bus, static_cast<GstMessageType>(GST_MESSAGE_ERROR | GST_MESSAGE_WARNING))) {
+    GError* error = nullptr;
+    gchar* debug = nullptr;
+    if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR)
+      gst_message_parse_error(message, &error, &debug);
+    else
+      gst_message_parse_warning(message, &error, &debug);
+    said += std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + error->message + " (" +
+            (debug ? debug : "") + ")\n";
+    g_error_free(error);
+    g_free(debug);
+    gst_message_unref(message);
+  }
+  gst_object_unref(bus);
+  return said;
+}
+
 TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
   auto device = startSequenceDevice();
   RecorderProcess recorder(device->port(), {"--rtsp", "127.0.0.1:0", "--duration", "60"});
@@ -41,10 +65,11 @@ TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
       gst_sample_unref(sample);
       ++frames;
     }
+    std::string trouble = troubleOn(pipeline);
     gst_element_set_state(pipeline, GST_STATE_NULL);
     gst_object_unref(sink);
     gst_object_unref(pipeline);
-    EXPECT_EQ(frames, 15) << protocols;
+    EXPECT_EQ(frames, 15) << protocols << "\n" << trouble << recorder.log();
     EXPECT_EQ(width, 352) << protocols;  // the scene's CIF frames, decoded
   }
 }
