@@ -168,8 +168,8 @@ TEST(CameraFaults, ADeviceRestartingDuringTheStopHoldsNothingUp) {
   // Gone mid-stop, and back a moment later: a new login answers the
   // recorder's, with frames, while it is finishing.
   expectSigintEndsItWithinThreeSeconds(recorder, [&] {
-    restarting.reset();
-    restarting = startSequenceDevice(port);
+    HeldPort off = switchOff(restarting);
+    restarting = switchOn(off);
   });
   ASSERT_TRUE(restarting);
   EXPECT_GT(indexedFrames(recorder.out(), cameraName(steady->port())), 0u) << recorder.log();

@@ -92,7 +92,7 @@ TEST(CameraIsolation, AVanishedDeviceHasItsFileFinishedAndIndexedWithinTheLinkTi
         return status.is_object() && status["streams"][0]["frames"].get<int>() >= 30;
       },
       10s));
-  device.reset();
+  HeldPort off = switchOff(device);
   auto vanished = Clock::now();
   // The link times out (2 s), then the file is finished: in the index, no
   // longer the open segment, its length readable.
@@ -106,7 +106,7 @@ TEST(CameraIsolation, AVanishedDeviceHasItsFileFinishedAndIndexedWithinTheLinkTi
   ASSERT_EQ(videos.size(), 1u);
   EXPECT_GT(durationOf(videos[0]), GST_SECOND);
   // The device comes back: the next file starts with its first frame.
-  device = startSequenceDevice(port);
+  device = switchOn(off);
   ASSERT_TRUE(device);
   EXPECT_TRUE(waitFor([&] { return recorder.files(".mkv").size() == 2; }, 15s)) << recorder.log();
   recorder.signal(SIGINT);

@@ -103,10 +103,10 @@ TEST_F(CameraRebuild, ACameraWhoseRebuildFailsComesBackAndRecords) {
   ASSERT_TRUE(runMainLoopUntil([&] { return frames() > 15; }, 10s));
 
   // The device goes away: the file ends, the first rebuild fails.
-  device.reset();
+  HeldPort off = switchOff(device);
   ASSERT_TRUE(runMainLoopUntil([&] { return builds >= 2; }, 10s)) << "no rebuild tried";
   EXPECT_EQ((*camera)->phase(), CameraPhase::kRestarting);
-  device = startSequenceDevice(port);
+  device = switchOn(off);
   ASSERT_TRUE(device);
   uint64_t before = frames();
   // Tried again after the backoff: it records again.

@@ -65,10 +65,10 @@ class Export : public ::testing::Test {
     camera_ = new std::string(cameraName(port));
     ASSERT_TRUE(waitFor([] { return recorder_->files(".mkv").size() >= 2; }, milliseconds(15000)))
         << recorder_->log();
-    device.reset();
+    HeldPort off = switchOff(device);
     ASSERT_TRUE(recorder_->waitForText("retrying in 400 ms", milliseconds(10000)))
         << recorder_->log();
-    device = startSequenceDevice(port);
+    device = switchOn(off);
     ASSERT_TRUE(waitFor([] { return recorder_->files(".mkv").size() >= 4; }, milliseconds(15000)))
         << recorder_->log();
     recorder_->signal(SIGINT);

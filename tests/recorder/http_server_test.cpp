@@ -215,7 +215,10 @@ TEST(WircRecorderHttp, LiveViewShowsTheCameraWithTheTagOverlayInChromium) {
   // at the page's load, as before, came ahead of the outline on a loaded
   // machine three times in a row: the outline follows the page's fetches,
   // not its load.)
-  auto page = DevToolsPage::launch(shot.parent_path() / "live-view", 800, 600);
+  // (The program's shared Chromium keeps its profile beside the path given,
+  // for as long as the program runs: not in the recorder's folder, which
+  // goes with the recorder.)
+  auto page = DevToolsPage::launch(std::filesystem::temp_directory_path() / "live-view", 800, 600);
   ASSERT_TRUE(page);
   ASSERT_TRUE(page->navigate(live.url));
   EXPECT_TRUE(

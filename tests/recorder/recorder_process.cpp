@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "gst_scoped.h"
@@ -23,11 +24,12 @@ namespace fs = std::filesystem;
 
 RecorderProcess::RecorderProcess(uint16_t port, std::vector<std::string> extra,
                                  std::vector<std::string> wrapper) {
-  static int count = 0;
-  folder_ = fs::temp_directory_path() /
-            ("wirc-recorder-test-" + std::to_string(getpid()) + "-" + std::to_string(++count));
-  fs::remove_all(folder_);
-  fs::create_directories(folder_);
+  // A folder no other run has: named by the process, a folder could be
+  // one left by an earlier process of the same number, or by its recorder
+  // still writing (when that test was cut off).
+  std::string pattern = (fs::temp_directory_path() / "wirc-recorder-test-XXXXXX").string();
+  if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp: " + pattern);
+  folder_ = pattern;
   out_ = folder_ / "out";
   std::vector<std::string> args = wrapper;
   args.insert(args.end(), {WIRC_RECORDER, "--status", "0.5"});
@@ -84,7 +86,8 @@ RecorderProcess::~RecorderProcess() {
   if (failed)
     std::fprintf(stderr, "--- wirc-recorder's log (%s) ---\n%s--- end of its log ---\n",
                  folder_.c_str(), tail(logBeforeDump, 64 * 1024).c_str());
-  fs::remove_all(folder_);
+  std::error_code ignored;  // a destructor that throws ends the program
+  fs::remove_all(folder_, ignored);
 }
 
 int RecorderProcess::wait() {

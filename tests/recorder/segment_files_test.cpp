@@ -204,11 +204,11 @@ TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
   ASSERT_TRUE(url) << recorder.log();
   ASSERT_TRUE(waitFor([&] { return framesOf(*url, cameraName(port)) >= 30; }, milliseconds(10000)))
       << recorder.log();
-  device.reset();
+  HeldPort off = switchOff(device);
   // The device stays off while the recorder backs off (200 + 400 + 800 +
   // 1600 ms): the outage the loss line's own time must show.
   ASSERT_TRUE(recorder.waitForText("retrying in 1600 ms", milliseconds(10000))) << recorder.log();
-  device = startSequenceDevice(port);
+  device = switchOn(off);
   ASSERT_TRUE(device);
   // The second file: a second and a half of frames.
   ASSERT_TRUE(waitFor([&] { return recorder.files(".mkv").size() == 2; }, milliseconds(10000)));
@@ -257,11 +257,9 @@ TEST(SegmentFilesOutage, ADeviceLossEndsTheFileAndNoFileHoldsAGap) {
 }
 
 TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {
-  uint16_t port;
-  {
-    auto probe = startSequenceDevice();
-    port = probe->port();
-  }
+  auto probe = startSequenceDevice();
+  HeldPort off = switchOff(probe);
+  uint16_t port = off.port();
   RecorderProcess recorder(port, {"--segment", "60", "--http", "127.0.0.1:0"});
   auto url = recorder.waitForLog("http://", milliseconds(5000));
   ASSERT_TRUE(url) << recorder.log();
@@ -272,7 +270,7 @@ TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {
       milliseconds(5000)));
   auto status = nlohmann::json::parse(fetch(*url + "api/status").body);
   EXPECT_EQ(status["streams"][0]["state"], "connecting") << status;
-  auto device = startSequenceDevice(port);
+  auto device = switchOn(off);
   ASSERT_TRUE(device);
   // The backoff, then two seconds of frames.
   ASSERT_TRUE(waitFor([&] { return framesOf(*url, cameraName(port)) >= 30; }, milliseconds(15000)))
@@ -287,12 +285,9 @@ TEST(SegmentFilesStartUp, ARecorderStartedBeforeItsDeviceWaitsAndThenRecords) {
 }
 
 TEST(SegmentFilesStartUp, StoppedWhileWaitingItEndsCleanly) {
-  uint16_t port;
-  {
-    auto probe = startSequenceDevice();
-    port = probe->port();
-  }
-  RecorderProcess recorder(port, {"--segment", "60"});
+  auto probe = startSequenceDevice();
+  HeldPort off = switchOff(probe);
+  RecorderProcess recorder(off.port(), {"--segment", "60"});
   ASSERT_TRUE(recorder.waitForText("retrying in 400 ms", milliseconds(10000))) << recorder.log();
   recorder.signal(SIGTERM);
   EXPECT_EQ(recorder.wait(), 0) << recorder.log();
