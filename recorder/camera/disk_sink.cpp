@@ -1,5 +1,6 @@
 #include "camera/disk_sink.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <string>
@@ -13,12 +14,13 @@ struct DiskSinkState {
   std::shared_ptr<wircam::recorder::DiskWriter> writer;
   std::shared_ptr<wircam::recorder::DiskWriter::File> file;
   std::shared_ptr<wircam::recorder::DiskBudget> budget;
-  std::function<void()> closed;
+  std::function<void(GstElement* sink)> closed;
   uint64_t offset = 0;  // where the muxer writes next, on the streaming thread
   // The muxer has ended and the file is closed. (A sink stopped before
   // that lets its writes go on: the file is closed after the last, when
   // the writer lets go of it.)
   bool finished = false;
+  std::atomic<bool> waitAtEnd{false};  // diskSinkWaitsAtEnd()
 };
 
 }  // namespace
@@ -66,8 +68,24 @@ bool finish(WircamDiskSink* self) {
     postWriteError(self, error);
     return false;
   }
-  if (state.closed) state.closed();
+  if (state.closed) state.closed(GST_ELEMENT(self));
   return true;
+}
+
+// The same, without waiting: on the writer's thread once the file is
+// written (the sink kept until then).
+void finishLater(WircamDiskSink* self) {
+  DiskSinkState& state = *self->state;
+  if (state.finished) return;
+  state.finished = true;
+  auto* sink = static_cast<WircamDiskSink*>(gst_object_ref(self));
+  state.writer->closeWhenWritten(state.file, [sink, closed = state.closed](int error) {
+    if (error)
+      postWriteError(sink, error);
+    else if (closed)
+      closed(GST_ELEMENT(sink));
+    gst_object_unref(sink);
+  });
 }
 
 gboolean event(GstBaseSink* sink, GstEvent* event) {
@@ -82,7 +100,12 @@ gboolean event(GstBaseSink* sink, GstEvent* event) {
       break;
     }
     case GST_EVENT_EOS:
-      if (!finish(self)) {
+      // A file cut off mid-run must not hold the muxer's thread (the
+      // camera's source) for a slow disk; at the run's end the pipeline's
+      // EOS must mean every file is written.
+      if (!self->state->waitAtEnd) {
+        finishLater(self);
+      } else if (!finish(self)) {
         gst_event_unref(event);
         return FALSE;
       }
@@ -139,13 +162,19 @@ static void wircam_disk_sink_init(WircamDiskSink* self) {
 namespace wircam::recorder {
 
 GstElement* makeDiskSink(std::shared_ptr<DiskWriter> writer, std::shared_ptr<DiskWriter::File> file,
-                         std::shared_ptr<DiskBudget> budget, std::function<void()> closed) {
+                         std::shared_ptr<DiskBudget> budget,
+                         std::function<void(GstElement* sink)> closed) {
   auto* sink = WIRCAM_DISK_SINK(g_object_new(wircam_disk_sink_get_type(), nullptr));
-  *sink->state = DiskSinkState{.writer = std::move(writer),
-                               .file = std::move(file),
-                               .budget = std::move(budget),
-                               .closed = std::move(closed)};
+  DiskSinkState& state = *sink->state;
+  state.writer = std::move(writer);
+  state.file = std::move(file);
+  state.budget = std::move(budget);
+  state.closed = std::move(closed);
   return GST_ELEMENT(sink);
+}
+
+void diskSinkWaitsAtEnd(GstElement* sink) {
+  if (WIRCAM_IS_DISK_SINK(sink)) WIRCAM_DISK_SINK(sink)->state->waitAtEnd = true;
 }
 
 }  // namespace wircam::recorder

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <map>
+#include <utility>
 
 #include "common/thread_priority.h"
 
@@ -44,9 +45,17 @@ class DiskWriter::File {
 
  private:
   friend class DiskWriter;
+  // Closes the descriptor; the first error its writes or its close met.
+  int closeNow() {
+    if (fd_ >= 0 && ::close(fd_) != 0 && error_ == 0) error_ = errno;
+    fd_ = -1;
+    return error_;
+  }
+
   int fd_;
   const std::string path_;
-  int waiting_ = 0;  // writes handed over, not done (the writer's mutex_)
+  int waiting_ = 0;                            // writes handed over, not done (the writer's mutex_)
+  std::function<void(int)> closeWhenWritten_;  // (the writer's mutex_)
   std::atomic<int> error_{0};
 };
 
@@ -103,9 +112,19 @@ int DiskWriter::close(const std::shared_ptr<File>& file) {
   wake_.notify_one();
   done_.wait(lock, [&] { return file->waiting_ == 0; });
   --closing_;
-  if (file->fd_ >= 0 && ::close(file->fd_) != 0 && file->error_ == 0) file->error_ = errno;
-  file->fd_ = -1;
-  return file->error_;
+  return file->closeNow();
+}
+
+void DiskWriter::closeWhenWritten(const std::shared_ptr<File>& file,
+                                  std::function<void(int error)> closed) {
+  {
+    std::lock_guard lock(mutex_);
+    if (file->waiting_ > 0) {
+      file->closeWhenWritten_ = std::move(closed);
+      return;
+    }
+  }
+  closed(file->closeNow());
 }
 
 int DiskWriter::errorOf(const File& file) { return file.error_; }
@@ -141,8 +160,14 @@ void DiskWriter::run() {
     lock.unlock();
     for (size_t i = 0; i < batch.size();) i += performRun(batch, i);
     lock.lock();
-    for (const Write& write : batch) --write.file->waiting_;
+    std::vector<std::pair<std::shared_ptr<File>, std::function<void(int)>>> written;
+    for (const Write& write : batch)
+      if (--write.file->waiting_ == 0 && write.file->closeWhenWritten_)
+        written.emplace_back(write.file, std::exchange(write.file->closeWhenWritten_, nullptr));
     done_.notify_all();
+    lock.unlock();
+    for (auto& [file, closed] : written) closed(file->closeNow());
+    lock.lock();
   }
 }
 

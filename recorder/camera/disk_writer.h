@@ -13,6 +13,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -67,6 +68,10 @@ class DiskWriter {
   // Waits until every write handed over for `file` is done, then closes
   // it. Returns the first error its writes met (errno; 0: none).
   int close(const std::shared_ptr<File>& file);
+  // Closes `file` once every write handed over for it is done, without
+  // waiting for it: `closed` then runs, on the writer's thread (or on the
+  // caller's, when nothing waits), with the first error its writes met.
+  void closeWhenWritten(const std::shared_ptr<File>& file, std::function<void(int error)> closed);
   // The error `file`'s writes have met so far (0: none), any thread.
   static int errorOf(const File& file);
 

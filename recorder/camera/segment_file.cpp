@@ -24,7 +24,10 @@ Expected<GstElement*, std::string> SegmentFile::makeSink(const CameraDisk& disk)
       g_error_free(error);
       return unexpected(message);
     }
-    return makeDiskSink(disk.writer, std::move(*file), disk.budget, [this] { postClosed(); });
+    // (Without `this`: a file cut off on a slow disk may be written after
+    // the camera has let go of it.)
+    return makeDiskSink(disk.writer, std::move(*file), disk.budget,
+                        [path = path_](GstElement* sink) { postClosed(sink, path); });
   }
   GstElement* sink = gst_element_factory_make("filesink", nullptr);
   if (!sink) return unexpected(std::string("no filesink (gst-plugins-good)"));
@@ -98,15 +101,20 @@ GstPadProbeReturn SegmentFile::onSinkEvent(GstPad*, GstPadProbeInfo* info, gpoin
   auto* self = static_cast<SegmentFile*>(data);
   if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_OK;
   self->closed_ = true;
-  if (self->writtenBySink_) self->postClosed();
+  if (self->writtenBySink_) postClosed(self->sink_, self->path_);
   return GST_PAD_PROBE_OK;
 }
 
-void SegmentFile::postClosed() {
+void SegmentFile::postClosed(GstElement* sink, const std::string& path) {
   gst_element_post_message(
-      sink_, gst_message_new_element(GST_OBJECT(sink_),
-                                     gst_structure_new(kClosedMessage, "location", G_TYPE_STRING,
-                                                       path_.c_str(), nullptr)));
+      sink, gst_message_new_element(GST_OBJECT(sink),
+                                    gst_structure_new(kClosedMessage, "location", G_TYPE_STRING,
+                                                      path.c_str(), nullptr)));
+}
+
+void SegmentFile::endVideoAtTheRunsEnd() {
+  diskSinkWaitsAtEnd(sink_);
+  endVideo();
 }
 
 }  // namespace wircam::recorder

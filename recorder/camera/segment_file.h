@@ -46,6 +46,9 @@ class SegmentFile {
 
   // The end of its frames, or of its text (EOS into that input, once).
   void endVideo() { end(videoInput_, videoEnded_); }
+  // The same at the run's end: the file is on the disk before its sink
+  // says it has ended (a cut mid-run does not wait for a slow disk).
+  void endVideoAtTheRunsEnd();
   void endText() { end(textInput_, textEnded_); }
   // The muxer has finished the file (its EOS reached the filesink): an
   // input fed now would answer EOS, which stops the thread feeding it.
@@ -55,7 +58,8 @@ class SegmentFile {
   SegmentFile() = default;
   static void end(GstPad* input, std::atomic<bool>& ended);
   static GstPadProbeReturn onSinkEvent(GstPad* pad, GstPadProbeInfo* info, gpointer self);
-  void postClosed();
+  // kClosedMessage from `sink`, for the file at `path`.
+  static void postClosed(GstElement* sink, const std::string& path);
   // The sink for `path`, or an error.
   Expected<GstElement*, std::string> makeSink(const CameraDisk& disk);
 

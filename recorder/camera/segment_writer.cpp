@@ -185,7 +185,7 @@ GstPadProbeReturn SegmentWriter::routeFrame(GstPad* pad, GstPadProbeInfo* info) 
     keepSegment(info, videoSegment_);
     if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_PASS;
     MutexLock lock(mutex_);
-    for (const auto& file : files_) file->endVideo();
+    for (const auto& file : files_) file->endVideoAtTheRunsEnd();
     return GST_PAD_PROBE_DROP;
   }
   GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);

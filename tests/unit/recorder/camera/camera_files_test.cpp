@@ -15,6 +15,7 @@
 #include <functional>
 #include <set>
 #include <thread>
+#include <utility>
 
 #include "camera/camera.h"
 #include "camera_events.h"
@@ -126,7 +127,8 @@ class CameraFilesTest : public ::testing::Test {
   // and /metrics too.
   void expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(StreamPlan plan,
                                                               const std::function<void()>& stall,
-                                                              const std::function<void()>& resume);
+                                                              const std::function<void()>& resume,
+                                                              SegmentLimits limits = {});
 
   fs::path folder_;
   GstClock* clock_ = nullptr;
@@ -225,10 +227,11 @@ GstElement* muxerIn(GstElement* pipeline) {
 }
 
 void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
-    StreamPlan p, const std::function<void()>& stall, const std::function<void()>& resume) {
+    StreamPlan p, const std::function<void()>& stall, const std::function<void()>& resume,
+    SegmentLimits limits) {
   p.liveSink = "live";
   Observed observed;
-  CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = {}};
+  CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = limits};
   auto camera = Camera::create(p, files, {}, observed, onTestClock());
   ASSERT_TRUE(camera) << camera.error();
   std::atomic<int> live{0};
@@ -240,6 +243,16 @@ void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
   ASSERT_TRUE(runMainLoopUntil([&] { return (muxer = muxerIn(pipeline_)) != nullptr; }, 5s));
   gst_object_unref(muxer);
   stall();
+  // The disk comes back whatever fails below: a disk still stalled would
+  // hold the files' end, hence the camera's teardown.
+  struct Resumed {
+    const std::function<void()>& resume;
+    bool done = false;
+    void now() {
+      if (!std::exchange(done, true)) resume();
+    }
+    ~Resumed() { now(); }
+  } resumed{resume};
   const size_t kFrames = 120;
   for (size_t i = 1; i < kFrames; ++i) push(i, at(i));
   // Every frame reaches the live branch: the source never waits for the disk.
@@ -252,7 +265,7 @@ void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
       },
       5s));
   // The disk comes back: what waited is written, the rest stays counted.
-  resume();
+  resumed.now();
   (*camera)->stop();
   ASSERT_TRUE(runMainLoopUntil([&] { return observed.over; }, 10s));
   uint64_t recorded = 0;
@@ -298,6 +311,8 @@ TEST_F(CameraFilesTest,
 
 // Without it the muxer hands the bytes to the disk's writer; the disk
 // stalls as that writer held. The camera's bytes wait up to their bound.
+// Files are cut every 0.4 s meanwhile: a file ended on a stalled disk is
+// closed once written, without holding the source.
 TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileTheLiveViewGoesOn) {
   StreamPlan p = plan();
   p.description +=
@@ -308,7 +323,7 @@ TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileT
   auto disk = DiskWriter::of(folder_.string());
   ASSERT_TRUE(disk) << disk.error();
   expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
-      p, [&] { (*disk)->hold(); }, [&] { (*disk)->release(); });
+      p, [&] { (*disk)->hold(); }, [&] { (*disk)->release(); }, {.maxDuration = 400 * GST_MSECOND});
 }
 
 // Waits until `disk` has written all it was handed so far: it writes in
