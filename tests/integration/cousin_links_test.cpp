@@ -15,6 +15,7 @@
 #include "common/socket.h"
 #include "devices/btemp/btemp_robot.h"
 #include "devices/rcoip/rcoip_receiver.h"
+#include "held_port.h"
 #include "rcoip/rcoip_transmitter.h"
 #include "wait_for.h"
 
@@ -129,7 +130,9 @@ TEST(RcoipLink, ReportsLostWhenTheReceiverGoesAwayAndLiveWhenItComesBack) {
   Events events(**link);
   ASSERT_TRUE(waitFor([&] { return (*link)->status().state == link::LinkState::Live; }));
   receiver->reset();
+  testing::HeldPort off(port);
   ASSERT_TRUE(waitFor([&] { return events.sawState(link::LinkState::Lost); }, milliseconds(3000)));
+  off.release();
   auto again = rcoip::Receiver::start({.port = port});
   ASSERT_TRUE(again);
   ASSERT_TRUE(waitFor([&] { return (*link)->status().state == link::LinkState::Live; },

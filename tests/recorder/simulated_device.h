@@ -2,13 +2,11 @@
 // ephemeral ports.
 #pragma once
 
-#include <sys/socket.h>
-
 #include <memory>
 
-#include "common/socket.h"
 #include "devices/wirc/device.h"
 #include "follow_scene.h"
+#include "held_port.h"
 #include "jpeg_sequence_scene.h"
 #include "scene_frames.h"
 
@@ -22,32 +20,6 @@ inline std::unique_ptr<wirc::Device> startSequenceDevice(uint16_t port = 0, doub
       std::make_shared<sim::JpegSequenceScene>(sceneFrames()));
   return device ? std::move(*device) : nullptr;
 }
-
-// The port of a device switched off, kept from every other socket until
-// the device comes back on it: the parallel tests' own ephemeral sockets
-// took a freed port now and then, and the device could not come back.
-// TCP bound but not listening (a connection is refused, as by a vehicle
-// that is off) and UDP (its discovery) bound.
-class HeldPort {
- public:
-  explicit HeldPort(uint16_t port) : port_(port) {
-    auto address = SocketAddress::loopback(port);
-    tcp_ = UniqueFd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
-    int on = 1;  // over its connections' TIME_WAIT, as the device's listener
-    setsockopt(tcp_.get(), SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
-    if (::bind(tcp_.get(), address.raw(), address.size()) != 0) tcp_.reset();
-    if (auto udp = bindUdp(address)) udp_ = std::move(*udp);
-  }
-  uint16_t port() const { return port_; }
-  void release() {
-    tcp_.reset();
-    udp_.reset();
-  }
-
- private:
-  uint16_t port_;
-  UniqueFd tcp_, udp_;
-};
 
 // `device` off, its port held.
 inline HeldPort switchOff(std::unique_ptr<wirc::Device>& device) {
