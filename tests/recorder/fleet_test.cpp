@@ -26,6 +26,7 @@
 #include "mqtt_broker.h"
 #include "recorder_process.h"
 #include "scene_frames.h"
+#include "scratch_folder.h"
 #include "shell_command.h"
 #include "signed_in_page.h"
 #include "wait_for.h"
@@ -220,9 +221,8 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
     ASSERT_TRUE(cars["car" + std::to_string(n)]);
   }
   auto port = [&](const char* car) { return cars[car]->port(); };
-  fs::path folder = fs::temp_directory_path() / ("wircam-fleet-" + std::to_string(getpid()));
-  fs::remove_all(folder);
-  fs::create_directories(folder);
+  ScratchFolder scratch("wircam-fleet");  // before the recorders: it outlives them
+  const fs::path& folder = scratch.path();
 
   Member first(folder, "first", broker, {{"car1", port("car1")}, {"car2", port("car2")}});
   // The second steers its vehicles after their tags.
@@ -419,7 +419,6 @@ TEST(Fleet, ThreeRecordersOneBrokerAVehicleMovedMidDriveHasOneHistoryAndAKilledO
   // A day that is not one is refused, as on one recorder.
   EXPECT_EQ(fetch(third.url() + "api/fleet/recordings?day=2026-02-30", "GET", kAuthorized).status,
             400u);
-  fs::remove_all(folder);
 }
 
 // From the fleet section of one recorder's page, a vehicle another
@@ -434,9 +433,8 @@ TEST(Fleet, ThePagesFleetSectionDrivesAVehicleAnotherRecorderHolds) {
   auto held = startVehicle("car-a", "SA");
   auto own = startVehicle("car-b", "SB");
   ASSERT_TRUE(held && own);
-  fs::path folder = fs::temp_directory_path() / ("wircam-fleet-drive-" + std::to_string(getpid()));
-  fs::remove_all(folder);
-  fs::create_directories(folder);
+  ScratchFolder scratch("wircam-fleet-drive");  // before the recorders: it outlives them
+  const fs::path& folder = scratch.path();
   Member holder(folder, "holder", broker, {{"cara", held->port()}}, false,
                 "detect=tag36h11\nfollow=true\n");
   Member fleet(folder, "fleet", broker, {{"carb", own->port()}}, true);
@@ -467,7 +465,6 @@ TEST(Fleet, ThePagesFleetSectionDrivesAVehicleAnotherRecorderHolds) {
   EXPECT_TRUE(page->waitUntil("document.querySelector('" + card +
                               " .fleet-follow').textContent === 'following: off'"));
   page->screenshot(shotPath("fleet-drive.png"));
-  fs::remove_all(folder);
 }
 
 }  // namespace
