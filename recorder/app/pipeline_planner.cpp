@@ -66,18 +66,20 @@ std::string positionsOf(const PositionSource& source, const std::string& name) {
          " port=" + std::to_string(source.port) + " beacons=" + source.beacons + " ";
 }
 
-// The telemetry's appsrc, on to the files' text track. It never blocks the
-// main loop: past 1 MB waiting it drops. Its track is named by a stream tag
-// (in Matroska a placeholder, rewritten when the file is finished:
-// telemetry_track_flags.h).
+// The files' text track. For Matroska, the element the recorder's one
+// text thread feeds (telemetry/text_feeder.h); for MP4, after an appsrc of
+// its own, which never blocks the main loop: past 1 MB waiting it drops.
+// Its track is named by a stream tag (in Matroska a placeholder, rewritten
+// when the file is finished: telemetry_track_flags.h).
 std::string telemetryTrack(const RecorderOptions& options, const StreamPlan& stream) {
-  std::string title(options.container == Container::kMatroska ? kTelemetryTrackPlaceholder
-                                                              : kTelemetryTrackName);
+  bool matroska = options.container == Container::kMatroska;
+  std::string title(matroska ? kTelemetryTrackPlaceholder : kTelemetryTrackName);
+  std::string tag = "taginject name=" + stream.telemetryTail + " tags=\"title=" + title + "\" ";
+  if (matroska) return tag;
   return "appsrc name=" + stream.telemetrySource +
          " is-live=true format=time min-latency=0 max-latency=-1 max-bytes=1000000 "
-         "leaky-type=downstream "
-         "caps=\"text/x-raw,format=(string)utf8\" ! taginject name=" +
-         stream.telemetryTail + " tags=\"title=" + title + "\" ";
+         "leaky-type=downstream caps=\"text/x-raw,format=(string)utf8\" ! " +
+         tag;
 }
 
 }  // namespace
@@ -110,7 +112,7 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       stream.muxer = muxerOf(options.container);
       stream.muxer.text = options.telemetryTrack;
       if (options.telemetryTrack) {
-        stream.telemetrySource = "tel";
+        if (options.container == Container::kMp4) stream.telemetrySource = "tel";
         stream.telemetryTail = "teltag";
       }
       if (!options.detectFamily.empty()) stream.detector = "det";
@@ -129,17 +131,18 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       if (branches) d += "! tee name=" + tee + " ";
       // A slow disk must hold up neither the source nor the other
       // branches; past --record-queue a camera's frames are dropped.
-      // - Without the text track, the muxer runs on the source's thread
-      //   and hands its bytes to the filesystem's writer, the camera's
-      //   bound in bytes (camera/disk_writer.h): one thread a camera.
-      // - With it, the muxer waits for the text's thread before it takes
-      //   a frame (GstCollectPads), and on saturated processors that
-      //   thread runs late: the file's frames cross a queue of their own
-      //   (bounded in bytes, camera/queue_drops.h), so that it is the
-      //   queue's thread that waits, never the source's.
+      // - Matroska, or no text track: the muxer runs on the source's
+      //   thread and hands its bytes to the filesystem's writer, the
+      //   camera's bound in bytes (camera/disk_writer.h): one thread a
+      //   camera (with the recorder's one text thread: text_feeder.h).
+      // - MP4 with the text track: mp4mux (an aggregator) takes a frame
+      //   on its own thread once the text's appsrc thread has passed it,
+      //   which on saturated processors runs late: the file's frames cross
+      //   a queue of their own (bounded in bytes, camera/queue_drops.h),
+      //   so that it is the queue's thread that waits, never the source's.
       // --record-queue 0: on the source's thread, whatever the disk does.
       std::string toFile = branches ? tee + ". ! " : "! ";
-      if (options.recordQueueBytes > 0 && options.telemetryTrack) {
+      if (options.recordQueueBytes > 0 && !stream.telemetrySource.empty()) {
         stream.recordQueue = "rq";
         d += toFile + "queue name=" + stream.recordQueue +
              " max-size-buffers=0 max-size-time=0 max-size-bytes=" +

@@ -24,8 +24,8 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
   gst_object_set_name(GST_OBJECT(camera->pipeline_), plan.name.c_str());
   camera->planner_ =
       std::make_unique<SegmentPlanner>(files.folder, plan.name, files.extension, files.limits);
-  camera->track_ = std::make_unique<TelemetryTrack>(camera->element(plan.telemetrySource),
-                                                    plan.muxer.textGapEvents);
+  camera->track_ =
+      std::make_unique<TelemetryTrack>(camera->textOutlet(plan), !plan.muxer.textGapEvents);
   camera->telemetry_ = std::make_unique<TelemetryRouter>(*camera->planner_, *camera->track_);
   if (plan.recordBound > 0) {
     auto writer = DiskWriter::of(files.folder);
@@ -71,6 +71,16 @@ CameraPipeline::~CameraPipeline() {
   telemetry_.reset();
   track_.reset();
   gst_object_unref(pipeline_);
+}
+
+std::unique_ptr<TextOutlet> CameraPipeline::textOutlet(const StreamPlan& plan) const {
+  if (GstElement* appsrc = element(plan.telemetrySource)) return appSrcOutlet(appsrc);
+  GstElement* tail = element(plan.telemetryTail);
+  if (!tail) return nullptr;
+  GstPad* input = gst_element_get_static_pad(tail, "sink");
+  auto outlet = TextFeeder::outletInto(input);
+  gst_object_unref(input);
+  return outlet;
 }
 
 GstElement* CameraPipeline::element(const std::string& name) const {

@@ -21,6 +21,7 @@
 #include "record/segment_planner.h"
 #include "telemetry/telemetry_router.h"
 #include "telemetry/telemetry_track.h"
+#include "telemetry/text_feeder.h"
 
 namespace wircam::recorder {
 
@@ -47,6 +48,8 @@ class CameraPipeline {
   GstElement* pipeline() const { return pipeline_; }
   // An element of this pipeline by name (borrowed), or null.
   GstElement* element(const std::string& name) const;
+  // Where the files' text track goes (null: they have none).
+  std::unique_ptr<TextOutlet> textOutlet(const StreamPlan& plan) const;
   SegmentPlanner& planner() { return *planner_; }
   TelemetryTrack& track() { return *track_; }
   TelemetryRouter& telemetry() { return *telemetry_; }

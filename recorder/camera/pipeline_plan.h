@@ -42,14 +42,17 @@ struct StreamPlan {
   // dropped and counted. 0: the files are written on the stream's own
   // thread (a filesink).
   uint64_t recordBound = 0;
-  std::string videoTail;        // the last element before the files' muxer (a tee: a new pad)
-  std::string telemetrySource;  // appsrc of the files' text track (empty: no track)
-  std::string telemetryTail;    // the last element before the muxer on the text track
-  MuxerSpec muxer;              // each file's
-  std::string detector;         // apriltagdetect, with --detect
-  std::string controller;       // wirccontrol, on the first camera of a following device
-  std::string liveSink;         // appsink of the frames as they arrive, with --http/--rtsp
-  std::string positions;        // marvelmindpositions, with --marvelmind
+  std::string videoTail;  // the last element before the files' muxer (a tee: a new pad)
+  // The files' text track (empty: none): its appsrc (MP4; with Matroska
+  // the recorder's text thread feeds the tail), and the last element
+  // before the muxer.
+  std::string telemetrySource;
+  std::string telemetryTail;
+  MuxerSpec muxer;         // each file's
+  std::string detector;    // apriltagdetect, with --detect
+  std::string controller;  // wirccontrol, on the first camera of a following device
+  std::string liveSink;    // appsink of the frames as they arrive, with --http/--rtsp
+  std::string positions;   // marvelmindpositions, with --marvelmind
   bool operator==(const StreamPlan&) const = default;
 };
 

@@ -152,29 +152,36 @@ bool SegmentWriter::planFrame(GstPad* pad, GstPadProbeInfo* info) {
   }
   if (cut != SegmentPlanner::Cut::kNone) open(time);
   afterFrame_();
-  track_.heartbeat(time);
   return true;
 }
 
 void SegmentWriter::open(GstClockTime start) {
   auto planned = planner_.current();
   if (!planned) return;
-  MutexLock lock(mutex_);
-  auto file = SegmentFile::open(parts_.pipeline, parts_.muxer, parts_.disk, planned->path, start,
+  {
+    MutexLock lock(mutex_);
+    if (!addFile(*planned, start)) return;
+  }
+  // Its text goes out from now on (numbered as the files are). (Outside
+  // the lock: the track pushes text, whose probe takes it.)
+  track_.fileOpened(start);
+}
+
+bool SegmentWriter::addFile(const PlannedSegment& planned, GstClockTime start) {
+  auto file = SegmentFile::open(parts_.pipeline, parts_.muxer, parts_.disk, planned.path, start,
                                 opened_ + 1);
   if (!file) {
     // Its error is on the bus too, and the camera starts again.
     logLine(std::string(GST_OBJECT_NAME(parts_.pipeline)) + ": " + file.error());
     broken_ = true;
-    return;
+    return false;
   }
   ++opened_;
   // At a stop the text may end before the last frames have come through:
   // a file they open then has all the text it will get.
   if (textEnded_) (*file)->endText();
   files_.push_back(std::move(*file));
-  // Its text goes out from now on (numbered as the files are).
-  track_.fileOpened(start);
+  return true;
 }
 
 // Ending and relinking happen under the lock: finished() (the main loop)
@@ -190,6 +197,7 @@ GstPadProbeReturn SegmentWriter::routeFrame(GstPad* pad, GstPadProbeInfo* info) 
   }
   GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
   GstClockTime time = runningTimeOf(videoSegment_, buffer);
+  uint64_t number;
   {
     MutexLock lock(mutex_);
     if (broken_ || !GST_CLOCK_TIME_IS_VALID(time)) return GST_PAD_PROBE_DROP;
@@ -206,8 +214,11 @@ GstPadProbeReturn SegmentWriter::routeFrame(GstPad* pad, GstPadProbeInfo* info) 
       relink(pad, to->videoInput());
       video_ = to;
     }
+    number = to->number();
   }
   planner_.addBytes(gst_buffer_get_size(buffer));
+  // Last before the frame's push: what the text track has up to it.
+  track_.beforeFrame(time, number);
   return GST_PAD_PROBE_PASS;
 }
 

@@ -5,12 +5,14 @@
 //   they leave for the file) drops each frame its disk has no room for
 //   (CameraDisk's budget) and shows the others to the planner;
 //   at a cut it opens the next file there and then (forcing a key frame
-//   first when the stream is transcoded, as every 0.5 s), and after each
-//   frame it sends the text track's heartbeat;
+//   first when the stream is transcoded, as every 0.5 s);
 // - a probe where the frames leave for the file moves them to the newest
-//   file at its first frame, ending the one before (EOS), and counts bytes;
+//   file at its first frame, ending the one before (EOS), counts bytes,
+//   and lets the text track's lines up to the frame go first
+//   (TelemetryTrack::beforeFrame);
 // - a probe where the telemetry leaves for the file does the same for the
-//   text, on the appsrc's thread, by the file number each buffer carries.
+//   text, on the thread that pushes it, by the file number each buffer
+//   carries.
 // A file is finished once both its inputs have ended; the camera then
 // takes it out of the pipeline (finished()).
 #pragma once
@@ -81,6 +83,9 @@ class SegmentWriter {
   // The text goes to file `number` from now on; false: it has no file.
   bool moveText(GstPad* pad, uint64_t number);
   void open(GstClockTime start);
+  // The file `planned` starting at `start` joins the pipeline; false: it
+  // would not open.
+  bool addFile(const PlannedSegment& planned, GstClockTime start) WIRCAM_REQUIRES(mutex_);
   // EOS from the source (after the text's lines, or kTextDrain after end()).
   void endFrames();
   static gboolean onTextDrainTick(gpointer self);

@@ -1,28 +1,31 @@
 #include "telemetry/telemetry_track.h"
 
-#include <gst/app/gstappsrc.h>
-
+#include <algorithm>
 #include <utility>
 
 namespace wircam::recorder {
 
 bool TelemetryTrack::write(const std::string& json, GstClockTime pts, GstClockTime fileStart) {
-  if (!source_ || !GST_CLOCK_TIME_IS_VALID(pts)) return false;
-  // The lock spans the push so that buffers enter the appsrc in time order.
+  if (!outlet_ || !GST_CLOCK_TIME_IS_VALID(pts)) return false;
   MutexLock lock(mutex_);
+  if (ended_) return false;
   if (openFile_ == 0 || fileStart > openStart_) {
     if (waiting_.size() == kMaxWaiting) waiting_.pop_front();
     waiting_.push_back({json, pts, fileStart});
     return true;
   }
-  if (fileStart == openStart_) {
-    pushLine(json, pts, openFile_);
-    return true;
+  uint64_t file = openFile_;
+  // The file before, as long as nothing of the newest has gone out: after
+  // its first buffer, the text track has moved on.
+  if (fileStart != openStart_) {
+    if (fileStart != previousStart_ || sentFile_ == openFile_) return false;
+    file = openFile_ - 1;
   }
-  // The file before, as long as the newest has not begun: after its first
-  // buffer, the text track has moved on.
-  if (fileStart != previousStart_ || sentFile_ == openFile_) return false;
-  pushLine(json, pts, openFile_ - 1);
+  if (due_.size() == kMaxWaiting) due_.pop_front();
+  // By file: a line of the file before goes ahead of the newest's.
+  auto later =
+      std::find_if(due_.begin(), due_.end(), [&](const Line& due) { return due.file > file; });
+  due_.insert(later, {json, pts, file});
   return true;
 }
 
@@ -32,19 +35,30 @@ uint64_t TelemetryTrack::fileOpened(GstClockTime start) {
   previousStart_ = std::exchange(openStart_, start);
   while (!waiting_.empty() && waiting_.front().fileStart <= start) {
     if (waiting_.front().fileStart == start)
-      pushLine(waiting_.front().json, waiting_.front().pts, openFile_);
+      due_.push_back({std::move(waiting_.front().json), waiting_.front().pts, openFile_});
     waiting_.pop_front();
   }
   return openFile_;
 }
 
-void TelemetryTrack::heartbeat(GstClockTime frameTime) {
-  if (!source_) return;
+void TelemetryTrack::beforeFrame(GstClockTime frameTime, uint64_t file) {
+  if (!outlet_) return;
   MutexLock lock(mutex_);
-  if (openFile_ == 0) return;
-  if (!gapsAhead_) return pushGap(frameTime + 1, kLineDuration, openFile_);
-  if (sentFile_ == openFile_ && frameTime + kGapLead / 2 < promised_) return;
-  pushGap(frameTime + 1, kGapLead, openFile_);
+  std::vector<GstBuffer*> lines;
+  for (auto line = due_.begin(); line != due_.end();) {
+    if (line->file < file || (line->file == file && line->pts <= frameTime)) {
+      lines.push_back(stamp(*line));
+      line = due_.erase(line);
+    } else {
+      ++line;
+    }
+  }
+  moveTo(file);
+  GstClockTime from = frameTime + 1;
+  if (gapsAreSamples_) last_ = std::max(last_, from);
+  GstBuffer* gap = gst_buffer_new();
+  GST_BUFFER_FLAG_SET(gap, GST_BUFFER_FLAG_GAP);
+  outlet_->beforeFrame(std::move(lines), bufferOf(gap, from, kLineDuration, file));
 }
 
 GstPadProbeReturn TelemetryTrack::passGap(GstPad* pad, GstPadProbeInfo* info, bool asEvent) {
@@ -60,44 +74,37 @@ GstPadProbeReturn TelemetryTrack::passGap(GstPad* pad, GstPadProbeInfo* info, bo
 }
 
 void TelemetryTrack::end() {
-  if (source_) gst_app_src_end_of_stream(GST_APP_SRC(source_));
+  if (!outlet_) return;
+  MutexLock lock(mutex_);
+  if (std::exchange(ended_, true)) return;
+  std::vector<GstBuffer*> lines;
+  for (const Line& line : due_) lines.push_back(stamp(line));
+  due_.clear();
+  waiting_.clear();  // for files that will not open
+  outlet_->end(std::move(lines));
 }
 
-bool TelemetryTrack::allSent() const {
-  return !source_ || gst_app_src_get_current_level_buffers(GST_APP_SRC(source_)) == 0;
-}
+bool TelemetryTrack::allSent() const { return !outlet_ || outlet_->allSent(); }
 
-void TelemetryTrack::pushLine(const std::string& json, GstClockTime pts, uint64_t file) {
-  moveTo(file);
-  last_ = std::max(last_, pts);
-  send(gst_buffer_new_memdup(json.data(), json.size()), last_, kLineDuration, file);
-  if (gapsAhead_ && promised_ > last_ + kLineDuration)
-    pushGap(last_ + kLineDuration, promised_ - last_ - kLineDuration, file);
-}
-
-void TelemetryTrack::pushGap(GstClockTime from, GstClockTime duration, uint64_t file) {
-  moveTo(file);
-  // An empty sample, for mp4mux: the lines after it must not go before it.
-  if (!gapsAhead_) last_ = std::max(last_, from);
-  promised_ = std::max(promised_, from + duration);
-  GstBuffer* gap = gst_buffer_new();
-  GST_BUFFER_FLAG_SET(gap, GST_BUFFER_FLAG_GAP);
-  send(gap, from, duration, file);
+GstBuffer* TelemetryTrack::stamp(const Line& line) {
+  moveTo(line.file);
+  last_ = std::max(last_, line.pts);
+  return bufferOf(gst_buffer_new_memdup(line.json.data(), line.json.size()), last_, kLineDuration,
+                  line.file);
 }
 
 void TelemetryTrack::moveTo(uint64_t file) {
   if (file == sentFile_) return;
   sentFile_ = file;
   last_ = 0;
-  promised_ = 0;
 }
 
-void TelemetryTrack::send(GstBuffer* buffer, GstClockTime pts, GstClockTime duration,
-                          uint64_t file) {
+GstBuffer* TelemetryTrack::bufferOf(GstBuffer* buffer, GstClockTime pts, GstClockTime duration,
+                                    uint64_t file) {
   GST_BUFFER_PTS(buffer) = pts;
   GST_BUFFER_DURATION(buffer) = duration;
   GST_BUFFER_OFFSET(buffer) = file;
-  gst_app_src_push_buffer(GST_APP_SRC(source_), buffer);
+  return buffer;
 }
 
 }  // namespace wircam::recorder

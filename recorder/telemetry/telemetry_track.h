@@ -3,27 +3,36 @@
 // with the file it is for.
 //
 // Files are numbered as they open (1, 2, ...); a buffer's offset
-// (GST_BUFFER_OFFSET) is its file's number, which is how the SegmentWriter,
-// on the appsrc's thread, knows when the text moves on to the next file.
+// (GST_BUFFER_OFFSET) is its file's number, which is how the SegmentWriter
+// knows when the text moves on to the next file.
+//
+// A line waits here until a frame at or after its time is about to enter
+// its file (beforeFrame): a muxer hands on a frame only once every track
+// has passed its time, so the line goes in then, and after it a gap (the
+// text has nothing more up to the frame) that lets the frame through.
 #pragma once
 
 #include <gst/gst.h>
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "common/mutex.h"
+#include "telemetry/text_outlet.h"
 
 namespace wircam::recorder {
 
 class TelemetryTrack {
  public:
-  // `source` is the stream's appsrc (text/x-raw, format=utf8); borrowed.
-  // Null: the files have no text track, and every line is refused.
-  // `gapsAhead`: the muxer takes gaps as GAP events (matroskamux), so the
-  // heartbeat may promise a stretch ahead of the frames (heartbeat()).
-  TelemetryTrack(GstElement* source, bool gapsAhead) : source_(source), gapsAhead_(gapsAhead) {}
+  // `outlet`: where the files' text track goes; null: the files have none,
+  // and every line is refused. `gapsAreSamples`: the muxer writes gaps as
+  // empty samples (mp4mux), whose times must rise, and lines' after them;
+  // matroskamux takes them as GAP events (passGap) and writes nothing.
+  TelemetryTrack(std::unique_ptr<TextOutlet> outlet, bool gapsAreSamples)
+      : outlet_(std::move(outlet)), gapsAreSamples_(gapsAreSamples) {}
 
   // A line for the file that starts at running time `fileStart`. A muxer
   // wants the timestamps of a track to rise, but events arrive a little out
@@ -34,25 +43,14 @@ class TelemetryTrack {
   // has moved past is refused (false): it stays in the sidecar only.
   bool write(const std::string& json, GstClockTime pts, GstClockTime fileStart);
 
-  // A file starting at `start` opened: the lines that waited for it go
-  // out. Returns its number.
+  // A file starting at `start` opened: the lines that waited for it wait
+  // now for its frames. Returns its number.
   uint64_t fileOpened(GstClockTime start);
 
-  // A muxer hands on a frame only once every track has passed its time,
-  // so a sparse text track would hold the video back: the text says it has
-  // nothing until past the frame (a gap: an empty buffer flagged GAP, which
-  // the SegmentWriter passes on as the muxer wants it). Called before each
-  // frame reaches the muxer, on the frame's thread.
-  // - With gapsAhead, one gap promises kGapLead, renewed once a frame comes
-  //   within half of it: the text's thread wakes for gaps twice a second,
-  //   not at every frame. A line is still written at its own time, behind the
-  //   promise; as a line takes the muxer's idea of the track's position
-  //   back to its time, the promise is restated after it, or the frames
-  //   past the line would wait for a gap that no frame asks for.
-  // - Otherwise (mp4mux: its gaps are empty samples, whose times must
-  //   rise, and lines after them), a gap just after each frame.
-  void heartbeat(GstClockTime frameTime);
-  static constexpr GstClockTime kGapLead = GST_SECOND;
+  // A frame at `frameTime` is about to enter file `file`, on its thread:
+  // the lines it reaches go to the outlet, then a gap just past it.
+  void beforeFrame(GstClockTime frameTime, uint64_t file);
+
   static bool isGap(GstBuffer* buffer) {
     return GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_GAP) && gst_buffer_get_size(buffer) == 0;
   }
@@ -62,37 +60,47 @@ class TelemetryTrack {
   // (an aggregator, GStreamer 1.22), which stalls on GAP events.
   static GstPadProbeReturn passGap(GstPad* pad, GstPadProbeInfo* info, bool asEvent);
 
-  // No more lines: the text track ends after the ones sent.
+  // No more lines: the text track ends after the ones waiting (the
+  // frames' end lets in those no frame reached).
   void end();
-  // Every line sent has left the track's queue for the muxer (where the
-  // last may still wait for a frame).
+  // Every line has gone on to the muxer (where the last may still wait
+  // for a frame).
   bool allSent() const;
 
   static uint64_t fileOf(GstBuffer* buffer) { return GST_BUFFER_OFFSET(buffer); }
 
  private:
-  void pushLine(const std::string& json, GstClockTime pts, uint64_t file) WIRCAM_REQUIRES(mutex_);
-  void pushGap(GstClockTime from, GstClockTime duration, uint64_t file) WIRCAM_REQUIRES(mutex_);
+  struct Line {
+    std::string json;
+    GstClockTime pts;
+    uint64_t file;
+  };
+  // The line as the buffer its file's track goes on with.
+  GstBuffer* stamp(const Line& line) WIRCAM_REQUIRES(mutex_);
   // Buffers for `file` from now on: its times rise on their own.
   void moveTo(uint64_t file) WIRCAM_REQUIRES(mutex_);
-  void send(GstBuffer* buffer, GstClockTime pts, GstClockTime duration, uint64_t file);
+  static GstBuffer* bufferOf(GstBuffer* buffer, GstClockTime pts, GstClockTime duration,
+                             uint64_t file);
 
   struct Waiting {
     std::string json;
     GstClockTime pts, fileStart;
   };
 
-  GstElement* source_;
-  const bool gapsAhead_;
-  Mutex mutex_;  // lines come from the main loop, heartbeats and openings from streaming
+  const std::unique_ptr<TextOutlet> outlet_;
+  const bool gapsAreSamples_;
+  // Lines come from the main loop, frames and openings from streaming; the
+  // outlet is fed under it, so that what it is handed stays in order.
+  mutable Mutex mutex_;
   uint64_t openFile_ WIRCAM_GUARDED_BY(mutex_) = 0;       // the newest file's number (0: none)
   GstClockTime openStart_ WIRCAM_GUARDED_BY(mutex_) = 0;  // and its start
   GstClockTime previousStart_ WIRCAM_GUARDED_BY(mutex_) = GST_CLOCK_TIME_NONE;  // the one before's
-  uint64_t sentFile_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the file of the newest buffer sent
-  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;        // the newest line's time
-  GstClockTime promised_ WIRCAM_GUARDED_BY(mutex_) = 0;    // where the newest gap ends
-  std::deque<Waiting> waiting_ WIRCAM_GUARDED_BY(mutex_);  // for files still to open
-  static constexpr size_t kMaxWaiting = 1024;
+  uint64_t sentFile_ WIRCAM_GUARDED_BY(mutex_) = 0;  // the file of the newest buffer sent
+  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;  // the newest buffer's time in it
+  bool ended_ WIRCAM_GUARDED_BY(mutex_) = false;
+  std::deque<Line> due_ WIRCAM_GUARDED_BY(mutex_);            // for open files, by file
+  std::deque<Waiting> waiting_ WIRCAM_GUARDED_BY(mutex_);     // for files still to open
+  static constexpr size_t kMaxWaiting = 1024;                 // each (past it: the oldest go)
   static constexpr GstClockTime kLineDuration = GST_MSECOND;  // an event, not a caption to read
 };
 

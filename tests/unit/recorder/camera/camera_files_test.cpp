@@ -128,7 +128,8 @@ class CameraFilesTest : public ::testing::Test {
   void expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(StreamPlan plan,
                                                               const std::function<void()>& stall,
                                                               const std::function<void()>& resume,
-                                                              SegmentLimits limits = {});
+                                                              SegmentLimits limits = {},
+                                                              bool withTelemetry = false);
 
   fs::path folder_;
   GstClock* clock_ = nullptr;
@@ -228,7 +229,7 @@ GstElement* muxerIn(GstElement* pipeline) {
 
 void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
     StreamPlan p, const std::function<void()>& stall, const std::function<void()>& resume,
-    SegmentLimits limits) {
+    SegmentLimits limits, bool withTelemetry) {
   p.liveSink = "live";
   Observed observed;
   CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = limits};
@@ -254,7 +255,11 @@ void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
     ~Resumed() { now(); }
   } resumed{resume};
   const size_t kFrames = 120;
-  for (size_t i = 1; i < kFrames; ++i) push(i, at(i));
+  for (size_t i = 1; i < kFrames; ++i) {
+    // (The lines go to the text thread, and then the frame waits for it.)
+    if (withTelemetry && i % 5 == 0) (*camera)->writeTelemetry({{"frame", i}});
+    push(i, at(i));
+  }
   // Every frame reaches the live branch: the source never waits for the disk.
   ASSERT_TRUE(runMainLoopUntil([&] { return live.load() == static_cast<int>(kFrames); }, 5s))
       << live.load() << " of " << kFrames << " frames reached the live view";
@@ -324,6 +329,25 @@ TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileT
   ASSERT_TRUE(disk) << disk.error();
   expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
       p, [&] { (*disk)->hold(); }, [&] { (*disk)->release(); }, {.maxDuration = 400 * GST_MSECOND});
+}
+
+// The recorder's default: the same with the text track, whose lines the
+// recorder's text thread brings to the muxer.
+TEST_F(CameraFilesTest, WithTheTelemetryTrackAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn) {
+  StreamPlan p = plan();
+  p.description +=
+      " ! tee name=t t. ! queue max-size-buffers=1000 ! appsink name=live "
+      "sync=false async=false taginject name=teltag";
+  p.videoTail = "t";
+  p.telemetryTail = "teltag";
+  p.muxer.text = true;
+  p.muxer.textGapEvents = true;
+  p.recordBound = 150000;
+  auto disk = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(disk) << disk.error();
+  expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
+      p, [&] { (*disk)->hold(); }, [&] { (*disk)->release(); }, {.maxDuration = 400 * GST_MSECOND},
+      true);
 }
 
 // Waits until `disk` has written all it was handed so far: it writes in

@@ -1,38 +1,45 @@
-// The text track beside the frames in a real matroskamux: its gaps run
-// ahead of the frames, so the text's thread is not woken at every frame,
-// and a line that comes behind the frames neither holds them back nor
-// lands anywhere but at its own time (read back with matroskademux).
+// The text track beside the frames in a real matroskamux, fed by the
+// recorder's one text thread: a frame with no line due goes through on its
+// own thread with its gap (nothing else wakes), a frame with lines lets
+// them in first, and a line that comes behind the frames neither holds
+// them back nor lands anywhere but at its own time (read back with
+// matroskademux).
 #include "telemetry/telemetry_track.h"
 
 #include <gst/app/gstappsink.h>
 #include <gtest/gtest.h>
+#include <pthread.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include "telemetry/text_feeder.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using wircam::recorder::TelemetryTrack;
+using wircam::recorder::TextFeeder;
 
 constexpr GstClockTime kFrameInterval = GST_SECOND / 15;
 constexpr int kFrames = 150;                             // 10 s
 constexpr int kLineEvery = 5;                            // a line every 5th frame
 constexpr GstClockTime kLineBehind = 100 * GST_MSECOND;  // a detection a frame late, or more
 
-// appsrc → matroskamux ← a pad the test pushes frames from (as wircsrc's
-// thread does) → filesink.
+// taginject (the recorder's text tail) → matroskamux ← a pad the test
+// pushes frames from (as wircsrc's thread does) → filesink.
 class TextBesideFrames {
  public:
   explicit TextBesideFrames(const fs::path& file) {
     pipeline_ = gst_parse_launch(
-        ("appsrc name=text is-live=true format=time caps=text/x-raw,format=(string)utf8 "
-         "! mux.subtitle_%u matroskamux name=mux ! filesink location=\"" +
+        ("taginject name=text ! mux.subtitle_%u matroskamux name=mux ! filesink location=\"" +
          file.string() + "\"")
             .c_str(),
         nullptr);
@@ -63,7 +70,14 @@ class TextBesideFrames {
     gst_object_unref(pipeline_);
   }
 
-  GstElement* textSource() const { return text_; }
+  // The text's way in, as the recorder feeds it.
+  std::unique_ptr<wircam::recorder::TextOutlet> textOutlet() const {
+    GstPad* input = gst_element_get_static_pad(text_, "sink");
+    auto outlet = TextFeeder::outletInto(input);
+    gst_object_unref(input);
+    return outlet;
+  }
+  void setFramesThread(std::thread::id id) { framesThread_ = id; }
   // Pushes a frame as a source's thread does: returns once the muxer took it.
   GstFlowReturn pushFrame(GstClockTime pts) {
     GstBuffer* frame = gst_buffer_new_allocate(nullptr, 1000, nullptr);
@@ -85,19 +99,40 @@ class TextBesideFrames {
   // Unblocks a frame held in the muxer (a failed test).
   void stop() { gst_element_set_state(pipeline_, GST_STATE_NULL); }
   int gapsSent() const { return gaps_; }
+  // Buffers that went to the muxer on the frames' own thread: lines, gaps.
+  int linesFromFramesThread() const { return framesThreadLines_; }
+  int gapsFromFramesThread() const { return framesThreadGaps_; }
 
  private:
-  static GstPadProbeReturn onText(GstPad* pad, GstPadProbeInfo* info, gpointer self) {
-    if (!TelemetryTrack::isGap(GST_PAD_PROBE_INFO_BUFFER(info))) return GST_PAD_PROBE_OK;
-    ++static_cast<TextBesideFrames*>(self)->gaps_;
+  static GstPadProbeReturn onText(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+    auto* self = static_cast<TextBesideFrames*>(data);
+    bool onFramesThread = std::this_thread::get_id() == self->framesThread_;
+    if (!TelemetryTrack::isGap(GST_PAD_PROBE_INFO_BUFFER(info))) {
+      if (onFramesThread) ++self->framesThreadLines_;
+      return GST_PAD_PROBE_OK;
+    }
+    ++self->gaps_;
+    if (onFramesThread) ++self->framesThreadGaps_;
     return TelemetryTrack::passGap(pad, info, true);
   }
 
   GstElement* pipeline_;
   GstElement* text_;
   GstPad* frames_;
-  std::atomic<int> gaps_{0};
+  std::atomic<int> gaps_{0}, framesThreadLines_{0}, framesThreadGaps_{0};
+  std::thread::id framesThread_;
 };
+
+// The threads of this process named `name`.
+int threadsNamed(const std::string& name) {
+  int count = 0;
+  for (const auto& task : fs::directory_iterator("/proc/self/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::string line;
+    if (std::getline(comm, line) && line == name) ++count;
+  }
+  return count;
+}
 
 struct ReadBack {
   int frames = 0;
@@ -130,40 +165,39 @@ ReadBack readBack(const fs::path& file) {
   return read;
 }
 
-TEST(TelemetryTrack, GapsRunAheadAndALineBehindTheFramesNeitherHoldsThemNorMoves) {
+TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAndOnlyThoseWakeTheTextThread) {
   gst_init(nullptr, nullptr);
   struct RemovedAtEnd {
     fs::path path;
     ~RemovedAtEnd() { fs::remove(path); }
   } file{fs::temp_directory_path() / ("text-track-" + std::to_string(getpid()) + ".mkv")};
   std::vector<GstClockTime> written;
-  int gapsSent = 0, framesPushed = 0;
+  int framesPushed = 0;
   {
     TextBesideFrames pipeline(file.path);
-    TelemetryTrack track(pipeline.textSource(), true);
+    TelemetryTrack track(pipeline.textOutlet(), false);
     track.fileOpened(0);
     // The frames' thread, as wircsrc's: a line for a frame already in the
-    // file, then the heartbeat, then the frame.
+    // file, then the frame, which lets in what is due before it.
     auto frames = std::async(std::launch::async, [&] {
+      pipeline.setFramesThread(std::this_thread::get_id());
       for (int i = 0; i < kFrames; ++i) {
         GstClockTime pts = i * kFrameInterval;
         if (i > 0 && i % kLineEvery == 0) {
           written.push_back(pts - kLineBehind);
           track.write("{\"frame\":" + std::to_string(i) + "}", written.back(), 0);
         }
-        track.heartbeat(pts);
+        track.beforeFrame(pts, 1);
         if (pipeline.pushFrame(pts) != GST_FLOW_OK) return -1;
       }
-      // As SegmentWriter ends a recording: the text's lines all go to the
-      // muxer first (each frame that still comes lets in one that waits
-      // there for a frame), then the frames end, so that the muxer, which
-      // finishes at its frames' end, has every line.
+      // As SegmentWriter ends a recording: a line no frame reached, then
+      // the text's end; the frames end once the text thread has them.
+      written.push_back(kFrames * kFrameInterval);
+      track.write("{\"last\":true}", written.back(), 0);
       track.end();
-      int pushed = kFrames;
-      for (; !track.allSent() && pushed < 2 * kFrames; ++pushed)
-        if (pipeline.pushFrame(pushed * kFrameInterval) != GST_FLOW_OK) return -1;
+      while (!track.allSent()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
       pipeline.endFrames();
-      return pushed;
+      return kFrames;
     });
     // 10 s of frames pushed as fast as the muxer takes them: a frame held
     // for a gap that never comes would hold them for ever.
@@ -171,15 +205,19 @@ TEST(TelemetryTrack, GapsRunAheadAndALineBehindTheFramesNeitherHoldsThemNorMoves
     if (!done) pipeline.stop();
     ASSERT_TRUE(done) << "a frame waited in the muxer for the text track";
     framesPushed = frames.get();
-    ASSERT_GE(framesPushed, kFrames);
+    ASSERT_EQ(framesPushed, kFrames);
     ASSERT_TRUE(pipeline.finished(10 * GST_SECOND));
-    gapsSent = pipeline.gapsSent();
+    EXPECT_EQ(threadsNamed("wircam-text"), 1);
+    // Every line came from the text thread, and the frames with none due
+    // (120 of 150) sent their gaps themselves (but where the text thread
+    // had not quite returned from the frame before: then it takes the gap).
+    EXPECT_EQ(pipeline.linesFromFramesThread(), 0);
+    EXPECT_GE(pipeline.gapsFromFramesThread(), 90);
+    EXPECT_EQ(pipeline.gapsSent(), kFrames);
   }
-  // A gap per frame would be 150; ahead by a second, renewed at half of
-  // it, 20, and one restating the promise after each of the 29 lines.
-  EXPECT_LE(gapsSent, 20 + 29 + 2);
   ReadBack read = readBack(file.path);
   EXPECT_EQ(read.frames, framesPushed);
+  // (The last line, past the last frame, is at its own time too.)
   ASSERT_EQ(read.lineTimes.size(), written.size());
   for (size_t i = 0; i < written.size(); ++i)  // Matroska keeps milliseconds
     EXPECT_NEAR(static_cast<double>(read.lineTimes[i]), static_cast<double>(written[i]),
