@@ -1,5 +1,5 @@
-// A thread that others wait on (the links' loop, the disk's writer, a
-// file's text track) runs ahead of the video work on busy processors:
+// A thread that others wait on (the links' loop, the disks' writers) runs
+// ahead of the video work on busy processors:
 // nice -10 for the calling thread. It needs CAP_SYS_NICE or an RLIMIT_NICE
 // that allows it (the service's LimitNICE=); without either the thread
 // keeps the process's priority, which is only slower.

@@ -4,8 +4,6 @@
 
 #include <algorithm>
 
-#include "common/thread_priority.h"
-
 namespace wircam::recorder {
 
 namespace {
@@ -130,9 +128,12 @@ void TextFeeder::post(Outlet& outlet, Batch batch) {
 
 void TextFeeder::run() {
   pthread_setname_np(pthread_self(), "wircam-text");
-  // Frames wait in their muxers for what this thread brings: on processors
-  // busy with video it must not wait its turn behind them.
-  runThisThreadAhead();
+  // At the process's priority, unlike the links' loop and the disks'
+  // writers: woken by a frame's thread, this one would take that thread's
+  // processor at once, then wait in the muxer for the very frame the
+  // thread was about to push, which on saturated processors waits its turn
+  // behind hundreds of others (measured: cameras took 18 s to be live).
+  // At an equal share the frame's thread goes on into the muxer first.
   std::unique_lock lock(mutex_);
   while (true) {
     wake_.wait(lock, [&] { return stopping_ || !ready_.empty(); });

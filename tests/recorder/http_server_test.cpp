@@ -221,19 +221,26 @@ TEST(WircRecorderHttp, LiveViewShowsTheCameraWithTheTagOverlayInChromium) {
   auto page = DevToolsPage::launch(std::filesystem::temp_directory_path() / "live-view", 800, 600);
   ASSERT_TRUE(page);
   ASSERT_TRUE(page->navigate(live.url));
-  EXPECT_TRUE(
-      page->waitUntil("document.querySelector('img[alt=live]').naturalWidth > 0 && "
-                      "document.querySelector('svg polygon.tag')",
-                      milliseconds(20000)));
-  ASSERT_TRUE(page->screenshot(shot));
-  // The camera's picture (its sky) and the overlay's green outline.
-  auto picture = readPng(shot);
-  ASSERT_EQ(picture.width, 800);
+  // The outline follows the detections: where the tag was not found in the
+  // newest frame (the target circles; on a loaded machine detection runs
+  // behind), the card shows none for that moment, so a user looks again.
+  // (One screenshot, in the suite's busy first seconds, came without it.)
   int sky = 0, overlay = 0;
-  for (size_t i = 0; i + 2 < picture.rgb.size(); i += 3) {
-    int r = picture.rgb[i], g = picture.rgb[i + 1], b = picture.rgb[i + 2];
-    if (b > 200 && r > 120 && r < 210 && g > 170) ++sky;
-    if (g > 200 && r < 90 && b < 90) ++overlay;
+  for (int look = 0; look < 10 && overlay <= 100; ++look) {
+    EXPECT_TRUE(
+        page->waitUntil("document.querySelector('img[alt=live]').naturalWidth > 0 && "
+                        "document.querySelector('svg polygon.tag')",
+                        milliseconds(20000)));
+    ASSERT_TRUE(page->screenshot(shot));
+    // The camera's picture (its sky) and the overlay's green outline.
+    auto picture = readPng(shot);
+    ASSERT_EQ(picture.width, 800);
+    sky = overlay = 0;
+    for (size_t i = 0; i + 2 < picture.rgb.size(); i += 3) {
+      int r = picture.rgb[i], g = picture.rgb[i + 1], b = picture.rgb[i + 2];
+      if (b > 200 && r > 120 && r < 210 && g > 170) ++sky;
+      if (g > 200 && r < 90 && b < 90) ++overlay;
+    }
   }
   EXPECT_GT(sky, 20000) << "no camera picture in " << shot;
   EXPECT_GT(overlay, 100) << "no tag overlay in " << shot;
