@@ -149,9 +149,8 @@ std::vector<OptionSpec> recordingRows() {
        .section = kFiles,
        .reloadable = true,
        .help = "the telemetry also as the file's text track `telemetry`; `off` keeps it in the "
-               "sidecar only. In Matroska one thread of the recorder feeds every camera's text "
-               "track; in MP4 the track costs a camera two threads, the text's and the file "
-               "queue's",
+               "sidecar only, which spares each camera its file queue's thread (in MP4 the "
+               "text's too): a camera is then one thread (for many cameras on a small machine)",
        .apply = onOff(&RecorderOptions::telemetryTrack),
        .example = "off"},
       {.name = "record-queue",
@@ -162,9 +161,9 @@ std::vector<OptionSpec> recordingRows() {
        .help = "how much of a camera's video may wait for a slow disk (`100K`..`1G`); past "
                "it the newest frames are dropped from the file, counted in `/api/status` "
                "(`recording_dropped`), `/metrics` and the log, while the live view, detection "
-               "and following go on. One thread writes the files of every camera on a "
-               "filesystem; in MP4 with the text track each camera's frames wait in a queue of "
-               "their own instead. `0`: each camera writes its files on its own thread, so a "
+               "and following go on. With `--telemetry-track off` one thread writes the files "
+               "of every camera on a filesystem, without it each camera's frames wait in a "
+               "queue of their own. `0`: each camera writes its files on its own thread, so a "
                "disk that stalls then stalls the camera's source and branches too",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          auto bytes = byteSize(value);

@@ -131,18 +131,20 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       if (branches) d += "! tee name=" + tee + " ";
       // A slow disk must hold up neither the source nor the other
       // branches; past --record-queue a camera's frames are dropped.
-      // - Matroska, or no text track: the muxer runs on the source's
-      //   thread and hands its bytes to the filesystem's writer, the
-      //   camera's bound in bytes (camera/disk_writer.h): one thread a
-      //   camera (with the recorder's one text thread: text_feeder.h).
-      // - MP4 with the text track: mp4mux (an aggregator) takes a frame
-      //   on its own thread once the text's appsrc thread has passed it,
-      //   which on saturated processors runs late: the file's frames cross
-      //   a queue of their own (bounded in bytes, camera/queue_drops.h),
-      //   so that it is the queue's thread that waits, never the source's.
+      // - Without the text track, the muxer runs on the source's thread
+      //   and hands its bytes to the filesystem's writer, the camera's
+      //   bound in bytes (camera/disk_writer.h): one thread a camera.
+      // - With it, the muxer takes a frame only once the text has passed
+      //   its time, and when lines are due that is the text thread's work
+      //   (telemetry/text_feeder.h; MP4: the text's appsrc), which on
+      //   busy processors runs late: the file's frames cross a queue of
+      //   their own (bounded in bytes, camera/queue_drops.h), so that it
+      //   is the queue's thread that waits, never the source's, whose live
+      //   view and detection go on (without it, the live view's tests
+      //   missed frames on a busy machine).
       // --record-queue 0: on the source's thread, whatever the disk does.
       std::string toFile = branches ? tee + ". ! " : "! ";
-      if (options.recordQueueBytes > 0 && !stream.telemetrySource.empty()) {
+      if (options.recordQueueBytes > 0 && options.telemetryTrack) {
         stream.recordQueue = "rq";
         d += toFile + "queue name=" + stream.recordQueue +
              " max-size-buffers=0 max-size-time=0 max-size-bytes=" +

@@ -32,13 +32,13 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   const auto& d = plan.description();
   EXPECT_TRUE(has(d, "wircsrc name=" + s.source + " host=10.0.0.2 port=1984"));
   EXPECT_TRUE(has(d, "wait-for-device=true"));
-  // From the source to the muxer, no queue: the disk's thread writes the
-  // bytes, within 8 MB, and the recorder's one text thread brings the
-  // lines. One thread a camera.
-  EXPECT_EQ(s.videoTail, s.source);
-  EXPECT_TRUE(s.recordQueue.empty());
-  EXPECT_EQ(s.recordBound, 8'000'000u);
-  EXPECT_FALSE(has(d, "queue"));
+  // With the text track the frames reach the file through its own bounded
+  // queue (the muxer waits for the text thread: the queue's thread waits,
+  // not the source's), no tee (the SegmentWriter puts each file in).
+  EXPECT_EQ(s.videoTail, s.recordQueue);
+  EXPECT_TRUE(has(d, "! queue name=" + s.recordQueue +
+                         " max-size-buffers=0 max-size-time=0 max-size-bytes=8000000"));
+  EXPECT_EQ(s.recordBound, 0u);
   EXPECT_FALSE(has(d, "tee"));
   EXPECT_FALSE(has(d, "splitmuxsink"));
   EXPECT_EQ(s.muxer.factory, "matroskamux");
@@ -108,9 +108,10 @@ TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
   EXPECT_EQ(names.size(), 4u);
   EXPECT_FALSE(plan.streams[0].controller.empty());
   EXPECT_TRUE(plan.streams[1].controller.empty());
-  // Branches: the file's frames leave the tee by a pad of their own.
-  EXPECT_EQ(plan.streams[0].videoTail, "t");
-  EXPECT_TRUE(plan.streams[0].recordQueue.empty());
+  // Branches: the file's frames leave the tee by a pad of their own, into
+  // their queue.
+  EXPECT_TRUE(has(plan.streams[0].description,
+                  "tee name=t t. ! queue name=" + plan.streams[0].recordQueue));
   EXPECT_FALSE(plan.streams[2].controller.empty());
   EXPECT_TRUE(has(plan.description(), "family=tag36h11"));
 }

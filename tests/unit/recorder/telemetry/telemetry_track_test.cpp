@@ -189,6 +189,9 @@ TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAndOnlyThoseWakeTheTextThread) {
         }
         track.beforeFrame(pts, 1);
         if (pipeline.pushFrame(pts) != GST_FLOW_OK) return -1;
+        // (A source's next frame comes 67 ms later: the text thread is
+        // back from the lines by then. Pushed at once, it may not be.)
+        if (i % kLineEvery == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
       }
       // As SegmentWriter ends a recording: a line no frame reached, then
       // the text's end; the frames end once the text thread has them.
@@ -212,7 +215,7 @@ TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAndOnlyThoseWakeTheTextThread) {
     // (120 of 150) sent their gaps themselves (but where the text thread
     // had not quite returned from the frame before: then it takes the gap).
     EXPECT_EQ(pipeline.linesFromFramesThread(), 0);
-    EXPECT_GE(pipeline.gapsFromFramesThread(), 90);
+    EXPECT_GE(pipeline.gapsFromFramesThread(), 75);
     EXPECT_EQ(pipeline.gapsSent(), kFrames);
   }
   ReadBack read = readBack(file.path);
