@@ -55,7 +55,7 @@ void TelemetryTrack::beforeFrame(GstClockTime frameTime, uint64_t file) {
   }
   moveTo(file);
   GstClockTime from = frameTime + 1;
-  if (gapsAreSamples_) last_ = std::max(last_, from);
+  if (gapsAreSamples_) from = startAfterTheLast(from);
   GstBuffer* gap = gst_buffer_new();
   GST_BUFFER_FLAG_SET(gap, GST_BUFFER_FLAG_GAP);
   outlet_->beforeFrame(std::move(lines), bufferOf(gap, from, kLineDuration, file));
@@ -88,9 +88,16 @@ bool TelemetryTrack::allSent() const { return !outlet_ || outlet_->allSent(); }
 
 GstBuffer* TelemetryTrack::stamp(const Line& line) {
   moveTo(line.file);
-  last_ = std::max(last_, line.pts);
-  return bufferOf(gst_buffer_new_memdup(line.json.data(), line.json.size()), last_, kLineDuration,
+  GstClockTime at =
+      gapsAreSamples_ ? startAfterTheLast(line.pts) : (last_ = std::max(last_, line.pts));
+  return bufferOf(gst_buffer_new_memdup(line.json.data(), line.json.size()), at, kLineDuration,
                   line.file);
+}
+
+GstClockTime TelemetryTrack::startAfterTheLast(GstClockTime pts) {
+  GstClockTime at = std::max(last_, pts);
+  last_ = at + kLineDuration;
+  return at;
 }
 
 void TelemetryTrack::moveTo(uint64_t file) {

@@ -77,6 +77,11 @@ class TelemetryTrack {
   };
   // The line as the buffer its file's track goes on with.
   GstBuffer* stamp(const Line& line) WIRCAM_REQUIRES(mutex_);
+  // A sample's start at `pts` or after the one before's end (mp4mux
+  // writes samples end to end: two lines of one moment, each lasting
+  // kLineDuration, overlapped, and the file's text track got a negative
+  // duration).
+  GstClockTime startAfterTheLast(GstClockTime pts) WIRCAM_REQUIRES(mutex_);
   // Buffers for `file` from now on: its times rise on their own.
   void moveTo(uint64_t file) WIRCAM_REQUIRES(mutex_);
   static GstBuffer* bufferOf(GstBuffer* buffer, GstClockTime pts, GstClockTime duration,
@@ -96,7 +101,8 @@ class TelemetryTrack {
   GstClockTime openStart_ WIRCAM_GUARDED_BY(mutex_) = 0;  // and its start
   GstClockTime previousStart_ WIRCAM_GUARDED_BY(mutex_) = GST_CLOCK_TIME_NONE;  // the one before's
   uint64_t sentFile_ WIRCAM_GUARDED_BY(mutex_) = 0;  // the file of the newest buffer sent
-  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;  // the newest buffer's time in it
+  // The newest line's time in it (samples: the end of the newest).
+  GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;
   bool ended_ WIRCAM_GUARDED_BY(mutex_) = false;
   std::deque<Line> due_ WIRCAM_GUARDED_BY(mutex_);            // for open files, by file
   std::deque<Waiting> waiting_ WIRCAM_GUARDED_BY(mutex_);     // for files still to open

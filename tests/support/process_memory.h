@@ -1,5 +1,5 @@
-// How much memory a process holds resident, and how many threads and file
-// descriptors, for tests that a hostile peer or churning clients cannot
+// How much memory a process holds resident, and how many threads (by
+// name too) and file descriptors, for tests that a hostile peer or churning clients cannot
 // make them grow.
 #pragma once
 
@@ -37,6 +37,18 @@ inline ProcessCounts processCounts(pid_t pid) {
     counts.sockets += fs::read_symlink(entry.path(), error).string().starts_with("socket:");
   }
   return counts;
+}
+
+// The threads of process `pid` named `name` (as top -H shows them).
+inline size_t threadsNamed(const std::string& name, pid_t pid = getpid()) {
+  size_t count = 0;
+  for (const auto& task :
+       std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task")) {
+    std::string comm;
+    std::getline(std::ifstream(task.path() / "comm"), comm);
+    count += comm == name;
+  }
+  return count;
 }
 
 }  // namespace wircam::testing

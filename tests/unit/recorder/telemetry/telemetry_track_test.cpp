@@ -14,12 +14,12 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <future>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "process_memory.h"
 #include "telemetry/text_feeder.h"
 
 namespace {
@@ -123,17 +123,6 @@ class TextBesideFrames {
   std::thread::id framesThread_;
 };
 
-// The threads of this process named `name`.
-int threadsNamed(const std::string& name) {
-  int count = 0;
-  for (const auto& task : fs::directory_iterator("/proc/self/task")) {
-    std::ifstream comm(task.path() / "comm");
-    std::string line;
-    if (std::getline(comm, line) && line == name) ++count;
-  }
-  return count;
-}
-
 struct ReadBack {
   int frames = 0;
   std::vector<GstClockTime> lineTimes;
@@ -210,7 +199,7 @@ TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAndOnlyThoseWakeTheTextThread) {
     framesPushed = frames.get();
     ASSERT_EQ(framesPushed, kFrames);
     ASSERT_TRUE(pipeline.finished(10 * GST_SECOND));
-    EXPECT_EQ(threadsNamed("wircam-text"), 1);
+    EXPECT_EQ(wircam::testing::threadsNamed("wircam-text"), 1u);
     // Every line came from the text thread, and the frames with none due
     // (120 of 150) sent their gaps themselves (but where the text thread
     // had not quite returned from the frame before: then it takes the gap).
@@ -226,6 +215,48 @@ TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAndOnlyThoseWakeTheTextThread) {
     EXPECT_NEAR(static_cast<double>(read.lineTimes[i]), static_cast<double>(written[i]),
                 static_cast<double>(GST_MSECOND))
         << "line " << i;
+}
+
+// mp4mux writes a text track's samples end to end: lines of one moment,
+// and a gap just after a line, each last kLineDuration and must not
+// overlap (they did, and the file's text track had a negative duration,
+// which ffprobe read as 4,294,967 s). What the track hands its outlet:
+class Kept : public wircam::recorder::TextOutlet {
+ public:
+  explicit Kept(std::vector<GstBuffer*>& kept) : kept_(kept) {}
+  void beforeFrame(std::vector<GstBuffer*> lines, GstBuffer* gap) override {
+    kept_.insert(kept_.end(), lines.begin(), lines.end());
+    kept_.push_back(gap);
+  }
+  void end(std::vector<GstBuffer*> lines) override {
+    kept_.insert(kept_.end(), lines.begin(), lines.end());
+  }
+  bool allSent() const override { return true; }
+
+ private:
+  std::vector<GstBuffer*>& kept_;
+};
+
+TEST(TelemetryTrack, AsSamplesEachStartsWhereTheOneBeforeEnds) {
+  gst_init(nullptr, nullptr);
+  std::vector<GstBuffer*> kept;
+  {
+    TelemetryTrack track(std::make_unique<Kept>(kept), true);
+    track.fileOpened(0);
+    track.write("{\"event\":\"live\"}", 0, 0);
+    track.write("{\"event\":\"control\"}", 0, 0);
+    track.beforeFrame(0, 1);
+    track.write("{\"late\":true}", 0, 0);  // after the gap, of a moment before it
+    track.beforeFrame(kFrameInterval, 1);
+    track.end();
+  }
+  ASSERT_EQ(kept.size(), 5u);  // two lines, a gap, a line, a gap
+  for (size_t i = 1; i < kept.size(); ++i)
+    EXPECT_GE(GST_BUFFER_PTS(kept[i]),
+              GST_BUFFER_PTS(kept[i - 1]) + GST_BUFFER_DURATION(kept[i - 1]))
+        << "sample " << i;
+  EXPECT_LE(GST_BUFFER_PTS(kept[4]), kFrameInterval + 1);  // the gap still just after its frame
+  for (GstBuffer* buffer : kept) gst_buffer_unref(buffer);
 }
 
 }  // namespace
