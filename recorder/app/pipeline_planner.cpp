@@ -130,28 +130,25 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       if (device.positions) d += "! " + positionsOf(*device.positions, stream.positions);
       if (branches) d += "! tee name=" + tee + " ";
       // A slow disk must hold up neither the source nor the other
-      // branches; past --record-queue a camera's frames are dropped.
-      // - Without the text track, the muxer runs on the source's thread
-      //   and hands its bytes to the filesystem's writer, the camera's
-      //   bound in bytes (camera/disk_writer.h): one thread a camera.
-      // - With it, the muxer takes a frame only once the text has passed
-      //   its time, and when lines are due that is the text thread's work
-      //   (telemetry/text_feeder.h; MP4: the text's appsrc), which on
-      //   busy processors runs late: the file's frames cross a queue of
-      //   their own (bounded in bytes, camera/queue_drops.h), so that it
-      //   is the queue's thread that waits, never the source's, whose live
-      //   view and detection go on (without it, the live view's tests
-      //   missed frames on a busy machine).
+      // branches, nor any other camera: the muxer hands its bytes to the
+      // filesystem's writer, within the camera's bound in bytes
+      // (camera/disk_writer.h), past which its frames are dropped.
+      // With the text track the muxer takes a frame only once the text
+      // has passed its time, and when lines are due that is the text
+      // thread's work (telemetry/text_feeder.h; MP4: the text's appsrc),
+      // which on busy processors runs late: the file's frames cross a
+      // queue of their own (bounded in bytes, camera/queue_drops.h), so
+      // that it is the queue's thread that waits, never the source's, whose
+      // live view and detection go on. Without it, a camera is one thread.
       // --record-queue 0: on the source's thread, whatever the disk does.
       std::string toFile = branches ? tee + ". ! " : "! ";
+      stream.recordBound = options.recordQueueBytes;
       if (options.recordQueueBytes > 0 && options.telemetryTrack) {
         stream.recordQueue = "rq";
         d += toFile + "queue name=" + stream.recordQueue +
              " max-size-buffers=0 max-size-time=0 max-size-bytes=" +
              std::to_string(options.recordQueueBytes) + " ";
         toFile = "! ";
-      } else {
-        stream.recordBound = options.recordQueueBytes;
       }
       if (plan.transcoded) {
         stream.videoTail = "enc";

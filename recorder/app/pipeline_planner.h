@@ -13,16 +13,17 @@ namespace wircam::recorder {
 // Each stream is a pipeline of its own, so that a camera that never sends a
 // frame, errors or stalls holds no other camera's preroll, EOS or stop.
 // Per stream: wircsrc → [marvelmindpositions →] [tee →] [queue →] [decode →
-// x264enc →] (the file), an appsrc of telemetry text → (the same file,
-// unless --telemetry-track off) and, when asked for, a leaky branch off the tee to
-// AprilTag detection (→ wirccontrol) and one to an appsink for the live
-// view and RTSP. The files themselves (a muxer and a sink each) are not in
-// the description: the recorder's SegmentWriter puts each in at its first
-// frame and takes it out when it is finished. A slow disk holds up neither
-// the source nor the live and detection branches (hence following): the
-// files' bytes are written by their filesystem's thread, each camera's
-// bounded (camera/disk_writer.h), or, with the text track, the frames cross
-// a bounded queue (camera/queue_drops.h) to a filesink.
+// x264enc →] (the file), the telemetry's text (the same file, unless
+// --telemetry-track off; for MP4 from an appsrc) and, when asked for, a
+// leaky branch off the tee to AprilTag detection (→ wirccontrol) and one
+// to an appsink for the live view and RTSP. The files themselves (a muxer
+// and a sink each) are not in the description: the recorder's
+// SegmentWriter puts each in at its first frame and takes it out when it
+// is finished. A slow disk holds up neither the source nor the live and
+// detection branches (hence following), nor another camera: the files'
+// bytes are written by their filesystem's thread, each camera's bounded
+// (camera/disk_writer.h); with the text track the frames also cross a
+// bounded queue (camera/queue_drops.h), which waits for the text thread.
 PipelinePlan planPipeline(const RecorderOptions& options);
 
 // Two streams of one name (devices whose names differ only in what a file

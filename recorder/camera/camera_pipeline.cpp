@@ -1,5 +1,7 @@
 #include "camera/camera_pipeline.h"
 
+#include "telemetry/text_feeder.h"
+
 namespace wircam::recorder {
 
 Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(

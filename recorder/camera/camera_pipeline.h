@@ -21,7 +21,7 @@
 #include "record/segment_planner.h"
 #include "telemetry/telemetry_router.h"
 #include "telemetry/telemetry_track.h"
-#include "telemetry/text_feeder.h"
+#include "telemetry/text_outlet.h"
 
 namespace wircam::recorder {
 
@@ -61,8 +61,7 @@ class CameraPipeline {
   uint64_t framesPlanned() const { return framesPlanned_.load(); }
   // The frames dropped for want of room (their disk behind), this run.
   uint64_t framesDropped() const {
-    if (drops_) return drops_->dropped();
-    return disk_.budget ? disk_.budget->framesDropped() : 0;
+    return (drops_ ? drops_->dropped() : 0) + (disk_.budget ? disk_.budget->framesDropped() : 0);
   }
   // The frames that came for the files: the camera's health counts these,
   // not the ones written (a slow disk is not a camera without video).

@@ -37,10 +37,9 @@ struct StreamPlan {
   // The file's frames' queue, with the text track (bounded in bytes,
   // camera/queue_drops.h); empty: none.
   std::string recordQueue;
-  // Without the queue: how much of the camera's video may wait for its
-  // disk's writer, in bytes (camera/disk_writer.h); past it frames are
-  // dropped and counted. 0: the files are written on the stream's own
-  // thread (a filesink).
+  // How much of the camera's video may wait for its disk's writer, in
+  // bytes (camera/disk_writer.h); past it frames are dropped and counted.
+  // 0: the files are written on the stream's own thread (a filesink).
   uint64_t recordBound = 0;
   std::string videoTail;  // the last element before the files' muxer (a tee: a new pad)
   // The files' text track (empty: none): its appsrc (MP4; with Matroska

@@ -34,11 +34,12 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   EXPECT_TRUE(has(d, "wait-for-device=true"));
   // With the text track the frames reach the file through its own bounded
   // queue (the muxer waits for the text thread: the queue's thread waits,
-  // not the source's), no tee (the SegmentWriter puts each file in).
+  // not the source's), no tee (the SegmentWriter puts each file in), and
+  // the disk's thread writes the bytes, within 8 MB.
   EXPECT_EQ(s.videoTail, s.recordQueue);
   EXPECT_TRUE(has(d, "! queue name=" + s.recordQueue +
                          " max-size-buffers=0 max-size-time=0 max-size-bytes=8000000"));
-  EXPECT_EQ(s.recordBound, 0u);
+  EXPECT_EQ(s.recordBound, 8'000'000u);
   EXPECT_FALSE(has(d, "tee"));
   EXPECT_FALSE(has(d, "splitmuxsink"));
   EXPECT_EQ(s.muxer.factory, "matroskamux");

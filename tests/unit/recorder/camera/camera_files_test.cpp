@@ -128,8 +128,27 @@ class CameraFilesTest : public ::testing::Test {
   void expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(StreamPlan plan,
                                                               const std::function<void()>& stall,
                                                               const std::function<void()>& resume,
-                                                              SegmentLimits limits = {},
-                                                              bool withTelemetry = false);
+                                                              SegmentLimits limits = {});
+  // The recorder's arrangement for those: a live branch beside the file's,
+  // the disk's writer within 150 KB and, with the text track (the
+  // recorder's default), the file's queue, bounded as much, and its lines.
+  StreamPlan withLiveBranch(bool textTrack) const {
+    StreamPlan p = plan();
+    p.description +=
+        " ! tee name=t t. ! queue max-size-buffers=1000 ! appsink name=live sync=false "
+        "async=false";
+    p.videoTail = "t";
+    p.recordBound = 150000;
+    if (textTrack) {
+      p.description +=
+          " t. ! queue name=rq max-size-buffers=0 max-size-time=0 max-size-bytes=150000 "
+          "taginject name=teltag";
+      p.recordQueue = p.videoTail = "rq";
+      p.telemetryTail = "teltag";
+      p.muxer.text = p.muxer.textGapEvents = true;
+    }
+    return p;
+  }
 
   fs::path folder_;
   GstClock* clock_ = nullptr;
@@ -229,7 +248,7 @@ GstElement* muxerIn(GstElement* pipeline) {
 
 void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
     StreamPlan p, const std::function<void()>& stall, const std::function<void()>& resume,
-    SegmentLimits limits, bool withTelemetry) {
+    SegmentLimits limits) {
   p.liveSink = "live";
   Observed observed;
   CameraFiles files{.folder = folder_.string(), .extension = ".mkv", .limits = limits};
@@ -257,7 +276,7 @@ void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
   const size_t kFrames = 120;
   for (size_t i = 1; i < kFrames; ++i) {
     // (The lines go to the text thread, and then the frame waits for it.)
-    if (withTelemetry && i % 5 == 0) (*camera)->writeTelemetry({{"frame", i}});
+    if (p.muxer.text && i % 5 == 0) (*camera)->writeTelemetry({{"frame", i}});
     push(i, at(i));
   }
   // Every frame reaches the live branch: the source never waits for the disk.
@@ -286,20 +305,15 @@ void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
       << metrics;
 }
 
-// With the text track the frames cross a queue of their own to the file;
-// the disk stalls as the muxer's output blocked by a pad probe.
+// The recorder's default: with the text track the frames cross a queue of
+// their own to the file, which the text thread's lines may hold; the file
+// stalls as the muxer's output blocked by a pad probe.
 TEST_F(CameraFilesTest,
        AStalledMuxerFillsTheBoundedQueueWhichDropsAndCountsWhileTheLiveViewGoesOn) {
-  StreamPlan p = plan();
-  p.description +=
-      " ! tee name=t t. ! queue name=rq max-size-buffers=0 max-size-time=0 "
-      "max-size-bytes=150000 t. ! queue max-size-buffers=1000 ! appsink name=live "
-      "sync=false async=false";
-  p.recordQueue = p.videoTail = "rq";
   GstPad* output = nullptr;
   gulong stall = 0;
   expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
-      p,
+      withLiveBranch(true),
       [&] {
         GstElement* muxer = muxerIn(pipeline_);
         output = gst_element_get_static_pad(muxer, "src");
@@ -314,40 +328,20 @@ TEST_F(CameraFilesTest,
       });
 }
 
-// Without it the muxer hands the bytes to the disk's writer; the disk
-// stalls as that writer held. The camera's bytes wait up to their bound.
-// Files are cut every 0.4 s meanwhile: a file ended on a stalled disk is
-// closed once written, without holding the source.
+// The muxer hands the bytes to the disk's writer; the disk stalls as that
+// writer held. The camera's bytes wait up to their bound. Files are cut
+// every 0.4 s meanwhile: a file ended on a stalled disk is closed once
+// written, without holding the source. Without the text track (a camera
+// is one thread) and with it (behind the file's queue).
 TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileTheLiveViewGoesOn) {
-  StreamPlan p = plan();
-  p.description +=
-      " ! tee name=t t. ! queue max-size-buffers=1000 ! appsink name=live "
-      "sync=false async=false";
-  p.videoTail = "t";
-  p.recordBound = 150000;
-  auto disk = DiskWriter::of(folder_.string());
-  ASSERT_TRUE(disk) << disk.error();
-  expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
-      p, [&] { (*disk)->hold(); }, [&] { (*disk)->release(); }, {.maxDuration = 400 * GST_MSECOND});
-}
-
-// The recorder's default: the same with the text track, whose lines the
-// recorder's text thread brings to the muxer.
-TEST_F(CameraFilesTest, WithTheTelemetryTrackAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn) {
-  StreamPlan p = plan();
-  p.description +=
-      " ! tee name=t t. ! queue max-size-buffers=1000 ! appsink name=live "
-      "sync=false async=false taginject name=teltag";
-  p.videoTail = "t";
-  p.telemetryTail = "teltag";
-  p.muxer.text = true;
-  p.muxer.textGapEvents = true;
-  p.recordBound = 150000;
-  auto disk = DiskWriter::of(folder_.string());
-  ASSERT_TRUE(disk) << disk.error();
-  expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
-      p, [&] { (*disk)->hold(); }, [&] { (*disk)->release(); }, {.maxDuration = 400 * GST_MSECOND},
-      true);
+  for (bool textTrack : {false, true}) {
+    SCOPED_TRACE(textTrack ? "with the text track" : "without the text track");
+    auto disk = DiskWriter::of(folder_.string());
+    ASSERT_TRUE(disk) << disk.error();
+    expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
+        withLiveBranch(textTrack), [&] { (*disk)->hold(); }, [&] { (*disk)->release(); },
+        {.maxDuration = 400 * GST_MSECOND});
+  }
 }
 
 // Waits until `disk` has written all it was handed so far: it writes in
