@@ -163,7 +163,9 @@ void SegmentWriter::open(GstClockTime start) {
     if (!addFile(*planned, start)) return;
   }
   // Its text goes out from now on (numbered as the files are). (Outside
-  // the lock: the track pushes text, whose probe takes it.)
+  // the lock: the track holds its own while it pushes text, whose probe
+  // takes this one, on another thread when the file's frames cross a
+  // queue.)
   track_.fileOpened(start);
 }
 

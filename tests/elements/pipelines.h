@@ -1,5 +1,5 @@
 // What the element tests do with whole pipelines: build one from a launch
-// line, and read the first error or warning its bus carries.
+// line (and read what its bus carries: bus_messages.h).
 #pragma once
 
 #include <gst/gst.h>
@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <string>
 
+#include "bus_messages.h"
 #include "shell_command.h"
 
 namespace wircam::testing {
@@ -18,29 +19,6 @@ inline GstElement* launch(const std::string& description) {
   GstElement* pipeline = gst_parse_launch(description.c_str(), &error);
   EXPECT_EQ(error, nullptr) << (error ? error->message : "");
   return pipeline;
-}
-
-// The first error or warning (of the types asked for) on the bus within
-// `timeout` as "message | debug", or "" when none came.
-inline std::string busMessage(GstElement* pipeline, std::chrono::milliseconds timeout,
-                              GstMessageType type = GST_MESSAGE_ERROR) {
-  GstBus* bus = gst_element_get_bus(pipeline);
-  GstMessage* message = gst_bus_timed_pop_filtered(bus, timeout.count() * GST_MSECOND, type);
-  std::string text;
-  if (message) {
-    GError* error = nullptr;
-    gchar* debug = nullptr;
-    if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_WARNING)
-      gst_message_parse_warning(message, &error, &debug);
-    else
-      gst_message_parse_error(message, &error, &debug);
-    text = std::string(error->message) + " | " + (debug ? debug : "");
-    g_error_free(error);
-    g_free(debug);
-    gst_message_unref(message);
-  }
-  gst_object_unref(bus);
-  return text;
 }
 
 // Plays `description` until its first error (as busMessage gives it, "" if

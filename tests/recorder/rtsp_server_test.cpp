@@ -3,6 +3,7 @@
 #include <gst/video/video.h>
 #include <gtest/gtest.h>
 
+#include "bus_messages.h"
 #include "recorder_process.h"
 #include "shell_command.h"
 #include "simulated_device.h"
@@ -12,30 +13,6 @@ namespace {
 
 using namespace wircam::testing;
 using std::chrono::milliseconds;
-
-// What the client's elements said went wrong (errors and warnings on its
-// bus), for the failure's message: "0 frames" alone does not tell a SETUP
-// refused from packets that never came.
-std::string troubleOn(GstElement* pipeline) {
-  std::string said;
-  GstBus* bus = gst_element_get_bus(pipeline);
-  while (GstMessage* message = gst_bus_pop_filtered(
-             bus, static_cast<GstMessageType>(GST_MESSAGE_ERROR | GST_MESSAGE_WARNING))) {
-    GError* error = nullptr;
-    gchar* debug = nullptr;
-    if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR)
-      gst_message_parse_error(message, &error, &debug);
-    else
-      gst_message_parse_warning(message, &error, &debug);
-    said += std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + error->message + " (" +
-            (debug ? debug : "") + ")\n";
-    g_error_free(error);
-    g_free(debug);
-    gst_message_unref(message);
-  }
-  gst_object_unref(bus);
-  return said;
-}
 
 TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
   auto device = startSequenceDevice();
@@ -65,7 +42,9 @@ TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
       gst_sample_unref(sample);
       ++frames;
     }
-    std::string trouble = troubleOn(pipeline);
+    // What the client's elements said went wrong: "0 frames" alone does
+    // not tell a SETUP refused from packets that never came.
+    std::string trouble = wircam::testing::busProblems(pipeline);
     gst_element_set_state(pipeline, GST_STATE_NULL);
     gst_object_unref(sink);
     gst_object_unref(pipeline);
