@@ -45,8 +45,8 @@ inline std::string busProblems(GstElement* pipeline) {
   GstBus* bus = gst_element_get_bus(pipeline);
   while (GstMessage* message = gst_bus_pop_filtered(
              bus, static_cast<GstMessageType>(GST_MESSAGE_ERROR | GST_MESSAGE_WARNING))) {
-    said += std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + problemText(message) +
-            "\n";
+    said +=
+        std::string(GST_OBJECT_NAME(GST_MESSAGE_SRC(message))) + ": " + problemText(message) + "\n";
     gst_message_unref(message);
   }
   gst_object_unref(bus);
