@@ -165,7 +165,8 @@ std::vector<OptionSpec> recordingRows() {
            "and following go on. One thread writes the files of every camera on a "
            "filesystem; with the text track each camera's frames also cross a queue of "
            "their own, bounded as much. `0`: each camera writes its files on its own thread, so a "
-           "disk that stalls then stalls the camera's source and branches too",
+           "disk that stalls then stalls the camera's source and branches too, and with the "
+           "text track every camera's recording (the cameras' lines go in from one thread)",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          auto bytes = byteSize(value);
          if (!bytes || (*bytes != 0 && (*bytes < 100'000 || *bytes > 1'000'000'000)))
