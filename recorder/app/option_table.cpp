@@ -148,9 +148,9 @@ std::vector<OptionSpec> recordingRows() {
        .fallback = "on",
        .section = kFiles,
        .reloadable = true,
-       .help = "the telemetry also as the file's text track `telemetry`; `off` keeps it in the "
-               "sidecar only, which spares each camera its file queue's thread (in MP4 the "
-               "text's too): a camera is then one thread (for many cameras on a small machine)",
+       .help = "the telemetry also as the file's text track `telemetry` (on the camera's own "
+               "thread; in MP4 the text has a thread of its own); `off` keeps it in the sidecar "
+               "only, which spares each frame its turn with the text in the muxer",
        .apply = onOff(&RecorderOptions::telemetryTrack),
        .example = "off"},
       {.name = "record-queue",
@@ -163,10 +163,8 @@ std::vector<OptionSpec> recordingRows() {
            "it the newest frames are dropped from the file, counted in `/api/status` "
            "(`recording_dropped`), `/metrics` and the log, while the live view, detection "
            "and following go on. One thread writes the files of every camera on a "
-           "filesystem; with the text track each camera's frames also cross a queue of "
-           "their own, bounded as much. `0`: each camera writes its files on its own thread, so a "
-           "disk that stalls then stalls the camera's source and branches too, and with the "
-           "text track every camera's recording (the cameras' lines go in from one thread)",
+           "filesystem. `0`: each camera writes its files on its own thread, so a disk that "
+           "stalls then stalls the camera's source and branches too",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          auto bytes = byteSize(value);
          if (!bytes || (*bytes != 0 && (*bytes < 100'000 || *bytes > 1'000'000'000)))

@@ -66,8 +66,8 @@ std::string positionsOf(const PositionSource& source, const std::string& name) {
          " port=" + std::to_string(source.port) + " beacons=" + source.beacons + " ";
 }
 
-// The files' text track. For Matroska, the element the recorder's one
-// text thread feeds (telemetry/text_feeder.h); for MP4, after an appsrc of
+// The files' text track. For Matroska, the element the frames' thread
+// feeds (telemetry/text_outlet.h); for MP4, after an appsrc of
 // its own, which never blocks the main loop: past 1 MB waiting it drops.
 // Its track is named by a stream tag (in Matroska a placeholder, rewritten
 // when the file is finished: telemetry_track_flags.h).
@@ -132,30 +132,16 @@ PipelinePlan planPipeline(const RecorderOptions& options) {
       // A slow disk must hold up neither the source nor the other
       // branches, nor any other camera: the muxer hands its bytes to the
       // filesystem's writer, within the camera's bound in bytes
-      // (camera/disk_writer.h), past which its frames are dropped.
-      // With the text track the muxer takes a frame only once the text
-      // has passed its time, and when lines are due that is the text
-      // thread's work (telemetry/text_feeder.h; MP4: the text's appsrc),
-      // which on busy processors runs late: the file's frames cross a
-      // queue of their own (bounded in bytes, camera/queue_drops.h), so
-      // that it is the queue's thread that waits, never the source's, whose
-      // live view and detection go on. Without it, a camera is one thread.
+      // (camera/disk_writer.h), past which its frames are dropped. The
+      // text track's lines go in on the same thread, each given its turn
+      // in the muxer (telemetry/collect_pads_turns.h): a camera is one thread.
       // --record-queue 0: on the source's thread, whatever the disk does.
       std::string toFile = branches ? tee + ". ! " : "! ";
       stream.recordBound = options.recordQueueBytes;
-      if (options.recordQueueBytes > 0 && options.telemetryTrack) {
-        stream.recordQueue = "rq";
-        d += toFile + "queue name=" + stream.recordQueue +
-             " max-size-buffers=0 max-size-time=0 max-size-bytes=" +
-             std::to_string(options.recordQueueBytes) + " ";
-        toFile = "! ";
-      }
       if (plan.transcoded) {
         stream.videoTail = "enc";
         stream.planPoint = "recdec";
         d += toFile + encoder(options, stream.planPoint, stream.videoTail);
-      } else if (!stream.recordQueue.empty()) {
-        stream.videoTail = stream.recordQueue;
       } else {
         stream.videoTail = branches ? tee : device.positions ? stream.positions : stream.source;
       }

@@ -22,8 +22,8 @@ namespace wircam::recorder {
 // is finished. A slow disk holds up neither the source nor the live and
 // detection branches (hence following), nor another camera: the files'
 // bytes are written by their filesystem's thread, each camera's bounded
-// (camera/disk_writer.h); with the text track the frames also cross a
-// bounded queue (camera/queue_drops.h), which waits for the text thread.
+// (camera/disk_writer.h). A camera is one thread, its source's: the
+// muxer, the text track's lines and the hand-over to the disk are on it.
 PipelinePlan planPipeline(const RecorderOptions& options);
 
 // Two streams of one name (devices whose names differ only in what a file

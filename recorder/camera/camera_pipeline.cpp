@@ -1,7 +1,5 @@
 #include "camera/camera_pipeline.h"
 
-#include "telemetry/text_feeder.h"
-
 namespace wircam::recorder {
 
 Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
@@ -47,8 +45,6 @@ Expected<std::unique_ptr<CameraPipeline>, std::string> CameraPipeline::build(
         self->telemetry_->onFrame();
         self->framesPlanned_.fetch_add(1, std::memory_order_relaxed);
       });
-  if (GstElement* queue = camera->element(plan.recordQueue))
-    camera->drops_ = std::make_unique<QueueDrops>(queue);
   if (frames && !plan.liveSink.empty()) {
     frames->attach(camera->element(plan.liveSink));
     camera->frames_ = frames;
@@ -69,7 +65,6 @@ CameraPipeline::~CameraPipeline() {
   if (encoded_) encoded_->detach();
   // The writer holds the elements' pads: before the pipeline goes.
   writer_.reset();
-  drops_.reset();
   telemetry_.reset();
   track_.reset();
   gst_object_unref(pipeline_);
@@ -80,7 +75,7 @@ std::unique_ptr<TextOutlet> CameraPipeline::textOutlet(const StreamPlan& plan) c
   GstElement* tail = element(plan.telemetryTail);
   if (!tail) return nullptr;
   GstPad* input = gst_element_get_static_pad(tail, "sink");
-  auto outlet = TextFeeder::outletInto(input);
+  auto outlet = frameThreadOutlet(input);
   gst_object_unref(input);
   return outlet;
 }

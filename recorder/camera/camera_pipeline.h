@@ -15,7 +15,6 @@
 #include "camera/disk_writer.h"
 #include "camera/frame_tap.h"
 #include "camera/pipeline_plan.h"
-#include "camera/queue_drops.h"
 #include "camera/segment_writer.h"
 #include "common/expected.h"
 #include "record/segment_planner.h"
@@ -60,13 +59,10 @@ class CameraPipeline {
   // Frames that reached the files' planner so far (any thread).
   uint64_t framesPlanned() const { return framesPlanned_.load(); }
   // The frames dropped for want of room (their disk behind), this run.
-  uint64_t framesDropped() const {
-    return (drops_ ? drops_->dropped() : 0) + (disk_.budget ? disk_.budget->framesDropped() : 0);
-  }
+  uint64_t framesDropped() const { return disk_.budget ? disk_.budget->framesDropped() : 0; }
   // The frames that came for the files: the camera's health counts these,
   // not the ones written (a slow disk is not a camera without video).
   uint64_t framesArrived() const {
-    if (drops_) return drops_->arrived();
     return disk_.budget ? disk_.budget->framesArrived() : framesPlanned();
   }
 
@@ -81,7 +77,6 @@ class CameraPipeline {
   std::unique_ptr<TelemetryTrack> track_;
   std::unique_ptr<TelemetryRouter> telemetry_;
   std::unique_ptr<SegmentWriter> writer_;
-  std::unique_ptr<QueueDrops> drops_;
   std::atomic<uint64_t> framesPlanned_{0};
 };
 

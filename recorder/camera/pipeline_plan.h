@@ -34,17 +34,14 @@ struct StreamPlan {
   // The encoder's first element: frames are planned into files (or
   // dropped for the disk) as they enter it. Empty: as they leave videoTail.
   std::string planPoint;
-  // The file's frames' queue, with the text track (bounded in bytes,
-  // camera/queue_drops.h); empty: none.
-  std::string recordQueue;
   // How much of the camera's video may wait for its disk's writer, in
   // bytes (camera/disk_writer.h); past it frames are dropped and counted.
   // 0: the files are written on the stream's own thread (a filesink).
   uint64_t recordBound = 0;
   std::string videoTail;  // the last element before the files' muxer (a tee: a new pad)
   // The files' text track (empty: none): its appsrc (MP4; with Matroska
-  // the recorder's text thread feeds the tail), and the last element
-  // before the muxer.
+  // the frames' thread feeds the tail), and the last element before the
+  // muxer.
   std::string telemetrySource;
   std::string telemetryTail;
   MuxerSpec muxer;         // each file's

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "camera/disk_sink.h"
+#include "telemetry/collect_pads_turns.h"
 
 namespace wircam::recorder {
 
@@ -71,6 +72,7 @@ Expected<std::unique_ptr<SegmentFile>, std::string> SegmentFile::open(
   // (Each failure is also an error on the bus, which restarts the camera.)
   if (!file->videoInput_ || (muxer.text && !file->textInput_))
     return unexpected(muxer.factory + " takes no video or text input");
+  file->takesTurns_ = file->textInput_ && collect_pads_turns::drive(file->videoInput_);
   if (!gst_element_sync_state_with_parent(file->sink_) ||
       !gst_element_sync_state_with_parent(file->muxer_))
     return unexpected("cannot open " + path);
@@ -91,6 +93,22 @@ SegmentFile::~SegmentFile() {
     gst_object_unref(input);
   }
   for (GstElement* element : {sink_, muxer_}) gst_bin_remove(GST_BIN(pipeline_), element);
+}
+
+bool SegmentFile::letLineIn(GstClockTime position) {
+  if (!takesTurns_) return true;
+  if (!collect_pads_turns::openForLine(videoInput_, position)) return false;
+  linesOpen_ = true;
+  return true;
+}
+
+void SegmentFile::afterLines() {
+  if (std::exchange(linesOpen_, false)) collect_pads_turns::closeAfterLines(videoInput_);
+}
+
+void SegmentFile::afterGap() {
+  afterLines();
+  if (takesTurns_) collect_pads_turns::textIsAhead(textInput_);
 }
 
 void SegmentFile::end(GstPad* input, std::atomic<bool>& ended) {

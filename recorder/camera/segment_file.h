@@ -44,12 +44,28 @@ class SegmentFile {
   GstPad* videoInput() const { return videoInput_; }
   GstPad* textInput() const { return textInput_; }
 
+  // The frames' and the lines' turns on the one thread that feeds both
+  // inputs (telemetry/collect_pads_turns.h; nothing for a muxer that does not
+  // make one input wait for the other). A line at `position` of the
+  // frames' segment: true once it may go in, false if it cannot now.
+  bool letLineIn(GstClockTime position);
+  bool takesTurns() const { return takesTurns_; }
+  // After the lines, and after the text's gap up to the next frame.
+  void afterLines();
+  void afterGap();
+
   // The end of its frames, or of its text (EOS into that input, once).
-  void endVideo() { end(videoInput_, videoEnded_); }
+  void endVideo() {
+    linesOpen_ = false;  // (its EOS ends what the lines' turn changed)
+    end(videoInput_, videoEnded_);
+  }
   // The same at the run's end: the file is on the disk before its sink
   // says it has ended (a cut mid-run does not wait for a slow disk).
   void endVideoAtTheRunsEnd();
-  void endText() { end(textInput_, textEnded_); }
+  void endText() {
+    afterLines();
+    end(textInput_, textEnded_);
+  }
   // The muxer has finished the file (its EOS reached the filesink): an
   // input fed now would answer EOS, which stops the thread feeding it.
   bool closed() const { return closed_; }
@@ -73,6 +89,8 @@ class SegmentFile {
   uint64_t number_ = 0;
   std::atomic<bool> videoEnded_{false}, textEnded_{false}, closed_{false};
   bool writtenBySink_ = false;  // a filesink: on the disk as the muxer ends
+  bool takesTurns_ = false;     // its muxer's inputs wait for each other
+  bool linesOpen_ = false;      // its frames' input is not waited for, for lines
 };
 
 }  // namespace wircam::recorder

@@ -193,6 +193,7 @@ GstPadProbeReturn SegmentWriter::routeFrame(GstPad* pad, GstPadProbeInfo* info) 
   if (isEvent(info)) {
     keepSegment(info, videoSegment_);
     if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_PASS;
+    track_.framesEnd();  // (outside the lock: the text's probe takes it)
     MutexLock lock(mutex_);
     for (const auto& file : files_) file->endVideoAtTheRunsEnd();
     return GST_PAD_PROBE_DROP;
@@ -234,9 +235,22 @@ GstPadProbeReturn SegmentWriter::routeText(GstPad* pad, GstPadProbeInfo* info) {
   }
   GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
   if (!moveText(pad, TelemetryTrack::fileOf(buffer))) return GST_PAD_PROBE_DROP;
-  if (!TelemetryTrack::isGap(buffer)) return GST_PAD_PROBE_PASS;
+  if (!TelemetryTrack::isGap(buffer))
+    return letLineIn(buffer) ? GST_PAD_PROBE_PASS : GST_PAD_PROBE_DROP;
   // (A GAP event comes through this probe again, as an event.)
-  return TelemetryTrack::passGap(pad, info, parts_.muxer.textGapEvents);
+  GstPadProbeReturn answer = TelemetryTrack::passGap(pad, info, parts_.muxer.textGapEvents);
+  MutexLock lock(mutex_);
+  if (text_) text_->afterGap();
+  return answer;
+}
+
+bool SegmentWriter::letLineIn(GstBuffer* line) {
+  MutexLock lock(mutex_);
+  if (!text_ || !text_->takesTurns()) return true;
+  // On the frames' thread (the lines go in just before a frame), which
+  // keeps their segment.
+  return text_->letLineIn(gst_segment_position_from_running_time(&videoSegment_, GST_FORMAT_TIME,
+                                                                 GST_BUFFER_PTS(line)));
 }
 
 bool SegmentWriter::moveText(GstPad* pad, uint64_t number) {
@@ -259,10 +273,9 @@ bool SegmentWriter::moveText(GstPad* pad, uint64_t number) {
 void SegmentWriter::end() {
   if (!parts_.textTail) return endFrames();
   // The frames end once the text's lines have all gone to the muxers: a
-  // muxer finishes at the end of its frames, and lines still queued (the
-  // text's thread runs behind the frames' under load) would be cut off.
-  // (The last line may wait in its muxer for a frame: the frames' end
-  // releases it.) Text held up longer gets kTextDrain.
+  // muxer finishes at the end of its frames, and lines not in by then
+  // would be cut off. They go in with the next frame (TextOutlet::end);
+  // with no frame for kTextDrain, at the frames' end.
   track_.end();
   textDrainEnds_ = std::chrono::steady_clock::now() + kTextDrain;
   textDrain_ = g_timeout_add(5, onTextDrainTick, this);

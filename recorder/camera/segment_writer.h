@@ -11,8 +11,9 @@
 //   and lets the text track's lines up to the frame go first
 //   (TelemetryTrack::beforeFrame);
 // - a probe where the telemetry leaves for the file does the same for the
-//   text, on the thread that pushes it, by the file number each buffer
-//   carries.
+//   text, by the file number each buffer carries, on the thread that
+//   pushes it: the frames' own for Matroska, which gives the lines their
+//   turns in the muxer (SegmentFile::letLineIn).
 // A file is finished once both its inputs have ended; the camera then
 // takes it out of the pipeline (finished()).
 #pragma once
@@ -82,6 +83,9 @@ class SegmentWriter {
   GstPadProbeReturn routeText(GstPad* pad, GstPadProbeInfo* info);
   // The text goes to file `number` from now on; false: it has no file.
   bool moveText(GstPad* pad, uint64_t number);
+  // The text's file takes `line` now (SegmentFile::letLineIn); false: the
+  // line cannot go in, and stays in the sidecar only.
+  bool letLineIn(GstBuffer* line);
   void open(GstClockTime start);
   // The file `planned` starting at `start` joins the pipeline; false: it
   // would not open.

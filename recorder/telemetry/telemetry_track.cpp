@@ -44,9 +44,12 @@ uint64_t TelemetryTrack::fileOpened(GstClockTime start) {
 void TelemetryTrack::beforeFrame(GstClockTime frameTime, uint64_t file) {
   if (!outlet_) return;
   MutexLock lock(mutex_);
+  // A file's lines wait for its second frame: until its first has gone in,
+  // its muxer cannot give them a turn (its frames' input has no segment).
+  bool started = std::exchange(framesFile_, file) == file;
   std::vector<GstBuffer*> lines;
   for (auto line = due_.begin(); line != due_.end();) {
-    if (line->file < file || (line->file == file && line->pts <= frameTime)) {
+    if (line->file < file || (started && line->file == file && line->pts <= frameTime)) {
       lines.push_back(stamp(*line));
       line = due_.erase(line);
     } else {
@@ -82,6 +85,12 @@ void TelemetryTrack::end() {
   due_.clear();
   waiting_.clear();  // for files that will not open
   outlet_->end(std::move(lines));
+}
+
+void TelemetryTrack::framesEnd() {
+  if (!outlet_) return;
+  MutexLock lock(mutex_);
+  outlet_->framesEnd();
 }
 
 bool TelemetryTrack::allSent() const { return !outlet_ || outlet_->allSent(); }

@@ -6,10 +6,11 @@
 // (GST_BUFFER_OFFSET) is its file's number, which is how the SegmentWriter
 // knows when the text moves on to the next file.
 //
-// A line waits here until a frame at or after its time is about to enter
-// its file (beforeFrame): a muxer hands on a frame only once every track
-// has passed its time, so the line goes in then, and after it a gap (the
-// text has nothing more up to the frame) that lets the frame through.
+// A line waits here until a frame after its file's first, at or after its
+// time, is about to enter its file (beforeFrame): a muxer hands on a frame
+// only once every track has passed its time, so the line goes in then, and
+// after it a gap (the text has nothing more up to the frame) that lets the
+// frame through.
 #pragma once
 
 #include <gst/gst.h>
@@ -60,11 +61,12 @@ class TelemetryTrack {
   // (an aggregator, GStreamer 1.22), which stalls on GAP events.
   static GstPadProbeReturn passGap(GstPad* pad, GstPadProbeInfo* info, bool asEvent);
 
-  // No more lines: the text track ends after the ones waiting (the
-  // frames' end lets in those no frame reached).
+  // No more lines: the text track ends after the ones waiting, with the
+  // next frame or at the frames' end.
   void end();
-  // Every line has gone on to the muxer (where the last may still wait
-  // for a frame).
+  // The frames end, on their thread: what end() left goes in now.
+  void framesEnd();
+  // Every line has gone on to the muxer.
   bool allSent() const;
 
   static uint64_t fileOf(GstBuffer* buffer) { return GST_BUFFER_OFFSET(buffer); }
@@ -104,6 +106,7 @@ class TelemetryTrack {
   // The newest line's time in it (samples: the end of the newest).
   GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;
   bool ended_ WIRCAM_GUARDED_BY(mutex_) = false;
+  uint64_t framesFile_ WIRCAM_GUARDED_BY(mutex_) = 0;         // the file of the newest frame
   std::deque<Line> due_ WIRCAM_GUARDED_BY(mutex_);            // for open files, by file
   std::deque<Waiting> waiting_ WIRCAM_GUARDED_BY(mutex_);     // for files still to open
   static constexpr size_t kMaxWaiting = 1024;                 // each (past it: the oldest go)

@@ -32,19 +32,17 @@ TEST(PipelinePlan, JpegInMatroskaIsMuxedUntouchedWithItsTelemetryTrack) {
   const auto& d = plan.description();
   EXPECT_TRUE(has(d, "wircsrc name=" + s.source + " host=10.0.0.2 port=1984"));
   EXPECT_TRUE(has(d, "wait-for-device=true"));
-  // With the text track the frames reach the file through its own bounded
-  // queue (the muxer waits for the text thread: the queue's thread waits,
-  // not the source's), no tee (the SegmentWriter puts each file in), and
-  // the disk's thread writes the bytes, within 8 MB.
-  EXPECT_EQ(s.videoTail, s.recordQueue);
-  EXPECT_TRUE(has(d, "! queue name=" + s.recordQueue +
-                         " max-size-buffers=0 max-size-time=0 max-size-bytes=8000000"));
+  // From the source to the muxer, text track and all, no queue and no tee
+  // (the SegmentWriter puts each file in): the disk's thread writes the
+  // bytes, within 8 MB. One thread a camera.
+  EXPECT_EQ(s.videoTail, s.source);
+  EXPECT_FALSE(has(d, "queue"));
   EXPECT_EQ(s.recordBound, 8'000'000u);
   EXPECT_FALSE(has(d, "tee"));
   EXPECT_FALSE(has(d, "splitmuxsink"));
   EXPECT_EQ(s.muxer.factory, "matroskamux");
   EXPECT_TRUE(s.muxer.text);
-  EXPECT_TRUE(s.telemetrySource.empty());  // fed by the text thread
+  EXPECT_TRUE(s.telemetrySource.empty());  // fed on the frames' thread
   EXPECT_FALSE(has(d, "appsrc"));
   EXPECT_TRUE(has(d, "taginject name=" + s.telemetryTail));
   EXPECT_TRUE(has(d, "title=telemetry-json-lines"));  // renamed when finished
@@ -60,10 +58,8 @@ TEST(PipelinePlan, H264InMp4IsTranscodedAndKeepsTheTextTrack) {
   // Frames are planned (or dropped for the disk) before they are decoded.
   EXPECT_TRUE(has(plan.description(), "tjpegdec name=" + plan.streams[0].planPoint + " !"));
   EXPECT_EQ(plan.streams[0].muxer.factory, "mp4mux");
-  // mp4mux takes its text from an appsrc's thread, and its frames from a
-  // bounded queue's (camera/queue_drops.h).
+  // mp4mux takes its text from an appsrc's thread.
   EXPECT_TRUE(has(plan.description(), "appsrc name=" + plan.streams[0].telemetrySource));
-  EXPECT_TRUE(has(plan.description(), "queue name=" + plan.streams[0].recordQueue));
   EXPECT_TRUE(has(plan.description(), "title=telemetry\""));
   // The muxers take H.264 as avc only: the encoder's output says so.
   EXPECT_TRUE(has(plan.description(), "capsfilter name=" + plan.streams[0].videoTail +
@@ -78,10 +74,8 @@ TEST(PipelinePlan, WithoutTheTelemetryTrackAStreamIsItsSourceAlone) {
   EXPECT_TRUE(s.telemetrySource.empty() && s.telemetryTail.empty());
   EXPECT_FALSE(has(plan.description(), "appsrc"));
   EXPECT_FALSE(has(plan.description(), "taginject"));
-  // Without it, from the source to the muxer, no queue: the disk's thread
-  // writes the bytes, within 8 MB. One thread a camera.
+  // From the source to the muxer, no queue, as with it.
   EXPECT_EQ(s.videoTail, s.source);
-  EXPECT_TRUE(s.recordQueue.empty());
   EXPECT_EQ(s.recordBound, 8'000'000u);
   EXPECT_FALSE(has(plan.description(), "queue"));
   // --record-queue 0: the files are written on the source's thread.
@@ -109,10 +103,9 @@ TEST(PipelinePlan, EachCameraIsAStreamAndOnlyTheFirstOfAFollowingDeviceSteers) {
   EXPECT_EQ(names.size(), 4u);
   EXPECT_FALSE(plan.streams[0].controller.empty());
   EXPECT_TRUE(plan.streams[1].controller.empty());
-  // Branches: the file's frames leave the tee by a pad of their own, into
-  // their queue.
-  EXPECT_TRUE(has(plan.streams[0].description,
-                  "tee name=t t. ! queue name=" + plan.streams[0].recordQueue));
+  // Branches: the file's frames leave the tee by a pad of their own
+  // (which the SegmentWriter links to each file).
+  EXPECT_EQ(plan.streams[0].videoTail, "t");
   EXPECT_FALSE(plan.streams[2].controller.empty());
   EXPECT_TRUE(has(plan.description(), "family=tag36h11"));
 }

@@ -131,7 +131,7 @@ class CameraFilesTest : public ::testing::Test {
                                                               SegmentLimits limits = {});
   // The recorder's arrangement for those: a live branch beside the file's,
   // the disk's writer within 150 KB and, with the text track (the
-  // recorder's default), the file's queue, bounded as much, and its lines.
+  // recorder's default), its lines, all on the source's thread.
   StreamPlan withLiveBranch(bool textTrack) const {
     StreamPlan p = plan();
     p.description +=
@@ -140,10 +140,7 @@ class CameraFilesTest : public ::testing::Test {
     p.videoTail = "t";
     p.recordBound = 150000;
     if (textTrack) {
-      p.description +=
-          " t. ! queue name=rq max-size-buffers=0 max-size-time=0 max-size-bytes=150000 "
-          "taginject name=teltag";
-      p.recordQueue = p.videoTail = "rq";
+      p.description += " taginject name=teltag";
       p.telemetryTail = "teltag";
       p.muxer.text = p.muxer.textGapEvents = true;
     }
@@ -275,7 +272,7 @@ void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
   } resumed{resume};
   const size_t kFrames = 120;
   for (size_t i = 1; i < kFrames; ++i) {
-    // (The lines go to the text thread, and then the frame waits for it.)
+    // (The lines go in on this thread, each just before a frame.)
     if (p.muxer.text && i % 5 == 0) (*camera)->writeTelemetry({{"frame", i}});
     push(i, at(i));
   }
@@ -305,34 +302,11 @@ void CameraFilesTest::expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
       << metrics;
 }
 
-// The recorder's default: with the text track the frames cross a queue of
-// their own to the file, which the text thread's lines may hold; the file
-// stalls as the muxer's output blocked by a pad probe.
-TEST_F(CameraFilesTest,
-       AStalledMuxerFillsTheBoundedQueueWhichDropsAndCountsWhileTheLiveViewGoesOn) {
-  GstPad* output = nullptr;
-  gulong stall = 0;
-  expectAStalledDiskDropsAndCountsWhileTheLiveViewGoesOn(
-      withLiveBranch(true),
-      [&] {
-        GstElement* muxer = muxerIn(pipeline_);
-        output = gst_element_get_static_pad(muxer, "src");
-        gst_object_unref(muxer);
-        stall = gst_pad_add_probe(
-            output, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
-            [](GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
-      },
-      [&] {
-        gst_pad_remove_probe(output, stall);
-        gst_object_unref(output);
-      });
-}
-
 // The muxer hands the bytes to the disk's writer; the disk stalls as that
 // writer held. The camera's bytes wait up to their bound. Files are cut
 // every 0.4 s meanwhile: a file ended on a stalled disk is closed once
-// written, without holding the source. Without the text track (a camera
-// is one thread) and with it (behind the file's queue).
+// written, without holding the source. Without the text track and with it
+// (its lines then go in on the source's thread too).
 TEST_F(CameraFilesTest, AStalledDiskHoldsTheCamerasBoundThenDropsAndCountsWhileTheLiveViewGoesOn) {
   for (bool textTrack : {false, true}) {
     SCOPED_TRACE(textTrack ? "with the text track" : "without the text track");

@@ -1,9 +1,9 @@
-// The text track beside the frames in a real matroskamux, fed by the
-// recorder's one text thread: a frame with no line due goes through on its
-// own thread with its gap (nothing else wakes), a frame with lines lets
-// them in first, and a line that comes behind the frames neither holds
-// them back nor lands anywhere but at its own time (read back with
-// matroskademux).
+// The text track beside the frames in a real matroskamux, all from the
+// frames' own thread as the recorder feeds it: a frame lets in the lines
+// due up to it, each given its turn in the muxer (collect_pads_turns.h),
+// and then its gap; nothing waits, no other thread takes part, and a line
+// that comes behind the frames neither holds them back nor lands anywhere
+// but at its own time (read back with matroskademux).
 #include "telemetry/telemetry_track.h"
 
 #include <gst/app/gstappsink.h>
@@ -20,13 +20,13 @@
 #include <vector>
 
 #include "process_memory.h"
-#include "telemetry/text_feeder.h"
+#include "telemetry/collect_pads_turns.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using wircam::recorder::TelemetryTrack;
-using wircam::recorder::TextFeeder;
+namespace turns = wircam::recorder::collect_pads_turns;
 
 constexpr GstClockTime kFrameInterval = GST_SECOND / 15;
 constexpr int kFrames = 150;                             // 10 s
@@ -34,7 +34,9 @@ constexpr int kLineEvery = 5;                            // a line every 5th fra
 constexpr GstClockTime kLineBehind = 100 * GST_MSECOND;  // a detection a frame late, or more
 
 // taginject (the recorder's text tail) → matroskamux ← a pad the test
-// pushes frames from (as wircsrc's thread does) → filesink.
+// pushes frames from (as wircsrc's thread does) → filesink. A probe where
+// the text leaves gives each line its turn and passes the gaps, as the
+// recorder's SegmentWriter does.
 class TextBesideFrames {
  public:
   explicit TextBesideFrames(const fs::path& file) {
@@ -46,13 +48,13 @@ class TextBesideFrames {
     text_ = gst_bin_get_by_name(GST_BIN(pipeline_), "text");
     GstPad* textOut = gst_element_get_static_pad(text_, "src");
     gst_pad_add_probe(textOut, GST_PAD_PROBE_TYPE_BUFFER, onText, this, nullptr);
+    muxText_ = gst_pad_get_peer(textOut);
     gst_object_unref(textOut);
     GstElement* mux = gst_bin_get_by_name(GST_BIN(pipeline_), "mux");
-    GstPad* muxVideo = gst_element_request_pad_simple(mux, "video_%u");
+    muxVideo_ = gst_element_request_pad_simple(mux, "video_%u");
     frames_ = gst_pad_new("frames", GST_PAD_SRC);
     gst_pad_set_active(frames_, TRUE);
-    gst_pad_link(frames_, muxVideo);
-    gst_object_unref(muxVideo);
+    gst_pad_link(frames_, muxVideo_);
     gst_object_unref(mux);
     gst_element_set_state(pipeline_, GST_STATE_PLAYING);
     gst_pad_push_event(frames_, gst_event_new_stream_start("frames"));
@@ -66,6 +68,8 @@ class TextBesideFrames {
   ~TextBesideFrames() {
     gst_element_set_state(pipeline_, GST_STATE_NULL);
     gst_object_unref(frames_);
+    gst_object_unref(muxVideo_);
+    gst_object_unref(muxText_);
     gst_object_unref(text_);
     gst_object_unref(pipeline_);
   }
@@ -73,11 +77,12 @@ class TextBesideFrames {
   // The text's way in, as the recorder feeds it.
   std::unique_ptr<wircam::recorder::TextOutlet> textOutlet() const {
     GstPad* input = gst_element_get_static_pad(text_, "sink");
-    auto outlet = TextFeeder::outletInto(input);
+    auto outlet = wircam::recorder::frameThreadOutlet(input);
     gst_object_unref(input);
     return outlet;
   }
   void setFramesThread(std::thread::id id) { framesThread_ = id; }
+  GstPad* muxerVideoInput() const { return muxVideo_; }
   // Pushes a frame as a source's thread does: returns once the muxer took it.
   GstFlowReturn pushFrame(GstClockTime pts) {
     GstBuffer* frame = gst_buffer_new_allocate(nullptr, 1000, nullptr);
@@ -107,18 +112,26 @@ class TextBesideFrames {
   static GstPadProbeReturn onText(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
     auto* self = static_cast<TextBesideFrames*>(data);
     bool onFramesThread = std::this_thread::get_id() == self->framesThread_;
-    if (!TelemetryTrack::isGap(GST_PAD_PROBE_INFO_BUFFER(info))) {
+    GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+    if (!TelemetryTrack::isGap(buffer)) {
       if (onFramesThread) ++self->framesThreadLines_;
-      return GST_PAD_PROBE_OK;
+      // (The frames' segment starts at 0: a running time is its position.)
+      return turns::openForLine(self->muxVideo_, GST_BUFFER_PTS(buffer)) ? GST_PAD_PROBE_OK
+                                                                         : GST_PAD_PROBE_DROP;
     }
     ++self->gaps_;
     if (onFramesThread) ++self->framesThreadGaps_;
-    return TelemetryTrack::passGap(pad, info, true);
+    GstPadProbeReturn answer = TelemetryTrack::passGap(pad, info, true);
+    turns::closeAfterLines(self->muxVideo_);
+    turns::textIsAhead(self->muxText_);
+    return answer;
   }
 
   GstElement* pipeline_;
   GstElement* text_;
   GstPad* frames_;
+  GstPad* muxVideo_;  // the muxer's inputs
+  GstPad* muxText_;
   std::atomic<int> gaps_{0}, framesThreadLines_{0}, framesThreadGaps_{0};
   std::thread::id framesThread_;
 };
@@ -154,7 +167,7 @@ ReadBack readBack(const fs::path& file) {
   return read;
 }
 
-TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAndOnlyThoseWakeTheTextThread) {
+TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAllOnItsOwnThread) {
   gst_init(nullptr, nullptr);
   struct RemovedAtEnd {
     fs::path path;
@@ -166,6 +179,7 @@ TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAndOnlyThoseWakeTheTextThread) {
     TextBesideFrames pipeline(file.path);
     TelemetryTrack track(pipeline.textOutlet(), false);
     track.fileOpened(0);
+    EXPECT_TRUE(turns::drive(pipeline.muxerVideoInput()));
     // The frames' thread, as wircsrc's: a line for a frame already in the
     // file, then the frame, which lets in what is due before it.
     auto frames = std::async(std::launch::async, [&] {
@@ -178,33 +192,30 @@ TEST(TelemetryTrack, AFrameLetsInTheLinesUpToItAndOnlyThoseWakeTheTextThread) {
         }
         track.beforeFrame(pts, 1);
         if (pipeline.pushFrame(pts) != GST_FLOW_OK) return -1;
-        // (A source's next frame comes 67 ms later: the text thread is
-        // back from the lines by then. Pushed at once, it may not be.)
-        if (i % kLineEvery == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
       }
       // As SegmentWriter ends a recording: a line no frame reached, then
-      // the text's end; the frames end once the text thread has them.
+      // the text's end, which goes in at the frames' end.
       written.push_back(kFrames * kFrameInterval);
       track.write("{\"last\":true}", written.back(), 0);
       track.end();
-      while (!track.allSent()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      EXPECT_FALSE(track.allSent());
+      track.framesEnd();
+      EXPECT_TRUE(track.allSent());
       pipeline.endFrames();
       return kFrames;
     });
-    // 10 s of frames pushed as fast as the muxer takes them: a frame held
-    // for a gap that never comes would hold them for ever.
+    // 10 s of frames pushed as fast as the muxer takes them: a frame or a
+    // line held for the other would hold them for ever.
     bool done = frames.wait_for(std::chrono::seconds(10)) == std::future_status::ready;
     if (!done) pipeline.stop();
-    ASSERT_TRUE(done) << "a frame waited in the muxer for the text track";
+    ASSERT_TRUE(done) << "a frame or a line waited in the muxer";
     framesPushed = frames.get();
     ASSERT_EQ(framesPushed, kFrames);
     ASSERT_TRUE(pipeline.finished(10 * GST_SECOND));
-    EXPECT_EQ(wircam::testing::threadsNamed("wircam-text"), 1u);
-    // Every line came from the text thread, and the frames with none due
-    // (120 of 150) sent their gaps themselves (but where the text thread
-    // had not quite returned from the frame before: then it takes the gap).
-    EXPECT_EQ(pipeline.linesFromFramesThread(), 0);
-    EXPECT_GE(pipeline.gapsFromFramesThread(), 75);
+    EXPECT_EQ(wircam::testing::threadsNamed("wircam-text"), 0u);
+    // Every line and every gap went in on the frames' thread.
+    EXPECT_EQ(pipeline.linesFromFramesThread(), static_cast<int>(written.size()));
+    EXPECT_EQ(pipeline.gapsFromFramesThread(), kFrames);
     EXPECT_EQ(pipeline.gapsSent(), kFrames);
   }
   ReadBack read = readBack(file.path);
