@@ -2,6 +2,7 @@
 
 #include <poll.h>
 #include <sys/eventfd.h>
+#include <sys/mman.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -9,12 +10,26 @@
 #include <array>
 #include <cstring>
 #include <ctime>
+#include <new>
 
 namespace wircam::wirc {
 
 namespace {
 
 constexpr size_t kBatch = 16;  // datagrams per recvmmsg
+// A slot a datagram, on page boundaries (kMaxDatagramSize rounded up).
+constexpr size_t kSlotBytes = 65536;
+static_assert(kSlotBytes >= kMaxDatagramSize);
+constexpr size_t kSlotsBytes = kBatch * kSlotBytes;
+// Slots kept resident after a burst: a 720p frame is two datagrams.
+constexpr size_t kKeptSlots = 2;
+
+uint8_t* mapSlots() {
+  void* slots =
+      mmap(nullptr, kSlotsBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (slots == MAP_FAILED) throw std::bad_alloc();
+  return static_cast<uint8_t*>(slots);
+}
 
 UniqueFd newEventFd() { return UniqueFd(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)); }
 
@@ -40,7 +55,9 @@ StreamInbox::StreamInbox()
     : interrupt_(newEventFd()),
       linkChanged_(newEventFd()),
       endRequest_(newEventFd()),
-      buffers_(new uint8_t[kBatch * kMaxDatagramSize]) {}
+      slots_(mapSlots()) {}
+
+void StreamInbox::Unmap::operator()(uint8_t* slots) const { munmap(slots, kSlotsBytes); }
 
 std::optional<std::string> StreamInbox::open(uint16_t port, FrameAssemblerConfig config) {
   auto socket = bindUdp(*SocketAddress::resolve("", port));
@@ -121,7 +138,7 @@ void StreamInbox::receiveBatch() {
   std::array<sockaddr_in, kBatch> sources{};
   std::array<std::array<char, CMSG_SPACE(sizeof(timespec))>, kBatch> stamps{};
   for (size_t i = 0; i < kBatch; ++i) {
-    vectors[i] = {buffers_.get() + i * kMaxDatagramSize, kMaxDatagramSize};
+    vectors[i] = {slots_.get() + i * kSlotBytes, kMaxDatagramSize};
     headers[i].msg_hdr.msg_iov = &vectors[i];
     headers[i].msg_hdr.msg_iovlen = 1;
     headers[i].msg_hdr.msg_name = &sources[i];
@@ -139,6 +156,11 @@ void StreamInbox::receiveBatch() {
                     arrivalOf(headers[i].msg_hdr, now, wallNow),
                     [&](AssembledFrame&& frame) { ready_.push_back(std::move(frame)); });
   }
+  // A burst's slots past the kept ones are given back (the receiver has
+  // copied what they held).
+  if (count > static_cast<int>(kKeptSlots))
+    madvise(slots_.get() + kKeptSlots * kSlotBytes,
+            (static_cast<size_t>(count) - kKeptSlots) * kSlotBytes, MADV_DONTNEED);
 }
 
 StreamInbox::Clock::time_point StreamInbox::arrivalOf(const msghdr& message, Clock::time_point now,
