@@ -21,8 +21,10 @@ constexpr size_t kBatch = 16;  // datagrams per recvmmsg
 constexpr size_t kSlotBytes = 65536;
 static_assert(kSlotBytes >= kMaxDatagramSize);
 constexpr size_t kSlotsBytes = kBatch * kSlotBytes;
-// Slots kept resident after a burst: a 720p frame is two datagrams.
+// Slots always kept resident: a 720p frame is two datagrams.
 constexpr size_t kKeptSlots = 2;
+// How long a batch's slots stay resident unused before they are given back.
+constexpr auto kSlotsWindow = std::chrono::seconds(1);
 
 uint8_t* mapSlots() {
   void* slots =
@@ -156,11 +158,25 @@ void StreamInbox::receiveBatch() {
                     arrivalOf(headers[i].msg_hdr, now, wallNow),
                     [&](AssembledFrame&& frame) { ready_.push_back(std::move(frame)); });
   }
-  // A burst's slots past the kept ones are given back (the receiver has
-  // copied what they held).
-  if (count > static_cast<int>(kKeptSlots))
-    madvise(slots_.get() + kKeptSlots * kSlotBytes,
-            (static_cast<size_t>(count) - kKeptSlots) * kSlotBytes, MADV_DONTNEED);
+  if (count > 0) giveBackUnusedSlots(static_cast<size_t>(count), now);
+}
+
+// Slots a burst filled and no batch has needed for kSlotsWindow go back to
+// the system (the receiver has copied what they held). Not at once: a
+// stream whose batches often hold a few datagrams (720p/30 on a busy
+// thread) would fault its slots in again and again (measured: wircsrc's
+// thread at 720p then cost twice as much).
+void StreamInbox::giveBackUnusedSlots(size_t used, Clock::time_point now) {
+  residentSlots_ = std::max(residentSlots_, used);
+  recentlyUsedSlots_ = std::max(recentlyUsedSlots_, used);
+  if (now - slotsWindowStart_ < kSlotsWindow) return;
+  size_t keep = std::max(recentlyUsedSlots_, kKeptSlots);
+  if (residentSlots_ > keep) {
+    madvise(slots_.get() + keep * kSlotBytes, (residentSlots_ - keep) * kSlotBytes, MADV_DONTNEED);
+    residentSlots_ = keep;
+  }
+  recentlyUsedSlots_ = 0;
+  slotsWindowStart_ = now;
 }
 
 StreamInbox::Clock::time_point StreamInbox::arrivalOf(const msghdr& message, Clock::time_point now,

@@ -70,15 +70,20 @@ class StreamInbox {
   UniqueFd endRequest_;
   std::optional<StreamReceiver> receiver_;
   std::deque<AssembledFrame> ready_;
+  void giveBackUnusedSlots(size_t used, Clock::time_point now);
+
   // Datagrams of up to 64 KB, a batch at a time, each in a page-aligned
   // slot of a region mapped lazily: only the pages datagrams fill become
-  // resident. After a burst (more than kKeptSlots at once: a busy machine
-  // let the socket fill) the slots past those are given back: bursts at
-  // the start of 256 cameras left 300 KB resident a camera, for good.
+  // resident. The slots a burst filled (a busy machine let the socket
+  // fill) are given back once unused for a while: bursts at the start of
+  // 256 cameras left 300 KB resident a camera, for good.
   struct Unmap {
     void operator()(uint8_t* slots) const;
   };
   std::unique_ptr<uint8_t, Unmap> slots_;
+  size_t residentSlots_ = 0;      // the most a batch has filled since the last give-back
+  size_t recentlyUsedSlots_ = 0;  // the most a batch has filled in this window
+  Clock::time_point slotsWindowStart_{};
 };
 
 }  // namespace wircam::wirc
