@@ -158,13 +158,12 @@ std::vector<OptionSpec> recordingRows() {
        .fallback = "8M",
        .section = kFiles,
        .reloadable = true,
-       .help =
-           "how much of a camera's video may wait for a slow disk (`100K`..`1G`); past "
-           "it the newest frames are dropped from the file, counted in `/api/status` "
-           "(`recording_dropped`), `/metrics` and the log, while the live view, detection "
-           "and following go on. One thread writes the files of every camera on a "
-           "filesystem. `0`: each camera writes its files on its own thread, so a disk that "
-           "stalls then stalls the camera's source and branches too",
+       .help = "how much of a camera's video may wait for a slow disk (`100K`..`1G`); past "
+               "it the newest frames are dropped from the file, counted in `/api/status` "
+               "(`recording_dropped`), `/metrics` and the log, while the live view, detection "
+               "and following go on. One thread writes the files of every camera on a "
+               "filesystem. `0`: each camera writes its files on its own thread, so a disk that "
+               "stalls then stalls the camera's source and branches too",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          auto bytes = byteSize(value);
          if (!bytes || (*bytes != 0 && (*bytes < 100'000 || *bytes > 1'000'000'000)))
