@@ -39,16 +39,4 @@ inline ProcessCounts processCounts(pid_t pid) {
   return counts;
 }
 
-// The threads of process `pid` named `name` (as top -H shows them).
-inline size_t threadsNamed(const std::string& name, pid_t pid = getpid()) {
-  size_t count = 0;
-  for (const auto& task :
-       std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task")) {
-    std::string comm;
-    std::getline(std::ifstream(task.path() / "comm"), comm);
-    count += comm == name;
-  }
-  return count;
-}
-
 }  // namespace wircam::testing
