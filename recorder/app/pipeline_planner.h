@@ -12,8 +12,8 @@ namespace wircam::recorder {
 
 // Each stream is a pipeline of its own, so that a camera that never sends a
 // frame, errors or stalls holds no other camera's preroll, EOS or stop.
-// Per stream: wircsrc → [marvelmindpositions →] [tee →] [queue →] [decode →
-// x264enc →] (the file), the telemetry's text (the same file, unless
+// Per stream: wircsrc → [marvelmindpositions →] [tee →] [decode → x264enc →]
+// (the file), the telemetry's text (the same file, unless
 // --telemetry-track off; for MP4 from an appsrc) and, when asked for, a
 // leaky branch off the tee to AprilTag detection (→ wirccontrol) and one
 // to an appsink for the live view and RTSP. The files themselves (a muxer

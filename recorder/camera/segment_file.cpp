@@ -103,12 +103,7 @@ bool SegmentFile::letLineIn(GstClockTime position) {
 }
 
 void SegmentFile::afterLines() {
-  if (std::exchange(linesOpen_, false)) collect_pads_turns::closeAfterLines(videoInput_);
-}
-
-void SegmentFile::afterGap() {
-  afterLines();
-  if (takesTurns_) collect_pads_turns::textIsAhead(textInput_);
+  if (std::exchange(linesOpen_, false)) collect_pads_turns::afterLines(videoInput_, textInput_);
 }
 
 void SegmentFile::end(GstPad* input, std::atomic<bool>& ended) {

@@ -50,9 +50,8 @@ class SegmentFile {
   // frames' segment: true once it may go in, false if it cannot now.
   bool letLineIn(GstClockTime position);
   bool takesTurns() const { return takesTurns_; }
-  // After the lines, and after the text's gap up to the next frame.
+  // After the lines (nothing if none went in since the last call).
   void afterLines();
-  void afterGap();
 
   // The end of its frames, or of its text (EOS into that input, once).
   void endVideo() {

@@ -164,8 +164,7 @@ void SegmentWriter::open(GstClockTime start) {
   }
   // Its text goes out from now on (numbered as the files are). (Outside
   // the lock: the track holds its own while it pushes text, whose probe
-  // takes this one, on another thread when the file's frames cross a
-  // queue.)
+  // takes this one: lock order.)
   track_.fileOpened(start);
 }
 
@@ -240,7 +239,7 @@ GstPadProbeReturn SegmentWriter::routeText(GstPad* pad, GstPadProbeInfo* info) {
   // (A GAP event comes through this probe again, as an event.)
   GstPadProbeReturn answer = TelemetryTrack::passGap(pad, info, parts_.muxer.textGapEvents);
   MutexLock lock(mutex_);
-  if (text_) text_->afterGap();
+  if (text_) text_->afterLines();
   return answer;
 }
 

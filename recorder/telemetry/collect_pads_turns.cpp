@@ -74,8 +74,9 @@ bool openForLine(GstPad* video, GstClockTime position) {
   return true;
 }
 
-void closeAfterLines(GstPad* video) { setWaiting(video, true); }
-
-void textIsAhead(GstPad* text) { setWaiting(text, false); }
+void afterLines(GstPad* video, GstPad* text) {
+  setWaiting(video, true);
+  setWaiting(text, false);
+}
 
 }  // namespace wircam::recorder::collect_pads_turns

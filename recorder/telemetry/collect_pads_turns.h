@@ -9,15 +9,17 @@
 // has gone on, so a line pushed alone would wait for the next frame, which
 // the same thread was to bring. Before a line, the video input says it has
 // nothing before the line (a GAP event up to just past it) and is set not
-// to be waited for, so the line goes on at once; after the lines it is
-// waited for again. After the text's gap (it has nothing up to the next
-// frame) the text input is set not to be waited for, which is what
-// GstCollectPads concludes itself once the frame is there: the frame then
-// goes on at once.
+// to be waited for, so the line goes on at once. After the lines the video
+// input is waited for again, and the text input, which has just been (its
+// line was the earliest), is not: the text's gap that follows says it has
+// nothing up to the next frame, which is what GstCollectPads concludes
+// itself once that frame is there, and the frame goes on at once. A frame
+// with no line due needs none of this: the text, past the frame before,
+// is not waited for.
 //
 // Two inputs both not waited for and both empty would read as the end of
-// every input to GstCollectPads; that lasts here only between a gap and
-// the frame the same thread pushes next.
+// every input to GstCollectPads; that lasts here only between a line's turn
+// and the line, which the same thread pushes next.
 #pragma once
 
 #include <gst/gst.h>
@@ -33,9 +35,7 @@ bool drive(GstPad* input);
 // with nothing changed: `video` has had no segment yet (a GAP event must
 // not come before it), or `position` is none.
 bool openForLine(GstPad* video, GstClockTime position);
-// After the lines: `video` is waited for again.
-void closeAfterLines(GstPad* video);
-// After the text's gap: `text` is not waited for.
-void textIsAhead(GstPad* text);
+// After the lines: `video` is waited for again, `text` is not.
+void afterLines(GstPad* video, GstPad* text);
 
 }  // namespace wircam::recorder::collect_pads_turns

@@ -120,8 +120,7 @@ class TextBesideFrames {
     ++self->gaps_;
     if (onFramesThread) ++self->framesThreadGaps_;
     GstPadProbeReturn answer = TelemetryTrack::passGap(pad, info, true);
-    turns::closeAfterLines(self->muxVideo_);
-    turns::textIsAhead(self->muxText_);
+    turns::afterLines(self->muxVideo_, self->muxText_);
     return answer;
   }
 
