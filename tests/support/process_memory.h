@@ -1,5 +1,5 @@
-// How much memory a process holds resident, and how many threads (by
-// name too) and file descriptors, for tests that a hostile peer or churning clients cannot
+// How much memory a process holds resident, and how many threads and file
+// descriptors, for tests that a hostile peer or churning clients cannot
 // make them grow.
 #pragma once
 
