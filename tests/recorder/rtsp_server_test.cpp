@@ -14,9 +14,16 @@ namespace {
 using namespace wircam::testing;
 using std::chrono::milliseconds;
 
+// The recorder's RTSP server says what it did with each client (in its
+// log, shown when a test fails): a client now and then sets up its stream
+// in a busy suite and then gets no packet at all, with the camera live.
+const std::vector<std::string> kServerSaysWhatItDoes = {
+    "env", "GST_DEBUG=rtspclient:4,rtspmedia:4,rtspstream:4", "GST_DEBUG_NO_COLOR=1"};
+
 TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
   auto device = startSequenceDevice();
-  RecorderProcess recorder(device->port(), {"--rtsp", "127.0.0.1:0", "--duration", "60"});
+  RecorderProcess recorder(device->port(), {"--rtsp", "127.0.0.1:0", "--duration", "60"},
+                           kServerSaysWhatItDoes);
   auto url = recorder.waitForLog("rtsp://", milliseconds(10000));
   ASSERT_TRUE(url) << recorder.log();
   EXPECT_NE(url->find("/127.0.0.1-" + std::to_string(device->port()) + "/cam0"), std::string::npos);
@@ -58,8 +65,10 @@ TEST(WircRecorderRtsp, AClientPlaysTheCamera) {
 TEST(WircRecorderRtsp, WithATokenOnlyAClientWithItPlays) {
   constexpr const char* kToken = "0123456789abcdef0123456789abcdef";
   auto device = startSequenceDevice();
-  RecorderProcess recorder(device->port(), {"--rtsp", "127.0.0.1:0", "--http", "127.0.0.1:0",
-                                            "--http-token", kToken, "--duration", "60"});
+  RecorderProcess recorder(device->port(),
+                           {"--rtsp", "127.0.0.1:0", "--http", "127.0.0.1:0", "--http-token",
+                            kToken, "--duration", "60"},
+                           kServerSaysWhatItDoes);
   auto url = recorder.waitForLog("rtsp://", milliseconds(10000));
   ASSERT_TRUE(url) << recorder.log();
   auto play = [&](const std::string& credentials) {
