@@ -1,33 +1,19 @@
 #include "http/rtsp_server.h"
 
-#include <gst/app/gstappsrc.h>
-
 #include <algorithm>
 
-#include "common/mutex.h"
+#include "http/rtsp_media_feed.h"
 #include "http/rtsp_token_auth.h"
 
 namespace wircam::recorder {
 
-// One camera's mount point and the appsrc of its media while it is playing.
+// One camera's mount point, and its frames' way into the media clients play.
 struct RtspServer::Mount {
   Camera camera;
   int listener = 0;
-  Mutex mutex;  // the streaming thread pushes into the sources
-  std::vector<GstElement*> sources WIRCAM_GUARDED_BY(mutex);
+  RtspMediaFeed feed;
   bool removed = false;  // by a reload: no feed, no mount point
 };
-
-namespace {
-
-// Frames are stamped by the appsrc with the media's own clock, and a new
-// client may start at any frame: every JPEG is a key frame.
-constexpr char kMediaLaunch[] =
-    "( appsrc name=frames is-live=true format=time do-timestamp=true "
-    "max-bytes=2000000 leaky-type=downstream "
-    "! rtpjpegpay name=pay0 pt=26 )";
-
-}  // namespace
 
 Expected<std::unique_ptr<RtspServer>, std::string> RtspServer::start(const ServerAddress& address,
                                                                      std::vector<Camera> cameras,
@@ -63,7 +49,8 @@ void RtspServer::addCamera(const RtspCamera& camera) {
   auto mount = std::make_unique<Mount>();
   mount->camera = camera;
   GstRTSPMediaFactory* factory = gst_rtsp_media_factory_new();
-  gst_rtsp_media_factory_set_launch(factory, kMediaLaunch);
+  std::string launch = std::string("( ") + kRtspFrameSource + " ! rtpjpegpay name=pay0 pt=26 )";
+  gst_rtsp_media_factory_set_launch(factory, launch.c_str());
   gst_rtsp_media_factory_set_shared(factory, TRUE);
   if (!token_.empty())
     gst_rtsp_media_factory_add_role(factory, kRtspViewerRole, GST_RTSP_PERM_MEDIA_FACTORY_ACCESS,
@@ -74,18 +61,7 @@ void RtspServer::addCamera(const RtspCamera& camera) {
   gst_rtsp_mount_points_add_factory(mounts, camera.path.c_str(), factory);
   g_object_unref(mounts);
   Mount* raw = mount.get();
-  mount->listener = camera.frames->listen([raw](GstSample* sample) {
-    MutexLock lock(raw->mutex);
-    if (raw->sources.empty()) return;
-    // Same memory, fresh metadata: the appsrc stamps it. The caps carry
-    // the frame size, which rtpjpegpay needs.
-    GstBuffer* jpeg =
-        gst_buffer_copy_region(gst_sample_get_buffer(sample), GST_BUFFER_COPY_MEMORY, 0, -1);
-    GstSample* fresh = gst_sample_new(jpeg, gst_sample_get_caps(sample), nullptr, nullptr);
-    gst_buffer_unref(jpeg);
-    for (GstElement* source : raw->sources) gst_app_src_push_sample(GST_APP_SRC(source), fresh);
-    gst_sample_unref(fresh);
-  });
+  mount->listener = camera.frames->listen([raw](GstSample* sample) { raw->feed.push(sample); });
   mounts_.push_back(std::move(mount));
 }
 
@@ -100,11 +76,8 @@ void RtspServer::removeCamera(const std::string& path) {
   mount.camera.frames->forget(mount.listener);
   // Its viewers see the stream end. The mount stays (without a feed): a
   // media still playing holds it in its callbacks until the server goes.
-  {
-    MutexLock lock(mount.mutex);
-    for (GstElement* source : mount.sources) gst_app_src_end_of_stream(GST_APP_SRC(source));
-    mount.removed = true;
-  }
+  mount.feed.end();
+  mount.removed = true;
   // And its clients' sessions end (a client would otherwise sit on a
   // stream that never sends again).
   gst_rtsp_server_client_filter(
@@ -128,9 +101,6 @@ void RtspServer::removeCamera(const std::string& path) {
 RtspServer::~RtspServer() {
   for (auto& mount : mounts_) {
     if (!mount->removed) mount->camera.frames->forget(mount->listener);
-    MutexLock lock(mount->mutex);
-    for (GstElement* source : mount->sources) gst_object_unref(source);
-    mount->sources.clear();
   }
   if (source_) g_source_remove(source_);
   if (server_) g_object_unref(server_);
@@ -142,24 +112,12 @@ void RtspServer::onMediaConfigure(GstRTSPMediaFactory*, GstRTSPMedia* media, gpo
   GstElement* source = gst_bin_get_by_name(GST_BIN(bin), "frames");
   gst_object_unref(bin);
   if (!source) return;
-  {
-    MutexLock lock(mount->mutex);
-    mount->sources.push_back(source);
-  }
+  mount->feed.add(source);
+  gst_object_unref(source);
   // When the last client leaves the media is unprepared: stop feeding it.
   g_signal_connect(media, "unprepared", G_CALLBACK(+[](GstRTSPMedia* m, gpointer d) {
-                     auto* unpreparedMount = static_cast<Mount*>(d);
                      GstElement* mediaBin = gst_rtsp_media_get_element(m);
-                     MutexLock lock(unpreparedMount->mutex);
-                     auto& list = unpreparedMount->sources;
-                     for (auto it = list.begin(); it != list.end();) {
-                       if (gst_object_has_as_ancestor(GST_OBJECT(*it), GST_OBJECT(mediaBin))) {
-                         gst_object_unref(*it);
-                         it = list.erase(it);
-                       } else {
-                         ++it;
-                       }
-                     }
+                     static_cast<Mount*>(d)->feed.removeWithin(mediaBin);
                      gst_object_unref(mediaBin);
                    }),
                    mount);
