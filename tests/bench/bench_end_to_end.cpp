@@ -3,18 +3,20 @@
 //   stock:   multifilesrc DIR ! rtpjpegpay ! udpsink  →  udpsrc ! rtpjpegdepay ! fakesink
 // Both senders run as separate processes and send the same JPEG files at the
 // same rate; only the receiver's CPU (user + system, all its threads) counts.
-// Usage: bench_end_to_end [SECONDS]   (default 5 per case)
+// Usage: bench_end_to_end [SECONDS [ROUNDS]]   (default 5 per receiver and round, 3 rounds)
 #include <gst/gst.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "child_process.h"
 #include "synthetic_jpeg.h"
@@ -109,14 +111,24 @@ std::string longestPcdGapIn(const fs::path& summary) {
 
 double ratio(double ours, double stock) { return stock > 0 ? ours / stock : 0; }
 
+// The median of a few values (the rounds' ratios).
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  size_t n = values.size();
+  return n == 0 ? 0 : n % 2 ? values[n / 2] : (values[n / 2 - 1] + values[n / 2]) / 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, FALSE);  // the build's wircsrc
   gst_init(&argc, &argv);
   double seconds = argc > 1 ? std::atof(argv[1]) : 5;
-  if (argc > 2 || seconds <= 0) {
-    std::fprintf(stderr, "usage: bench_end_to_end [SECONDS]   (measured per case; default 5)\n");
+  int rounds = argc > 2 ? std::atoi(argv[2]) : 3;
+  if (argc > 3 || seconds <= 0 || rounds <= 0) {
+    std::fprintf(stderr,
+                 "usage: bench_end_to_end [SECONDS [ROUNDS]]   (SECONDS measured per receiver "
+                 "and round, default 5; ROUNDS default 3)\n");
     return 2;
   }
   fs::path self = fs::canonical("/proc/self/exe").parent_path();
@@ -124,7 +136,10 @@ int main(int argc, char** argv) {
 
   std::printf(
       "CPU per frame in µs (wake-ups per frame): the whole receiving process, its\n"
-      "streaming thread, and its other threads (wircsrc's: the vehicle link)\n");
+      "streaming thread, and its other threads (wircsrc's: the vehicle link).\n"
+      "The receivers take turns, %d rounds: this machine's speed drifts over\n"
+      "seconds, and a ratio is taken within a round.\n",
+      rounds);
   std::printf("%-12s %-22s %7s %17s %17s %7s\n", "stream", "receiver", "whole", "streaming",
               "other", "frames");
   for (Case c : {Case{352, 288, 15}, Case{1280, 720, 30}}) {
@@ -140,46 +155,61 @@ int main(int argc, char** argv) {
     }
     // Ports from the pid keep parallel runs apart.
     int port = 10000 + getpid() % 20000;  // below the ephemeral ports (32768 and up)
+    int rtpPort = port + 1;
 
     // The simulator's summary at its end says the longest gap between two
     // commands (PCD) it heard: the keepalive's, however they were sent.
-    fs::path summary = dir.string() + "-sim.txt";
-    pid_t sender = spawn(sim + " --bind 127.0.0.1 --port " + std::to_string(port) + " --fps " +
-                             std::to_string(c.fps) + " --frames " + dir.string(),
-                         summary.string());
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    auto wircam = receive(
-        "wircsrc host=127.0.0.1 port=" + std::to_string(port) + " ! fakesink name=sink sync=false",
-        seconds);
-    stop(sender);
-    std::string longestPcdGap = longestPcdGapIn(summary);
-    fs::remove(summary);
-
-    int rtpPort = port + 1;
+    auto receiveFromSimulator = [&](std::string& longestPcdGap) {
+      fs::path summary = dir.string() + "-sim.txt";
+      pid_t sender = spawn(sim + " --bind 127.0.0.1 --port " + std::to_string(port) + " --fps " +
+                               std::to_string(c.fps) + " --frames " + dir.string(),
+                           summary.string());
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      auto result = receive("wircsrc host=127.0.0.1 port=" + std::to_string(port) +
+                                " ! fakesink name=sink sync=false",
+                            seconds);
+      stop(sender);
+      longestPcdGap = longestPcdGapIn(summary);
+      fs::remove(summary);
+      return result;
+    };
     // multifilesrc does not timestamp: identity's sleep paces it instead.
-    sender = spawn("gst-launch-1.0 multifilesrc location=" + (dir / "%05d.jpg").string() +
-                   " loop=true caps=image/jpeg,width=" + std::to_string(c.width) +
-                   ",height=" + std::to_string(c.height) + ",framerate=" + std::to_string(c.fps) +
-                   "/1 ! identity sleep-time=" + std::to_string(1000000 / c.fps) +
-                   " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" + std::to_string(rtpPort));
-    auto rtp = receive(
-        "udpsrc port=" + std::to_string(rtpPort) +
-            " buffer-size=8388608 "
-            "caps=application/x-rtp,media=video,clock-rate=90000,encoding-name=JPEG,payload=26 "
-            "! rtpjpegdepay ! fakesink name=sink sync=false",
-        seconds);
-    stop(sender);
-    fs::remove_all(dir);
+    auto receiveRtp = [&] {
+      pid_t sender =
+          spawn("gst-launch-1.0 multifilesrc location=" + (dir / "%05d.jpg").string() +
+                " loop=true caps=image/jpeg,width=" + std::to_string(c.width) +
+                ",height=" + std::to_string(c.height) + ",framerate=" + std::to_string(c.fps) +
+                "/1 ! identity sleep-time=" + std::to_string(1000000 / c.fps) +
+                " ! rtpjpegpay ! udpsink host=127.0.0.1 port=" + std::to_string(rtpPort));
+      auto result = receive(
+          "udpsrc port=" + std::to_string(rtpPort) +
+              " buffer-size=8388608 "
+              "caps=application/x-rtp,media=video,clock-rate=90000,encoding-name=JPEG,payload=26 "
+              "! rtpjpegdepay ! fakesink name=sink sync=false",
+          seconds);
+      stop(sender);
+      return result;
+    };
 
     char label[32];
     std::snprintf(label, sizeof label, "%dx%d@%d", c.width, c.height, c.fps);
-    printRow(label, "wircsrc", wircam);
-    printRow(label, "udpsrc ! rtpjpegdepay", rtp);
+    std::vector<double> whole, streaming;
+    std::string longestPcdGap, longestOfAll;
+    for (int round = 0; round < rounds; ++round) {
+      auto wircam = receiveFromSimulator(longestPcdGap);
+      auto rtp = receiveRtp();
+      printRow(label, "wircsrc", wircam);
+      printRow(label, "udpsrc ! rtpjpegdepay", rtp);
+      whole.push_back(ratio(wircam.cpuPerFrameUs, rtp.cpuPerFrameUs));
+      streaming.push_back(ratio(wircam.streamingUsPerFrame, rtp.streamingUsPerFrame));
+      longestOfAll += (round ? ", " : "") + longestPcdGap;
+    }
+    fs::remove_all(dir);
+    auto [lowest, highest] = std::minmax_element(whole.begin(), whole.end());
     std::printf(
-        "%-12s wircsrc ÷ stock: whole %.2f×, streaming thread %.2f×; keepalive on, "
-        "longest PCD gap %s\n",
-        label, ratio(wircam.cpuPerFrameUs, rtp.cpuPerFrameUs),
-        ratio(wircam.streamingUsPerFrame, rtp.streamingUsPerFrame), longestPcdGap.c_str());
+        "%-12s wircsrc ÷ stock, median of %d rounds: whole %.2f× (%.2f–%.2f), streaming thread "
+        "%.2f×; keepalive on, longest PCD gaps %s\n",
+        label, rounds, median(whole), *lowest, *highest, median(streaming), longestOfAll.c_str());
   }
   return 0;
 }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <mutex>
 #include <thread>
 
@@ -205,21 +206,28 @@ TEST(TransmitterSession, SendsAChangedCommandAtOnceAndKeepsTheWatchdogFedWhileNo
 }
 
 // A stream's receive loop lends the link its turns (every 66 ms, as at
-// 15 fps): the keepalives leave on them, and the link's event loop wakes
-// only for the device's status reports (two a second), not for its
-// keepalive timer (ten a second). When the turns stop, the timer feeds the
+// 15 fps): the keepalives leave on them, the device's status reports (two
+// a second) are read as they leave, and the link's event loop wakes for
+// neither: not for its keepalive timer (ten a second), nor for the
+// reports, nor for the link's timeout, which they keep pushing back, but
+// once a timeout at most. When the turns stop, the timer feeds the
 // device's watchdog again.
-TEST(TransmitterSession, KeepalivesRideOnAStreamsTurnsAndTheEventLoopSleeps) {
+TEST(TransmitterSession, KeepalivesAndStatusReportsRideOnAStreamsTurnsAndTheEventLoopSleeps) {
   auto device = startDevice();
   link::EventLoop loop;
   auto acquired = TransmitterSession::acquire(sessionFor(*device), "test", loop);
   ASSERT_TRUE(acquired) << acquired.error();
   auto session = *acquired;
+  std::atomic<int> heard = 0;
+  int listener = session->addListener([&](const link::LinkEvent& event) {
+    if (std::holds_alternative<link::TelemetryReceived>(event)) ++heard;
+  });
   ASSERT_EQ(session->waitLoggedIn(milliseconds(3000)), std::nullopt);
   ASSERT_TRUE(waitFor([&] { return session->status().hasControl; }));
   session->shareTurn(milliseconds(66));
   uint64_t wakeUps = loop.wakeUps();
   uint64_t reports = device->stats().psdSent;
+  int heardBefore = heard;
   uint64_t commands = device->stats().pcdReceived;
   // A turn this machine let come late (past the keepalive's early margin)
   // leaves the keepalive to the timer: one wake-up it may take.
@@ -234,13 +242,23 @@ TEST(TransmitterSession, KeepalivesRideOnAStreamsTurnsAndTheEventLoopSleeps) {
   }
   uint64_t woke = loop.wakeUps() - wakeUps;
   uint64_t reported = device->stats().psdSent - reports;
-  EXPECT_LE(woke, reported + late + 2) << reported << " status reports, " << late << " late turns";
+  // 2 s of turns: the link's timeout (its 2 s) once, and a late turn each.
+  EXPECT_LE(woke, late + 1u) << woke << " wake-ups, " << reported << " status reports, " << late
+                             << " late turns";
   EXPECT_GE(device->stats().pcdReceived - commands, 29u);
+  // Every report sent was heard, but one on its way (one keepalive later).
+  EXPECT_GE(static_cast<uint64_t>(heard - heardBefore) + 1, reported);
+  EXPECT_GE(reported, 3u);
   // Without turns, the timer feeds the watchdog: keepalives go on, and the
   // device never fails safe (its 800 ms without a command).
   commands = device->stats().pcdReceived;
   EXPECT_TRUE(waitFor([&] { return device->stats().pcdReceived >= commands + 8; }));
   EXPECT_EQ(device->stats().failsafeEntries, 0u);
+  // And the reports still come, with the keepalives the timer sends.
+  int heardWithoutTurns = heard;
+  EXPECT_TRUE(waitFor([&] { return heard >= heardWithoutTurns + 2; }));
+  EXPECT_EQ(session->status().state, link::LinkState::Live);
+  session->removeListener(listener);
   session.reset();  // logs out on the loop, before it goes
 }
 

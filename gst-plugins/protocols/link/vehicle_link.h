@@ -100,9 +100,11 @@ struct LinkStatus {
 // Listeners: added and removed from any thread. Once remove() returns, the
 // listener is not running and never runs again, so it may be called from a
 // listener or a GStreamer bus sync handler alike. Listeners run on the event
-// loop thread: they must not block, and must not drop the last reference to
-// their link (as a GStreamer application must not set a pipeline to NULL
-// from a streaming thread).
+// loop thread (but a WiRC status report, while its transmitter steers, on
+// the thread whose keepalive read it: a stream's that lends its turns, or
+// a command's): they must not block, and must not drop the last reference
+// to their link (as a GStreamer application must not set a pipeline to
+// NULL from a streaming thread).
 //
 // The link's state and control right are sticky, as GStreamer's sticky
 // events are for a pad linked late: a listener added after the link logged

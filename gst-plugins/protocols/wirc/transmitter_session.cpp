@@ -138,6 +138,7 @@ class TransmitterSession::Impl {
       std::lock_guard lock(mutex_);
       actions = event(machine_);
       deadline = machine_.nextDeadline();
+      followStatusReports();
     }
     changed_.notify_all();
     if (loop_.inLoopThread()) {
@@ -155,8 +156,19 @@ class TransmitterSession::Impl {
   void onTcp(uint32_t events);
   void readTcp();
   void onDiscoveryAnswer();
-  void onPsd();
+  void readStatusReports();
   void onPacerTimer();
+  // While steering, a keepalive leaves at least every 100 ms (on a
+  // stream's turn or the pacer's timer), and the status reports waiting are
+  // read as it leaves: the loop wakes for none of them (two a second, at
+  // CIF/15 a tenth of the receiving process's CPU). Otherwise the loop
+  // wakes for each. Under mutex_.
+  void followStatusReports() {
+    bool wake = !steering();
+    if (wake == loopWakesForStatus_) return;
+    loop_.setEvents(psdWatch_, wake ? uint32_t{EPOLLIN} : 0u);
+    loopWakesForStatus_ = wake;
+  }
   // Whether commands reach the vehicle now: logged in, holding the control
   // right, the device's address known. Under mutex_.
   bool steering() const {
@@ -187,6 +199,7 @@ class TransmitterSession::Impl {
   std::condition_variable changed_;
   LoginMachine machine_;
   link::CommandPacer pacer_;
+  bool loopWakesForStatus_ = true;
 
   // The TCP connection; sendMutex_ serialises writers from any thread.
   std::mutex sendMutex_;
@@ -213,10 +226,14 @@ TransmitterSession::Impl::Impl(SessionConfig config, link::LinkListeners& listen
       pcdSocket_(boundUdp()),
       machine_(config, boundPort(psdSocket_), Clock::now()),
       pacer_(pacerConfig(config)) {
-  psdWatch_ = loop_.watch(psdSocket_.get(), EPOLLIN, [this](uint32_t) { onPsd(); });
+  psdWatch_ = loop_.watch(psdSocket_.get(), EPOLLIN, [this](uint32_t) { readStatusReports(); });
   pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
-  deadlineTimer_ = loop_.addTimer(
-      [this] { handle([](LoginMachine& m) { return m.onDeadline(Clock::now()); }); });
+  // The link's timeout looks at the reports waiting too, not only at those
+  // a keepalive took with it.
+  deadlineTimer_ = loop_.addTimer([this] {
+    readStatusReports();
+    handle([](LoginMachine& m) { return m.onDeadline(Clock::now()); });
+  });
   loop_.arm(deadlineTimer_, Clock::now());
 }
 
@@ -369,9 +386,10 @@ void TransmitterSession::Impl::sendPcd(const link::Pulses& pulses) {
     std::lock_guard lock(mutex_);
     machine_.countCommandSent();
   }
+  readStatusReports();  // those that came since the last (followStatusReports)
 }
 
-void TransmitterSession::Impl::onPsd() {
+void TransmitterSession::Impl::readStatusReports() {
   std::array<uint8_t, 64> buffer;
   // At most a few per wake-up: a flood on this port cannot starve the loop.
   receiveDatagrams(psdSocket_.get(), buffer, 16,
