@@ -24,7 +24,7 @@ function addControls(view, name) {
       return false;
     }
     message.textContent = "";
-    showControls(view, answer);
+    showControls(view, answer, performance.now());
     return true;
   };
   box.querySelector(".follow").addEventListener("click", () =>
@@ -41,9 +41,14 @@ function addControls(view, name) {
   });
 }
 
-// Follow button and target from the camera's state (/api/status, /api/cameras).
-function showControls(view, state) {
+// Follow button and target from the camera's state (/api/status, /api/cameras),
+// as it was at `askedAt` (performance.now()). A state asked for before the
+// answer to a command came (a status poll on its way) is older than that
+// answer: it would show the follow button as it was before the click.
+function showControls(view, state, askedAt) {
   if (!view.controls || state.following === undefined) return;
+  if (askedAt < (view.controlsAnsweredAt || 0)) return;
+  view.controlsAnsweredAt = askedAt;
   view.following = state.following;
   view.controls.querySelector(".follow").textContent =
       state.following ? "following: on" : "following: off";

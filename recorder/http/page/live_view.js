@@ -19,7 +19,7 @@ function addCamera(camera) {
                          width: camera.width, height: camera.height, state: "" };
   if (camera.status && camera.status.following !== undefined)
     addControls(views[camera.name], camera.name);
-  if (camera.status) showStream(camera.status);
+  if (camera.status) showStream(camera.status, 0);
   else setState(views[camera.name], "live", null);
   showDetections({ stream: camera.name, detections: camera.detections });
 }
@@ -106,11 +106,11 @@ function controlText(stream) {
          (stream.following ? `on (${target})` : "off");
 }
 
-function showStream(stream) {
+function showStream(stream, askedAt) {
   const view = views[stream.name];
   if (!view) return;
   setState(view, stream.state, stream.state_since_utc);
-  showControls(view, stream);
+  showControls(view, stream, askedAt);
   view.stats.textContent = `${stream.fps.toFixed(1)} fps  ` +
       `loss ${stream.loss_percent.toFixed(1)} %  ${Math.round(stream.kbps)} kbit/s  ` +
       `battery ${stream.battery_v.toFixed(2)} V` +
@@ -118,9 +118,9 @@ function showStream(stream) {
       controlText(stream) + positionText(stream.position);
 }
 
-function showStatus(status) {
+function showStatus(status, askedAt) {
   for (const stream of status.streams) {
-    showStream(stream);
+    showStream(stream, askedAt);
     const p = stream.position;
     if (!p || p.x === undefined) continue;
     const trail = trails[stream.name] || (trails[stream.name] = { points: [] });
@@ -174,7 +174,8 @@ function drawMap() {
 }
 
 async function refreshStatus() {
-  showStatus(await (await fetch("/api/status")).json());
+  const askedAt = performance.now();
+  showStatus(await (await fetch("/api/status")).json(), askedAt);
 }
 
 // The finished segments from the recording index, by camera and by day
