@@ -200,6 +200,7 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(stats.pcdReceived),
               static_cast<unsigned long long>(stats.pcdRejected));
   std::printf("  max PCD gap        %lld ms\n", static_cast<long long>(stats.maxPcdGap.count()));
+  std::printf("  max frame tick gap %lld ms\n", static_cast<long long>(stats.maxTickGap.count()));
   std::printf("  failsafe entries   %llu\n",
               static_cast<unsigned long long>(stats.failsafeEntries));
   std::printf("  ERR sent           %llu\n", static_cast<unsigned long long>(stats.errSent));

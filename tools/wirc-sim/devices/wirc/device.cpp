@@ -165,6 +165,8 @@ void Device::Impl::runTimers(DeviceClock::time_point now) {
 
 void Device::Impl::tickFrame(DeviceClock::time_point now) {
   if (lastTick_) {
+    localStats_.maxTickGap =
+        std::max(localStats_.maxTickGap, duration_cast<milliseconds>(now - *lastTick_));
     // The battery drains with throttle (channel 2) away from neutral.
     double seconds = std::chrono::duration<double>(now - *lastTick_).count();
     double throttle = std::abs(static_cast<int>(localOutputs_.pulses[1]) - kPulseNeutral) / 500.0;

@@ -83,6 +83,9 @@ struct DeviceStats {
   uint64_t restarts = 0;
   uint64_t restartsDone = 0;               // listening again after a restart
   std::chrono::milliseconds maxPcdGap{0};  // longest wait between two PCD
+  // Longest time between two frame ticks: a machine too busy to let the
+  // device send on time (its frames are then skipped, not sent late).
+  std::chrono::milliseconds maxTickGap{0};
 };
 
 class Device {
