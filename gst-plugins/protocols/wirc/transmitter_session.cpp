@@ -158,11 +158,11 @@ class TransmitterSession::Impl {
   void onDiscoveryAnswer();
   void readStatusReports();
   void onPacerTimer();
-  // While steering, a keepalive leaves at least every 100 ms (on a
-  // stream's turn or the pacer's timer), and the status reports waiting are
-  // read as it leaves: the loop wakes for none of them (two a second, at
-  // CIF/15 a tenth of the receiving process's CPU). Otherwise the loop
-  // wakes for each. Under mutex_.
+  // While steering, a keepalive leaves at least every `keepalive` (100 ms
+  // by default, never off; on a stream's turn or the pacer's timer), and
+  // the status reports waiting are read as it leaves: the loop wakes for
+  // none of them (two a second, at CIF/15 about a tenth of the receiving
+  // process's CPU). Otherwise the loop wakes for each. Under mutex_.
   void followStatusReports() {
     bool wake = !steering();
     if (wake == loopWakesForStatus_) return;
