@@ -15,8 +15,9 @@ using namespace wircam::testing;
 using std::chrono::milliseconds;
 
 // The recorder's RTSP server says what it did with each client (in its
-// log, shown when a test fails): a client now and then sets up its stream
-// in a busy suite and then gets no packet at all, with the camera live.
+// log, shown when a test fails): whether a client that got no frame was
+// refused, or set up its stream and then got no packet (frames stamped
+// before the media's base time did that once: rtsp_media_feed.cpp).
 const std::vector<std::string> kServerSaysWhatItDoes = {
     "env", "GST_DEBUG=rtspclient:4,rtspmedia:4,rtspstream:4", "GST_DEBUG_NO_COLOR=1"};
 
@@ -74,7 +75,7 @@ TEST(WircRecorderRtsp, WithATokenOnlyAClientWithItPlays) {
   auto play = [&](const std::string& credentials) {
     std::string location = "rtsp://" + credentials + url->substr(7);
     // (rtspsrc's own account of the exchange, for a client that gets no
-    // frame: it failed so once in a busy suite, saying nothing.)
+    // frame: without it, gst-launch's exit code alone says nothing.)
     return runCommand(
         "GST_DEBUG=rtspsrc:4 GST_DEBUG_NO_COLOR=1 timeout 20 gst-launch-1.0 -q "
         "rtspsrc location='" +

@@ -63,6 +63,7 @@ class StreamInbox {
 
  private:
   void receiveBatch();
+  void giveBackUnusedSlots(size_t used, Clock::time_point now);
 
   UniqueFd socket_;
   UniqueFd interrupt_;
@@ -70,7 +71,6 @@ class StreamInbox {
   UniqueFd endRequest_;
   std::optional<StreamReceiver> receiver_;
   std::deque<AssembledFrame> ready_;
-  void giveBackUnusedSlots(size_t used, Clock::time_point now);
 
   // Datagrams of up to 64 KB, a batch at a time, each in a page-aligned
   // slot of a region mapped lazily: only the pages datagrams fill become

@@ -99,7 +99,10 @@ class TransmitterSession : public link::VehicleLink {
   // next one (`untilNextTurn` from now) leaves now, from this thread, and
   // the link's timer moves to the keepalive after, so the event loop does
   // not wake for it. The timer still sends whatever no turn did: the gaps
-  // between commands are the keepalive's at most, video or not.
+  // between commands are the keepalive's at most, video or not. While the
+  // session steers, the device's status reports waiting are read as a
+  // keepalive leaves, so a listener may hear TelemetryReceived on this
+  // thread.
   void shareTurn(std::chrono::steady_clock::duration untilNextTurn);
   void requestControl() override;
   link::LinkStatus status() const override;

@@ -58,8 +58,10 @@ TEST(RtspMediaFeed, AFrameWaitsForNoMediaThatIsNotPlayingYet) {
   EXPECT_EQ(GST_BUFFER_PTS(gst_sample_get_buffer(sent)), 40 * GST_MSECOND);
   gst_sample_unref(sent);
 
+  // A media that went takes nothing more, PLAYING or not.
   feed.removeWithin(pipeline);
-  feed.push(frame);  // to no source
+  feed.push(frame);
+  EXPECT_EQ(gst_app_sink_try_pull_sample(GST_APP_SINK(out), 200 * GST_MSECOND), nullptr);
   gst_sample_unref(frame);
   gst_element_set_state(pipeline, GST_STATE_NULL);
   gst_object_unref(out);
