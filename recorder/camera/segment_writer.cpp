@@ -270,6 +270,7 @@ bool SegmentWriter::moveText(GstPad* pad, uint64_t number) {
 }
 
 void SegmentWriter::end() {
+  planner_.finishing();
   if (!parts_.textTail) return endFrames();
   // The frames end once the text's lines have all gone to the muxers: a
   // muxer finishes at the end of its frames, and lines not in by then

@@ -65,7 +65,7 @@ SegmentPlanner::Cut SegmentPlanner::onFrame(uint64_t pts,
     cut = Cut::kFirst;
   } else {
     const PlannedSegment& open = segments_.back();
-    bool full = limits_.maxDuration > 0 && pts >= open.start + limits_.maxDuration;
+    bool full = limits_.maxDuration > 0 && !finishing_ && pts >= open.start + limits_.maxDuration;
     bool gap = pts > open.lastFrame + limits_.maxGap;
     if (full || gap || splitPending_) cut = Cut::kNext;
   }
@@ -88,6 +88,11 @@ void SegmentPlanner::addBytes(uint64_t bytes) {
   PlannedSegment& open = segments_.back();
   open.bytes += bytes;
   if (limits_.maxBytes > 0 && open.bytes >= limits_.maxBytes) splitPending_ = true;
+}
+
+void SegmentPlanner::finishing() {
+  MutexLock lock(mutex_);
+  finishing_ = true;
 }
 
 std::optional<PlannedSegment> SegmentPlanner::segmentAt(uint64_t runningTime) const {

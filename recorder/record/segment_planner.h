@@ -57,6 +57,10 @@ class SegmentPlanner {
   // Bytes of the current segment reached the muxer; past the limit, the
   // next frame starts a new segment.
   void addBytes(uint64_t bytes);
+  // The recording is stopping: the frames still coming until it ends join
+  // the open segment past its length, so a stop never opens a file of a
+  // frame or two. (The byte limit and a gap still cut.)
+  void finishing();
 
   // The segment a time belongs to: the last that started at or before it
   // (times before the first frame belong to the first segment).
@@ -85,6 +89,7 @@ class SegmentPlanner {
   std::vector<PlannedSegment> segments_ WIRCAM_GUARDED_BY(mutex_);  // the newest last
   std::set<std::string> used_ WIRCAM_GUARDED_BY(mutex_);            // names given out
   bool splitPending_ WIRCAM_GUARDED_BY(mutex_) = false;             // the byte limit was reached
+  bool finishing_ WIRCAM_GUARDED_BY(mutex_) = false;                // the length no longer cuts
   // Past segments kept for look-ups of late telemetry and closing files.
   static constexpr size_t kKept = 16;
 };

@@ -99,7 +99,8 @@ TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
   auto device = startSequenceDevice();
   std::time_t launched = std::time(nullptr);
   // 2 s segments: each holds at least one of the once-a-second statistics.
-  RecorderProcess recorder(device->port(), {"--segment", "2", "--duration", "6", "--codec", codec,
+  // 7 s from the launch: three files even if the login takes 2 s.
+  RecorderProcess recorder(device->port(), {"--segment", "2", "--duration", "7", "--codec", codec,
                                             "--format", container});
   ASSERT_EQ(recorder.wait(), 0) << recorder.log();
   auto videos = recorder.files(std::string(".") + container);
@@ -108,19 +109,26 @@ TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
   for (size_t i = 0; i < videos.size(); ++i) {
     const auto& video = videos[i];
     SCOPED_TRACE(video.filename().string());
+    bool last = i + 1 == videos.size();
     auto frames = probeFrames(video);
+    // The last file runs from its cut to the stop, however short that is.
     // (A device this machine starved for seconds skips its frames: a file
     // then holds a gap, and the device says how long it was held.)
-    ASSERT_GT(frames.size(), 10u) << "the device's longest wait between frames: "
-                                  << device->stats().maxTickGap.count() << " ms";
+    ASSERT_GT(frames.size(), last ? 0u : 10u)
+        << "the device's longest wait between frames: " << device->stats().maxTickGap.count()
+        << " ms";
     EXPECT_TRUE(frames.front().key);
     EXPECT_LT(frames.front().pts, 0.1);
     // Every packet decodes to a frame, without a word from the decoder.
     EXPECT_EQ(static_cast<int>(frames.size()), probePackets(video));
     EXPECT_EQ(ffmpegDecodeErrors(video), "");
     double duration = probeDuration(video);
-    if (i + 1 < videos.size()) {
-      EXPECT_NEAR(duration, 2.0, 0.5);  // the last ends when the recording does
+    // The last ends when the recording does: what its stop let through
+    // stays in it (no file of a frame or two).
+    if (last) {
+      EXPECT_LE(duration, 3.0);
+    } else {
+      EXPECT_NEAR(duration, 2.0, 0.5);
     }
     // Named by the wall clock time of its first frame: the first once the
     // recorder has started and logged in (seconds on a loaded machine), each
@@ -143,7 +151,7 @@ TEST_P(SegmentFiles, EachStartsAtZeroOnAKeyFrameDecodesWholeAndLastsItsLength) {
     // last file ends with the recording, and may end before a statistics
     // line comes.)
     auto lines = sidecarOf(video);
-    if (i + 1 < videos.size()) {
+    if (!last) {
       ASSERT_FALSE(lines.empty());
     }
     for (const auto& line : lines) {
@@ -181,10 +189,12 @@ TEST(SegmentFilesSidecarOnly, WithTheTelemetryTrackOffAFileIsItsFramesAndTheSide
               "video\n");
     EXPECT_EQ(ffmpegDecodeErrors(video), "");
     auto frames = probeFrames(video);
-    // (A device this machine starved for seconds skips its frames: a file
+    // (The last file runs from its cut to the stop, however short. A
+    // device this machine starved for seconds skips its frames: a file
     // then holds a gap, and the device says how long it was held.)
-    ASSERT_GT(frames.size(), 10u) << "the device's longest wait between frames: "
-                                  << device->stats().maxTickGap.count() << " ms";
+    ASSERT_GT(frames.size(), last ? 0u : 10u)
+        << "the device's longest wait between frames: " << device->stats().maxTickGap.count()
+        << " ms";
     EXPECT_TRUE(frames.front().key);
     EXPECT_LT(frames.front().pts, 0.1);
     for (const auto& segment : index["segments"]) {

@@ -1,5 +1,6 @@
-// Where segments begin: at the first frame, at their length, at the byte
-// limit and at a gap in the frames; and which segment a time belongs to.
+// Where segments begin: at the first frame, at their length (not once the
+// recording stops), at the byte limit and at a gap in the frames; and which
+// segment a time belongs to.
 #include "record/segment_planner.h"
 
 #include <gtest/gtest.h>
@@ -81,6 +82,18 @@ TEST_F(SegmentPlannerTest, TheByteLimitCutsAtTheNextFrame) {
   p.addBytes(600);
   EXPECT_EQ(p.onFrame(2 * kFrame, at(kNoon)), Cut::kNext);
   EXPECT_EQ(p.current()->bytes, 0u);
+}
+
+TEST_F(SegmentPlannerTest, WhileTheRecordingStopsTheLengthNoLongerCutsButTheByteLimitDoes) {
+  auto p = planner({.maxDuration = 2 * kSecond, .maxBytes = 1000});
+  feed(p, 0, 29);  // up to just before 2 s
+  p.finishing();
+  // The frames the stop still lets through stay in the open file.
+  EXPECT_TRUE(feed(p, 29 * kFrame, 5).empty());
+  EXPECT_EQ(p.current()->start, 0u);
+  EXPECT_EQ(p.current()->frames, 34u);
+  p.addBytes(1200);
+  EXPECT_EQ(p.onFrame(34 * kFrame, at(kNoon)), Cut::kNext);
 }
 
 TEST_F(SegmentPlannerTest, NamesThatWouldCollideGetACounterAndStillSortInTimeOrder) {
