@@ -18,6 +18,7 @@
 #include <tuple>
 #include <vector>
 
+#include "bench_arguments.h"
 #include "devices/wirc/device.h"
 #include "follow_scene.h"
 
@@ -169,7 +170,10 @@ void runStalled(double seconds) {
 int main(int argc, char** argv) {
   g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, FALSE);
   gst_init(&argc, &argv);
-  double seconds = argc > 1 ? std::atof(argv[1]) : 10;
+  auto arguments = wircam::bench::positiveArguments(
+      argc, argv, {10}, "usage: bench_control_latency [SECONDS]   (per pipeline, default 10)");
+  if (!arguments) return 2;
+  double seconds = (*arguments)[0];
   std::printf("CIF, 15 fps; a changed command leaves at once, keepalive every 100 ms\n");
   run("tjpegdec", seconds);
   run("jpegdec", seconds);

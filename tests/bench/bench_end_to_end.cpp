@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_arguments.h"
 #include "child_process.h"
 #include "synthetic_jpeg.h"
 #include "thread_times.h"
@@ -123,14 +124,13 @@ double median(std::vector<double> values) {
 int main(int argc, char** argv) {
   g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, FALSE);  // the build's wircsrc
   gst_init(&argc, &argv);
-  double seconds = argc > 1 ? std::atof(argv[1]) : 5;
-  int rounds = argc > 2 ? std::atoi(argv[2]) : 3;
-  if (argc > 3 || seconds <= 0 || rounds <= 0) {
-    std::fprintf(stderr,
-                 "usage: bench_end_to_end [SECONDS [ROUNDS]]   (SECONDS measured per receiver "
-                 "and round, default 5; ROUNDS default 3)\n");
-    return 2;
-  }
+  auto arguments = wircam::bench::positiveArguments(
+      argc, argv, {5, 3},
+      "usage: bench_end_to_end [SECONDS [ROUNDS]]   (SECONDS measured per receiver and round, "
+      "default 5; ROUNDS default 3)");
+  if (!arguments) return 2;
+  double seconds = (*arguments)[0];
+  int rounds = static_cast<int>((*arguments)[1]);
   fs::path self = fs::canonical("/proc/self/exe").parent_path();
   std::string sim = (self / "wirc-sim").string();
 

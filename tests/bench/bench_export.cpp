@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_arguments.h"
 #include "child_process.h"
 #include "synthetic_jpeg.h"
 
@@ -57,8 +58,11 @@ std::optional<Run> measure(const std::string& command) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  double seconds = argc > 1 ? std::atof(argv[1]) : 20;
-  int fps = argc > 2 ? std::atoi(argv[2]) : 60;
+  auto arguments = wircam::bench::positiveArguments(
+      argc, argv, {20, 60}, "usage: bench_export [SECONDS [FPS]]   (default 20 s at 60 fps)");
+  if (!arguments) return 2;
+  double seconds = (*arguments)[0];
+  int fps = static_cast<int>((*arguments)[1]);
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-export-" + std::to_string(getpid()));
   fs::create_directories(work / "frames");

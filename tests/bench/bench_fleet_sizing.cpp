@@ -27,6 +27,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_arguments.h"
 #include "child_process.h"
 #include "fleet/fleet_announcement.h"
 #include "fleet/mqtt_client.h"
@@ -88,9 +89,13 @@ std::string announcementOf(int recorder, int cameras, const std::string& prefix)
 }  // namespace
 
 int main(int argc, char** argv) {
-  int recorders = argc > 1 ? std::atoi(argv[1]) : 100;
-  int cameras = argc > 2 ? std::atoi(argv[2]) : 256;
-  double seconds = argc > 3 ? std::atof(argv[3]) : 15;
+  auto arguments = wircam::bench::positiveArguments(
+      argc, argv, {100, 256, 15},
+      "usage: bench_fleet_sizing [RECORDERS [CAMERAS [SECONDS]]]   (default 100 256 15)");
+  if (!arguments) return 2;
+  int recorders = static_cast<int>((*arguments)[0]);
+  int cameras = static_cast<int>((*arguments)[1]);
+  double seconds = (*arguments)[2];
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-fleet-" + std::to_string(getpid()));
   fs::create_directories(work);

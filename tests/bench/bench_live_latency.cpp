@@ -31,6 +31,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_arguments.h"
 #include "child_process.h"
 #include "devtools_page.h"
 #include "free_port.h"
@@ -164,7 +165,10 @@ nlohmann::json run(DevToolsPage& page, const std::string& script, double seconds
 }  // namespace
 
 int main(int argc, char** argv) {
-  double seconds = argc > 1 ? std::atof(argv[1]) : 10;
+  auto arguments = wircam::bench::positiveArguments(
+      argc, argv, {10}, "usage: bench_live_latency [SECONDS]   (per measurement, default 10)");
+  if (!arguments) return 2;
+  double seconds = (*arguments)[0];
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-latency-" + std::to_string(getpid()));
   fs::create_directories(work);

@@ -30,6 +30,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_arguments.h"
 #include "child_process.h"
 #include "free_port.h"
 
@@ -217,8 +218,11 @@ long recordedFrames(const fs::path& folder) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  double seconds = argc > 1 ? std::atof(argv[1]) : 20;
-  int viewers = argc > 2 ? std::atoi(argv[2]) : 50;
+  auto arguments = wircam::bench::positiveArguments(
+      argc, argv, {20, 50}, "usage: bench_live_viewers [SECONDS [VIEWERS]]   (default 20 s, 50)");
+  if (!arguments) return 2;
+  double seconds = (*arguments)[0];
+  int viewers = static_cast<int>((*arguments)[1]);
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-viewers-" + std::to_string(getpid()));
   fs::create_directories(work);

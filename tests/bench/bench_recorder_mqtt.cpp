@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_arguments.h"
 #include "child_process.h"
 #include "common/socket.h"
 #include "scene_frames.h"
@@ -41,8 +42,11 @@ size_t linesIn(const fs::path& file, const std::string& containing) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  double seconds = argc > 1 ? std::atof(argv[1]) : 15;
-  int streams = argc > 2 ? std::atoi(argv[2]) : 16;
+  auto arguments = wircam::bench::positiveArguments(
+      argc, argv, {15, 16}, "usage: bench_recorder_mqtt [SECONDS [N]]   (default 15 s, 16 streams)");
+  if (!arguments) return 2;
+  double seconds = (*arguments)[0];
+  int streams = static_cast<int>((*arguments)[1]);
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-mqtt-" + std::to_string(getpid()));
   fs::create_directories(work / "frames");

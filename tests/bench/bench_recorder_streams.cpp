@@ -24,6 +24,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -377,6 +378,12 @@ int main(int argc, char** argv) {
   double seconds = argc > 1 ? std::atof(argv[1]) : 10;
   std::vector<int> counts;
   for (int i = 2; i < argc; ++i) counts.push_back(std::atoi(argv[i]));
+  if (seconds <= 0 || std::any_of(counts.begin(), counts.end(), [](int n) { return n <= 0; })) {
+    std::fprintf(stderr,
+                 "usage: bench_recorder_streams [--together] [SECONDS [N...]]   (SECONDS per "
+                 "run, default 10; N streams, default 1 2 4 8)\n");
+    return 2;
+  }
   if (counts.empty()) counts = {1, 2, 4, 8};
   fs::path bin = fs::canonical("/proc/self/exe").parent_path();
   fs::path work = fs::temp_directory_path() / ("wircam-bench-rec-" + std::to_string(getpid()));
