@@ -43,7 +43,8 @@ size_t linesIn(const fs::path& file, const std::string& containing) {
 
 int main(int argc, char** argv) {
   auto arguments = wircam::bench::positiveArguments(
-      argc, argv, {15, 16}, "usage: bench_recorder_mqtt [SECONDS [N]]   (default 15 s, 16 streams)");
+      argc, argv, {15, 16},
+      "usage: bench_recorder_mqtt [SECONDS [N]]   (default 15 s, 16 streams)");
   if (!arguments) return 2;
   double seconds = (*arguments)[0];
   int streams = static_cast<int>((*arguments)[1]);
