@@ -10,6 +10,11 @@
 // RLIMIT_RTPRIO of 1 (the service's LimitRTPRIO=1). Without it, nice -10
 // (CAP_SYS_NICE or RLIMIT_NICE, the service's LimitNICE=-10); without
 // either, the process's priority, which is only slower.
+//
+// Such a thread must then never wait on a video thread, which the
+// scheduler may leave preempted among hundreds: the locks it shares with
+// them lend priority (priority_inheriting_mutex.h), and it neither mallocs
+// nor frees in its loop (malloc's arena locks lend nothing).
 #pragma once
 
 #include <pthread.h>

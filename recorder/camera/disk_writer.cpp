@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <map>
+#include <mutex>
 #include <utility>
 
 #include "common/thread_priority.h"
@@ -25,6 +26,11 @@ constexpr auto kGather = std::chrono::milliseconds(20);
 constexpr uint64_t kGatherBytes = 1 << 20;
 // Writes of one file that follow each other on it go out in one call.
 constexpr size_t kMaxRun = 64;
+
+// Written bytes waiting to be freed past this many are freed at once (a
+// camera that stopped handing over cannot hold them all).
+constexpr size_t kMaxGivenBack = 256;
+constexpr size_t kGivenBackReserved = 32;
 
 std::mutex registryMutex;
 std::map<dev_t, std::weak_ptr<DiskWriter>>& registry() {
@@ -59,6 +65,38 @@ class DiskWriter::File {
   std::atomic<int> error_{0};
 };
 
+DiskBudget::DiskBudget(uint64_t bound) : bound_(bound) {
+  // A frame is a few of the muxer's buffers: the lists rarely grow past
+  // this, so the writer rarely grows them (a malloc).
+  givenBack_.reserve(kGivenBackReserved);
+  freeing_.reserve(kGivenBackReserved);
+}
+
+DiskBudget::~DiskBudget() {
+  for (GstBuffer* bytes : givenBack_) gst_buffer_unref(bytes);
+}
+
+void DiskBudget::giveBack(GstBuffer* bytes) {
+  std::lock_guard lock(givenBackMutex_);
+  if (givenBack_.size() < kMaxGivenBack) {
+    givenBack_.push_back(bytes);
+    return;
+  }
+  gst_buffer_unref(bytes);  // (never in a camera that keeps handing over)
+}
+
+void DiskBudget::freeGivenBack() {
+  std::unique_lock freeing(freeingMutex_, std::try_to_lock);
+  if (!freeing) return;
+  {
+    std::lock_guard lock(givenBackMutex_);
+    if (givenBack_.empty()) return;
+    freeing_.swap(givenBack_);
+  }
+  for (GstBuffer* bytes : freeing_) gst_buffer_unref(bytes);
+  freeing_.clear();
+}
+
 Expected<std::shared_ptr<DiskWriter>, std::string> DiskWriter::of(const std::string& folder) {
   struct stat info {};
   if (stat(folder.c_str(), &info) != 0)
@@ -71,14 +109,18 @@ Expected<std::shared_ptr<DiskWriter>, std::string> DiskWriter::of(const std::str
   return writer;
 }
 
-DiskWriter::DiskWriter(dev_t device) : device_(device), thread_([this] { run(); }) {}
+DiskWriter::DiskWriter(dev_t device) : device_(device) {
+  maps_.resize(kMaxRun);
+  pieces_.reserve(kMaxRun);
+  thread_ = std::thread([this] { run(); });
+}
 
 DiskWriter::~DiskWriter() {
   {
     std::lock_guard lock(mutex_);
     ending_ = true;
   }
-  wake_.notify_one();
+  wake_.notifyOne();
   thread_.join();
   std::lock_guard lock(registryMutex);
   auto found = registry().find(device_);
@@ -93,6 +135,7 @@ Expected<std::shared_ptr<DiskWriter::File>, int> DiskWriter::open(const std::str
 
 void DiskWriter::write(const std::shared_ptr<File>& file, uint64_t offset, GstBuffer* bytes,
                        const std::shared_ptr<DiskBudget>& budget) {
+  budget->freeGivenBack();
   uint64_t size = gst_buffer_get_size(bytes);
   budget->handedOver(size);
   bool first;
@@ -103,14 +146,14 @@ void DiskWriter::write(const std::shared_ptr<File>& file, uint64_t offset, GstBu
     bytesWaiting_ += size;
     writes_.push_back({file, offset, gst_buffer_ref(bytes), budget});
   }
-  if (first) wake_.notify_one();
+  if (first) wake_.notifyOne();
 }
 
 int DiskWriter::close(const std::shared_ptr<File>& file) {
-  std::unique_lock lock(mutex_);
+  std::lock_guard lock(mutex_);
   ++closing_;
-  wake_.notify_one();
-  done_.wait(lock, [&] { return file->waiting_ == 0; });
+  wake_.notifyOne();
+  done_.wait(mutex_, [&] { return file->waiting_ == 0; });
   --closing_;
   return file->closeNow();
 }
@@ -139,7 +182,7 @@ void DiskWriter::release() {
     std::lock_guard lock(mutex_);
     held_ = false;
   }
-  wake_.notify_one();
+  wake_.notifyOne();
 }
 
 void DiskWriter::run() {
@@ -150,56 +193,56 @@ void DiskWriter::run() {
   runThisThreadAhead();
   std::unique_lock lock(mutex_);
   while (true) {
-    wake_.wait(lock, [&] { return (ending_ || !writes_.empty()) && !held_; });
+    wake_.wait(mutex_, [&] { return (ending_ || !writes_.empty()) && !held_; });
     if (writes_.empty()) return;  // ending, all written
-    wake_.wait_for(lock, kGather,
-                   [&] { return ending_ || closing_ > 0 || bytesWaiting_ >= kGatherBytes; });
-    std::deque<Write> batch;
-    batch.swap(writes_);
+    wake_.waitFor(mutex_, kGather,
+                  [&] { return ending_ || closing_ > 0 || bytesWaiting_ >= kGatherBytes; });
+    batch_.swap(writes_);  // (both keep their capacity: no malloc)
     bytesWaiting_ = 0;
     lock.unlock();
-    for (size_t i = 0; i < batch.size();) i += performRun(batch, i);
+    for (size_t i = 0; i < batch_.size();) i += performRun(i);
     lock.lock();
     std::vector<std::pair<std::shared_ptr<File>, std::function<void(int)>>> written;
-    for (const Write& write : batch)
+    for (const Write& write : batch_)
       if (--write.file->waiting_ == 0 && write.file->closeWhenWritten_)
         written.emplace_back(write.file, std::exchange(write.file->closeWhenWritten_, nullptr));
-    done_.notify_all();
+    done_.notifyAll();
     lock.unlock();
+    // (What a file's end does, as a camera's last hold on its budget, may
+    // malloc and free: once a file.)
+    batch_.clear();
     for (auto& [file, closed] : written) closed(file->closeNow());
     lock.lock();
   }
 }
 
-size_t DiskWriter::performRun(const std::deque<Write>& batch, size_t first) {
+size_t DiskWriter::performRun(size_t first) {
   // The writes from `first` on that continue each other in one file.
   size_t count = 1;
-  uint64_t end = batch[first].offset + gst_buffer_get_size(batch[first].bytes);
-  while (first + count < batch.size() && count < kMaxRun) {
-    const Write& next = batch[first + count];
-    if (next.file != batch[first].file || next.offset != end) break;
+  uint64_t end = batch_[first].offset + gst_buffer_get_size(batch_[first].bytes);
+  while (first + count < batch_.size() && count < kMaxRun) {
+    const Write& next = batch_[first + count];
+    if (next.file != batch_[first].file || next.offset != end) break;
     end += gst_buffer_get_size(next.bytes);
     ++count;
   }
-  File& file = *batch[first].file;
-  std::vector<GstMapInfo> maps(count);
-  std::vector<iovec> pieces;
-  pieces.reserve(count);
+  File& file = *batch_[first].file;
+  pieces_.clear();
   size_t mapped = 0;
   // After a file's first error its other writes are let go: a full disk
   // fails them all, and the muxer's error ends the file.
   if (file.error_ == 0 && file.fd_ >= 0) {
     for (; mapped < count; ++mapped) {
-      if (!gst_buffer_map(batch[first + mapped].bytes, &maps[mapped], GST_MAP_READ)) break;
-      pieces.push_back({maps[mapped].data, maps[mapped].size});
+      if (!gst_buffer_map(batch_[first + mapped].bytes, &maps_[mapped], GST_MAP_READ)) break;
+      pieces_.push_back({maps_[mapped].data, maps_[mapped].size});
     }
-    writeAll(file, pieces, batch[first].offset);
+    writeAll(file, pieces_, batch_[first].offset);
   }
   for (size_t i = 0; i < count; ++i) {
-    const Write& write = batch[first + i];
-    if (i < mapped) gst_buffer_unmap(write.bytes, &maps[i]);
+    const Write& write = batch_[first + i];
+    if (i < mapped) gst_buffer_unmap(write.bytes, &maps_[i]);
     write.budget->written(gst_buffer_get_size(write.bytes));
-    gst_buffer_unref(write.bytes);
+    write.budget->giveBack(write.bytes);
   }
   return count;
 }

@@ -10,9 +10,7 @@
 #include <sys/uio.h>
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -21,15 +19,21 @@
 #include <vector>
 
 #include "common/expected.h"
+#include "common/priority_inheriting_mutex.h"
 
 namespace wircam::recorder {
 
 // How much of one camera's video may wait for its disk, in bytes; what
 // came and what was dropped past it. Shared by the camera's files and the
-// writes in flight (any thread).
+// writes in flight (any thread). It also takes the written bytes back
+// from the writer, for the camera's thread to free: the writer frees
+// nothing (see DiskWriter).
 class DiskBudget {
  public:
-  explicit DiskBudget(uint64_t bound) : bound_(bound) {}
+  explicit DiskBudget(uint64_t bound);
+  ~DiskBudget();
+  DiskBudget(const DiskBudget&) = delete;
+  DiskBudget& operator=(const DiskBudget&) = delete;
   bool full() const { return waiting_.load(std::memory_order_relaxed) >= bound_; }
   uint64_t waiting() const { return waiting_.load(std::memory_order_relaxed); }
   void handedOver(uint64_t bytes) { waiting_.fetch_add(bytes, std::memory_order_relaxed); }
@@ -41,11 +45,31 @@ class DiskBudget {
   uint64_t framesArrived() const { return arrived_.load(std::memory_order_relaxed); }
   uint64_t framesDropped() const { return dropped_.load(std::memory_order_relaxed); }
 
+  // `bytes` are written (the writer's thread); they wait to be freed.
+  void giveBack(GstBuffer* bytes);
+  // Frees what was given back (the camera's thread, at its next hand-over;
+  // nothing if another of its threads is at it).
+  void freeGivenBack();
+
  private:
   const uint64_t bound_;
   std::atomic<uint64_t> waiting_{0}, arrived_{0}, dropped_{0};
+  PriorityInheritingMutex givenBackMutex_;  // shared with the writer
+  std::vector<GstBuffer*> givenBack_ WIRCAM_GUARDED_BY(givenBackMutex_);
+  // The camera's side (two of its files may hand over on two threads);
+  // kept for its capacity. Never taken by the writer.
+  std::mutex freeingMutex_;
+  std::vector<GstBuffer*> freeing_;
 };
 
+// The writer runs ahead of the video threads (thread_priority.h), and so
+// must never wait for one: it shares only priority-inheriting locks with
+// them, and calls neither malloc nor free in its loop, whose locks (an
+// arena's, shared by dozens of threads) it would otherwise wait on behind
+// a preempted video thread. (Seen at 256 cameras on saturated processors:
+// nearly every time the writer slept, it slept in malloc's lock, and the
+// cameras' bounds filled.) So its lists keep their capacity, and it gives
+// the written bytes back to each camera's DiskBudget to free.
 class DiskWriter {
  public:
   // A file open for writing: its descriptor, the writes still waiting, and
@@ -89,17 +113,22 @@ class DiskWriter {
     std::shared_ptr<DiskBudget> budget;
   };
   void run();
-  // Writes batch[first] and the writes after it that continue it in its
+  // Writes batch_[first] and the writes after it that continue it in its
   // file; returns how many.
-  static size_t performRun(const std::deque<Write>& batch, size_t first);
+  size_t performRun(size_t first);
   static void writeAll(File& file, std::vector<iovec>& pieces, uint64_t offset);
 
   const dev_t device_;
   // Guards writes_, ending_, idle_ and each File's count of writes waiting.
-  std::mutex mutex_;
-  std::condition_variable wake_;  // writes to do, or the end
-  std::condition_variable done_;  // a file's writes are all done
-  std::deque<Write> writes_;
+  PriorityInheritingMutex mutex_;
+  PriorityInheritingCondition wake_;  // writes to do, or the end
+  PriorityInheritingCondition done_;  // a file's writes are all done
+  std::vector<Write> writes_;
+  // The writer's own (the batch being written, a run's pieces), kept for
+  // their capacity.
+  std::vector<Write> batch_;
+  std::vector<GstMapInfo> maps_;
+  std::vector<iovec> pieces_;
   uint64_t bytesWaiting_ = 0;
   int closing_ = 0;  // callers of close() waiting: no gathering then
   bool held_ = false;

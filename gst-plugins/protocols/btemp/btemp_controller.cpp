@@ -9,6 +9,7 @@
 #include <random>
 
 #include "btemp/btemp_probe.h"
+#include "common/priority_inheriting_mutex.h"
 #include "common/socket.h"
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
@@ -79,8 +80,9 @@ class Controller::Impl {
   link::LinkListeners& listeners_;
   EventLoop::Id watch_ = 0, phaseTimer_ = 0, pacerTimer_ = 0;
 
-  // Guards what follows; never held while sending or emitting.
-  mutable std::mutex mutex_;
+  // Guards what follows; never held while sending or emitting. Shared by
+  // the loop with the streams' threads, so it lends priority (event_loop.h).
+  mutable PriorityInheritingMutex mutex_;
   Registration registration_;
   link::CommandPacer pacer_;
 };

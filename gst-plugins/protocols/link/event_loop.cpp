@@ -8,6 +8,7 @@
 
 #include <array>
 #include <future>
+#include <mutex>
 #include <vector>
 
 #include "common/thread_priority.h"
@@ -80,8 +81,14 @@ void EventLoop::arm(Id id, Clock::time_point when) {
   std::lock_guard lock(mutex_);
   auto it = entries_.find(id);
   if (it == entries_.end()) return;
-  unqueue(it->second);
-  it->second.queued = timers_.emplace(when, id);
+  Entry& entry = it->second;
+  unqueue(entry);
+  if (entry.spare) {
+    entry.spare.key() = when;
+    entry.queued = timers_.insert(std::move(entry.spare));
+  } else {
+    entry.queued = timers_.emplace(when, id);  // its first arm
+  }
   followEarliestTimer();
 }
 
@@ -104,7 +111,7 @@ void EventLoop::disarm(Id id) {
 
 void EventLoop::unqueue(Entry& entry) {
   if (!entry.queued) return;
-  timers_.erase(*entry.queued);
+  entry.spare = timers_.extract(*entry.queued);
   entry.queued.reset();
 }
 
@@ -125,9 +132,9 @@ void EventLoop::followEarliestTimer() {
   timerfd_settime(alarm_.get(), TFD_TIMER_ABSTIME, &due, nullptr);
 }
 
-void EventLoop::waitUntilIdle(Id id, std::unique_lock<std::mutex>& lock) {
+void EventLoop::waitUntilIdle(Id id) {
   if (inLoopThread()) return;
-  idle_.wait(lock, [&] { return running_ != id; });
+  idle_.wait(mutex_, [&] { return running_ != id; });
 }
 
 void EventLoop::remove(Id id) {
@@ -140,7 +147,7 @@ void EventLoop::remove(Id id) {
   // Destroyed here, outside the lock, once the loop has let go of it.
   Entry entry = std::move(it->second);
   entries_.erase(it);
-  waitUntilIdle(id, lock);
+  waitUntilIdle(id);
   lock.unlock();
 }
 
@@ -195,7 +202,7 @@ void EventLoop::run() {
         std::lock_guard lock(mutex_);
         running_ = 0;
       }
-      idle_.notify_all();
+      idle_.notifyAll();
     };
 
     for (int i = 0; i < count; ++i) {
@@ -220,8 +227,9 @@ void EventLoop::run() {
       auto horizon = Clock::now() + kCoalesce;
       while (!timers_.empty() && timers_.begin()->first <= horizon) {
         Id id = timers_.begin()->second;
-        entries_[id].queued.reset();
-        timers_.erase(timers_.begin());
+        Entry& entry = entries_[id];
+        entry.queued.reset();
+        entry.spare = timers_.extract(timers_.begin());
         due.push_back(id);
       }
       followEarliestTimer();

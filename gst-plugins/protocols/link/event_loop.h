@@ -2,19 +2,23 @@
 // process runs: a single thread around epoll, so a recorder of 200 vehicles
 // stays a handful of threads. Callbacks run on the loop thread and must not
 // block; anything may be registered or removed from any thread.
+//
+// The loop runs ahead of the video threads (thread_priority.h), so what it
+// shares with them must not hold it behind one preempted: its lock lends
+// priority, and re-arming a timer reuses the timer's node in the queue (a
+// malloc could wait on an arena's lock, which lends nothing).
 #pragma once
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <thread>
 
+#include "common/priority_inheriting_mutex.h"
 #include "common/socket.h"
 
 namespace wircam::link {
@@ -75,11 +79,12 @@ class EventLoop {
     std::shared_ptr<const Callback> onTimer;
     std::shared_ptr<const IoCallback> onIo;
     std::optional<TimerQueue::iterator> queued;  // armed: its place in timers_
+    TimerQueue::node_type spare;                 // disarmed: its node, for the next arm
   };
 
   void run();
   void wake();
-  void waitUntilIdle(Id id, std::unique_lock<std::mutex>& lock);
+  void waitUntilIdle(Id id);  // with mutex_ held
   void unqueue(Entry& entry);
   // Sets the timerfd to the earliest timer, if that changed.
   void followEarliestTimer();
@@ -90,8 +95,8 @@ class EventLoop {
   std::thread thread_;
 
   // Guards everything below; never held while a callback runs.
-  mutable std::mutex mutex_;
-  std::condition_variable idle_;  // a callback finished
+  mutable PriorityInheritingMutex mutex_;
+  PriorityInheritingCondition idle_;  // a callback finished
   std::map<Id, Entry> entries_;
   TimerQueue timers_;  // armed timers by due time
   Id nextId_ = 1;

@@ -7,6 +7,7 @@
 #include <array>
 #include <mutex>
 
+#include "common/priority_inheriting_mutex.h"
 #include "common/socket.h"
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
@@ -69,8 +70,9 @@ class Transmitter::Impl {
   link::LinkListeners& listeners_;
   EventLoop::Id watch_ = 0, pacerTimer_ = 0, silenceTimer_ = 0;
 
-  // Guards what follows; never held while sending or emitting.
-  mutable std::mutex mutex_;
+  // Guards what follows; never held while sending or emitting. Shared by
+  // the loop with the streams' threads, so it lends priority (event_loop.h).
+  mutable PriorityInheritingMutex mutex_;
   link::CommandPacer pacer_;
   ReplyMonitor monitor_;
 };

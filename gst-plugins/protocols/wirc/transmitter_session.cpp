@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
-#include <condition_variable>
 #include <functional>
 #include <map>
 #include <mutex>
 
+#include "common/priority_inheriting_mutex.h"
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
 #include "link/link_registry.h"
@@ -140,7 +140,7 @@ class TransmitterSession::Impl {
       deadline = machine_.nextDeadline();
       followStatusReports();
     }
-    changed_.notify_all();
+    changed_.notifyAll();
     if (loop_.inLoopThread()) {
       if (deadline)
         loop_.arm(deadlineTimer_, *deadline);
@@ -194,15 +194,16 @@ class TransmitterSession::Impl {
   MessageStreamParser parser_;  // one per connection, for its whole life
 
   // Guards the machine and the pacer; never held while sending, waiting or
-  // emitting.
-  mutable std::mutex mutex_;
-  std::condition_variable changed_;
+  // emitting. Both locks are shared by the loop with the streams' threads,
+  // so they lend priority (event_loop.h).
+  mutable PriorityInheritingMutex mutex_;
+  PriorityInheritingCondition changed_;
   LoginMachine machine_;
   link::CommandPacer pacer_;
   bool loopWakesForStatus_ = true;
 
   // The TCP connection; sendMutex_ serialises writers from any thread.
-  std::mutex sendMutex_;
+  PriorityInheritingMutex sendMutex_;
   UniqueFd tcp_;
 };
 
@@ -476,7 +477,7 @@ TransmitterSession::~TransmitterSession() = default;
 std::optional<std::string> TransmitterSession::waitLoggedIn(milliseconds timeout) {
   std::unique_lock lock(impl_->mutex_);
   const auto& machine = impl_->machine_;
-  bool done = impl_->changed_.wait_for(lock, timeout, [&] {
+  bool done = impl_->changed_.waitFor(impl_->mutex_, timeout, [&] {
     return machine.status().state == link::LinkState::Live || machine.failedAttempts() > 0;
   });
   if (machine.status().state == link::LinkState::Live) return std::nullopt;
@@ -559,7 +560,8 @@ std::optional<std::vector<TransmitterInfo>> TransmitterSession::listTransmitters
   if (!sent) return std::nullopt;
   std::unique_lock lock(impl_->mutex_);
   const auto& machine = impl_->machine_;
-  if (!impl_->changed_.wait_for(lock, timeout, [&] { return machine.transmitterListComplete(); }))
+  if (!impl_->changed_.waitFor(impl_->mutex_, timeout,
+                               [&] { return machine.transmitterListComplete(); }))
     return std::nullopt;
   return machine.transmitters();
 }
@@ -577,7 +579,7 @@ std::optional<Err> TransmitterSession::sendConfiguration(const Message& message,
   if (!sent) return Err{command, static_cast<uint16_t>(ErrorCode::System)};
   std::unique_lock lock(impl_->mutex_);
   std::optional<Err> answer;
-  impl_->changed_.wait_for(lock, timeout, [&] {
+  impl_->changed_.waitFor(impl_->mutex_, timeout, [&] {
     for (const auto& err : impl_->machine_.errors())
       if (err.command == command) answer = err;
     return answer.has_value();
