@@ -159,6 +159,7 @@ void Camera::tearDown() {
   }
   if (pipeline_) {
     gst_element_set_state(pipeline_->pipeline(), GST_STATE_NULL);
+    keepFinalCounts();
     // A file EOS did not finish is still playable (Matroska written in
     // clusters, fragmented MP4): indexed like any other.
     for (const auto& file : pipeline_->writer().unfinished()) closed(file);
@@ -174,6 +175,20 @@ void Camera::tearDown() {
   earlierRuns_.commandsSent += runCounts_.commandsSent;
   runCounts_ = {};
   earlierDropped_ = report_.recordingDropped;
+}
+
+void Camera::keepFinalCounts() {
+  // The source's own counters (report() reads them while it is there): its
+  // once-a-second message may be most of a second old, and the camera's
+  // last status line, printed once it has gone, would count fewer frames
+  // than its files hold.
+  CameraReport latest = report();
+  runCounts_.frames = latest.frames - earlierRuns_.frames;
+  runCounts_.incomplete = latest.incomplete - earlierRuns_.incomplete;
+  runCounts_.bytes = latest.bytes - earlierRuns_.bytes;
+  report_.frames = latest.frames;
+  report_.incomplete = latest.incomplete;
+  report_.bytes = latest.bytes;
 }
 
 void Camera::reportDrops() {

@@ -135,6 +135,8 @@ class Camera {
   void publishState();
   // The frames dropped for the disk: into the report, and the log.
   void reportDrops();
+  // The source's last counts into the report, before its pipeline goes.
+  void keepFinalCounts();
 
   StreamPlan plan_;
   CameraFiles files_;
