@@ -168,10 +168,14 @@ Expected<RecorderOptions, std::string> parseOptions(int argc, char** argv) {
   RecorderOptions o;
   o.outDir.clear();
   optind = 1;
+  opterr = 0;  // (getopt's own message, then ours, said it twice)
   int opt, index = 0;
-  while ((opt = getopt_long(argc, argv, "h", options.data(), &index)) != -1) {
+  while ((opt = getopt_long(argc, argv, ":h", options.data(), &index)) != -1) {
     if (opt == 'h') return unexpected("help");
-    if (opt != 0) return unexpected("unknown option");
+    // The word getopt stopped at: the option without its value, or unknown.
+    std::string given = argv[optind - 1];
+    if (opt == ':') return unexpected(given + " needs a value");
+    if (opt != 0) return unexpected("unknown option " + given);
     const OptionSpec& spec = optionTable()[index];
     std::string name = spec.name;
     if (name == "help") return unexpected("help");

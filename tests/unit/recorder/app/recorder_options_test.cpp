@@ -113,6 +113,11 @@ TEST(RecorderOptions, RefusesNumbersNoFieldCanHold) {
   EXPECT_FALSE(parse({"--out", "x", "--segment", "nan"}).has_value());
 }
 
+TEST(RecorderOptions, AMissingValueOrAnUnknownOptionIsNamedOnce) {
+  EXPECT_EQ(parse({"--out", "x", "--segment"}).error(), "--segment needs a value");
+  EXPECT_EQ(parse({"--out", "x", "--nope"}).error(), "unknown option --nope");
+}
+
 TEST(RecorderOptions, APortIsAWholeNumberWhereverItIsGiven) {
   // 1984.5 read as 1984 once: a typo went to another port without a word.
   auto device = parse({"--out", "x", "--device", "127.0.0.1:1984.5"});
