@@ -84,7 +84,7 @@ std::vector<OptionSpec> recordingRows() {
        .fallback = "60",
        .section = kFiles,
        .reloadable = true,
-       .help = "seconds per segment, at least 1",
+       .help = "seconds per segment, at least 1 (fractions too: `1.5`)",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          auto s = number(value);
          if (!s || *s < 1) return "seconds >= 1";
