@@ -178,17 +178,15 @@ void Camera::tearDown() {
 }
 
 void Camera::keepFinalCounts() {
-  // The source's own counters (report() reads them while it is there): its
-  // once-a-second message may be most of a second old, and the camera's
-  // last status line, printed once it has gone, would count fewer frames
-  // than its files hold.
-  CameraReport latest = report();
-  runCounts_.frames = latest.frames - earlierRuns_.frames;
-  runCounts_.incomplete = latest.incomplete - earlierRuns_.incomplete;
-  runCounts_.bytes = latest.bytes - earlierRuns_.bytes;
-  report_.frames = latest.frames;
-  report_.incomplete = latest.incomplete;
-  report_.bytes = latest.bytes;
+  // Its once-a-second message may be most of a second old, and the
+  // camera's last status line, printed once the source has gone, would
+  // count fewer frames than its files hold.
+  auto stats = sourceStatsNow();
+  if (!stats) return;
+  countFrom(*stats, report_);
+  runCounts_.frames = report_.frames - earlierRuns_.frames;
+  runCounts_.incomplete = report_.incomplete - earlierRuns_.incomplete;
+  runCounts_.bytes = report_.bytes - earlierRuns_.bytes;
 }
 
 void Camera::reportDrops() {

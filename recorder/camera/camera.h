@@ -28,6 +28,7 @@
 #include "camera/frame_tap.h"
 #include "camera/pipeline_plan.h"
 #include "status/camera_report.h"
+#include "wirc_bus_messages.h"
 
 namespace wircam::recorder {
 
@@ -137,6 +138,10 @@ class Camera {
   void reportDrops();
   // The source's last counts into the report, before its pipeline goes.
   void keepFinalCounts();
+  // The source's counters now (updated at each frame), while it is there.
+  std::optional<bus::Stats> sourceStatsNow() const;
+  // Raises `report`'s counts to what `stats` say of this run.
+  void countFrom(const bus::Stats& stats, CameraReport& report) const;
 
   StreamPlan plan_;
   CameraFiles files_;

@@ -8,7 +8,6 @@
 #include "camera/wall_clock.h"
 #include "log_line.h"
 #include "record/segment_planner.h"
-#include "wirc_bus_messages.h"
 
 namespace wircam::recorder {
 
@@ -33,25 +32,31 @@ void Camera::writeTelemetry(const nlohmann::json& line) {
   if (pipeline_) writeTelemetry(line, pipeline_->runningTime());
 }
 
+std::optional<bus::Stats> Camera::sourceStatsNow() const {
+  GstElement* source = pipeline_ ? pipeline_->element(plan_.source) : nullptr;
+  if (!source || !g_object_class_find_property(G_OBJECT_GET_CLASS(source), "stats"))
+    return std::nullopt;
+  GstStructure* now = nullptr;
+  g_object_get(source, "stats", &now, nullptr);
+  if (!now) return std::nullopt;
+  auto stats = bus::Stats::read(now);
+  gst_structure_free(now);
+  return stats;
+}
+
+void Camera::countFrom(const bus::Stats& stats, CameraReport& report) const {
+  report.frames = std::max(report.frames, earlierRuns_.frames + stats.framesComplete);
+  report.incomplete = std::max(report.incomplete, earlierRuns_.incomplete + stats.framesIncomplete);
+  report.bytes = std::max(report.bytes, earlierRuns_.bytes + stats.bytes);
+}
+
 CameraReport Camera::report() const {
   CameraReport report = report_;
   report.everLive = everLive_;
   // The counters as they are now, from the source's own stats (updated at
   // each frame), not as its once-a-second message left them: two scrapes
   // a few seconds apart read the camera's true rate.
-  if (GstElement* source = pipeline_ ? pipeline_->element(plan_.source) : nullptr;
-      source && g_object_class_find_property(G_OBJECT_GET_CLASS(source), "stats")) {
-    GstStructure* now = nullptr;
-    g_object_get(source, "stats", &now, nullptr);
-    if (now) {
-      auto stats = bus::Stats::read(now);
-      gst_structure_free(now);
-      report.frames = std::max(report.frames, earlierRuns_.frames + stats.framesComplete);
-      report.incomplete =
-          std::max(report.incomplete, earlierRuns_.incomplete + stats.framesIncomplete);
-      report.bytes = std::max(report.bytes, earlierRuns_.bytes + stats.bytes);
-    }
-  }
+  if (auto stats = sourceStatsNow()) countFrom(*stats, report);
   if (!plan_.controller.empty()) {
     ControlReport control;
     if (GstElement* element = controller()) {
