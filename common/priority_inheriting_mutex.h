@@ -58,14 +58,17 @@ class PriorityInheritingCondition {
   void notifyOne() { pthread_cond_signal(&condition_); }
   void notifyAll() { pthread_cond_broadcast(&condition_); }
 
-  // With `mutex` held (let go while waiting): until `ready()`.
+  // With `mutex` held (let go while waiting): until `ready()`. A `ready`
+  // that reads fields the mutex guards says so: [&]() WIRCAM_REQUIRES(m).
   template <class Ready>
-  void wait(PriorityInheritingMutex& mutex, Ready ready) {
+  void wait(PriorityInheritingMutex& mutex, Ready ready)
+      WIRCAM_REQUIRES(mutex) WIRCAM_NO_THREAD_SAFETY_ANALYSIS {
     while (!ready()) pthread_cond_wait(&condition_, &mutex.mutex_);
   }
   // The same, for at most `timeout`; what `ready()` says at the end.
   template <class Ready>
-  bool waitFor(PriorityInheritingMutex& mutex, std::chrono::nanoseconds timeout, Ready ready) {
+  bool waitFor(PriorityInheritingMutex& mutex, std::chrono::nanoseconds timeout, Ready ready)
+      WIRCAM_REQUIRES(mutex) WIRCAM_NO_THREAD_SAFETY_ANALYSIS {
     timespec until{};
     clock_gettime(CLOCK_MONOTONIC, &until);
     auto ns = static_cast<long long>(until.tv_nsec) + timeout.count();

@@ -77,7 +77,7 @@ DiskBudget::~DiskBudget() {
 }
 
 void DiskBudget::giveBack(GstBuffer* bytes) {
-  std::lock_guard lock(givenBackMutex_);
+  MutexLock lock(givenBackMutex_);
   if (givenBack_.size() < kMaxGivenBack) {
     givenBack_.push_back(bytes);
     return;
@@ -89,7 +89,7 @@ void DiskBudget::freeGivenBack() {
   std::unique_lock freeing(freeingMutex_, std::try_to_lock);
   if (!freeing) return;
   {
-    std::lock_guard lock(givenBackMutex_);
+    MutexLock lock(givenBackMutex_);
     if (givenBack_.empty()) return;
     freeing_.swap(givenBack_);
   }
@@ -117,7 +117,7 @@ DiskWriter::DiskWriter(dev_t device) : device_(device) {
 
 DiskWriter::~DiskWriter() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     ending_ = true;
   }
   wake_.notifyOne();
@@ -140,7 +140,7 @@ void DiskWriter::write(const std::shared_ptr<File>& file, uint64_t offset, GstBu
   budget->handedOver(size);
   bool first;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     first = writes_.empty();
     ++file->waiting_;
     bytesWaiting_ += size;
@@ -150,7 +150,7 @@ void DiskWriter::write(const std::shared_ptr<File>& file, uint64_t offset, GstBu
 }
 
 int DiskWriter::close(const std::shared_ptr<File>& file) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   ++closing_;
   wake_.notifyOne();
   done_.wait(mutex_, [&] { return file->waiting_ == 0; });
@@ -161,7 +161,7 @@ int DiskWriter::close(const std::shared_ptr<File>& file) {
 void DiskWriter::closeWhenWritten(const std::shared_ptr<File>& file,
                                   std::function<void(int error)> closed) {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (file->waiting_ > 0) {
       file->closeWhenWritten_ = std::move(closed);
       return;
@@ -173,13 +173,13 @@ void DiskWriter::closeWhenWritten(const std::shared_ptr<File>& file,
 int DiskWriter::errorOf(const File& file) { return file.error_; }
 
 void DiskWriter::hold() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   held_ = true;
 }
 
 void DiskWriter::release() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     held_ = false;
   }
   wake_.notifyOne();
@@ -191,12 +191,14 @@ void DiskWriter::run() {
   // busy with video, at an equal share, it would fall behind the cameras
   // (their bounds fill, then their frames drop).
   runThisThreadAhead();
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   while (true) {
-    wake_.wait(mutex_, [&] { return (ending_ || !writes_.empty()) && !held_; });
+    wake_.wait(mutex_,
+               [&]() WIRCAM_REQUIRES(mutex_) { return (ending_ || !writes_.empty()) && !held_; });
     if (writes_.empty()) return;  // ending, all written
-    wake_.waitFor(mutex_, kGather,
-                  [&] { return ending_ || closing_ > 0 || bytesWaiting_ >= kGatherBytes; });
+    wake_.waitFor(mutex_, kGather, [&]() WIRCAM_REQUIRES(mutex_) {
+      return ending_ || closing_ > 0 || bytesWaiting_ >= kGatherBytes;
+    });
     batch_.swap(writes_);  // (both keep their capacity: no malloc)
     bytesWaiting_ = 0;
     lock.unlock();

@@ -123,16 +123,16 @@ class DiskWriter {
   PriorityInheritingMutex mutex_;
   PriorityInheritingCondition wake_;  // writes to do, or the end
   PriorityInheritingCondition done_;  // a file's writes are all done
-  std::vector<Write> writes_;
+  std::vector<Write> writes_ WIRCAM_GUARDED_BY(mutex_);
   // The writer's own (the batch being written, a run's pieces), kept for
   // their capacity.
   std::vector<Write> batch_;
   std::vector<GstMapInfo> maps_;
   std::vector<iovec> pieces_;
-  uint64_t bytesWaiting_ = 0;
-  int closing_ = 0;  // callers of close() waiting: no gathering then
-  bool held_ = false;
-  bool ending_ = false;
+  uint64_t bytesWaiting_ WIRCAM_GUARDED_BY(mutex_) = 0;
+  int closing_ WIRCAM_GUARDED_BY(mutex_) = 0;  // callers of close() waiting: no gathering then
+  bool held_ WIRCAM_GUARDED_BY(mutex_) = false;
+  bool ending_ WIRCAM_GUARDED_BY(mutex_) = false;
   std::thread thread_;
 };
 

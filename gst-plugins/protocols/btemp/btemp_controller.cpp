@@ -62,7 +62,7 @@ class Controller::Impl {
   void armPhaseTimer();
   void send(const Message& message, const SocketAddress& to) {
     if (sendDatagram(socket_.get(), to, encode(message))) {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       registration_.countCommandSent();
     }
   }
@@ -112,7 +112,7 @@ Controller::Impl::~Impl() {
   // The last word is the failsafe, so the robot stops now.
   std::optional<SocketAddress> robot;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     robot = registration_.registeredRobot();
   }
   if (robot) send(ctrlOf(config_.failsafe), *robot);
@@ -128,7 +128,7 @@ void Controller::Impl::perform(RegistrationActions actions) {
       listeners_.emit(emit->event);
     } else if (std::holds_alternative<registration::StartCommands>(action)) {
       {
-        std::lock_guard lock(mutex_);
+        MutexLock lock(mutex_);
         pacer_.restart();
       }
       loop_.arm(pacerTimer_, Clock::now());
@@ -139,7 +139,7 @@ void Controller::Impl::perform(RegistrationActions actions) {
 void Controller::Impl::armPhaseTimer() {
   Clock::time_point deadline;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     deadline = registration_.nextDeadline();
   }
   loop_.arm(phaseTimer_, deadline);
@@ -148,7 +148,7 @@ void Controller::Impl::armPhaseTimer() {
 void Controller::Impl::onPhaseTimer() {
   RegistrationActions actions;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     actions = registration_.onDeadline(Clock::now());
   }
   armPhaseTimer();
@@ -161,7 +161,7 @@ void Controller::Impl::onPacerTimer() {
   std::optional<SocketAddress> robot;
   bool commanded;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     robot = registration_.registeredRobot();
     if (!robot) return;
     commanded = pacer_.commanded();
@@ -179,12 +179,12 @@ void Controller::Impl::onReadable() {
   std::array<uint8_t, 2048> buffer;
   RegistrationActions actions;
   receiveDatagrams(socket_.get(), buffer, 64, [&](auto datagram, const SocketAddress& from) {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     auto caused = registration_.onDatagram(from, datagram, Clock::now());
     actions.insert(actions.end(), caused.begin(), caused.end());
   });
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (auto summary = registration_.rejectSummary(Clock::now()))
       actions.push_back(registration::Emit{*summary});
   }
@@ -220,7 +220,7 @@ void Controller::setCommand(const link::Pulses& pulses) {
   link::PacedStep step;
   std::optional<SocketAddress> robot;
   {
-    std::lock_guard lock(impl_->mutex_);
+    MutexLock lock(impl_->mutex_);
     step = link::PacedStep::offer(impl_->pacer_, pulses, now);
     robot = impl_->registration_.registeredRobot();
   }
@@ -236,7 +236,7 @@ void Controller::requestControl() {
 }
 
 ControllerStatus Controller::controllerStatus() const {
-  std::lock_guard lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   return impl_->registration_.status();
 }
 

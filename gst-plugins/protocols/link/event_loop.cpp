@@ -39,7 +39,7 @@ EventLoop::EventLoop()
 
 EventLoop::~EventLoop() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     stopping_ = true;
   }
   wake();
@@ -54,7 +54,7 @@ void EventLoop::wake() {
 }
 
 EventLoop::Id EventLoop::watch(int fd, uint32_t events, IoCallback callback) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   Id id = nextId_++;
   entries_[id] = Entry{.fd = fd, .onIo = std::make_shared<const IoCallback>(std::move(callback))};
   epoll_event event{.events = events, .data = {.u64 = id}};
@@ -63,7 +63,7 @@ EventLoop::Id EventLoop::watch(int fd, uint32_t events, IoCallback callback) {
 }
 
 void EventLoop::setEvents(Id id, uint32_t events) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   auto it = entries_.find(id);
   if (it == entries_.end()) return;
   epoll_event event{.events = events, .data = {.u64 = id}};
@@ -71,14 +71,14 @@ void EventLoop::setEvents(Id id, uint32_t events) {
 }
 
 EventLoop::Id EventLoop::addTimer(Callback callback) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   Id id = nextId_++;
   entries_[id] = Entry{.onTimer = std::make_shared<const Callback>(std::move(callback))};
   return id;
 }
 
 void EventLoop::arm(Id id, Clock::time_point when) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   auto it = entries_.find(id);
   if (it == entries_.end()) return;
   Entry& entry = it->second;
@@ -94,7 +94,7 @@ void EventLoop::arm(Id id, Clock::time_point when) {
 
 void EventLoop::armIfEarlier(Id id, Clock::time_point when) {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     auto it = entries_.find(id);
     if (it == entries_.end() || (it->second.queued && (*it->second.queued)->first <= when)) return;
   }
@@ -102,7 +102,7 @@ void EventLoop::armIfEarlier(Id id, Clock::time_point when) {
 }
 
 void EventLoop::disarm(Id id) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   auto it = entries_.find(id);
   if (it == entries_.end()) return;
   unqueue(it->second);
@@ -134,11 +134,11 @@ void EventLoop::followEarliestTimer() {
 
 void EventLoop::waitUntilIdle(Id id) {
   if (inLoopThread()) return;
-  idle_.wait(mutex_, [&] { return running_ != id; });
+  idle_.wait(mutex_, [&]() WIRCAM_REQUIRES(mutex_) { return running_ != id; });
 }
 
 void EventLoop::remove(Id id) {
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   auto it = entries_.find(id);
   if (it == entries_.end()) return;
   if (it->second.fd >= 0) epoll_ctl(epoll_.get(), EPOLL_CTL_DEL, it->second.fd, nullptr);
@@ -176,7 +176,7 @@ void EventLoop::run() {
   std::vector<Id> due;
   for (;;) {
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       if (stopping_) return;
     }
     int count = epoll_wait(epoll_.get(), events.data(), static_cast<int>(events.size()), -1);
@@ -187,7 +187,7 @@ void EventLoop::run() {
       std::shared_ptr<const Callback> onTimer;
       std::shared_ptr<const IoCallback> onIo;
       {
-        std::lock_guard lock(mutex_);
+        MutexLock lock(mutex_);
         auto it = entries_.find(id);
         if (it == entries_.end()) return;
         if (ready == 0)
@@ -199,7 +199,7 @@ void EventLoop::run() {
       if (onIo) (*onIo)(ready);
       if (onTimer) (*onTimer)();
       {
-        std::lock_guard lock(mutex_);
+        MutexLock lock(mutex_);
         running_ = 0;
       }
       idle_.notifyAll();
@@ -213,7 +213,7 @@ void EventLoop::run() {
           // Spurious: nothing to drain.
         }
         if (data == kAlarmData) {
-          std::lock_guard lock(mutex_);
+          MutexLock lock(mutex_);
           alarmTime_.reset();  // spent: set again below
         }
         continue;
@@ -223,7 +223,7 @@ void EventLoop::run() {
 
     due.clear();
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       auto horizon = Clock::now() + kCoalesce;
       while (!timers_.empty() && timers_.begin()->first <= horizon) {
         Id id = timers_.begin()->second;

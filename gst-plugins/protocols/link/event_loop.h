@@ -84,25 +84,26 @@ class EventLoop {
 
   void run();
   void wake();
-  void waitUntilIdle(Id id);  // with mutex_ held
-  void unqueue(Entry& entry);
+  void waitUntilIdle(Id id) WIRCAM_REQUIRES(mutex_);
+  void unqueue(Entry& entry) WIRCAM_REQUIRES(mutex_);
   // Sets the timerfd to the earliest timer, if that changed.
-  void followEarliestTimer();
+  void followEarliestTimer() WIRCAM_REQUIRES(mutex_);
 
   UniqueFd epoll_;
   UniqueFd wake_;
   UniqueFd alarm_;  // a timerfd: the earliest timer's due time
   std::thread thread_;
 
-  // Guards everything below; never held while a callback runs.
+  // Guards what is marked so; never held while a callback runs.
   mutable PriorityInheritingMutex mutex_;
   PriorityInheritingCondition idle_;  // a callback finished
-  std::map<Id, Entry> entries_;
-  TimerQueue timers_;  // armed timers by due time
-  Id nextId_ = 1;
-  Id running_ = 0;  // the entry whose callback runs now
-  bool stopping_ = false;
-  std::optional<Clock::time_point> alarmTime_;  // what alarm_ is set to, if it has not fired
+  std::map<Id, Entry> entries_ WIRCAM_GUARDED_BY(mutex_);
+  TimerQueue timers_ WIRCAM_GUARDED_BY(mutex_);  // armed timers by due time
+  Id nextId_ WIRCAM_GUARDED_BY(mutex_) = 1;
+  Id running_ WIRCAM_GUARDED_BY(mutex_) = 0;  // the entry whose callback runs now
+  bool stopping_ WIRCAM_GUARDED_BY(mutex_) = false;
+  std::optional<Clock::time_point> alarmTime_
+      WIRCAM_GUARDED_BY(mutex_);  // what alarm_ is set to, if it has not fired
   std::atomic<uint64_t> wakeUps_ = 0;
 };
 

@@ -110,7 +110,7 @@ void Transmitter::Impl::send(const link::Pulses& pulses) {
   for (size_t channel = 1; channel <= config_.channelCount; ++channel)
     command.channels.push_back(config_.map.toByte(channel, pulses[channel - 1]));
   if (sendDatagram(socket_.get(), receiver_, encode(command))) {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     monitor_.countCommandSent();
   }
 }
@@ -119,7 +119,7 @@ void Transmitter::Impl::onPacerTimer() {
   auto now = Clock::now();
   link::PacedStep step;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     step = link::PacedStep::poll(pacer_, now);
   }
   step.carryOut([this](const link::Pulses& pulses) { send(pulses); }, loop_, pacerTimer_);
@@ -129,12 +129,12 @@ void Transmitter::Impl::onReadable() {
   std::array<uint8_t, 512> buffer;
   std::vector<link::LinkEvent> events;
   receiveDatagrams(socket_.get(), buffer, 64, [&](auto datagram, const SocketAddress& from) {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     auto caused = monitor_.onDatagram(from, datagram, Clock::now());
     events.insert(events.end(), caused.begin(), caused.end());
   });
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (auto summary = monitor_.rejectSummary(Clock::now())) events.push_back(*summary);
   }
   armSilenceTimer();
@@ -144,7 +144,7 @@ void Transmitter::Impl::onReadable() {
 void Transmitter::Impl::onSilenceTimer() {
   std::vector<link::LinkEvent> events;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     events = monitor_.onDeadline(Clock::now());
   }
   armSilenceTimer();
@@ -154,7 +154,7 @@ void Transmitter::Impl::onSilenceTimer() {
 void Transmitter::Impl::armSilenceTimer() {
   std::optional<Clock::time_point> deadline;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     deadline = monitor_.nextDeadline();
   }
   if (deadline)
@@ -187,7 +187,7 @@ void Transmitter::setCommand(const link::Pulses& pulses) {
   auto now = Clock::now();
   link::PacedStep step;
   {
-    std::lock_guard lock(impl_->mutex_);
+    MutexLock lock(impl_->mutex_);
     step = link::PacedStep::offer(impl_->pacer_, pulses, now);
   }
   // A change leaves now, from this thread.
@@ -201,7 +201,7 @@ void Transmitter::requestControl() {
 }
 
 TransmitterStatus Transmitter::transmitterStatus() const {
-  std::lock_guard lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   return impl_->monitor_.status();
 }
 

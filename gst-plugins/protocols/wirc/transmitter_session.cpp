@@ -135,7 +135,7 @@ class TransmitterSession::Impl {
     LoginActions actions;
     std::optional<Clock::time_point> deadline;
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       actions = event(machine_);
       deadline = machine_.nextDeadline();
       followStatusReports();
@@ -264,7 +264,7 @@ void TransmitterSession::Impl::perform(LoginAction action) {
     ::connect(pcdSocket_.get(), aim->control.raw(), aim->control.size());
   } else if (std::holds_alternative<login::StartCommands>(action)) {
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       pacer_.restart();
     }
     loop_.arm(pacerTimer_, Clock::now());
@@ -295,7 +295,7 @@ void TransmitterSession::Impl::connect(const SocketAddress& device) {
     return handle([&](LoginMachine& m) { return m.onConnectionLost(fd.error(), Clock::now()); });
   int fdNumber = fd->get();
   {
-    std::lock_guard lock(sendMutex_);
+    MutexLock lock(sendMutex_);
     tcp_ = std::move(*fd);
   }
   // TCP's own keepalive as well, for a device that vanishes while PSD are
@@ -312,7 +312,7 @@ void TransmitterSession::Impl::connect(const SocketAddress& device) {
 void TransmitterSession::Impl::onTcp(uint32_t events) {
   bool connecting;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     connecting = machine_.phase() == LoginMachine::Phase::Connecting;
   }
   if (!connecting) return readTcp();
@@ -320,7 +320,7 @@ void TransmitterSession::Impl::onTcp(uint32_t events) {
   if (error != 0 || (events & (EPOLLERR | EPOLLHUP))) {
     std::string device;
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       device = machine_.device() ? machine_.device()->toString() : machine_.config().host;
     }
     std::string why = "cannot connect to " + device + ": " +
@@ -363,7 +363,7 @@ void TransmitterSession::Impl::closeConnection() {
   if (discoveryWatch_) loop_.remove(discoveryWatch_);
   discoveryWatch_ = 0;
   discovery_.reset();
-  std::lock_guard lock(sendMutex_);
+  MutexLock lock(sendMutex_);
   if (tcp_.valid()) ::shutdown(tcp_.get(), SHUT_RDWR);
   tcp_.reset();
 }
@@ -371,7 +371,7 @@ void TransmitterSession::Impl::closeConnection() {
 bool TransmitterSession::Impl::sendControl(const Message& message) {
   auto frame = encode(message);
   if (!frame) return false;
-  std::lock_guard lock(sendMutex_);
+  MutexLock lock(sendMutex_);
   if (!tcp_.valid()) return false;
   // Non-blocking: a device that stops reading its connection is not waited
   // for; the short write shows up as a lost connection on the next read.
@@ -384,7 +384,7 @@ void TransmitterSession::Impl::sendPcd(const link::Pulses& pulses) {
   auto frame = encode(Pcd{pulses});  // the pacer clamps: always valid
   if (frame && ::send(pcdSocket_.get(), frame->data(), frame->size(), MSG_NOSIGNAL) ==
                    static_cast<ssize_t>(frame->size())) {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     machine_.countCommandSent();
   }
   readStatusReports();  // those that came since the last (followStatusReports)
@@ -407,7 +407,7 @@ void TransmitterSession::Impl::onPacerTimer() {
   auto now = Clock::now();
   link::PacedStep step;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (!steering()) return;
     step = link::PacedStep::poll(pacer_, now);
   }
@@ -441,7 +441,7 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
         return std::shared_ptr<TransmitterSession>(new TransmitterSession(config, loop));
       },
       [](TransmitterSession& shared) {
-        std::lock_guard lock(shared.impl_->mutex_);
+        MutexLock lock(shared.impl_->mutex_);
         link::SettingValues current;
         for (const auto& setting : sharedSettings())
           current[setting.name] = setting.text(shared.impl_->machine_.config());
@@ -449,7 +449,7 @@ Expected<std::shared_ptr<TransmitterSession>, std::string> TransmitterSession::a
       },
       [&](TransmitterSession& shared, const std::vector<std::string>& changes) {
         auto* impl = shared.impl_.get();
-        std::lock_guard lock(impl->mutex_);
+        MutexLock lock(impl->mutex_);
         auto& linkConfig = impl->machine_.config();
         for (const auto& setting : sharedSettings()) {
           if (std::find(changes.begin(), changes.end(), setting.name) == changes.end()) continue;
@@ -475,7 +475,7 @@ TransmitterSession::TransmitterSession(const SessionConfig& config, EventLoop& l
 TransmitterSession::~TransmitterSession() = default;
 
 std::optional<std::string> TransmitterSession::waitLoggedIn(milliseconds timeout) {
-  std::unique_lock lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   const auto& machine = impl_->machine_;
   bool done = impl_->changed_.waitFor(impl_->mutex_, timeout, [&] {
     return machine.status().state == link::LinkState::Live || machine.failedAttempts() > 0;
@@ -488,12 +488,12 @@ std::optional<std::string> TransmitterSession::waitLoggedIn(milliseconds timeout
 link::LinkStatus TransmitterSession::status() const { return sessionStatus(); }
 
 SessionStatus TransmitterSession::sessionStatus() const {
-  std::lock_guard lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   return impl_->machine_.status();
 }
 
 std::optional<SocketAddress> TransmitterSession::deviceAddress() const {
-  std::lock_guard lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   return impl_->machine_.device();
 }
 
@@ -510,7 +510,7 @@ void TransmitterSession::setCommand(const link::Pulses& pulses) {
   link::PacedStep step;
   bool steering;
   {
-    std::lock_guard lock(impl_->mutex_);
+    MutexLock lock(impl_->mutex_);
     step = link::PacedStep::offer(impl_->pacer_, pulses, now);
     steering = impl_->steering();
   }
@@ -524,7 +524,7 @@ void TransmitterSession::shareTurn(Clock::duration untilNextTurn) {
   auto now = Clock::now();
   std::optional<link::Pulses> due;
   {
-    std::lock_guard lock(impl_->mutex_);
+    MutexLock lock(impl_->mutex_);
     if (!impl_->steering()) return;
     due = impl_->pacer_.pollAhead(now, untilNextTurn);
     if (!due) return;  // the timer stands
@@ -539,7 +539,7 @@ void TransmitterSession::shareTurn(Clock::duration untilNextTurn) {
 void TransmitterSession::requestControl() {
   uint8_t id;
   {
-    std::lock_guard lock(impl_->mutex_);
+    MutexLock lock(impl_->mutex_);
     id = impl_->machine_.status().connectionId;
   }
   requestControlFor(id);
@@ -558,7 +558,7 @@ std::optional<std::vector<TransmitterInfo>> TransmitterSession::listTransmitters
     return actions;
   });
   if (!sent) return std::nullopt;
-  std::unique_lock lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   const auto& machine = impl_->machine_;
   if (!impl_->changed_.waitFor(impl_->mutex_, timeout,
                                [&] { return machine.transmitterListComplete(); }))
@@ -577,7 +577,7 @@ std::optional<Err> TransmitterSession::sendConfiguration(const Message& message,
     return actions;
   });
   if (!sent) return Err{command, static_cast<uint16_t>(ErrorCode::System)};
-  std::unique_lock lock(impl_->mutex_);
+  MutexLock lock(impl_->mutex_);
   std::optional<Err> answer;
   impl_->changed_.waitFor(impl_->mutex_, timeout, [&] {
     for (const auto& err : impl_->machine_.errors())

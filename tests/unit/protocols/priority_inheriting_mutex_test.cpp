@@ -14,6 +14,7 @@
 
 namespace {
 
+using wircam::MutexLock;
 using wircam::PriorityInheritingCondition;
 using wircam::PriorityInheritingMutex;
 using Clock = std::chrono::steady_clock;
@@ -48,7 +49,7 @@ TEST(PriorityInheritingMutex, TheHolderRunsAheadOfAMiddleThreadWhileAHighOneWait
   std::atomic<bool> allowed{true};
   std::thread low([&] {
     allowed = allowed && runOnProcessorZeroAt(0);
-    std::lock_guard lock(mutex);
+    MutexLock lock(mutex);
     held = true;
     while (!highWaiting) std::this_thread::yield();
     spinFor(5ms);  // its work under the lock
@@ -57,7 +58,7 @@ TEST(PriorityInheritingMutex, TheHolderRunsAheadOfAMiddleThreadWhileAHighOneWait
   std::thread high([&] {
     allowed = allowed && runOnProcessorZeroAt(2);
     highWaiting = true;
-    std::lock_guard lock(mutex);
+    MutexLock lock(mutex);
     highGotIt = true;
   });
   std::thread middle([&] {
@@ -81,19 +82,19 @@ TEST(PriorityInheritingCondition, WaitsUntilNotifiedOrForItsTimeout) {
   PriorityInheritingCondition condition;
   bool ready = false;
   {
-    std::lock_guard lock(mutex);
+    MutexLock lock(mutex);
     auto start = Clock::now();
     EXPECT_FALSE(condition.waitFor(mutex, 30ms, [&] { return ready; }));
     EXPECT_GE(Clock::now() - start, 30ms);
   }
   std::thread notifier([&] {
     std::this_thread::sleep_for(10ms);
-    std::lock_guard lock(mutex);
+    MutexLock lock(mutex);
     ready = true;
     condition.notifyAll();
   });
   {
-    std::lock_guard lock(mutex);
+    MutexLock lock(mutex);
     EXPECT_TRUE(condition.waitFor(mutex, 10s, [&] { return ready; }));
   }
   notifier.join();
