@@ -92,7 +92,8 @@ class Timeline {
            (!request_.end || utcNs <= *request_.end);
   }
 
-  std::optional<ExportError> frame(GstBuffer* buffer, int64_t utcNs, bool key, GstCaps* caps) {
+  std::optional<ExportError> frame(GstBuffer* buffer, int64_t utcNs, bool key, GstCaps* caps,
+                                   const std::string& recorder) {
     if (!origin_) {
       onFirst_(utcNs);
       // The format cannot hold these frames (JPEG in MP4), or its muxer is missing.
@@ -111,6 +112,7 @@ class Timeline {
     int64_t pts = lastFrame_ < 0 ? 0 : std::max(utcNs - *origin_, lastFrame_ + step_);
     lastFrame_ = pts;
     lastUtc_ = utcNs;
+    lastRecorder_ = recorder;
     report.lastUtcNs = utcNs;
     ++report.frames;
     return failed(sink_.frame(buffer, pts, utcNs, key));
@@ -126,15 +128,17 @@ class Timeline {
   }
 
   bool started() const { return origin_.has_value(); }
-  // A frame at `utcNs` of a segment that has given the export no frame yet
-  // would repeat a moment already exported: no later than half a frame
-  // after the last one (two recorders stamp one frame of the device each on
-  // its own arrival, microseconds apart). Once a segment's frames are
-  // taken, the rest of it follows them in time: none repeats, however close
-  // two came (a sender that was late for one frame and on time for the
-  // next).
-  bool repeats(int64_t utcNs) const {
-    return request_.overlapping && lastUtc_ && utcNs < *lastUtc_ + step_ / 2;
+  // A frame at `utcNs` of a segment from `recorder` that has given the
+  // export no frame yet would repeat a moment already exported: another
+  // recorder's, no later than half a frame after the last one (two
+  // recorders stamp one frame of the device each on its own arrival,
+  // microseconds apart). The same recorder's next segment, and the rest of
+  // a segment once its frames are taken, follow in time: none repeats,
+  // however close two came (a sender late for one frame and on time for
+  // the next).
+  bool repeats(int64_t utcNs, const std::string& recorder) const {
+    return request_.overlapping && lastUtc_ && recorder != lastRecorder_ &&
+           utcNs < *lastUtc_ + step_ / 2;
   }
   ExportReport report;
 
@@ -152,6 +156,7 @@ class Timeline {
   static constexpr int64_t kLongestFrameInterval = 1000000000;  // 1 fps
   int64_t lastFrame_ = -1;
   std::optional<int64_t> lastUtc_;
+  std::string lastRecorder_;        // whose segment the last frame came from
   int64_t step_ = 1000000000 / 15;  // the frames' last real interval
 };
 
@@ -200,7 +205,7 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
     for (; nextLine < lines.size() && lines[nextLine].utcNs <= utc; ++nextLine)
       if (timeline.inRange(lines[nextLine].utcNs)) waiting.push_back(std::move(lines[nextLine]));
     if (!timeline.inRange(utc)) continue;
-    if (!taking && timeline.repeats(utc)) {
+    if (!taking && timeline.repeats(utc, segment.recorder)) {
       // So are its lines: the other recorder's of that moment are in.
       afterRepeats = true;
       waiting.clear();
@@ -212,7 +217,8 @@ std::optional<ExportError> exportSegment(const ExportSegment& segment, Timeline&
     if ((!timeline.started() || afterRepeats) && !(*frame)->key) continue;
     afterRepeats = false;
     if (!caps) caps = gst_caps_ref((*reader)->caps());
-    if (auto problem = timeline.frame((*frame)->buffer, utc, (*frame)->key, caps)) return problem;
+    if (auto problem = timeline.frame((*frame)->buffer, utc, (*frame)->key, caps, segment.recorder))
+      return problem;
     taking = true;
     if (!onFrame()) return std::nullopt;  // stopped: the caller knows
     for (auto& line : waiting)

@@ -29,8 +29,9 @@ struct ExportRequest {
   // ExportTarget), `out` only naming it, and no .jsonl.
   int stream = -1;
   // Segments may overlap in time (a fleet's: two recorders held the vehicle
-  // at once while it moved): a frame less than half a frame after the last
-  // one taken is the same moment seen twice, and left out.
+  // at once while it moved): a frame of another recorder's segment less
+  // than half a frame after the last one taken is the same moment seen
+  // twice, and left out. (One recorder's segments follow each other.)
   bool overlapping = false;
 };
 

@@ -114,7 +114,8 @@ Expected<FleetFetchReport, std::string> fetchFromFleet(const FleetFetchRequest& 
   FleetFetchReport report;
   struct Wanted {
     Json entry;
-    std::string base;  // the recorder's HTTP URL, ending in '/'
+    std::string base;      // the recorder's HTTP URL, ending in '/'
+    std::string recorder;  // its id
   };
   std::vector<Wanted> wanted;
   std::string suffix = "-" + request.camera;
@@ -147,7 +148,7 @@ Expected<FleetFetchReport, std::string> fetchFromFleet(const FleetFetchRequest& 
       if (!entry.value("camera", "").ends_with(suffix) || !overlaps(entry, request)) continue;
       if (vehicleName.empty() && entry.contains("vehicle") && entry["vehicle"].is_object())
         vehicleName = entry["vehicle"].value("name", "");
-      wanted.push_back({entry, base});
+      wanted.push_back({entry, base, recorder.value("id", "")});
     }
     if (wanted.size() > before) ++report.holders;
   }
@@ -171,7 +172,7 @@ Expected<FleetFetchReport, std::string> fetchFromFleet(const FleetFetchRequest& 
   if (error) return unexpected("cannot make " + request.folder.string() + ": " + error.message());
   RecordingIndex index(request.folder);
   for (size_t i = 0; i < wanted.size(); ++i) {
-    const auto& [entry, base] = wanted[i];
+    const auto& [entry, base, recorder] = wanted[i];
     std::string file = entry.value("file", "");
     std::string stem = report.camera + "-" + compactTimeOf(*parseIsoTime(entry["start_utc"])) +
                        "-" + std::to_string(i + 1);
@@ -194,6 +195,7 @@ Expected<FleetFetchReport, std::string> fetchFromFleet(const FleetFetchRequest& 
     indexed.frames = entry.value("frames", uint64_t{0});
     indexed.bytes = fs::file_size(request.folder / indexed.file, error);
     indexed.vehicle = entry.value("vehicle", Json());
+    indexed.recorder = recorder;
     report.bytes += indexed.bytes;
     index.add(std::move(indexed));
     ++report.segments;

@@ -9,10 +9,12 @@ namespace wircam::recorder {
 namespace fs = std::filesystem;
 
 nlohmann::json toJson(const IndexEntry& e) {
-  return {{"camera", e.camera},      {"file", e.file},
-          {"start_utc", e.startUtc}, {"duration_s", e.durationSeconds},
-          {"frames", e.frames},      {"bytes", e.bytes},
-          {"vehicle", e.vehicle}};
+  nlohmann::json j = {{"camera", e.camera},      {"file", e.file},
+                      {"start_utc", e.startUtc}, {"duration_s", e.durationSeconds},
+                      {"frames", e.frames},      {"bytes", e.bytes},
+                      {"vehicle", e.vehicle}};
+  if (!e.recorder.empty()) j["recorder"] = e.recorder;
+  return j;
 }
 
 namespace {
@@ -28,6 +30,7 @@ std::optional<IndexEntry> entryOf(const nlohmann::json& j) {
   e.bytes = j.value("bytes", uint64_t{0});
   if (auto vehicle = j.find("vehicle"); vehicle != j.end() && vehicle->is_object())
     e.vehicle = *vehicle;
+  e.recorder = j.value("recorder", "");
   return e;
 }
 

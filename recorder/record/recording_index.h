@@ -25,6 +25,9 @@ struct IndexEntry {
   uint64_t bytes = 0;
   // The vehicle as the device named itself ({"name", "serial"}), or null.
   nlohmann::json vehicle;
+  // The fleet's recorder it was fetched from (a fleet export's folder),
+  // or empty: one recorder's segments never overlap, two recorders' may.
+  std::string recorder;
 };
 
 nlohmann::json toJson(const IndexEntry& entry);

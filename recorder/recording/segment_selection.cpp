@@ -125,7 +125,8 @@ Expected<ExportSelection, std::string> selectSegments(const fs::path& folder,
     if (!begins) continue;
     auto lasts = static_cast<int64_t>(entry.durationSeconds * 1e9);
     if ((end && *begins > *end) || (start && *begins + lasts < *start)) continue;
-    selection.segments.push_back({folder / entry.file, *begins, lasts, entry.frames});
+    selection.segments.push_back(
+        {folder / entry.file, *begins, lasts, entry.frames, entry.recorder});
   }
   // A file of the camera the index lacks: still being written (the recorder
   // indexes each as it closes, and writes the open one at least every

@@ -25,6 +25,7 @@ struct ExportSegment {
   int64_t startNs = 0;          // its first frame, UTC ns
   int64_t durationNs = 0;
   uint64_t frames = 0;
+  std::string recorder;  // a fleet's recorder it came from, or empty
 };
 
 struct ExportSelection {

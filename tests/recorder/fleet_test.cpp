@@ -176,14 +176,16 @@ int64_t unixNsOf(const std::string& iso) { return std::llround(unixOf(iso) * 1e3
 
 // The frames of a merged history up to `end`, each moment once: two
 // recorders holding the vehicle at once got each of its frames, stamped
-// each on its own arrival, a few milliseconds apart at most (a frame is
-// 67 ms at 15 fps). A recording's own frames are each a moment, however
-// close two came. Their digests in time order.
+// each on its own arrival, milliseconds apart (a frame is 67 ms at 15 fps):
+// another recorder's frame less than half a frame interval after the last
+// moment is that moment (fleet.md). A recorder's own frames are each a
+// moment, however close two came (a frame late, the next on time). Their
+// digests in time order.
 template <typename FileOf>
 std::vector<std::string> momentsOf(const Json& recordings, const std::string& end, FileOf fileOf) {
   struct Frame {
     int64_t utcNs;
-    size_t recording;
+    std::string recorder;
     std::string digest;
     bool operator<(const Frame& other) const { return utcNs < other.utcNs; }
   };
@@ -194,17 +196,20 @@ std::vector<std::string> momentsOf(const Json& recordings, const std::string& en
     auto pts = contentsOf(file).framePts;
     int64_t start = unixNsOf(recordings[n]["start_utc"]);
     for (size_t i = 0; i < std::min(digests.size(), pts.size()); ++i)
-      frames.push_back({start + static_cast<int64_t>(pts[i]), n, digests[i]});
+      frames.push_back(
+          {start + static_cast<int64_t>(pts[i]), recordings[n]["recorder"], digests[i]});
   }
   std::stable_sort(frames.begin(), frames.end());
   std::vector<std::string> moments;
   std::optional<Frame> last;
+  int64_t interval = 1000000000 / 15;  // the moments' last, as the export counts it
   int64_t upTo = unixNsOf(end);
   for (const auto& frame : frames) {
     if (frame.utcNs > upTo) continue;
-    bool repeat =
-        last && last->recording != frame.recording && frame.utcNs - last->utcNs < 20 * 1000000;
-    if (repeat) continue;
+    if (last && last->recorder != frame.recorder && frame.utcNs < last->utcNs + interval / 2)
+      continue;
+    if (last && frame.utcNs > last->utcNs && frame.utcNs - last->utcNs <= 1000000000)
+      interval = frame.utcNs - last->utcNs;
     moments.push_back(frame.digest);
     last = frame;
   }
