@@ -84,10 +84,12 @@ std::vector<OptionSpec> recordingRows() {
        .fallback = "60",
        .section = kFiles,
        .reloadable = true,
-       .help = "seconds per segment, at least 1 (fractions too: `1.5`)",
+       .help = "seconds per segment, 1..86400 (a day; fractions too: `1.5`)",
        .apply = [](RecorderOptions& o, const char* value) -> OptionProblem {
          auto s = number(value);
-         if (!s || *s < 1) return "seconds >= 1";
+         // (A length too long for nanoseconds in 64 bits reached a cast that is
+         // undefined; a segment past a day is more likely a slip than a wish.)
+         if (!s || *s < 1 || *s > 86400) return "seconds 1..86400";
          o.segmentSeconds = *s;
          return std::nullopt;
        },

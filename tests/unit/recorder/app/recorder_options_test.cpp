@@ -111,6 +111,9 @@ TEST(RecorderOptions, RefusesNumbersNoFieldCanHold) {
   EXPECT_FALSE(parse({"--out", "x", "--max-bytes", "inf"}).has_value());
   EXPECT_FALSE(parse({"--out", "x", "--device", "127.0.0.1:nan"}).has_value());
   EXPECT_FALSE(parse({"--out", "x", "--segment", "nan"}).has_value());
+  EXPECT_FALSE(parse({"--out", "x", "--segment", "99999999999999999999"}).has_value());
+  EXPECT_FALSE(parse({"--out", "x", "--segment", "86401"}).has_value());
+  EXPECT_TRUE(parse({"--out", "x", "--segment", "86400"}).has_value());
 }
 
 TEST(RecorderOptions, AMissingValueOrAnUnknownOptionIsNamedOnce) {
