@@ -10,6 +10,7 @@
 #include "app/recorder_options.h"
 #include "app/slice_allocator.h"
 #include "app/supervisor.h"
+#include "camera/disk_writer.h"
 
 int main(int argc, char** argv) {
   using namespace wircam::recorder;
@@ -48,5 +49,6 @@ int main(int argc, char** argv) {
   }
   int code = (*supervisor)->run();
   supervisor->reset();
+  DiskWriter::finishAll();
   endProcess(code);
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 
 #include "app/pipeline_planner.h"
 #include "gst_scoped.h"
@@ -126,6 +127,7 @@ Supervisor::~Supervisor() {
   hook_.reset();
   fleet_.reset();  // says offline
   cameras_.clear();
+  if (indexSave_) saveIndexNow();  // (its idle source must not outlive this)
   if (loop_) g_main_loop_unref(loop_);
 }
 
@@ -184,6 +186,7 @@ void Supervisor::publishSnapshots() {
 }
 
 void Supervisor::enforceRetention() {
+  if (!retention_.active()) return saveIndexSoon();
   auto open = openSegments();
   updateIndex(retention_.enforce({open.begin(), open.end()}));
 }
@@ -346,6 +349,23 @@ std::optional<std::pair<guint, std::string>> Supervisor::deleteSegment(const std
 
 void Supervisor::updateIndex(const std::vector<std::string>& deleted) {
   for (const auto& file : deleted) index_.remove(std::filesystem::path(file).filename().string());
+  if (deleted.empty()) return saveIndexSoon();
+  saveIndexNow();
+}
+
+void Supervisor::saveIndexSoon() {
+  if (!indexSave_) indexSave_ = g_idle_add(onSaveIndex, this);
+}
+
+gboolean Supervisor::onSaveIndex(gpointer self) {
+  auto* supervisor = static_cast<Supervisor*>(self);
+  supervisor->indexSave_ = 0;
+  supervisor->saveIndexNow();
+  return G_SOURCE_REMOVE;
+}
+
+void Supervisor::saveIndexNow() {
+  if (indexSave_) g_source_remove(std::exchange(indexSave_, 0));
   if (!index_.save()) logLine("cannot write " + index_.path().string());
 }
 
@@ -486,6 +506,7 @@ int Supervisor::run() {
     if (GSource* timer = g_main_context_find_source_by_id(nullptr, id)) g_source_destroy(timer);
   printStatus();
   for (auto& c : cameras_) c->halt();  // what still runs (a second signal, the backstop)
+  saveIndexNow();                      // with what the cameras' ends closed
   if (hook_) {
     // The last segments' uploads get a little time; what is left is named.
     auto limit = std::chrono::duration<double>(options_.hookDrainSeconds);

@@ -101,6 +101,13 @@ class Supervisor : CameraObserver {
   std::optional<std::pair<guint, std::string>> deleteSegment(const std::string& file);
   void updateIndex(const std::vector<std::string>& deleted);
   void enforceRetention();  // and the index after it
+  // index.json written once the main loop is idle: many segments closing
+  // at once (a stop of hundreds of cameras) write it once, not once each,
+  // which kept the loop from the cameras' ends until they were cut off.
+  // Deletions are written at once (the files are gone).
+  void saveIndexSoon();
+  void saveIndexNow();
+  static gboolean onSaveIndex(gpointer self);
   void publishSnapshots();  // --mqtt-discovery's camera entity
   void printStatus();
   void guardDisk();
@@ -117,6 +124,7 @@ class Supervisor : CameraObserver {
   Retention retention_;
   DiskGuard disk_;
   RecordingIndex index_;
+  guint indexSave_ = 0;  // saveIndexSoon()'s idle source, while one waits
   std::map<std::string, RecordedTotals> recorded_;  // by camera, since the start
   GMainLoop* loop_ = nullptr;
   std::vector<std::unique_ptr<Camera>> cameras_;

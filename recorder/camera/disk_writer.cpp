@@ -172,6 +172,24 @@ void DiskWriter::closeWhenWritten(const std::shared_ptr<File>& file,
 
 int DiskWriter::errorOf(const File& file) { return file.error_; }
 
+void DiskWriter::finishAll() {
+  std::vector<std::shared_ptr<DiskWriter>> writers;
+  {
+    std::lock_guard lock(registryMutex);
+    for (const auto& [device, writer] : registry())
+      if (auto held = writer.lock()) writers.push_back(std::move(held));
+  }
+  for (const auto& writer : writers) {
+    MutexLock lock(writer->mutex_);
+    ++writer->closing_;  // no gathering: write now
+    writer->wake_.notifyOne();
+    writer->done_.wait(writer->mutex_, [&]() WIRCAM_REQUIRES(writer->mutex_) {
+      return writer->writes_.empty() && !writer->writing_;
+    });
+    --writer->closing_;
+  }
+}
+
 void DiskWriter::hold() {
   MutexLock lock(mutex_);
   held_ = true;
@@ -201,6 +219,7 @@ void DiskWriter::run() {
     });
     batch_.swap(writes_);  // (both keep their capacity: no malloc)
     bytesWaiting_ = 0;
+    writing_ = true;
     lock.unlock();
     for (size_t i = 0; i < batch_.size();) i += performRun(i);
     lock.lock();
@@ -208,6 +227,7 @@ void DiskWriter::run() {
     for (const Write& write : batch_)
       if (--write.file->waiting_ == 0 && write.file->closeWhenWritten_)
         written.emplace_back(write.file, std::exchange(write.file->closeWhenWritten_, nullptr));
+    writing_ = false;
     done_.notifyAll();
     lock.unlock();
     // (What a file's end does, as a camera's last hold on its budget, may

@@ -98,6 +98,10 @@ class DiskWriter {
   void closeWhenWritten(const std::shared_ptr<File>& file, std::function<void(int error)> closed);
   // The error `file`'s writes have met so far (0: none), any thread.
   static int errorOf(const File& file);
+  // Waits until every writer has written all that was handed to it: before
+  // the process exits, which would lose what a writer still holds (a file
+  // cut off at the stop lets its writes go on without anyone waiting).
+  static void finishAll();
 
   // A disk that stops taking data, for tests: the thread writes nothing
   // from hold() until release().
@@ -130,7 +134,8 @@ class DiskWriter {
   std::vector<GstMapInfo> maps_;
   std::vector<iovec> pieces_;
   uint64_t bytesWaiting_ WIRCAM_GUARDED_BY(mutex_) = 0;
-  int closing_ WIRCAM_GUARDED_BY(mutex_) = 0;  // callers of close() waiting: no gathering then
+  int closing_ WIRCAM_GUARDED_BY(mutex_) = 0;       // callers of close() waiting: no gathering then
+  bool writing_ WIRCAM_GUARDED_BY(mutex_) = false;  // a batch taken from writes_ is being written
   bool held_ WIRCAM_GUARDED_BY(mutex_) = false;
   bool ending_ WIRCAM_GUARDED_BY(mutex_) = false;
   std::thread thread_;
