@@ -20,8 +20,9 @@
 #define WIRCAM_ACQUIRE(...) WIRCAM_THREAD_ANNOTATION(acquire_capability(__VA_ARGS__))
 #define WIRCAM_RELEASE(...) WIRCAM_THREAD_ANNOTATION(release_capability(__VA_ARGS__))
 #define WIRCAM_EXCLUDES(...) WIRCAM_THREAD_ANNOTATION(locks_excluded(__VA_ARGS__))
-// For a wrapper whose body the analysis cannot follow (a predicate that
-// needs the caller's mutex, called by pthread_cond_wait's caller).
+// For a wrapper whose body the analysis cannot follow: a condition's wait
+// calls its caller's predicate, which needs the caller's mutex under the
+// caller's name for it.
 #define WIRCAM_NO_THREAD_SAFETY_ANALYSIS WIRCAM_THREAD_ANNOTATION(no_thread_safety_analysis)
 
 namespace wircam {

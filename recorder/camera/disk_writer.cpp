@@ -149,12 +149,17 @@ void DiskWriter::write(const std::shared_ptr<File>& file, uint64_t offset, GstBu
   if (first) wake_.notifyOne();
 }
 
-int DiskWriter::close(const std::shared_ptr<File>& file) {
-  MutexLock lock(mutex_);
+template <class Done>
+void DiskWriter::writeNowUntil(Done done) {
   ++closing_;
   wake_.notifyOne();
-  done_.wait(mutex_, [&] { return file->waiting_ == 0; });
+  done_.wait(mutex_, done);
   --closing_;
+}
+
+int DiskWriter::close(const std::shared_ptr<File>& file) {
+  MutexLock lock(mutex_);
+  writeNowUntil([&] { return file->waiting_ == 0; });
   return file->closeNow();
 }
 
@@ -181,12 +186,9 @@ void DiskWriter::finishAll() {
   }
   for (const auto& writer : writers) {
     MutexLock lock(writer->mutex_);
-    ++writer->closing_;  // no gathering: write now
-    writer->wake_.notifyOne();
-    writer->done_.wait(writer->mutex_, [&]() WIRCAM_REQUIRES(writer->mutex_) {
+    writer->writeNowUntil([&]() WIRCAM_REQUIRES(writer->mutex_) {
       return writer->writes_.empty() && !writer->writing_;
     });
-    --writer->closing_;
   }
 }
 
@@ -227,7 +229,6 @@ void DiskWriter::run() {
     for (const Write& write : batch_)
       if (--write.file->waiting_ == 0 && write.file->closeWhenWritten_)
         written.emplace_back(write.file, std::exchange(write.file->closeWhenWritten_, nullptr));
-    writing_ = false;
     done_.notifyAll();
     lock.unlock();
     // (What a file's end does, as a camera's last hold on its budget, may
@@ -235,6 +236,9 @@ void DiskWriter::run() {
     batch_.clear();
     for (auto& [file, closed] : written) closed(file->closeNow());
     lock.lock();
+    // The pass is over, its files' ends too: finishAll() may return.
+    writing_ = false;
+    done_.notifyAll();
   }
 }
 

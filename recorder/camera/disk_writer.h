@@ -117,6 +117,10 @@ class DiskWriter {
     std::shared_ptr<DiskBudget> budget;
   };
   void run();
+  // With mutex_ held: the thread writes at once, without gathering, until
+  // `done()` (close(), finishAll()).
+  template <class Done>
+  void writeNowUntil(Done done) WIRCAM_REQUIRES(mutex_);
   // Writes batch_[first] and the writes after it that continue it in its
   // file; returns how many.
   size_t performRun(size_t first);
@@ -134,8 +138,9 @@ class DiskWriter {
   std::vector<GstMapInfo> maps_;
   std::vector<iovec> pieces_;
   uint64_t bytesWaiting_ WIRCAM_GUARDED_BY(mutex_) = 0;
-  int closing_ WIRCAM_GUARDED_BY(mutex_) = 0;       // callers of close() waiting: no gathering then
-  bool writing_ WIRCAM_GUARDED_BY(mutex_) = false;  // a batch taken from writes_ is being written
+  int closing_ WIRCAM_GUARDED_BY(mutex_) = 0;  // callers of writeNowUntil(): no gathering then
+  bool writing_ WIRCAM_GUARDED_BY(mutex_) =
+      false;  // a batch taken from writes_, and its files' ends
   bool held_ WIRCAM_GUARDED_BY(mutex_) = false;
   bool ending_ WIRCAM_GUARDED_BY(mutex_) = false;
   std::thread thread_;
