@@ -27,11 +27,6 @@ constexpr uint64_t kGatherBytes = 1 << 20;
 // Writes of one file that follow each other on it go out in one call.
 constexpr size_t kMaxRun = 64;
 
-// Written bytes waiting to be freed past this many are freed at once (a
-// camera that stopped handing over cannot hold them all).
-constexpr size_t kMaxGivenBack = 256;
-constexpr size_t kGivenBackReserved = 32;
-
 std::mutex registryMutex;
 std::map<dev_t, std::weak_ptr<DiskWriter>>& registry() {
   static auto* writers = new std::map<dev_t, std::weak_ptr<DiskWriter>>;
@@ -40,14 +35,14 @@ std::map<dev_t, std::weak_ptr<DiskWriter>>& registry() {
 
 }  // namespace
 
-class DiskWriter::File {
+class DiskFile {
  public:
-  File(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}
-  ~File() {
+  DiskFile(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}
+  ~DiskFile() {
     if (fd_ >= 0) ::close(fd_);
   }
-  File(const File&) = delete;
-  File& operator=(const File&) = delete;
+  DiskFile(const DiskFile&) = delete;
+  DiskFile& operator=(const DiskFile&) = delete;
 
  private:
   friend class DiskWriter;
@@ -60,42 +55,12 @@ class DiskWriter::File {
 
   int fd_;
   const std::string path_;
-  int waiting_ = 0;                            // writes handed over, not done (the writer's mutex_)
+  // Writes handed over, not done: raised by the camera, lowered by the
+  // writer under its mutex_ (as closeWhenWritten() reads it).
+  std::atomic<int> waiting_{0};
   std::function<void(int)> closeWhenWritten_;  // (the writer's mutex_)
   std::atomic<int> error_{0};
 };
-
-DiskBudget::DiskBudget(uint64_t bound) : bound_(bound) {
-  // A frame is a few of the muxer's buffers: the lists rarely grow past
-  // this, so the writer rarely grows them (a malloc).
-  givenBack_.reserve(kGivenBackReserved);
-  freeing_.reserve(kGivenBackReserved);
-}
-
-DiskBudget::~DiskBudget() {
-  for (GstBuffer* bytes : givenBack_) gst_buffer_unref(bytes);
-}
-
-void DiskBudget::giveBack(GstBuffer* bytes) {
-  MutexLock lock(givenBackMutex_);
-  if (givenBack_.size() < kMaxGivenBack) {
-    givenBack_.push_back(bytes);
-    return;
-  }
-  gst_buffer_unref(bytes);  // (never in a camera that keeps handing over)
-}
-
-void DiskBudget::freeGivenBack() {
-  std::unique_lock freeing(freeingMutex_, std::try_to_lock);
-  if (!freeing) return;
-  {
-    MutexLock lock(givenBackMutex_);
-    if (givenBack_.empty()) return;
-    freeing_.swap(givenBack_);
-  }
-  for (GstBuffer* bytes : freeing_) gst_buffer_unref(bytes);
-  freeing_.clear();
-}
 
 Expected<std::shared_ptr<DiskWriter>, std::string> DiskWriter::of(const std::string& folder) {
   struct stat info {};
@@ -137,16 +102,28 @@ void DiskWriter::write(const std::shared_ptr<File>& file, uint64_t offset, GstBu
                        const std::shared_ptr<DiskBudget>& budget) {
   budget->freeGivenBack();
   uint64_t size = gst_buffer_get_size(bytes);
-  budget->handedOver(size);
-  bool first;
-  {
-    MutexLock lock(mutex_);
-    first = writes_.empty();
-    ++file->waiting_;
-    bytesWaiting_ += size;
-    writes_.push_back({file, offset, gst_buffer_ref(bytes), budget});
-  }
-  if (first) wake_.notifyOne();
+  file->waiting_.fetch_add(1, std::memory_order_relaxed);
+  bool wakeUp = false;
+  if (budget->queue({file, offset, gst_buffer_ref(bytes)}, budget)) wakeUp = list(budget.get());
+  uint64_t before = bytesWaiting_.fetch_add(size, std::memory_order_relaxed);
+  if (before < kGatherBytes && before + size >= kGatherBytes) wakeUp = true;
+  if (wakeUp) wake();
+}
+
+bool DiskWriter::list(DiskBudget* lane) {
+  DiskBudget* head = listed_.load(std::memory_order_relaxed);
+  do {
+    lane->nextListed_ = head;
+  } while (!listed_.compare_exchange_weak(head, lane, std::memory_order_release,
+                                          std::memory_order_relaxed));
+  return head == nullptr;
+}
+
+void DiskWriter::wake() {
+  // Through the mutex: the thread either has not yet read what changed,
+  // or already waits and hears this.
+  { MutexLock lock(mutex_); }
+  wake_.notifyOne();
 }
 
 template <class Done>
@@ -187,7 +164,7 @@ void DiskWriter::finishAll() {
   for (const auto& writer : writers) {
     MutexLock lock(writer->mutex_);
     writer->writeNowUntil([&]() WIRCAM_REQUIRES(writer->mutex_) {
-      return writer->writes_.empty() && !writer->writing_;
+      return !writer->anyListed() && !writer->writing_;
     });
   }
 }
@@ -214,27 +191,22 @@ void DiskWriter::run() {
   MutexLock lock(mutex_);
   while (true) {
     wake_.wait(mutex_,
-               [&]() WIRCAM_REQUIRES(mutex_) { return (ending_ || !writes_.empty()) && !held_; });
-    if (writes_.empty()) return;  // ending, all written
+               [&]() WIRCAM_REQUIRES(mutex_) { return (ending_ || anyListed()) && !held_; });
+    if (!anyListed()) return;  // ending, all written
     wake_.waitFor(mutex_, kGather, [&]() WIRCAM_REQUIRES(mutex_) {
-      return ending_ || closing_ > 0 || bytesWaiting_ >= kGatherBytes;
+      return ending_ || closing_ > 0 ||
+             bytesWaiting_.load(std::memory_order_relaxed) >= kGatherBytes;
     });
-    batch_.swap(writes_);  // (both keep their capacity: no malloc)
-    bytesWaiting_ = 0;
     writing_ = true;
     lock.unlock();
-    for (size_t i = 0; i < batch_.size();) i += performRun(i);
-    lock.lock();
-    std::vector<std::pair<std::shared_ptr<File>, std::function<void(int)>>> written;
-    for (const Write& write : batch_)
-      if (--write.file->waiting_ == 0 && write.file->closeWhenWritten_)
-        written.emplace_back(write.file, std::exchange(write.file->closeWhenWritten_, nullptr));
-    done_.notifyAll();
-    lock.unlock();
-    // (What a file's end does, as a camera's last hold on its budget, may
-    // malloc and free: once a file.)
-    batch_.clear();
-    for (auto& [file, closed] : written) closed(file->closeNow());
+    bytesWaiting_.store(0, std::memory_order_relaxed);
+    // (A lane's link is read before the lane is taken: once taken, its
+    // camera may list it again.)
+    for (DiskBudget* lane = listed_.exchange(nullptr, std::memory_order_acquire); lane;) {
+      DiskBudget* next = lane->nextListed_;
+      writeLane(*lane);
+      lane = next;
+    }
     lock.lock();
     // The pass is over, its files' ends too: finishAll() may return.
     writing_ = false;
@@ -242,12 +214,37 @@ void DiskWriter::run() {
   }
 }
 
+void DiskWriter::writeLane(DiskBudget& lane) {
+  std::shared_ptr<DiskBudget> kept = lane.take(batch_);
+  for (size_t i = 0; i < batch_.size();) i += performRun(i);
+  lane.giveBack(batch_);
+  countWritten();
+  batch_.clear();
+  // (The last hold on a camera's lane, once it is gone, frees it: once a
+  // camera.)
+}
+
+void DiskWriter::countWritten() {
+  std::vector<std::pair<std::shared_ptr<File>, std::function<void(int)>>> ended;
+  {
+    MutexLock lock(mutex_);
+    for (const DiskWrite& write : batch_)
+      if (write.file->waiting_.fetch_sub(1, std::memory_order_relaxed) == 1 &&
+          write.file->closeWhenWritten_)
+        ended.emplace_back(write.file, std::exchange(write.file->closeWhenWritten_, nullptr));
+    done_.notifyAll();
+  }
+  // (What a file's end does, as a camera's last hold on its budget, may
+  // malloc and free: once a file.)
+  for (auto& [file, closed] : ended) closed(file->closeNow());
+}
+
 size_t DiskWriter::performRun(size_t first) {
   // The writes from `first` on that continue each other in one file.
   size_t count = 1;
   uint64_t end = batch_[first].offset + gst_buffer_get_size(batch_[first].bytes);
   while (first + count < batch_.size() && count < kMaxRun) {
-    const Write& next = batch_[first + count];
+    const DiskWrite& next = batch_[first + count];
     if (next.file != batch_[first].file || next.offset != end) break;
     end += gst_buffer_get_size(next.bytes);
     ++count;
@@ -264,12 +261,7 @@ size_t DiskWriter::performRun(size_t first) {
     }
     writeAll(file, pieces_, batch_[first].offset);
   }
-  for (size_t i = 0; i < count; ++i) {
-    const Write& write = batch_[first + i];
-    if (i < mapped) gst_buffer_unmap(write.bytes, &maps_[i]);
-    write.budget->written(gst_buffer_get_size(write.bytes));
-    write.budget->giveBack(write.bytes);
-  }
+  for (size_t i = 0; i < mapped; ++i) gst_buffer_unmap(batch_[first + i].bytes, &maps_[i]);
   return count;
 }
 

@@ -18,49 +18,11 @@
 #include <thread>
 #include <vector>
 
+#include "camera/disk_budget.h"
 #include "common/expected.h"
 #include "common/priority_inheriting_mutex.h"
 
 namespace wircam::recorder {
-
-// How much of one camera's video may wait for its disk, in bytes; what
-// came and what was dropped past it. Shared by the camera's files and the
-// writes in flight (any thread). It also takes the written bytes back
-// from the writer, for the camera's thread to free: the writer frees
-// nothing (see DiskWriter).
-class DiskBudget {
- public:
-  explicit DiskBudget(uint64_t bound);
-  ~DiskBudget();
-  DiskBudget(const DiskBudget&) = delete;
-  DiskBudget& operator=(const DiskBudget&) = delete;
-  bool full() const { return waiting_.load(std::memory_order_relaxed) >= bound_; }
-  uint64_t waiting() const { return waiting_.load(std::memory_order_relaxed); }
-  void handedOver(uint64_t bytes) { waiting_.fetch_add(bytes, std::memory_order_relaxed); }
-  void written(uint64_t bytes) { waiting_.fetch_sub(bytes, std::memory_order_relaxed); }
-
-  // Frames that came for the files (recorded or dropped), and those dropped.
-  void countArrival() { arrived_.fetch_add(1, std::memory_order_relaxed); }
-  void countDrop() { dropped_.fetch_add(1, std::memory_order_relaxed); }
-  uint64_t framesArrived() const { return arrived_.load(std::memory_order_relaxed); }
-  uint64_t framesDropped() const { return dropped_.load(std::memory_order_relaxed); }
-
-  // `bytes` are written (the writer's thread); they wait to be freed.
-  void giveBack(GstBuffer* bytes);
-  // Frees what was given back (the camera's thread, at its next hand-over;
-  // nothing if another of its threads is at it).
-  void freeGivenBack();
-
- private:
-  const uint64_t bound_;
-  std::atomic<uint64_t> waiting_{0}, arrived_{0}, dropped_{0};
-  PriorityInheritingMutex givenBackMutex_;  // shared with the writer
-  std::vector<GstBuffer*> givenBack_ WIRCAM_GUARDED_BY(givenBackMutex_);
-  // The camera's side (two of its files may hand over on two threads);
-  // kept for its capacity. Never taken by the writer.
-  std::mutex freeingMutex_;
-  std::vector<GstBuffer*> freeing_;
-};
 
 // The writer runs ahead of the video threads (thread_priority.h), and so
 // must never wait for one: it shares only priority-inheriting locks with
@@ -69,12 +31,15 @@ class DiskBudget {
 // a preempted video thread. (Seen at 256 cameras on saturated processors:
 // nearly every time the writer slept, it slept in malloc's lock, and the
 // cameras' bounds filled.) So its lists keep their capacity, and it gives
-// the written bytes back to each camera's DiskBudget to free.
+// the written bytes back to each camera's DiskBudget to free. Nor does a
+// camera's hand-over lock anything another camera locks: each camera has
+// its lane (disk_budget.h), and the lanes with writes wait on a list that
+// takes no lock.
 class DiskWriter {
  public:
   // A file open for writing: its descriptor, the writes still waiting, and
   // the first error a write met (errno; 0: none).
-  class File;
+  using File = DiskFile;
 
   // The writer of the filesystem `folder` is on: made at the first use,
   // shared while any camera holds it.
@@ -86,7 +51,8 @@ class DiskWriter {
   // `path`, created or emptied, on the caller's thread; or why not (errno).
   static Expected<std::shared_ptr<File>, int> open(const std::string& path);
   // `bytes` (a reference is taken) at `offset` of `file`, on the writer's
-  // thread, in the order handed over; counted in `budget` until written.
+  // thread, in the order handed over; counted in `budget` (the camera's
+  // lane to this writer) until written.
   void write(const std::shared_ptr<File>& file, uint64_t offset, GstBuffer* bytes,
              const std::shared_ptr<DiskBudget>& budget);
   // Waits until every write handed over for `file` is done, then closes
@@ -110,13 +76,14 @@ class DiskWriter {
 
  private:
   explicit DiskWriter(dev_t device);
-  struct Write {
-    std::shared_ptr<File> file;
-    uint64_t offset;
-    GstBuffer* bytes;
-    std::shared_ptr<DiskBudget> budget;
-  };
   void run();
+  // Puts `lane` on the list of lanes with writes; true when it was empty.
+  bool list(DiskBudget* lane);
+  bool anyListed() const { return listed_.load(std::memory_order_acquire) != nullptr; }
+  // Wakes the thread (after a change to what its waits read).
+  void wake();
+  // Writes what `lane` holds: taken into batch_, written, given back.
+  void writeLane(DiskBudget& lane);
   // With mutex_ held: the thread writes at once, without gathering, until
   // `done()` (close(), finishAll()).
   template <class Done>
@@ -124,23 +91,29 @@ class DiskWriter {
   // Writes batch_[first] and the writes after it that continue it in its
   // file; returns how many.
   size_t performRun(size_t first);
+  // With batch_ written: its files' counts of writes waiting, and the ends
+  // of those closed when written.
+  void countWritten();
   static void writeAll(File& file, std::vector<iovec>& pieces, uint64_t offset);
 
   const dev_t device_;
-  // Guards writes_, ending_, idle_ and each File's count of writes waiting.
+  // The lanes with writes, linked through DiskBudget::nextListed_: pushed
+  // by the cameras, taken all at once by the thread.
+  std::atomic<DiskBudget*> listed_{nullptr};
+  std::atomic<uint64_t> bytesWaiting_{0};  // handed over since the pass began
+  // Guards the marked fields and the decrease of each File's count of
+  // writes waiting (its end waits on it). No camera takes it to hand over,
+  // only to wake the thread.
   PriorityInheritingMutex mutex_;
   PriorityInheritingCondition wake_;  // writes to do, or the end
   PriorityInheritingCondition done_;  // a file's writes are all done
-  std::vector<Write> writes_ WIRCAM_GUARDED_BY(mutex_);
-  // The writer's own (the batch being written, a run's pieces), kept for
-  // their capacity.
-  std::vector<Write> batch_;
+  // The writer's own (a lane's writes being written, a run's pieces), kept
+  // for their capacity.
+  std::vector<DiskWrite> batch_;
   std::vector<GstMapInfo> maps_;
   std::vector<iovec> pieces_;
-  uint64_t bytesWaiting_ WIRCAM_GUARDED_BY(mutex_) = 0;
   int closing_ WIRCAM_GUARDED_BY(mutex_) = 0;  // callers of writeNowUntil(): no gathering then
-  bool writing_ WIRCAM_GUARDED_BY(mutex_) =
-      false;  // a batch taken from writes_, and its files' ends
+  bool writing_ WIRCAM_GUARDED_BY(mutex_) = false;  // lanes taken, not all written
   bool held_ WIRCAM_GUARDED_BY(mutex_) = false;
   bool ending_ WIRCAM_GUARDED_BY(mutex_) = false;
   std::thread thread_;
