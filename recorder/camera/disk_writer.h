@@ -112,7 +112,7 @@ class DiskWriter {
   std::vector<DiskWrite> batch_;
   std::vector<GstMapInfo> maps_;
   std::vector<iovec> pieces_;
-  int closing_ WIRCAM_GUARDED_BY(mutex_) = 0;  // callers of writeNowUntil(): no gathering then
+  int closing_ WIRCAM_GUARDED_BY(mutex_) = 0;       // callers of writeNowUntil(): no gathering then
   bool writing_ WIRCAM_GUARDED_BY(mutex_) = false;  // lanes taken, not all written
   bool held_ WIRCAM_GUARDED_BY(mutex_) = false;
   bool ending_ WIRCAM_GUARDED_BY(mutex_) = false;
