@@ -31,11 +31,20 @@ DiskBudget::~DiskBudget() {
 
 bool DiskBudget::queue(DiskWrite&& write, const std::shared_ptr<DiskBudget>& self) {
   waiting_.fetch_add(gst_buffer_get_size(write.bytes), std::memory_order_relaxed);
-  MutexLock lock(laneMutex_);
-  writes_.push_back(std::move(write));
-  if (listed_) return false;
-  listed_ = self;
-  return true;
+  std::unique_lock freeing(freeingMutex_, std::try_to_lock);
+  bool toList;
+  {
+    MutexLock lock(laneMutex_);
+    writes_.push_back(std::move(write));
+    if (freeing) freeing_.swap(givenBack_);  // (freeing_ is empty: both keep a capacity)
+    toList = !listed_;
+    if (toList) listed_ = self;
+  }
+  if (freeing) {
+    for (GstBuffer* bytes : freeing_) gst_buffer_unref(bytes);
+    freeing_.clear();
+  }
+  return toList;
 }
 
 std::shared_ptr<DiskBudget> DiskBudget::take(std::vector<DiskWrite>& into) {
@@ -55,18 +64,6 @@ void DiskBudget::giveBack(const std::vector<DiskWrite>& written) {
       gst_buffer_unref(write.bytes);  // (never in a camera that keeps handing over)
   }
   waiting_.fetch_sub(bytes, std::memory_order_relaxed);
-}
-
-void DiskBudget::freeGivenBack() {
-  std::unique_lock freeing(freeingMutex_, std::try_to_lock);
-  if (!freeing) return;
-  {
-    MutexLock lock(laneMutex_);
-    if (givenBack_.empty()) return;
-    freeing_.swap(givenBack_);
-  }
-  for (GstBuffer* bytes : freeing_) gst_buffer_unref(bytes);
-  freeing_.clear();
 }
 
 }  // namespace wircam::recorder

@@ -50,15 +50,12 @@ class DiskBudget {
   uint64_t framesArrived() const { return arrived_.load(std::memory_order_relaxed); }
   uint64_t framesDropped() const { return dropped_.load(std::memory_order_relaxed); }
 
-  // Frees what the writer gave back (the camera's thread, at its next
-  // hand-over; nothing if another of its threads is at it).
-  void freeGivenBack();
-
  private:
   friend class DiskWriter;
-  // The camera's side: queues `write` (its bytes counted until written);
-  // true when the lane was not on its writer's list of lanes with writes,
-  // and so is to be put there.
+  // The camera's side: queues `write` (its bytes counted until written)
+  // and frees what the writer gave back since (unless another of the
+  // camera's threads is at it), under one lock; true when the lane was not
+  // on its writer's list of lanes with writes, and so is to be put there.
   bool queue(DiskWrite&& write, const std::shared_ptr<DiskBudget>& self);
   // The writer's side: takes the waiting writes into `into` (empty; the
   // lane keeps its capacity) and what keeps the lane alive meanwhile.

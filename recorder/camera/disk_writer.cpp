@@ -37,7 +37,7 @@ std::map<dev_t, std::weak_ptr<DiskWriter>>& registry() {
 
 class DiskFile {
  public:
-  DiskFile(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}
+  explicit DiskFile(int fd) : fd_(fd) {}
   ~DiskFile() {
     if (fd_ >= 0) ::close(fd_);
   }
@@ -54,7 +54,6 @@ class DiskFile {
   }
 
   int fd_;
-  const std::string path_;
   // Writes handed over, not done: raised by the camera, lowered by the
   // writer under its mutex_ (as closeWhenWritten() reads it).
   std::atomic<int> waiting_{0};
@@ -95,12 +94,11 @@ DiskWriter::~DiskWriter() {
 Expected<std::shared_ptr<DiskWriter::File>, int> DiskWriter::open(const std::string& path) {
   int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return unexpected(errno);
-  return std::make_shared<File>(fd, path);
+  return std::make_shared<File>(fd);
 }
 
 void DiskWriter::write(const std::shared_ptr<File>& file, uint64_t offset, GstBuffer* bytes,
                        const std::shared_ptr<DiskBudget>& budget) {
-  budget->freeGivenBack();
   uint64_t size = gst_buffer_get_size(bytes);
   file->waiting_.fetch_add(1, std::memory_order_relaxed);
   bool wakeUp = false;
