@@ -200,7 +200,8 @@ void DiskWriter::run() {
     bytesWaiting_.store(0, std::memory_order_relaxed);
     // (A lane's link is read before the lane is taken: once taken, its
     // camera may list it again.)
-    for (DiskBudget* lane = listed_.exchange(nullptr, std::memory_order_acquire); lane;) {
+    for (DiskBudget* lane = inListedOrder(listed_.exchange(nullptr, std::memory_order_acquire));
+         lane;) {
       DiskBudget* next = lane->nextListed_;
       writeLane(*lane);
       lane = next;
@@ -210,6 +211,17 @@ void DiskWriter::run() {
     writing_ = false;
     done_.notifyAll();
   }
+}
+
+DiskBudget* DiskWriter::inListedOrder(DiskBudget* newestFirst) {
+  // (Its lanes are still listed, so no camera touches their links.)
+  DiskBudget* oldestFirst = nullptr;
+  while (newestFirst) {
+    DiskBudget* next = newestFirst->nextListed_;
+    newestFirst->nextListed_ = oldestFirst;
+    oldestFirst = std::exchange(newestFirst, next);
+  }
+  return oldestFirst;
 }
 
 void DiskWriter::writeLane(DiskBudget& lane) {

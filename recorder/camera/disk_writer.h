@@ -80,6 +80,11 @@ class DiskWriter {
   // Puts `lane` on the list of lanes with writes; true when it was empty.
   bool list(DiskBudget* lane);
   bool anyListed() const { return listed_.load(std::memory_order_acquire) != nullptr; }
+  // The lanes taken off the list (newest first, as pushed), oldest first:
+  // what waits longest goes first, and a lane listed after another is
+  // written after it, so a write that lists its lane waits for every write
+  // handed over before it.
+  static DiskBudget* inListedOrder(DiskBudget* newestFirst);
   // Wakes the thread (after a change to what its waits read).
   void wake();
   // Writes what `lane` holds: taken into batch_, written, given back.

@@ -95,6 +95,30 @@ TEST_F(DiskWriterTest, AFullDiskIsTheFilesErrorAndItsCloseSaysSo) {
   EXPECT_EQ(budget_->waiting(), 0u) << "what failed is no longer waiting";
 }
 
+// The lanes are written in the order they got writes: once a write on a
+// lane of its own is done, so is every write handed over before it.
+TEST_F(DiskWriterTest, AWriteOnAFreshLaneIsDoneAfterEveryWriteHandedOverBeforeIt) {
+  auto writer = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(writer);
+  auto video = DiskWriter::open((folder_ / "video.mkv").string());
+  auto marker = DiskWriter::open((folder_ / "marker").string());
+  ASSERT_TRUE(video && marker);
+  auto camera = std::make_shared<DiskBudget>(1 << 30);
+  (*writer)->hold();
+  constexpr size_t kPiece = 1 << 16, kPieces = 64;  // long enough to be caught writing
+  for (size_t piece = 0; piece < kPieces; ++piece) {
+    GstBuffer* bytes = bytesOf(std::string(kPiece, 'v'));
+    (*writer)->write(*video, piece * kPiece, bytes, camera);
+    gst_buffer_unref(bytes);
+  }
+  write(**writer, *marker, 0, "m");
+  (*writer)->release();
+  EXPECT_EQ((*writer)->close(*marker), 0);
+  EXPECT_EQ(camera->waiting(), 0u) << "the marker was written before the video handed over first";
+  EXPECT_EQ((*writer)->close(*video), 0);
+  EXPECT_EQ(fs::file_size(folder_ / "video.mkv"), kPiece * kPieces);
+}
+
 // Each camera hands over on its own lane, none locking another's: the
 // lanes listed at once, taken and listed again while the writer runs, lose
 // and reorder nothing.
