@@ -11,6 +11,7 @@
 #include "btemp/btemp_probe.h"
 #include "common/priority_inheriting_mutex.h"
 #include "common/socket.h"
+#include "link/alarm.h"
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
 #include "link/link_registry.h"
@@ -57,7 +58,7 @@ class Controller::Impl {
 
   void onReadable();
   void onPhaseTimer();
-  void onPacerTimer();
+  void onPacerAlarm();
   void perform(RegistrationActions actions);
   void armPhaseTimer();
   void send(const Message& message, const SocketAddress& to) {
@@ -78,7 +79,8 @@ class Controller::Impl {
   const NodeInfo self_{randomGuid(), nodeFlags(NodeType::Controller)};
   UniqueFd socket_;
   link::LinkListeners& listeners_;
-  EventLoop::Id watch_ = 0, phaseTimer_ = 0, pacerTimer_ = 0;
+  EventLoop::Id watch_ = 0, phaseTimer_ = 0;
+  link::Alarm pacerAlarm_;
 
   // Guards what follows; never held while sending or emitting. Shared by
   // the loop with the streams' threads, so it lends priority (event_loop.h).
@@ -93,6 +95,7 @@ Controller::Impl::Impl(ControllerConfig config, UniqueFd socket, link::LinkListe
       config_(std::move(config)),
       socket_(std::move(socket)),
       listeners_(listeners),
+      pacerAlarm_(loop, [this] { onPacerAlarm(); }),
       registration_(self_, config_.host, config_.port, config_.keepaliveTimeout, Clock::now()),
       pacer_({.keepalive = config_.ctrlPeriod,
               .minInterval = link::intervalOf(config_.rateLimit),
@@ -101,13 +104,13 @@ Controller::Impl::Impl(ControllerConfig config, UniqueFd socket, link::LinkListe
               .keepaliveEarly = EventLoop::kCoalesce}) {
   watch_ = loop_.watch(socket_.get(), EPOLLIN, [this](uint32_t) { onReadable(); });
   phaseTimer_ = loop_.addTimer([this] { onPhaseTimer(); });
-  pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
   loop_.arm(phaseTimer_, Clock::now());
 }
 
 Controller::Impl::~Impl() {
   loop_.invoke([this] {
-    for (auto id : {watch_, phaseTimer_, pacerTimer_}) loop_.remove(id);
+    for (auto id : {watch_, phaseTimer_}) loop_.remove(id);
+    pacerAlarm_.stop();
   });
   // The last word is the failsafe, so the robot stops now.
   std::optional<SocketAddress> robot;
@@ -127,11 +130,9 @@ void Controller::Impl::perform(RegistrationActions actions) {
     } else if (auto* emit = std::get_if<registration::Emit>(&action)) {
       listeners_.emit(emit->event);
     } else if (std::holds_alternative<registration::StartCommands>(action)) {
-      {
-        MutexLock lock(mutex_);
-        pacer_.restart();
-      }
-      loop_.arm(pacerTimer_, Clock::now());
+      MutexLock lock(mutex_);
+      pacer_.restart();
+      pacerAlarm_.set(Clock::now());
     }
   }
 }
@@ -155,9 +156,9 @@ void Controller::Impl::onPhaseTimer() {
   perform(std::move(actions));
 }
 
-void Controller::Impl::onPacerTimer() {
+void Controller::Impl::onPacerAlarm() {
   auto now = Clock::now();
-  link::PacedStep step;
+  std::optional<link::Pulses> due;
   std::optional<SocketAddress> robot;
   bool commanded;
   {
@@ -165,14 +166,16 @@ void Controller::Impl::onPacerTimer() {
     robot = registration_.registeredRobot();
     if (!robot) return;
     commanded = pacer_.commanded();
-    if (commanded) step = link::PacedStep::poll(pacer_, now);
+    if (commanded) {
+      due = pacer_.poll(now);
+      link::followPacer(pacer_, pacerAlarm_, now);
+    } else {
+      pacerAlarm_.set(now + kIdlePeriod);
+    }
   }
-  if (!commanded) {
-    // Nothing worthwhile to send: IDLE tells the robot we are still here.
-    send(Idle{}, *robot);
-    return loop_.armIfEarlier(pacerTimer_, now + kIdlePeriod);
-  }
-  step.carryOut([&](const link::Pulses& due) { send(ctrlOf(due), *robot); }, loop_, pacerTimer_);
+  // Nothing worthwhile to send: IDLE tells the robot we are still here.
+  if (!commanded) return send(Idle{}, *robot);
+  if (due) send(ctrlOf(*due), *robot);
 }
 
 void Controller::Impl::onReadable() {
@@ -217,16 +220,16 @@ Controller::~Controller() = default;
 
 void Controller::setCommand(const link::Pulses& pulses) {
   auto now = Clock::now();
-  link::PacedStep step;
+  std::optional<link::Pulses> due;
   std::optional<SocketAddress> robot;
   {
     MutexLock lock(impl_->mutex_);
-    step = link::PacedStep::offer(impl_->pacer_, pulses, now);
+    due = impl_->pacer_.offer(pulses, now);
     robot = impl_->registration_.registeredRobot();
+    if (!robot) return;  // kept for when the robot is registered
+    link::followPacer(impl_->pacer_, impl_->pacerAlarm_, now);
   }
-  if (!robot) return;  // kept for when the robot is registered
-  step.carryOut([&](const link::Pulses& due) { impl_->send(impl_->ctrlOf(due), *robot); },
-                impl_->loop_, impl_->pacerTimer_);
+  if (due) impl_->send(impl_->ctrlOf(*due), *robot);
 }
 
 void Controller::requestControl() {

@@ -58,6 +58,12 @@ CommandPacer::Clock::time_point CommandPacer::nextDeadline(Clock::time_point now
   return next;
 }
 
+CommandPacer::Window CommandPacer::nextWindow(Clock::time_point now) const {
+  auto latest = nextDeadline(now);
+  if (!lastSent_) return {latest, latest};
+  return {std::min(latest, lastSentTime_ + config_.keepalive - config_.keepaliveEarly), latest};
+}
+
 void CommandPacer::restart() {
   lastSent_.reset();
   lastChangeTime_.reset();

@@ -42,6 +42,13 @@ class CommandPacer {
   std::optional<Pulses> pollAhead(Clock::time_point now, Clock::duration ahead);
   // When poll() has something to send next, seen from `now`.
   Clock::time_point nextDeadline(Clock::time_point now) const;
+  // The same as a window for a timer (link/alarm.h): from the first time
+  // poll() would send (a keepalive may leave `keepaliveEarly` sooner) to
+  // the deadline.
+  struct Window {
+    Clock::time_point earliest, latest;
+  };
+  Window nextWindow(Clock::time_point now) const;
   // Forget what was sent (a new login): the next poll sends at once.
   void restart();
   // Whether anyone has given a command yet (until then the failsafe goes).
@@ -61,28 +68,16 @@ class CommandPacer {
   std::optional<Clock::time_point> lastChangeTime_;  // the last send of a new value
 };
 
-// What the pacer decided under a link's lock: the pulses to send now, if
-// any, and when to look again. Every link (WiRC, RCOIP, BTEMP) sends its
-// commands the same way: decide under its lock, then carry out outside it.
-struct PacedStep {
-  std::optional<Pulses> due;
-  CommandPacer::Clock::time_point next{};
-
-  static PacedStep offer(CommandPacer& pacer, const Pulses& pulses,
-                         CommandPacer::Clock::time_point now) {
-    return {pacer.offer(pulses, now), pacer.nextDeadline(now)};
-  }
-  static PacedStep poll(CommandPacer& pacer, CommandPacer::Clock::time_point now) {
-    return {pacer.poll(now), pacer.nextDeadline(now)};
-  }
-  // Outside the lock: the send, then the pacer's timer armed at `next`, or
-  // earlier (armIfEarlier): a command set meanwhile, on another thread, may
-  // have armed an earlier wake that must not be pushed back.
-  template <typename Send, typename Loop, typename Timer>
-  void carryOut(Send&& send, Loop& loop, Timer timer) const {
-    if (due) send(*due);
-    loop.armIfEarlier(timer, next);
-  }
-};
+// Sets a link's alarm (link/alarm.h) to when its pacer has something to
+// send next. Every link (WiRC, RCOIP, BTEMP) sends its commands the same
+// way: under its lock, decide and set the alarm; outside it, send. The
+// alarm is set under the lock so that the sets of several threads (a
+// command, a frame's turn, the alarm's own) land in the order the pacer
+// decided them.
+template <typename Alarm>
+void followPacer(const CommandPacer& pacer, Alarm& alarm, CommandPacer::Clock::time_point now) {
+  auto window = pacer.nextWindow(now);
+  alarm.set(window.earliest, window.latest);
+}
 
 }  // namespace wircam::link

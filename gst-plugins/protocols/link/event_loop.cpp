@@ -92,15 +92,6 @@ void EventLoop::arm(Id id, Clock::time_point when) {
   followEarliestTimer();
 }
 
-void EventLoop::armIfEarlier(Id id, Clock::time_point when) {
-  {
-    MutexLock lock(mutex_);
-    auto it = entries_.find(id);
-    if (it == entries_.end() || (it->second.queued && (*it->second.queued)->first <= when)) return;
-  }
-  arm(id, when);
-}
-
 void EventLoop::disarm(Id id) {
   MutexLock lock(mutex_);
   auto it = entries_.find(id);

@@ -49,15 +49,14 @@ class EventLoop {
   // timer callbacks work out what is due from their own state.
   //
   // Timers due within kCoalesce of the one that wakes the loop fire with it
-  // (early): 200 links' keepalives share wake-ups instead of each paying one.
-  // The loop sleeps on a timerfd set to its earliest timer, so a timer
-  // moved later from another thread (a keepalive another thread's turn
-  // sent) never wakes it, and one moved earlier wakes it only when due.
+  // (early): 200 links' deadlines share wake-ups instead of each paying one
+  // (the links' keepalives, on alarms of their own, share a grid
+  // kCoalesce apart: link/alarm.h). The loop sleeps on a timerfd set to
+  // its earliest timer, so a timer moved later from another thread never
+  // wakes it, and one moved earlier wakes it only when due.
   static constexpr std::chrono::milliseconds kCoalesce{10};
   Id addTimer(Callback callback);
   void arm(Id timer, Clock::time_point when);
-  // Arms only when `when` is earlier than the pending time (or none is).
-  void armIfEarlier(Id timer, Clock::time_point when);
   void disarm(Id timer);
 
   // Unwatches or deletes a timer. Once it returns, the callback is not

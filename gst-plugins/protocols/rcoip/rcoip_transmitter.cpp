@@ -9,6 +9,7 @@
 
 #include "common/priority_inheriting_mutex.h"
 #include "common/socket.h"
+#include "link/alarm.h"
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
 #include "link/link_registry.h"
@@ -55,7 +56,7 @@ class Transmitter::Impl {
   ~Impl();
 
   void onReadable();
-  void onPacerTimer();
+  void onPacerAlarm();
   void onSilenceTimer();
   void armSilenceTimer();
   void send(const link::Pulses& pulses);
@@ -68,7 +69,8 @@ class Transmitter::Impl {
   const SocketAddress receiver_;
   UniqueFd socket_;
   link::LinkListeners& listeners_;
-  EventLoop::Id watch_ = 0, pacerTimer_ = 0, silenceTimer_ = 0;
+  EventLoop::Id watch_ = 0, silenceTimer_ = 0;
+  link::Alarm pacerAlarm_;
 
   // Guards what follows; never held while sending or emitting. Shared by
   // the loop with the streams' threads, so it lends priority (event_loop.h).
@@ -84,6 +86,7 @@ Transmitter::Impl::Impl(TransmitterConfig config, SocketAddress receiver, Unique
       receiver_(receiver),
       socket_(std::move(socket)),
       listeners_(listeners),
+      pacerAlarm_(loop, [this] { onPacerAlarm(); }),
       pacer_({.keepalive = config_.keepalive,
               .minInterval = link::intervalOf(config_.rateLimit),
               .ttl = config_.commandTtl,
@@ -91,14 +94,14 @@ Transmitter::Impl::Impl(TransmitterConfig config, SocketAddress receiver, Unique
               .keepaliveEarly = EventLoop::kCoalesce}),
       monitor_(receiver_, config_.failInterval) {
   watch_ = loop_.watch(socket_.get(), EPOLLIN, [this](uint32_t) { onReadable(); });
-  pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
   silenceTimer_ = loop_.addTimer([this] { onSilenceTimer(); });
-  loop_.arm(pacerTimer_, Clock::now());
+  pacerAlarm_.set(Clock::now());
 }
 
 Transmitter::Impl::~Impl() {
   loop_.invoke([this] {
-    for (auto id : {watch_, pacerTimer_, silenceTimer_}) loop_.remove(id);
+    for (auto id : {watch_, silenceTimer_}) loop_.remove(id);
+    pacerAlarm_.stop();
   });
   // The last word is the failsafe, so the vehicle stops now rather than
   // after its fail interval.
@@ -115,14 +118,15 @@ void Transmitter::Impl::send(const link::Pulses& pulses) {
   }
 }
 
-void Transmitter::Impl::onPacerTimer() {
+void Transmitter::Impl::onPacerAlarm() {
   auto now = Clock::now();
-  link::PacedStep step;
+  std::optional<link::Pulses> due;
   {
     MutexLock lock(mutex_);
-    step = link::PacedStep::poll(pacer_, now);
+    due = pacer_.poll(now);
+    link::followPacer(pacer_, pacerAlarm_, now);
   }
-  step.carryOut([this](const link::Pulses& pulses) { send(pulses); }, loop_, pacerTimer_);
+  if (due) send(*due);
 }
 
 void Transmitter::Impl::onReadable() {
@@ -185,14 +189,14 @@ Transmitter::~Transmitter() = default;
 
 void Transmitter::setCommand(const link::Pulses& pulses) {
   auto now = Clock::now();
-  link::PacedStep step;
+  std::optional<link::Pulses> due;
   {
     MutexLock lock(impl_->mutex_);
-    step = link::PacedStep::offer(impl_->pacer_, pulses, now);
+    due = impl_->pacer_.offer(pulses, now);
+    link::followPacer(impl_->pacer_, impl_->pacerAlarm_, now);
   }
   // A change leaves now, from this thread.
-  step.carryOut([this](const link::Pulses& due) { impl_->send(due); }, impl_->loop_,
-                impl_->pacerTimer_);
+  if (due) impl_->send(*due);
 }
 
 void Transmitter::requestControl() {

@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "common/priority_inheriting_mutex.h"
+#include "link/alarm.h"
 #include "link/command_pacer.h"
 #include "link/event_loop.h"
 #include "link/link_registry.h"
@@ -157,7 +158,7 @@ class TransmitterSession::Impl {
   void readTcp();
   void onDiscoveryAnswer();
   void readStatusReports();
-  void onPacerTimer();
+  void onPacerAlarm();
   // While steering, a keepalive leaves at least every `keepalive` (100 ms
   // by default, never off; on a stream's turn or the pacer's timer), and
   // the status reports waiting are read as it leaves: the loop wakes for
@@ -185,7 +186,8 @@ class TransmitterSession::Impl {
   UniqueFd pcdSocket_;  // PCD leave from here
   EventLoop::Id psdWatch_ = 0;
   EventLoop::Id deadlineTimer_ = 0;
-  EventLoop::Id pacerTimer_ = 0;
+  // Of its own (link/alarm.h): moved by the streams' threads on their turns.
+  link::Alarm pacerAlarm_;
 
   // Loop thread only.
   UniqueFd discovery_;
@@ -225,10 +227,10 @@ TransmitterSession::Impl::Impl(SessionConfig config, link::LinkListeners& listen
       listeners_(listeners),
       psdSocket_(boundUdp()),
       pcdSocket_(boundUdp()),
+      pacerAlarm_(loop, [this] { onPacerAlarm(); }),
       machine_(config, boundPort(psdSocket_), Clock::now()),
       pacer_(pacerConfig(config)) {
   psdWatch_ = loop_.watch(psdSocket_.get(), EPOLLIN, [this](uint32_t) { readStatusReports(); });
-  pacerTimer_ = loop_.addTimer([this] { onPacerTimer(); });
   // The link's timeout looks at the reports waiting too, not only at those
   // a keepalive took with it.
   deadlineTimer_ = loop_.addTimer([this] {
@@ -243,7 +245,8 @@ TransmitterSession::Impl::~Impl() {
   loop_.invoke([this] {
     // Log out: stop the streams this session started (best effort, no wait).
     handle([](LoginMachine& m) { return m.close(); });
-    for (auto id : {psdWatch_, deadlineTimer_, pacerTimer_}) loop_.remove(id);
+    for (auto id : {psdWatch_, deadlineTimer_}) loop_.remove(id);
+    pacerAlarm_.stop();
   });
 }
 
@@ -263,11 +266,9 @@ void TransmitterSession::Impl::perform(LoginAction action) {
     // lookup a sendto pays, many times a second.
     ::connect(pcdSocket_.get(), aim->control.raw(), aim->control.size());
   } else if (std::holds_alternative<login::StartCommands>(action)) {
-    {
-      MutexLock lock(mutex_);
-      pacer_.restart();
-    }
-    loop_.arm(pacerTimer_, Clock::now());
+    MutexLock lock(mutex_);
+    pacer_.restart();
+    pacerAlarm_.set(Clock::now());
   }
 }
 
@@ -403,15 +404,16 @@ void TransmitterSession::Impl::readStatusReports() {
                    });
 }
 
-void TransmitterSession::Impl::onPacerTimer() {
+void TransmitterSession::Impl::onPacerAlarm() {
   auto now = Clock::now();
-  link::PacedStep step;
+  std::optional<link::Pulses> due;
   {
     MutexLock lock(mutex_);
     if (!steering()) return;
-    step = link::PacedStep::poll(pacer_, now);
+    due = pacer_.poll(now);
+    link::followPacer(pacer_, pacerAlarm_, now);
   }
-  step.carryOut([this](const link::Pulses& pulses) { sendPcd(pulses); }, loop_, pacerTimer_);
+  if (due) sendPcd(*due);
 }
 
 // ---------------------------------------------------------------------------
@@ -507,17 +509,15 @@ void TransmitterSession::stopStream(uint8_t camera) {
 
 void TransmitterSession::setCommand(const link::Pulses& pulses) {
   auto now = Clock::now();
-  link::PacedStep step;
-  bool steering;
+  std::optional<link::Pulses> due;
   {
     MutexLock lock(impl_->mutex_);
-    step = link::PacedStep::offer(impl_->pacer_, pulses, now);
-    steering = impl_->steering();
+    due = impl_->pacer_.offer(pulses, now);
+    if (!impl_->steering()) return;  // kept for when the control right comes
+    link::followPacer(impl_->pacer_, impl_->pacerAlarm_, now);
   }
-  if (!steering) return;  // kept for when the control right comes
   // A change leaves now, from this thread: no wait for a tick.
-  step.carryOut([this](const link::Pulses& due) { impl_->sendPcd(due); }, impl_->loop_,
-                impl_->pacerTimer_);
+  if (due) impl_->sendPcd(*due);
 }
 
 void TransmitterSession::shareTurn(Clock::duration untilNextTurn) {
@@ -527,11 +527,11 @@ void TransmitterSession::shareTurn(Clock::duration untilNextTurn) {
     MutexLock lock(impl_->mutex_);
     if (!impl_->steering()) return;
     due = impl_->pacer_.pollAhead(now, untilNextTurn);
-    if (!due) return;  // the timer stands
-    // Later than it stood: the loop sleeps on (EventLoop's timerfd). Under
-    // the lock, so a change another thread sets meanwhile arms its own
-    // earlier time after this.
-    impl_->loop_.arm(impl_->pacerTimer_, impl_->pacer_.nextDeadline(now));
+    if (!due) return;  // the alarm stands
+    // Later than it stood, so the loop sleeps on; and at the deadline
+    // itself, not the window's first shared tick, which would go off
+    // before the next turn could send the next keepalive.
+    impl_->pacerAlarm_.set(impl_->pacer_.nextDeadline(now));
   }
   impl_->sendPcd(*due);
 }

@@ -49,6 +49,23 @@ TEST_F(CommandPacerTest, AKeepaliveMayLeaveEarlyToShareAWakeUpButNeverLate) {
   EXPECT_EQ(pacer.nextDeadline(at(90)), at(190));
 }
 
+// The window a timer may go off in: a keepalive's opens keepaliveEarly
+// before its deadline, and poll() sends anywhere in it; any other deadline
+// (a change held back, the command running out) is a point.
+TEST_F(CommandPacerTest, AKeepalivesWindowOpensAsEarlyAsPollWouldSendIt) {
+  pacer.offer(steer(1700), at(0));
+  auto keepalive = pacer.nextWindow(at(0));
+  EXPECT_EQ(keepalive.earliest, at(90));
+  EXPECT_EQ(keepalive.latest, at(100));
+  EXPECT_EQ(pacer.poll(keepalive.earliest), steer(1700));
+
+  EXPECT_EQ(pacer.offer(steer(1800), at(92)), steer(1800));
+  EXPECT_EQ(pacer.offer(steer(1900), at(95)), std::nullopt);  // held by the rate limit
+  auto change = pacer.nextWindow(at(95));
+  EXPECT_EQ(change.earliest, at(102));
+  EXPECT_EQ(change.latest, at(102));
+}
+
 TEST_F(CommandPacerTest, HoldsBackAChangeWithinTheRateLimitAndSendsItWhenAllowed) {
   pacer.offer(steer(1700), at(0));
   EXPECT_EQ(pacer.offer(steer(1800), at(4)), std::nullopt);

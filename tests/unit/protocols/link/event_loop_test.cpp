@@ -46,9 +46,8 @@ TEST(EventLoop, ADisarmedTimerDoesNotFire) {
   EXPECT_FALSE(fired);
 }
 
-// What lets another thread send a keepalive on its own turn: moving the
-// link's timer later from that thread costs the loop no wake-up, and a
-// timer moved earlier still fires at its time.
+// A timer moved later from another thread costs the loop no wake-up, and
+// a timer moved earlier still fires at its time.
 TEST(EventLoop, ATimerMovedLaterFromAnotherThreadDoesNotWakeTheLoop) {
   EventLoop loop;
   std::atomic<int> fired{0};
