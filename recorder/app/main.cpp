@@ -11,6 +11,35 @@
 #include "app/slice_allocator.h"
 #include "app/supervisor.h"
 #include "camera/disk_writer.h"
+#include "common/open_file_limit.h"
+
+namespace {
+
+// A camera holds about a dozen open files (12 measured at 64: its sockets
+// and its link's, its pipeline's wake-ups, the files it writes); room
+// besides for a segment's next files, the servers and the logs.
+constexpr uint64_t kFilesPerCamera = 16;
+constexpr uint64_t kFilesBesideCameras = 64;
+
+// Raises this process's limit of open files as far as it may go, and says
+// so when even that is short for the cameras asked for.
+void warnIfFilesRunShort(const wircam::recorder::RecorderOptions& options) {
+  uint64_t cameras = 0;
+  for (const auto& device : options.devices)
+    cameras += device.cameras.empty() ? options.cameras.size() : device.cameras.size();
+  uint64_t limit = wircam::raiseOpenFileLimit();
+  uint64_t wanted = cameras * kFilesPerCamera + kFilesBesideCameras;
+  if (limit >= wanted) return;
+  std::fprintf(stderr,
+               "wirc-recorder: %llu cameras may need %llu open files, and this process may open "
+               "%llu: raise the limit (`ulimit -n %llu` in its shell, LimitNOFILE=%llu in its "
+               "systemd unit) or some cameras will not start\n",
+               static_cast<unsigned long long>(cameras), static_cast<unsigned long long>(wanted),
+               static_cast<unsigned long long>(limit), static_cast<unsigned long long>(wanted),
+               static_cast<unsigned long long>(wanted));
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace wircam::recorder;
@@ -33,6 +62,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "wirc-recorder: %s (see wirc-recorder --help)\n", options.error().c_str());
     return 2;
   }
+  warnIfFilesRunShort(*options);
   // The plugins of an uninstalled build sit beside bin/ in gst-plugins/.
   auto plugins =
       std::filesystem::canonical("/proc/self/exe").parent_path().parent_path() / "gst-plugins";

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "child_process.h"
+#include "common/open_file_limit.h"
 #include "synthetic_jpeg.h"
 
 namespace {
@@ -383,6 +384,9 @@ void compare(const fs::path& work, const fs::path& bin, int basePort, int n, dou
 
 int main(int argc, char** argv) {
   g_setenv("GST_PLUGIN_PATH", WIRCAM_PLUGIN_DIR, FALSE);
+  // Both sides' receivers inherit it: 256 stock pipelines need more than
+  // Debian's soft limit of 1024 open files too.
+  wircam::raiseOpenFileLimit();
   gst_init(&argc, &argv);
   bool together = argc > 1 && std::string(argv[1]) == "--together";
   if (together) --argc, ++argv;
