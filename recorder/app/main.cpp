@@ -23,7 +23,7 @@ constexpr uint64_t kFilesBesideCameras = 64;
 
 // Raises this process's limit of open files as far as it may go, and says
 // so when even that is short for the cameras asked for.
-void warnIfFilesRunShort(const wircam::recorder::RecorderOptions& options) {
+void raiseOpenFileLimitFor(const wircam::recorder::RecorderOptions& options) {
   uint64_t cameras = 0;
   for (const auto& device : options.devices)
     cameras += device.cameras.empty() ? options.cameras.size() : device.cameras.size();
@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "wirc-recorder: %s (see wirc-recorder --help)\n", options.error().c_str());
     return 2;
   }
-  warnIfFilesRunShort(*options);
+  raiseOpenFileLimitFor(*options);
   // The plugins of an uninstalled build sit beside bin/ in gst-plugins/.
   auto plugins =
       std::filesystem::canonical("/proc/self/exe").parent_path().parent_path() / "gst-plugins";

@@ -168,7 +168,7 @@ void Controller::Impl::onPacerAlarm() {
     commanded = pacer_.commanded();
     if (commanded) {
       due = pacer_.poll(now);
-      link::followPacer(pacer_, pacerAlarm_, now);
+      pacerAlarm_.set(pacer_.nextWindow(now));
     } else {
       pacerAlarm_.set(now + kIdlePeriod);
     }
@@ -227,7 +227,7 @@ void Controller::setCommand(const link::Pulses& pulses) {
     due = impl_->pacer_.offer(pulses, now);
     robot = impl_->registration_.registeredRobot();
     if (!robot) return;  // kept for when the robot is registered
-    link::followPacer(impl_->pacer_, impl_->pacerAlarm_, now);
+    impl_->pacerAlarm_.set(impl_->pacer_.nextWindow(now));
   }
   if (due) impl_->send(impl_->ctrlOf(*due), *robot);
 }

@@ -13,6 +13,7 @@
 #pragma once
 
 #include "common/socket.h"
+#include "link/command_pacer.h"
 #include "link/event_loop.h"
 
 namespace wircam::link {
@@ -30,6 +31,10 @@ class Alarm {
   // link's lock), as the last set wins.
   void set(Clock::time_point earliest, Clock::time_point latest);
   void set(Clock::time_point when) { set(when, when); }
+  // When a pacer has something to send next. Every link (WiRC, RCOIP,
+  // BTEMP) sends its commands the same way: under its lock, ask its pacer
+  // and set its alarm by it; outside the lock, send.
+  void set(const CommandPacer::Window& window) { set(window.earliest, window.latest); }
 
   // Once it returns, the callback does not run again (unless called from
   // the callback itself). Also done by the destructor.

@@ -68,16 +68,4 @@ class CommandPacer {
   std::optional<Clock::time_point> lastChangeTime_;  // the last send of a new value
 };
 
-// Sets a link's alarm (link/alarm.h) to when its pacer has something to
-// send next. Every link (WiRC, RCOIP, BTEMP) sends its commands the same
-// way: under its lock, decide and set the alarm; outside it, send. The
-// alarm is set under the lock so that the sets of several threads (a
-// command, a frame's turn, the alarm's own) land in the order the pacer
-// decided them.
-template <typename Alarm>
-void followPacer(const CommandPacer& pacer, Alarm& alarm, CommandPacer::Clock::time_point now) {
-  auto window = pacer.nextWindow(now);
-  alarm.set(window.earliest, window.latest);
-}
-
 }  // namespace wircam::link

@@ -124,7 +124,7 @@ void Transmitter::Impl::onPacerAlarm() {
   {
     MutexLock lock(mutex_);
     due = pacer_.poll(now);
-    link::followPacer(pacer_, pacerAlarm_, now);
+    pacerAlarm_.set(pacer_.nextWindow(now));
   }
   if (due) send(*due);
 }
@@ -193,7 +193,7 @@ void Transmitter::setCommand(const link::Pulses& pulses) {
   {
     MutexLock lock(impl_->mutex_);
     due = impl_->pacer_.offer(pulses, now);
-    link::followPacer(impl_->pacer_, impl_->pacerAlarm_, now);
+    impl_->pacerAlarm_.set(impl_->pacer_.nextWindow(now));
   }
   // A change leaves now, from this thread.
   if (due) impl_->send(*due);

@@ -160,7 +160,7 @@ class TransmitterSession::Impl {
   void readStatusReports();
   void onPacerAlarm();
   // While steering, a keepalive leaves at least every `keepalive` (100 ms
-  // by default, never off; on a stream's turn or the pacer's timer), and
+  // by default, never off; on a stream's turn or the pacer's alarm), and
   // the status reports waiting are read as it leaves: the loop wakes for
   // none of them (two a second, at CIF/15 about a tenth of the receiving
   // process's CPU). Otherwise the loop wakes for each. Under mutex_.
@@ -411,7 +411,7 @@ void TransmitterSession::Impl::onPacerAlarm() {
     MutexLock lock(mutex_);
     if (!steering()) return;
     due = pacer_.poll(now);
-    link::followPacer(pacer_, pacerAlarm_, now);
+    pacerAlarm_.set(pacer_.nextWindow(now));
   }
   if (due) sendPcd(*due);
 }
@@ -514,7 +514,7 @@ void TransmitterSession::setCommand(const link::Pulses& pulses) {
     MutexLock lock(impl_->mutex_);
     due = impl_->pacer_.offer(pulses, now);
     if (!impl_->steering()) return;  // kept for when the control right comes
-    link::followPacer(impl_->pacer_, impl_->pacerAlarm_, now);
+    impl_->pacerAlarm_.set(impl_->pacer_.nextWindow(now));
   }
   // A change leaves now, from this thread: no wait for a tick.
   if (due) impl_->sendPcd(*due);

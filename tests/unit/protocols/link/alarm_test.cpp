@@ -44,8 +44,7 @@ TEST(Alarm, GoesOffOnceNotBeforeItsTime) {
 }
 
 // What lets a stream's thread send a keepalive on its own turn: moving the
-// link's alarm later costs the loop no wake-up, and the loop's lock is not
-// taken (nothing else here would wake it).
+// link's alarm later costs the loop no wake-up.
 TEST(Alarm, MovedLaterFromAnotherThreadItNeitherWakesTheLoopNorGoesOff) {
   EventLoop loop;
   std::atomic<int> fired{0};
@@ -66,7 +65,7 @@ TEST(Alarm, MovedLaterFromAnotherThreadItNeitherWakesTheLoopNorGoesOff) {
 // Keepalives of many links due within one grid step of each other expire
 // together: the loop wakes once for all of them (twice at most, should the
 // kernel take two processors' timer interrupts for them), not once each.
-TEST(Alarm, AlarmsWhoseWindowsShareATickGoOffOnOneWakeUp) {
+TEST(Alarm, AlarmsWhoseWindowsShareATickShareTheLoopsWakeUp) {
   EventLoop loop;
   constexpr int kLinks = 8;
   std::atomic<int> fired{0};
