@@ -26,7 +26,10 @@ namespace wircam::recorder {
   X(messageCallbackSet, mosquitto_message_callback_set) \
   X(publishCallbackSet, mosquitto_publish_callback_set) \
   X(connect, mosquitto_connect)                         \
-  X(loop, mosquitto_loop)                               \
+  X(socket, mosquitto_socket)                           \
+  X(loopRead, mosquitto_loop_read)                      \
+  X(loopWrite, mosquitto_loop_write)                    \
+  X(loopMisc, mosquitto_loop_misc)                      \
   X(wantWrite, mosquitto_want_write)                    \
   X(publish, mosquitto_publish)                         \
   X(subscribe, mosquitto_subscribe)                     \

@@ -1,8 +1,10 @@
 #include "fleet/mqtt_client.h"
 
 #include <poll.h>
+#include <sys/eventfd.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 
 #include "common/socket.h"
@@ -15,6 +17,10 @@ namespace {
 constexpr int kKeepaliveSeconds = 10;
 constexpr std::chrono::seconds kMaxBackoff{30};
 constexpr int kReachTimeoutMs = 2000;
+// The longest wait between two keepalive checks of the library.
+constexpr int kServeTimeoutMs = 1000;
+// How long a write the library holds back waits before it is tried again.
+constexpr int kHeldWriteRetryMs = 10;
 
 }  // namespace
 
@@ -24,7 +30,8 @@ MqttClient::MqttClient(const MosquittoLibrary& lib, MqttUrl url, MqttWill will, 
       url_(std::move(url)),
       handle_(handle),
       handlers_(std::move(handlers)),
-      will_(std::move(will)) {}
+      will_(std::move(will)),
+      wakeFd_(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)) {}
 
 Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttUrl& url,
                                                                      const std::string& clientId,
@@ -36,6 +43,8 @@ Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttU
   mosquitto* handle = lib.create(clientId.c_str(), true, nullptr);
   if (!handle) return unexpected(std::string("cannot create an MQTT client"));
   std::unique_ptr<MqttClient> client(new MqttClient(lib, url, will, handle, std::move(handlers)));
+  if (!client->wakeFd_.valid())
+    return unexpected("cannot create the MQTT client's wake-up: " + errnoText(errno));
   lib.userDataSet(handle, client.get());
   lib.threadedSet(handle, true);
   if (!url.user.empty() &&
@@ -65,7 +74,7 @@ Expected<std::unique_ptr<MqttClient>, std::string> MqttClient::start(const MqttU
 
 MqttClient::~MqttClient() {
   stopping_ = true;
-  wake_.notify_all();
+  wake();
   if (thread_.joinable()) thread_.join();
   lib_.destroy(handle_);
 }
@@ -103,10 +112,59 @@ std::string MqttClient::cannotConnect(int rc) const {
          ", or the broker does not speak TLS there; retrying with backoff, the recording goes on";
 }
 
+void MqttClient::wake() {
+  uint64_t one = 1;
+  [[maybe_unused]] auto written = write(wakeFd_.get(), &one, sizeof one);
+}
+
+void MqttClient::takeWake() {
+  uint64_t count;
+  [[maybe_unused]] auto taken = read(wakeFd_.get(), &count, sizeof count);
+}
+
 void MqttClient::waitBackoff() {
-  std::unique_lock lock(mutex_);
-  wake_.wait_for(lock, backoff_, [this] { return stopping_.load(); });
+  using namespace std::chrono;
+  auto until = steady_clock::now() + backoff_;
+  pollfd wakeUp{.fd = wakeFd_.get(), .events = POLLIN, .revents = 0};
+  while (!stopping_) {
+    auto left = duration_cast<milliseconds>(until - steady_clock::now()).count();
+    if (left <= 0) break;
+    poll(&wakeUp, 1, static_cast<int>(left));
+    takeWake();
+  }
   backoff_ = std::min(backoff_ * 2, kMaxBackoff);
+}
+
+int MqttClient::serve(int timeoutMs) {
+  int socket = lib_.socket(handle_);
+  if (socket < 0) return MOSQ_ERR_NO_CONN;
+  // The library holds what it queued until its TLS handshake is done, and
+  // says nothing of it: when a write to a socket poll() called writable
+  // left something queued, the next waits a moment for the broker's answer
+  // alone, rather than spin on a socket that is always writable.
+  bool held = writeWaits_;
+  writeWaits_ = false;
+  short events = POLLIN;
+  if (!held && lib_.wantWrite(handle_)) events |= POLLOUT;
+  pollfd waits[2] = {{.fd = socket, .events = events, .revents = 0},
+                     {.fd = wakeFd_.get(), .events = POLLIN, .revents = 0}};
+  if (poll(waits, 2, held ? kHeldWriteRetryMs : timeoutMs) < 0 && errno != EINTR)
+    return MOSQ_ERR_ERRNO;
+  bool woken = waits[1].revents != 0;
+  if (woken) takeWake();
+  if (waits[0].revents & (POLLIN | POLLERR | POLLHUP)) {
+    int rc = lib_.loopRead(handle_, 1);
+    if (rc != MOSQ_ERR_SUCCESS || lib_.socket(handle_) < 0) return rc;
+  }
+  // Woken for a publish, the socket is tried at once: it is most often
+  // writable, and one poll fewer.
+  bool writable = waits[0].revents & POLLOUT;
+  if ((writable || woken || held) && lib_.wantWrite(handle_)) {
+    int rc = lib_.loopWrite(handle_, 1);
+    if (rc != MOSQ_ERR_SUCCESS || lib_.socket(handle_) < 0) return rc;
+    writeWaits_ = (writable || held) && lib_.wantWrite(handle_);
+  }
+  return lib_.loopMisc(handle_);
 }
 
 void MqttClient::run() {
@@ -125,7 +183,7 @@ void MqttClient::run() {
       }
       session = true;
     }
-    int rc = lib_.loop(handle_, 100, 1);
+    int rc = serve(kServeTimeoutMs);
     if (rc != MOSQ_ERR_SUCCESS) {
       session = false;
       if (connected_.exchange(false))
@@ -141,9 +199,9 @@ void MqttClient::run() {
     if (!will_.topic.empty())
       lib_.publish(handle_, nullptr, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
                    will_.payload.data(), 1, true);
-    for (int turn = 0; turn < 5 && lib_.wantWrite(handle_); ++turn) lib_.loop(handle_, 100, 1);
+    for (int turn = 0; turn < 5 && lib_.wantWrite(handle_); ++turn) serve(100);
     lib_.disconnect(handle_);
-    lib_.loop(handle_, 100, 1);
+    serve(100);
     connected_ = false;
   }
 }
@@ -190,11 +248,13 @@ bool MqttClient::publish(const std::string& topic, const std::string& payload, b
   int rc = lib_.publish(handle_, nullptr, topic.c_str(), static_cast<int>(payload.size()),
                         payload.data(), qos, retain);
   if (rc != MOSQ_ERR_SUCCESS) return --published_, ++dropped_, false;
+  wake();
   return true;
 }
 
 void MqttClient::subscribe(const std::string& pattern) {
   lib_.subscribe(handle_, nullptr, pattern.c_str(), 1);
+  wake();
 }
 
 MqttClient::Stats MqttClient::stats() const {

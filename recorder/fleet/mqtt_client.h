@@ -4,18 +4,23 @@
 // away or too much is still unsent. The connection is made again with backoff (1 s doubling to
 // 30 s) for as long as the client lives, and every wait is bounded, so a
 // dead broker never holds up a recording or its stop.
+//
+// The thread waits with poll(), not with mosquitto_loop(): that one's
+// select() refuses any socket numbered 1024 or more, and a recorder of a
+// hundred cameras holds more files than that, so a broker it lost was
+// never joined again.
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
+#include <chrono>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "common/expected.h"
+#include "common/socket.h"
 #include "fleet/mqtt_url.h"
 
 struct mosquitto;
@@ -75,6 +80,11 @@ class MqttClient {
   MqttClient(const MosquittoLibrary& lib, MqttUrl url, MqttWill will, mosquitto* handle,
              Handlers handlers);
   void run();
+  // One wait on the broker's socket (at most `timeoutMs`) and the library's
+  // reads, writes and keepalive that it calls for; a mosquitto error code.
+  int serve(int timeoutMs);
+  void wake();
+  void takeWake();
   bool reachable();
   // Why a connection could not be made, in words (a TLS failure explained).
   std::string cannotConnect(int rc) const;
@@ -93,9 +103,9 @@ class MqttClient {
   std::atomic<bool> stopping_{false};
   std::atomic<uint64_t> published_{0}, written_{0}, dropped_{0}, connects_{0};
   std::chrono::seconds backoff_{1};
-  std::string lastReport_;  // client thread only
-  std::mutex mutex_;        // the stop's wake-up
-  std::condition_variable wake_;
+  std::string lastReport_;   // client thread only
+  bool writeWaits_ = false;  // client thread only: see serve()
+  const UniqueFd wakeFd_;    // an eventfd: something to publish, or the stop
   std::thread thread_;
 };
 
