@@ -58,10 +58,18 @@ void TelemetryTrack::beforeFrame(GstClockTime frameTime, uint64_t file) {
   }
   moveTo(file);
   GstClockTime from = frameTime + 1;
-  if (gapsAreSamples_) from = startAfterTheLast(from);
+  GstClockTime reach = kLineDuration;
+  if (gapsAreSamples_) {
+    from = startAfterTheLast(from);
+  } else {
+    if (lines.empty() && !ended_ && file == gapFile_ && frameTime < gapEnd_) return;
+    reach = kGapAhead;
+    gapFile_ = file;
+    gapEnd_ = from + reach;
+  }
   GstBuffer* gap = gst_buffer_new();
   GST_BUFFER_FLAG_SET(gap, GST_BUFFER_FLAG_GAP);
-  outlet_->beforeFrame(std::move(lines), bufferOf(gap, from, kLineDuration, file));
+  outlet_->beforeFrame(std::move(lines), bufferOf(gap, from, reach, file));
 }
 
 GstPadProbeReturn TelemetryTrack::passGap(GstPad* pad, GstPadProbeInfo* info, bool asEvent) {

@@ -10,7 +10,10 @@
 // time, is about to enter its file (beforeFrame): a muxer hands on a frame
 // only once every track has passed its time, so the line goes in then, and
 // after it a gap (the text has nothing more up to the frame) that lets the
-// frame through.
+// frame through. For matroskamux the gap reaches a second past the frame,
+// so the frames after it that no line precedes go in without one: a gap a
+// frame cost a camera's thread about 30 µs (docs/performance.md). A line
+// may still come within that second; its muxer takes it all the same.
 #pragma once
 
 #include <gst/gst.h>
@@ -49,7 +52,8 @@ class TelemetryTrack {
   uint64_t fileOpened(GstClockTime start);
 
   // A frame at `frameTime` is about to enter file `file`, on its thread:
-  // the lines it reaches go to the outlet, then a gap just past it.
+  // the lines it reaches go to the outlet, then a gap just past it (none
+  // when there is no line and the gap before reaches past the frame).
   void beforeFrame(GstClockTime frameTime, uint64_t file);
 
   static bool isGap(GstBuffer* buffer) {
@@ -106,11 +110,15 @@ class TelemetryTrack {
   // The newest line's time in it (samples: the end of the newest).
   GstClockTime last_ WIRCAM_GUARDED_BY(mutex_) = 0;
   bool ended_ WIRCAM_GUARDED_BY(mutex_) = false;
+  // Where the newest gap (matroskamux's) left the text, and in which file.
+  uint64_t gapFile_ WIRCAM_GUARDED_BY(mutex_) = 0;
+  GstClockTime gapEnd_ WIRCAM_GUARDED_BY(mutex_) = 0;
   uint64_t framesFile_ WIRCAM_GUARDED_BY(mutex_) = 0;         // the file of the newest frame
   std::deque<Line> due_ WIRCAM_GUARDED_BY(mutex_);            // for open files, by file
   std::deque<Waiting> waiting_ WIRCAM_GUARDED_BY(mutex_);     // for files still to open
   static constexpr size_t kMaxWaiting = 1024;                 // each (past it: the oldest go)
   static constexpr GstClockTime kLineDuration = GST_MSECOND;  // an event, not a caption to read
+  static constexpr GstClockTime kGapAhead = GST_SECOND;       // a GAP event's reach past its frame
 };
 
 }  // namespace wircam::recorder
