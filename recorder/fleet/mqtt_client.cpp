@@ -152,7 +152,7 @@ int MqttClient::serve(int timeoutMs) {
     return MOSQ_ERR_ERRNO;
   bool woken = waits[1].revents != 0;
   if (woken) takeWake();
-  if (waits[0].revents & (POLLIN | POLLERR | POLLHUP)) {
+  if (waits[0].revents & (POLLIN | POLLERR | POLLHUP | POLLNVAL)) {
     int rc = lib_.loopRead(handle_, 1);
     if (rc != MOSQ_ERR_SUCCESS || lib_.socket(handle_) < 0) return rc;
   }
