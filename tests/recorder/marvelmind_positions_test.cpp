@@ -102,7 +102,7 @@ TEST(RecorderPositions, ReachTheRecordingWithinNoiseOfTheTruthAndAtMostAPollLate
   double travelled = std::hypot(truth.back().x - truth.front().x, truth.back().y - truth.front().y);
   EXPECT_GT(travelled, 0.5);
 
-  int positions = 0, matched = 0;
+  int positions = 0, matched = 0, unwitnessed = 0;
   double worst = 0;
   for (const auto& sidecar : recorder.files(".jsonl")) {
     std::ifstream in(sidecar);
@@ -116,14 +116,24 @@ TEST(RecorderPositions, ReachTheRecordingWithinNoiseOfTheTruthAndAtMostAPollLate
       // the scene moves the car on with the wall clock, but writes a truth
       // line only with a frame, so nothing here says where the car was.
       if (at > truth.back().unixMs + 70) continue;
-      ++positions;
       // The truth somewhere between one poll period (and a frame of the
       // scene's stepping) before the line's time and a frame after it.
       double best = 1e9;
+      bool witnessed = false;
       for (const auto& sample : truth)
-        if (sample.unixMs >= at - (kPollSeconds * 1000 + 70) && sample.unixMs <= at + 70)
+        if (sample.unixMs >= at - (kPollSeconds * 1000 + 70) && sample.unixMs <= at + 70) {
+          witnessed = true;
           best = std::min(best, std::hypot(sample.x - line["x"].get<double>(),
                                            sample.y - line["y"].get<double>()));
+        }
+      // A busy machine can hold the scene's frames back for longer than
+      // that window (seen beside the whole suite); with no truth line in
+      // it, nothing says where the car was.
+      if (!witnessed) {
+        ++unwitnessed;
+        continue;
+      }
+      ++positions;
       worst = std::max(worst, best);
       // 5 sigma of the 2-D noise, plus the centimetre rounding.
       if (best <= 5 * kNoise * std::sqrt(2.0) + 0.01)
@@ -134,7 +144,7 @@ TEST(RecorderPositions, ReachTheRecordingWithinNoiseOfTheTruthAndAtMostAPollLate
     }
   }
   // 10 polls a second for most of the 6 s recorded.
-  EXPECT_GT(positions, 40);
+  EXPECT_GT(positions, 40) << unwitnessed << " without a truth line near them";
   EXPECT_EQ(matched, positions) << "the worst was " << worst << " m from the truth";
   fs::remove_all(folder);
 }
