@@ -24,9 +24,8 @@ constexpr uint64_t kFilesBesideCameras = 64;
 // Raises this process's limit of open files as far as it may go, and says
 // so when even that is short for the cameras asked for.
 void raiseOpenFileLimitFor(const wircam::recorder::RecorderOptions& options) {
-  uint64_t cameras = 0;
-  for (const auto& device : options.devices)
-    cameras += device.cameras.empty() ? options.cameras.size() : device.cameras.size();
+  uint64_t cameras = 0;  // (a device's list holds the --camera default when it named none)
+  for (const auto& device : options.devices) cameras += device.cameras.size();
   uint64_t limit = wircam::raiseOpenFileLimit();
   uint64_t wanted = cameras * kFilesPerCamera + kFilesBesideCameras;
   if (limit >= wanted) return;

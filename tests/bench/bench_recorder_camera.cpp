@@ -36,13 +36,22 @@ constexpr int kFrames = 450;
 constexpr GstClockTime kFrameInterval = GST_SECOND / 15;
 constexpr uint64_t kRecordQueue = 8 << 20;  // the recorder's default --record-queue
 
-fs::path benchFolder(const char* name) {
-  fs::path folder =
-      fs::temp_directory_path() / ("wircam-bench-camera-" + std::to_string(getpid()) + "-" + name);
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
-}
+// A folder of its own for what one benchmark records, emptied by each
+// iteration (a camera names its files by the second: 450 frames an
+// iteration filled hundreds of MB a run) and removed at the end.
+struct BenchFolder {
+  explicit BenchFolder(const char* name)
+      : path(fs::temp_directory_path() /
+             ("wircam-bench-camera-" + std::to_string(getpid()) + "-" + name)) {
+    empty();
+  }
+  ~BenchFolder() { fs::remove_all(path); }
+  void empty() const {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  fs::path path;
+};
 
 GstBuffer* frame(int index) {
   const auto& jpeg = sceneFrames()[index % sceneFrames().size()];
@@ -74,9 +83,10 @@ StreamPlan cameraPlan(bool textTrack, uint64_t recordQueue) {
 // `recordQueue` 0: the camera writes its files itself (filesink), as with
 // --record-queue 0; else through the filesystem's DiskWriter.
 void recordCamera(benchmark::State& state, bool textTrack, uint64_t recordQueue) {
-  fs::path folder = benchFolder(textTrack ? "text" : recordQueue ? "notext" : "noqueue");
+  BenchFolder folder(textTrack ? "text" : recordQueue ? "notext" : "noqueue");
   for (auto _ : state) {
     state.PauseTiming();  // the camera's start is not a frame's cost
+    folder.empty();
     wircam::testing::CameraEvents observed;
     GstElement* source = nullptr;
     GstClock* clock = nullptr;
@@ -93,7 +103,7 @@ void recordCamera(benchmark::State& state, bool textTrack, uint64_t recordQueue)
       }
       return pipeline;
     };
-    CameraFiles files{.folder = folder.string(), .extension = ".mkv", .limits = {}};
+    CameraFiles files{.folder = folder.path.string(), .extension = ".mkv", .limits = {}};
     auto camera = Camera::create(cameraPlan(textTrack, recordQueue), files, {}, observed, builder);
     if (!camera || !(*camera)->start() || !source) {
       state.SkipWithError("the camera did not start");
@@ -124,7 +134,6 @@ void recordCamera(benchmark::State& state, bool textTrack, uint64_t recordQueue)
     state.ResumeTiming();
   }
   state.SetItemsProcessed(state.iterations() * kFrames);
-  fs::remove_all(folder);
 }
 
 void BM_RecorderCamera(benchmark::State& state) { recordCamera(state, true, kRecordQueue); }
@@ -134,10 +143,10 @@ void BM_RecorderCameraNoTextTrack(benchmark::State& state) {
 void BM_RecorderCameraNoTextTrackNoQueue(benchmark::State& state) { recordCamera(state, false, 0); }
 
 void BM_StockMatroskaFile(benchmark::State& state) {
-  fs::path folder = benchFolder("stock");
+  BenchFolder folder("stock");  // one file, written over by each iteration
   std::string description = std::string("appsrc name=src format=time caps=") + kCaps +
                             " ! matroskamux ! filesink location=\"" +
-                            (folder / "stock.mkv").string() + "\"";
+                            (folder.path / "stock.mkv").string() + "\"";
   for (auto _ : state) {
     state.PauseTiming();
     GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
@@ -162,7 +171,6 @@ void BM_StockMatroskaFile(benchmark::State& state) {
     state.ResumeTiming();
   }
   state.SetItemsProcessed(state.iterations() * kFrames);
-  fs::remove_all(folder);
 }
 
 }  // namespace
