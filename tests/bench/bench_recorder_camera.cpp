@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "appsrc_camera_plan.h"
 #include "camera/camera.h"
 #include "camera/camera_pipeline.h"
 #include "camera_events.h"
@@ -61,22 +62,11 @@ GstBuffer* frame(int index) {
   return buffer;
 }
 
-const char* kCaps = "image/jpeg,width=352,height=288,framerate=15/1";
-
-// The recorder's plan for a camera whose source is an appsrc.
+// The recorder's plan for a camera whose source is an appsrc, the test's.
 StreamPlan cameraPlan(bool textTrack, uint64_t recordQueue) {
-  StreamPlan plan;
-  plan.description = std::string("appsrc name=src format=time caps=") + kCaps;
-  plan.device = "bench";
-  plan.name = "bench-cam0";
-  plan.source = plan.videoTail = "src";
+  StreamPlan plan = wircam::testing::appSrcCameraPlan();
   plan.recordBound = recordQueue;
-  plan.muxer = {.factory = "matroskamux", .text = false};
-  if (textTrack) {
-    plan.description += " taginject name=teltag";
-    plan.telemetryTail = "teltag";
-    plan.muxer.text = plan.muxer.textGapEvents = true;
-  }
+  if (textTrack) wircam::testing::addTextTrack(plan);
   return plan;
 }
 
@@ -144,7 +134,7 @@ void BM_RecorderCameraNoTextTrackNoQueue(benchmark::State& state) { recordCamera
 
 void BM_StockMatroskaFile(benchmark::State& state) {
   BenchFolder folder("stock");  // one file, written over by each iteration
-  std::string description = std::string("appsrc name=src format=time caps=") + kCaps +
+  std::string description = std::string(wircam::testing::kAppSrcCamera) +
                             " ! matroskamux ! filesink location=\"" +
                             (folder.path / "stock.mkv").string() + "\"";
   for (auto _ : state) {

@@ -17,6 +17,7 @@
 #include <thread>
 #include <utility>
 
+#include "appsrc_camera_plan.h"
 #include "camera/camera.h"
 #include "camera_events.h"
 #include "scene_frames.h"
@@ -75,18 +76,8 @@ class CameraFilesTest : public ::testing::Test {
     fs::remove_all(folder_);
   }
 
-  // The recorder's plan for a camera without a device: the appsrc is the
-  // source and the tail (nothing branches), no text track.
-  StreamPlan plan() const {
-    StreamPlan p;
-    p.description =
-        "appsrc name=src format=time caps=image/jpeg,width=352,height=288,framerate=15/1";
-    p.device = "bench";
-    p.name = "bench-cam0";
-    p.source = p.videoTail = "src";
-    p.muxer = {.factory = "matroskamux", .text = false};
-    return p;
-  }
+  // The recorder's plan for a camera without a device (appsrc_camera_plan.h).
+  StreamPlan plan() const { return wircam::testing::appSrcCameraPlan(); }
 
   // Builds as the recorder does, then puts the pipeline on a test clock.
   Camera::PipelineBuilder onTestClock() {
@@ -139,11 +130,7 @@ class CameraFilesTest : public ::testing::Test {
         "async=false";
     p.videoTail = "t";
     p.recordBound = 150000;
-    if (textTrack) {
-      p.description += " taginject name=teltag";
-      p.telemetryTail = "teltag";
-      p.muxer.text = p.muxer.textGapEvents = true;
-    }
+    if (textTrack) wircam::testing::addTextTrack(p);
     return p;
   }
 
