@@ -11,9 +11,10 @@
 // only once every track has passed its time, so the line goes in then, and
 // after it a gap (the text has nothing more up to the frame) that lets the
 // frame through. For matroskamux the gap reaches a second past the frame,
-// so the frames after it that no line precedes go in without one: a gap a
-// frame cost a camera's thread about 30 µs (docs/performance.md). A line
-// may still come within that second; its muxer takes it all the same.
+// so the frames after it that no line precedes go in without one: with a
+// gap a frame the text track cost 3.7 µs a frame, now 1.2 µs
+// (bench_recorder_camera, docs/performance.md). A line may still come
+// within that second; its muxer takes it all the same.
 #pragma once
 
 #include <gst/gst.h>
