@@ -41,13 +41,14 @@ Expected<std::unique_ptr<Camera>, std::string> Camera::create(StreamPlan plan, C
 
 Camera::~Camera() {
   if (deadlineTimer_) g_source_remove(deadlineTimer_);
-  if (busWatch_) g_source_remove(busWatch_);
+  busWatch_.reset();
   pipeline_.reset();
 }
 
 void Camera::watchBus() {
+  busWatch_.reset();  // (a bus takes one watch at a time)
   GstBus* bus = gst_element_get_bus(pipeline_->pipeline());
-  busWatch_ = gst_bus_add_watch(bus, onBusMessage, this);
+  busWatch_ = std::make_unique<BusWatch>(bus, onBusMessage, this);
   gst_object_unref(bus);
 }
 
@@ -55,16 +56,14 @@ bool Camera::play() {
   watchBus();
   if (gst_element_set_state(pipeline_->pipeline(), GST_STATE_PLAYING) != GST_STATE_CHANGE_FAILURE)
     return true;
-  // The error itself is on the bus: say it.
-  GstBus* bus = gst_element_get_bus(pipeline_->pipeline());
-  if (GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR)) {
+  // The error itself was posted: say it.
+  if (GstMessage* message = busWatch_->take(GST_MESSAGE_ERROR)) {
     GError* error = nullptr;
     gst_message_parse_error(message, &error, nullptr);
     logLine(name() + ": cannot start: " + error->message);
     g_error_free(error);
     gst_message_unref(message);
   }
-  gst_object_unref(bus);
   return false;
 }
 
@@ -149,7 +148,7 @@ void Camera::endFile(bool forGood) {
 }
 
 void Camera::tearDown() {
-  if (busWatch_) g_source_remove(std::exchange(busWatch_, 0));
+  busWatch_.reset();
   if (GstElement* control = controller()) {
     // What the user set (following, the target) carries over to the next run.
     gboolean enabled = FALSE;

@@ -22,6 +22,7 @@
 #include <optional>
 #include <string>
 
+#include "camera/bus_watch.h"
 #include "camera/camera_health.h"
 #include "camera/camera_machine.h"
 #include "camera/camera_pipeline.h"
@@ -155,7 +156,7 @@ class Camera {
   FrameTap frames_;
   FrameTap encodedFrames_;
   std::unique_ptr<CameraPipeline> pipeline_;
-  guint busWatch_ = 0;
+  std::unique_ptr<BusWatch> busWatch_;
   guint deadlineTimer_ = 0;  // at machine_.nextDeadline()
   uint64_t filesClosed_ = 0;
   uint64_t framesSeen_ = 0;      // the frames that came for the files, at the last tick
