@@ -29,7 +29,15 @@ std::string fileSafe(std::string text) {
 // empty buffers instead, as it did inside splitmuxsink.
 MuxerSpec muxerOf(Container container) {
   if (container == Container::kMp4) return {"mp4mux", {{"fragment-duration", "500"}}, false};
-  return {"matroskamux", {{"max-cluster-duration", "500000000"}}, true};
+  // A cue (the index a player seeks by) for the first key frame of each
+  // half second, as clusters are cut, not for every one: every JPEG frame
+  // is a key frame, and matroskamux holds each file's cues in memory until
+  // its end (24 bytes a frame: 5.5 MB for 256 cameras' minute at 15 fps).
+  // Seeks stay exact: the demuxer starts at the cue before and the
+  // playback's seeks are accurate.
+  return {"matroskamux",
+          {{"max-cluster-duration", "500000000"}, {"min-index-interval", "500000000"}},
+          true};
 }
 
 // What the frames pass through on their way to the file, ending in the
