@@ -325,14 +325,20 @@ Run recordWithStock(const fs::path& work, const fs::path& frames, int basePort, 
   return run;
 }
 
-// A recorder run over the stock one: CPU while recording, peak memory.
+// A recorder run over the stock one: CPU while recording, a stream's and a
+// frame recorded's (on saturated processors stock records fewer of the
+// frames sent, and spends less on those it loses), and peak memory.
 std::string ratios(const Run& recorder, const Run& stock) {
-  char text[120];
-  std::snprintf(text, sizeof text, "wirc-recorder ÷ stock: CPU %.2f×, memory %.2f×",
-                stock.recordingCpu > 0 ? recorder.recordingCpu / stock.recordingCpu : 0.0,
-                stock.usage.maxRssKb > 0
-                    ? static_cast<double>(recorder.usage.maxRssKb) / stock.usage.maxRssKb
-                    : 0.0);
+  auto perFrame = [](const Run& run) {
+    return run.recorded > 0 ? run.recordingCpu / run.recorded : 0.0;
+  };
+  char text[160];
+  std::snprintf(
+      text, sizeof text, "wirc-recorder ÷ stock: CPU %.2f× (a frame recorded: %.2f×), memory %.2f×",
+      stock.recordingCpu > 0 ? recorder.recordingCpu / stock.recordingCpu : 0.0,
+      perFrame(stock) > 0 ? perFrame(recorder) / perFrame(stock) : 0.0,
+      stock.usage.maxRssKb > 0 ? static_cast<double>(recorder.usage.maxRssKb) / stock.usage.maxRssKb
+                               : 0.0);
   return text;
 }
 
