@@ -27,9 +27,13 @@ constexpr uint64_t kGatherBytes = 1 << 20;
 // Writes of one file that follow each other on it go out in one call.
 constexpr size_t kMaxRun = 64;
 
+// Each writer made, for the rest of the process. (Held by its cameras
+// alone, its last holder could be its own thread: a file whose camera's
+// pipeline is gone ends there, and the sink it lets go of held the
+// writer; a thread cannot join itself.)
 std::mutex registryMutex;
-std::map<dev_t, std::weak_ptr<DiskWriter>>& registry() {
-  static auto* writers = new std::map<dev_t, std::weak_ptr<DiskWriter>>;
+std::map<dev_t, std::shared_ptr<DiskWriter>>& registry() {
+  static auto* writers = new std::map<dev_t, std::shared_ptr<DiskWriter>>;
   return *writers;
 }
 
@@ -67,13 +71,11 @@ Expected<std::shared_ptr<DiskWriter>, std::string> DiskWriter::of(const std::str
     return unexpected("cannot write into " + folder + ": " + std::strerror(errno));
   std::lock_guard lock(registryMutex);
   auto& known = registry()[info.st_dev];
-  if (auto writer = known.lock()) return writer;
-  std::shared_ptr<DiskWriter> writer(new DiskWriter(info.st_dev));
-  known = writer;
-  return writer;
+  if (!known) known.reset(new DiskWriter);
+  return known;
 }
 
-DiskWriter::DiskWriter(dev_t device) : device_(device) {
+DiskWriter::DiskWriter() {
   maps_.resize(kMaxRun);
   pieces_.reserve(kMaxRun);
   thread_ = std::thread([this] { run(); });
@@ -86,9 +88,6 @@ DiskWriter::~DiskWriter() {
   }
   wake_.notifyOne();
   thread_.join();
-  std::lock_guard lock(registryMutex);
-  auto found = registry().find(device_);
-  if (found != registry().end() && found->second.expired()) registry().erase(found);
 }
 
 Expected<std::shared_ptr<DiskWriter::File>, int> DiskWriter::open(const std::string& path) {
@@ -156,8 +155,7 @@ void DiskWriter::finishAll() {
   std::vector<std::shared_ptr<DiskWriter>> writers;
   {
     std::lock_guard lock(registryMutex);
-    for (const auto& [device, writer] : registry())
-      if (auto held = writer.lock()) writers.push_back(std::move(held));
+    for (const auto& [device, writer] : registry()) writers.push_back(writer);
   }
   for (const auto& writer : writers) {
     MutexLock lock(writer->mutex_);

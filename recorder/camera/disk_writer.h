@@ -1,5 +1,6 @@
 // Writes the recorded files of every camera on one filesystem from one
-// thread (one per st_dev, shared while used): a camera's muxer hands its
+// thread (one per st_dev, made at its first use, for the rest of the
+// process; it sleeps while nothing is handed over): a camera's muxer hands its
 // bytes over on the camera's own thread and goes on, so a slow or stalled
 // disk holds up the cameras writing to it only through their DiskBudget
 // (past it their frames are dropped and counted), never their threads, and
@@ -42,9 +43,9 @@ class DiskWriter {
   using File = DiskFile;
 
   // The writer of the filesystem `folder` is on: made at the first use,
-  // shared while any camera holds it.
+  // kept for the rest of the process.
   static Expected<std::shared_ptr<DiskWriter>, std::string> of(const std::string& folder);
-  ~DiskWriter();  // after what was handed over is written
+  ~DiskWriter();  // after what was handed over is written (the registry's never is)
   DiskWriter(const DiskWriter&) = delete;
   DiskWriter& operator=(const DiskWriter&) = delete;
 
@@ -75,7 +76,7 @@ class DiskWriter {
   void release();
 
  private:
-  explicit DiskWriter(dev_t device);
+  DiskWriter();
   void run();
   // Puts `lane` on the list of lanes with writes; true when it was empty.
   bool list(DiskBudget* lane);
@@ -101,7 +102,6 @@ class DiskWriter {
   void countWritten();
   static void writeAll(File& file, std::vector<iovec>& pieces, uint64_t offset);
 
-  const dev_t device_;
   // The lanes with writes, linked through DiskBudget::nextListed_: pushed
   // by the cameras, taken all at once by the thread.
   std::atomic<DiskBudget*> listed_{nullptr};

@@ -9,8 +9,10 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <string>
 #include <thread>
@@ -93,6 +95,34 @@ TEST_F(DiskWriterTest, AFullDiskIsTheFilesErrorAndItsCloseSaysSo) {
   EXPECT_EQ((*writer)->close(*file), ENOSPC);
   EXPECT_EQ(DiskWriter::errorOf(**file), ENOSPC);
   EXPECT_EQ(budget_->waiting(), 0u) << "what failed is no longer waiting";
+}
+
+// A file cut off after its camera's pipeline is gone ends on the writer's
+// thread, and what it lets go of there (its sink) may have held the last
+// reference to the writer: the writer must not end with it (a thread
+// cannot join itself; the recorder aborted).
+TEST_F(DiskWriterTest, AFileEndingOnTheWritersThreadLetsGoOfTheWriterWithoutEndingIt) {
+  auto writer = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(writer);
+  DiskWriter* shared = writer->get();
+  auto file = DiskWriter::open((folder_ / "e.mkv").string());
+  ASSERT_TRUE(file);
+  shared->hold();
+  write(*shared, *file, 0, "last frame");
+  std::promise<int> ended;
+  shared->closeWhenWritten(*file, [heldBySink = *writer, &ended](int error) mutable {
+    heldBySink.reset();
+    ended.set_value(error);
+  });
+  writer->reset();  // the camera's pipeline is gone
+  shared->release();
+  auto end = ended.get_future();
+  ASSERT_EQ(end.wait_for(std::chrono::seconds(10)), std::future_status::ready);
+  EXPECT_EQ(end.get(), 0);
+  EXPECT_EQ(contentOf(folder_ / "e.mkv"), "last frame");
+  auto again = DiskWriter::of(folder_.string());
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->get(), shared) << "the next camera on this filesystem takes up the same writer";
 }
 
 // The lanes are written in the order they got writes: once a write on a
