@@ -46,6 +46,14 @@ class Hub {
     if (wasEmpty) g_source_set_ready_time(source_, 0);
   }
 
+  // No more posts from its bus, and none delivered of those waiting. On
+  // the main loop.
+  static void close(BusWatch::Lane& lane) {
+    if (!lane.open) return;
+    lane.open = false;
+    gst_bus_set_sync_handler(lane.bus, nullptr, nullptr, nullptr);
+  }
+
   GstMessage* take(const BusWatch::Lane& lane, GstMessageType type) {
     MutexLock lock(mutex_);
     auto found = std::find_if(queued_.begin(), queued_.end(), [&](const Posted& posted) {
@@ -92,15 +100,6 @@ class Hub {
     delivering_.clear();  // (its capacity kept)
   }
 
- public:
-  // No more posts from its bus, and none delivered of those waiting.
-  static void close(BusWatch::Lane& lane) {
-    if (!lane.open) return;
-    lane.open = false;
-    gst_bus_set_sync_handler(lane.bus, nullptr, nullptr, nullptr);
-  }
-
- private:
   GSource* source_;
   Mutex mutex_;
   std::vector<Posted> queued_ WIRCAM_GUARDED_BY(mutex_);
