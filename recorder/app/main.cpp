@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "app/live_servers_module.h"
+#include "app/open_files_check.h"
 #include "app/recorder_options.h"
 #include "app/slice_allocator.h"
 #include "app/supervisor.h"
@@ -15,27 +16,13 @@
 
 namespace {
 
-// A camera holds about a dozen open files (12 measured at 64: its sockets
-// and its link's, its pipeline's wake-ups, the files it writes); room
-// besides for a segment's next files, the servers and the logs.
-constexpr uint64_t kFilesPerCamera = 16;
-constexpr uint64_t kFilesBesideCameras = 64;
-
 // Raises this process's limit of open files as far as it may go, and says
 // so when even that is short for the cameras asked for.
 void raiseOpenFileLimitFor(const wircam::recorder::RecorderOptions& options) {
   uint64_t cameras = 0;  // (a device's list holds the --camera default when it named none)
   for (const auto& device : options.devices) cameras += device.cameras.size();
-  uint64_t limit = wircam::raiseOpenFileLimit();
-  uint64_t wanted = cameras * kFilesPerCamera + kFilesBesideCameras;
-  if (limit >= wanted) return;
-  std::fprintf(stderr,
-               "wirc-recorder: %llu cameras may need %llu open files, and this process may open "
-               "%llu: raise the limit (`ulimit -n %llu` in its shell, LimitNOFILE=%llu in its "
-               "systemd unit) or some cameras will not start\n",
-               static_cast<unsigned long long>(cameras), static_cast<unsigned long long>(wanted),
-               static_cast<unsigned long long>(limit), static_cast<unsigned long long>(wanted),
-               static_cast<unsigned long long>(wanted));
+  if (auto shortfall = wircam::recorder::openFilesShortfall(cameras, wircam::raiseOpenFileLimit()))
+    std::fprintf(stderr, "wirc-recorder: %s\n", shortfall->c_str());
 }
 
 }  // namespace

@@ -6,9 +6,11 @@
 // not validate or change what only a restart of the recorder can.
 #include <algorithm>
 
+#include "app/open_files_check.h"
 #include "app/pipeline_planner.h"
 #include "app/reload_plan.h"
 #include "app/supervisor.h"
+#include "common/open_file_limit.h"
 #include "log_line.h"
 
 namespace wircam::recorder {
@@ -63,6 +65,9 @@ Expected<nlohmann::json, std::string> Supervisor::reload() {
   }
   options_ = std::move(*reread);
   retention_.setLimits(retentionOf(options_));
+  if (!added.empty())
+    if (auto shortfall = openFilesShortfall(plan.streams.size(), raiseOpenFileLimit()))
+      logLine("reload: " + *shortfall);
   for (auto& camera : added) {
     Camera& fresh = *camera;
     cameras_.push_back(std::move(camera));
