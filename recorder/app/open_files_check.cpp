@@ -3,8 +3,8 @@
 namespace wircam::recorder {
 
 namespace {
-// Room besides a camera's own for a segment's next files; and besides the
-// cameras for the servers and the logs.
+// A camera's dozen, with room for a segment's next files; and, besides
+// the cameras, the servers and the logs.
 constexpr uint64_t kFilesPerCamera = 16;
 constexpr uint64_t kFilesBesideCameras = 64;
 }  // namespace

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -33,9 +34,10 @@ struct Posted {
 // every other thread (thread_priority.h), post too, and GLib's own ways
 // of waking a loop (g_source_set_ready_time, g_main_context_wakeup) take
 // its context's lock, which the main loop's thread holds as it polls,
-// and which lends no priority: behind a preempted main thread, the links'
-// keepalives stopped for 800 ms on a busy machine. The queue's own lock
-// does lend it, and the main thread holds it only to take the queue.
+// and which lends no priority. (With them, a simulator twice went 800 ms
+// without a keepalive under the whole suite's load, likely behind a
+// preempted main thread.) The queue's own lock does lend it, and the main
+// thread holds it only to take the queue.
 class Hub {
  public:
   // Made at the first watch, for the rest of the process.
@@ -79,6 +81,10 @@ class Hub {
 
  private:
   Hub() : wake_(eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK)) {
+    // Without it no camera would hear its elements: said, not limped on.
+    if (wake_ < 0)
+      g_error("wirc-recorder: cannot make an eventfd for the cameras' messages: %s",
+              g_strerror(errno));
     static GSourceFuncs funcs = {.prepare = nullptr,
                                  .check = nullptr,
                                  .dispatch = onReady,
