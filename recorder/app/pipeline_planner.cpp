@@ -20,24 +20,8 @@ std::string fileSafe(std::string text) {
   return text;
 }
 
-// Each file's muxer. Crash safety: Matroska clusters and MP4 fragments of
-// at most 0.5 s (the muxers write a cluster or fragment whole), so a killed
-// recorder leaves the open segment playable up to about its last second.
-// The text track's gaps (TelemetryTrack::heartbeat) reach matroskamux as
-// GAP events, for which it writes nothing, not even to the duration;
-// mp4mux (an aggregator, GStreamer 1.22) stalls on GAP events, and gets
-// empty buffers instead, as it did inside splitmuxsink.
 MuxerSpec muxerOf(Container container) {
-  if (container == Container::kMp4) return {"mp4mux", {{"fragment-duration", "500"}}, false};
-  // A cue (the index a player seeks by) for the first key frame of each
-  // half second, as clusters are cut, not for every one: every JPEG frame
-  // is a key frame, and matroskamux holds each file's cues in memory until
-  // its end (24 bytes a frame: 5.5 MB for 256 cameras' minute at 15 fps).
-  // Seeks stay exact: the demuxer starts at the cue before and the
-  // playback's seeks are accurate.
-  return {"matroskamux",
-          {{"max-cluster-duration", "500000000"}, {"min-index-interval", "500000000"}},
-          true};
+  return container == Container::kMp4 ? mp4Muxer() : matroskaMuxer();
 }
 
 // What the frames pass through on their way to the file, ending in the

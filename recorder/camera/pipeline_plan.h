@@ -21,6 +21,11 @@ struct MuxerSpec {
   bool operator==(const MuxerSpec&) const = default;
 };
 
+// Each file's muxer as the recorder writes it, its text track included
+// (`text`: turn it off for none).
+MuxerSpec matroskaMuxer();
+MuxerSpec mp4Muxer();
+
 // One device camera: its own pipeline, and the names of its elements
 // (empty: not in this run).
 struct StreamPlan {

@@ -10,23 +10,24 @@ namespace wircam::testing {
 inline constexpr char kAppSrcCamera[] =
     "appsrc name=src format=time caps=image/jpeg,width=352,height=288,framerate=15/1";
 
-// The appsrc is the source and the tail (nothing branches), no text track.
+// The appsrc is the source and the tail (nothing branches), the recorder's
+// Matroska muxer, no text track.
 inline recorder::StreamPlan appSrcCameraPlan() {
   recorder::StreamPlan plan;
   plan.description = kAppSrcCamera;
   plan.device = "bench";
   plan.name = "bench-cam0";
   plan.source = plan.videoTail = "src";
-  plan.muxer = {.factory = "matroskamux", .text = false};
+  plan.muxer = recorder::matroskaMuxer();
+  plan.muxer.text = false;
   return plan;
 }
 
-// With the recorder's text track (its default): the telemetry's tail, and
-// matroskamux's gaps as GAP events.
+// With the recorder's text track (its default): the telemetry's tail.
 inline void addTextTrack(recorder::StreamPlan& plan) {
   plan.description += " taginject name=teltag";
   plan.telemetryTail = "teltag";
-  plan.muxer.text = plan.muxer.textGapEvents = true;
+  plan.muxer.text = true;
 }
 
 }  // namespace wircam::testing
